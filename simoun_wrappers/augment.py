@@ -1,0 +1,90 @@
+"""Random convolution (Lee et al. 2020, "network randomization") for batches and for envs.
+
+Weight initialisation: every kernel is drawn from a Xavier/Glorot normal distribution,
+``N(0, 2 / (fan_in + fan_out))`` with ``fan_in = fan_out = C * k * k``, as in the authors'
+netrand code. Its gain is 1, so an output pixel has about the same mean square as the input
+pixels; the convolution is linear and unclamped, so outputs may leave the input's range
+(negative values included) unless ``clamp`` is given. Borders use replicate padding, which keeps
+the image size and avoids the dark frame zero padding would draw.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import torch
+
+
+def random_conv(
+    batch: torch.Tensor,
+    kernel_size: int = 3,
+    generator: torch.Generator | None = None,
+    clamp: tuple[float, float] | None = None,
+) -> torch.Tensor:
+    """Pass every sample of a batch through its own random ``C -> C`` convolution.
+
+    Args:
+        batch: float tensor ``(B, C, H, W)`` or ``(B, T, C, H, W)``; the ``T`` frames of one sample
+            share that sample's kernel, so motion between them is kept.
+        kernel_size: odd kernel width; the output keeps ``H`` and ``W``.
+        generator: source of the kernel weights; ``None`` uses torch's global RNG, so a saved RNG
+            state replays the same kernels. It may live on another device than ``batch``.
+        clamp: optional ``(low, high)`` bounds for the output, e.g. ``(0.0, 1.0)`` for images in
+            [0, 1]; ``None`` returns the raw linear output.
+
+    Returns:
+        A tensor of ``batch``'s shape, dtype and device. All samples go through one grouped
+        convolution: there is no Python loop over the batch.
+
+    Example:
+        >>> import torch
+        >>> from simoun_wrappers.augment import random_conv
+        >>> frames = torch.rand(8, 3, 3, 64, 64)  # 8 triplets of RGB frames in [0, 1]
+        >>> random_conv(frames, generator=torch.Generator().manual_seed(0)).shape
+        torch.Size([8, 3, 3, 64, 64])
+    """
+    import torch
+    import torch.nn.functional as F
+
+    if not isinstance(batch, torch.Tensor) or not batch.is_floating_point():
+        raise TypeError(
+            f"random_conv expects a floating-point torch.Tensor, got "
+            f"{getattr(batch, 'dtype', type(batch))}; convert uint8 frames first, "
+            f"e.g. torch.as_tensor(frames).float() / 255."
+        )
+    if batch.ndim not in (4, 5):
+        raise ValueError(
+            f"random_conv expects a (B, C, H, W) or (B, T, C, H, W) batch, got shape "
+            f"{tuple(batch.shape)}; add a leading batch axis with batch[None] for one sample."
+        )
+    if not isinstance(kernel_size, int) or kernel_size < 1 or kernel_size % 2 == 0:
+        raise ValueError(
+            f"kernel_size must be a positive odd int so the output keeps its size, got "
+            f"{kernel_size!r}; use 3 (Lee et al. 2020) or another odd value."
+        )
+    shape = batch.shape
+    frames = batch if batch.ndim == 5 else batch.unsqueeze(1)
+    b, t, c, h, w = frames.shape
+
+    fan = c * kernel_size * kernel_size
+    std = (2.0 / (fan + fan)) ** 0.5
+    weight_device = batch.device if generator is None else generator.device
+    weight = torch.randn(
+        (b * c, c, kernel_size, kernel_size),
+        generator=generator,
+        device=weight_device,
+        dtype=batch.dtype,
+    )
+    weight = (weight * std).to(batch.device)
+
+    # Frames go on the conv's batch axis and samples on its channel axis, so groups=b gives each
+    # sample its own kernel while all T frames of a sample see the same one.
+    stacked = frames.transpose(0, 1).reshape(t, b * c, h, w)
+    pad = kernel_size // 2
+    stacked = F.pad(stacked, (pad, pad, pad, pad), mode="replicate")
+    out = F.conv2d(stacked, weight, groups=b)
+    out = out.reshape(t, b, c, h, w).transpose(0, 1)
+    if clamp is not None:
+        out = out.clamp(clamp[0], clamp[1])
+    return out.reshape(shape).contiguous()
