@@ -1,0 +1,128 @@
+"""Eq. 13 core (simoun_wrappers.curiosity): hand computations and the running maxima."""
+
+import math
+import pickle
+
+import numpy as np
+import pytest
+import torch
+
+from simoun_wrappers.curiosity import (
+    FeatureSource,
+    RunningMax,
+    consistency_distance,
+    consistency_reward,
+)
+
+F_M = np.array([[1.0, -2.0, 0.5], [0.0, 0.0, 0.0]], dtype=np.float32)
+F_A = np.array(
+    [
+        [[0.0, 0.0, 0.0], [1.0, -1.0, 2.0], [0.0, 1.0, 2.0]],
+        [[3.0, 3.0, 3.0], [3.0, 3.0, 3.0], [3.0, 3.0, 3.0]],
+    ],
+    dtype=np.float32,
+)
+
+
+def _hand_distance():
+    # sample 0: |f_m| = [1, 2, .5]; |a1-a0| + |a2-a1| = [1, 1, 2] + [1, 2, 0] = [2, 3, 2]
+    # diff = [-1, -1, -1.5] -> sqrt(1 + 1 + 2.25); sample 1: all zero -> 0
+    return np.array([math.sqrt(4.25), 0.0])
+
+
+def test_distance_matches_hand_computation_numpy():
+    d = consistency_distance(F_M, F_A)
+    assert d.shape == (2,) and d.dtype == np.float32
+    np.testing.assert_allclose(d, _hand_distance(), rtol=1e-6)
+
+
+def test_distance_and_reward_match_on_torch_without_leaving_the_tensor_world():
+    d = consistency_distance(torch.from_numpy(F_M), torch.from_numpy(F_A))
+    assert isinstance(d, torch.Tensor)
+    np.testing.assert_allclose(d.numpy(), _hand_distance(), rtol=1e-6)
+    r = consistency_reward(d, torch.tensor(1000.0), torch.tensor(3.0), torch.tensor(2.0))
+    assert isinstance(r, torch.Tensor) and r.shape == (2,)
+    expected = 0.2 * math.exp(-2e-5 * 1000) * _hand_distance() * 3.0 / 2.0
+    np.testing.assert_allclose(r.numpy(), expected, rtol=1e-6)
+
+
+def test_reward_is_eq13_and_decays_with_step():
+    d = _hand_distance()
+    r0 = consistency_reward(d, 0, r_e_max=4.0, r_i_max=2.0, scale=0.5, decay=1e-3)
+    np.testing.assert_allclose(r0, 0.5 * d * 4.0 / 2.0)
+    r1 = consistency_reward(d, 1000, r_e_max=4.0, r_i_max=2.0, scale=0.5, decay=1e-3)
+    np.testing.assert_allclose(r1, r0 * math.exp(-1.0))
+    assert r1[0] < r0[0]
+
+
+def test_bad_feature_shapes_are_named():
+    with pytest.raises(ValueError, match=r"f_a must have shape \(B, 3, D\)"):
+        consistency_distance(F_M, F_A[:, :2])
+    with pytest.raises(ValueError, match="f_m must have shape"):
+        consistency_distance(F_M[:, :2], F_A)
+
+
+def test_running_max_tracks_magnitude_of_extrinsic_and_raw_distance():
+    stats = RunningMax(r_e_max=0.5, r_i_max=0.1)
+    stats.update(np.array([-3.0, 1.0]), np.array([0.05]))
+    assert stats.r_e_max == 3.0 and stats.r_i_max == 0.1
+    stats.update(np.array([2.0]), np.array([0.7, 0.2]))
+    assert stats.r_e_max == 3.0 and stats.r_i_max == pytest.approx(0.7)
+    stats.update(np.array([]), np.array([]))
+    assert stats.r_e_max == 3.0
+
+
+def test_update_before_reward_bounds_intrinsic_by_scale_times_r_e_max():
+    rng = np.random.default_rng(0)
+    stats = RunningMax(r_e_max=1e-3, r_i_max=1e-3)
+    for step in range(50):
+        r_e = rng.normal(size=8)
+        d = rng.exponential(size=8) * (step + 1)
+        stats.update(r_e, d)
+        r_i = consistency_reward(d, step, stats.r_e_max, stats.r_i_max, scale=0.2, decay=0.0)
+        assert np.all(r_i <= 0.2 * stats.r_e_max + 1e-12)
+
+
+def test_running_max_rejects_bad_values_with_a_fix():
+    with pytest.raises(ValueError, match="finite number > 0"):
+        RunningMax(r_e_max=0.0)
+    stats = RunningMax()
+    with pytest.raises(ValueError, match="NaN or inf extrinsic reward"):
+        stats.update(np.array([np.nan]), np.array([1.0]))
+    with pytest.raises(ValueError, match="NaN or inf consistency distance"):
+        stats.update(np.array([1.0]), np.array([np.inf]))
+    assert stats.state_dict() == {"r_e_max": 1.0, "r_i_max": 1.0}
+
+
+def test_running_max_on_tensors_stays_a_0d_tensor():
+    stats = RunningMax(r_e_max=2.0, r_i_max=1.0).to("cpu")
+    stats.update(torch.tensor([-5.0, 1.0]), torch.tensor([0.5]))
+    assert isinstance(stats.r_e_max, torch.Tensor) and stats.r_e_max.shape == ()
+    assert float(stats.r_e_max) == 5.0 and float(stats.r_i_max) == 1.0
+    plain = RunningMax()
+    plain.update(torch.tensor([3.0]), torch.tensor([4.0]))
+    assert isinstance(plain.r_i_max, torch.Tensor) and float(plain.r_i_max) == 4.0
+
+
+def test_state_dict_round_trip_and_pickle():
+    stats = RunningMax(r_e_max=1.0, r_i_max=1.0)
+    stats.update(np.array([7.0]), np.array([3.0]))
+    clone = pickle.loads(pickle.dumps(stats))
+    assert clone == stats
+    on_device = RunningMax().to("cpu")
+    on_device.load_state_dict(stats.state_dict())
+    assert isinstance(on_device.r_e_max, torch.Tensor)
+    assert on_device.state_dict() == {"r_e_max": 7.0, "r_i_max": 3.0}
+    with pytest.raises(KeyError, match="missing"):
+        RunningMax().load_state_dict({"r_e_max": 1.0})
+
+
+def test_feature_source_protocol_is_runtime_checkable():
+    projection = np.random.default_rng(0).normal(size=(12, 4)).astype(np.float32)
+
+    def project(triplets):
+        flat = triplets.reshape(*triplets.shape[:2], -1).astype(np.float32) @ projection
+        return flat[:, 2] - flat[:, 1], flat
+
+    assert isinstance(project, FeatureSource)
+    assert not isinstance(object(), FeatureSource)
