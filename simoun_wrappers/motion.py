@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
 
 
 def residual_motion(frames: np.ndarray) -> np.ndarray:
@@ -35,3 +39,56 @@ def residual_motion(frames: np.ndarray) -> np.ndarray:
     diff = np.diff(frames.astype(np.int16), axis=-4)
     *lead, k1, c, h, w = diff.shape
     return diff.reshape(*lead, k1 * c, h, w)
+
+
+class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
+    """Add residual motion channels to a stacked ``(k, C, H, W)`` uint8 observation.
+
+    The observation becomes ``{"frames": (k, C, H, W) uint8, "motion": ((k-1)*C, H, W) int16}``
+    with ``motion = [o_{t-1} - o_{t-2}, o_t - o_{t-1}]`` for a triplet (see ``residual_motion``):
+    exact, negative differences kept, no uint8 wrap-around.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> import numpy as np
+        >>> from gymnasium.wrappers import AddRenderObservation, ResizeObservation
+        >>> from gymnasium.wrappers import TransformObservation
+        >>> from simoun_wrappers import FrameTriplet, ResidualMotion
+        >>> env = gym.make("CartPole-v1", render_mode="rgb_array")
+        >>> env = ResizeObservation(AddRenderObservation(env), (32, 32))
+        >>> chw = gym.spaces.Box(0, 255, (3, 32, 32), np.uint8)
+        >>> env = TransformObservation(env, lambda o: o.transpose(2, 0, 1), chw)
+        >>> env = ResidualMotion(FrameTriplet(env))
+        >>> env.observation_space["motion"]
+        Box(-255, 255, (6, 32, 32), int16)
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        """Wrap ``env``, whose observation space must be a uint8 ``Box`` of shape ``(k, C, H, W)``.
+
+        Args:
+            env: a stacked-frame environment, e.g. ``FrameTriplet`` over channel-first images.
+        """
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.ObservationWrapper.__init__(self, env)
+        space = env.observation_space
+        if not isinstance(space, spaces.Box) or space.dtype != np.uint8 or len(space.shape) != 4:
+            raise TypeError(
+                f"ResidualMotion expects a uint8 Box of shape (k, C, H, W), got {space}; "
+                f"stack channel-first uint8 frames first, e.g. SimounObservation(env) does it all."
+            )
+        k, c, h, w = space.shape
+        if k < 2:
+            raise ValueError(
+                f"ResidualMotion needs at least 2 stacked frames to take differences, got k={k}; "
+                f"stack more frames (FrameTriplet(env, num_frames=3)) or drop the motion channels."
+            )
+        self.observation_space = spaces.Dict(
+            {
+                "frames": space,
+                "motion": spaces.Box(-255, 255, ((k - 1) * c, h, w), dtype=np.int16),
+            }
+        )
+
+    def observation(self, observation: np.ndarray) -> dict[str, Any]:
+        return {"frames": observation, "motion": residual_motion(observation)}

@@ -1,0 +1,95 @@
+"""Frame stacking: the last k observations on a new leading axis, reset-padded."""
+
+from __future__ import annotations
+
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector.utils import batch_space
+
+
+class FrameRing:
+    """The last ``num_frames`` frames in a preallocated ring buffer, oldest first on read.
+
+    ``reset(frame)`` fills every slot with ``frame`` (reset padding); ``push(frame)`` overwrites
+    the oldest slot. Both return a fresh ``(num_frames, *frame.shape)`` array made by one copy,
+    so callers may keep or hand out what they get.
+
+    Example:
+        >>> import numpy as np
+        >>> ring = FrameRing(3, shape=(1,), dtype=np.uint8)
+        >>> ring.reset(np.array([7], dtype=np.uint8)).ravel().tolist()
+        [7, 7, 7]
+        >>> ring.push(np.array([8], dtype=np.uint8)).ravel().tolist()
+        [7, 7, 8]
+    """
+
+    def __init__(self, num_frames: int, shape: tuple[int, ...], dtype: np.dtype) -> None:
+        self._buffer = np.zeros((num_frames, *shape), dtype=dtype)
+        self._head = 0  # slot of the oldest frame, the next one to overwrite
+
+    def reset(self, frame: np.ndarray) -> np.ndarray:
+        self._buffer[:] = frame
+        self._head = 0
+        return self._buffer.copy()
+
+    def push(self, frame: np.ndarray) -> np.ndarray:
+        self._buffer[self._head] = frame
+        self._head = (self._head + 1) % len(self._buffer)
+        return np.concatenate((self._buffer[self._head :], self._buffer[: self._head]))
+
+
+class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Stack the last ``num_frames`` observations on a new leading axis, reset-padded.
+
+    Step for step equal to ``gymnasium.wrappers.FrameStackObservation(env, num_frames,
+    padding_type="reset")``, with the same observation space, but each step writes one frame
+    into a ring buffer and copies the stack once (no deepcopy of the whole stack). Every
+    returned array is fresh. With the default ``num_frames=3`` the observation is Simoun's
+    triplet ``[o_{t-2}, o_{t-1}, o_t]``.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import FrameTriplet
+        >>> env = FrameTriplet(gym.make("CartPole-v1"))
+        >>> env.observation_space.shape
+        (3, 4)
+        >>> obs, _ = env.reset(seed=0)
+        >>> bool((obs[0] == obs[2]).all())
+        True
+    """
+
+    def __init__(self, env: gym.Env, num_frames: int = 3) -> None:
+        """Wrap ``env``, whose observation space must be a ``Box``.
+
+        Args:
+            env: the environment to wrap.
+            num_frames: how many consecutive observations to stack (``k``).
+        """
+        gym.utils.RecordConstructorArgs.__init__(self, num_frames=num_frames)
+        gym.Wrapper.__init__(self, env)
+        if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
+            raise ValueError(
+                f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
+            )
+        space = env.observation_space
+        if not isinstance(space, spaces.Box):
+            raise TypeError(
+                f"FrameTriplet stacks Box observations, got {space}; select or build an image "
+                f"first, e.g. SimounObservation(env) or gymnasium.wrappers.AddRenderObservation."
+            )
+        self.num_frames = int(num_frames)
+        self.observation_space = batch_space(space, n=self.num_frames)
+        self._ring = FrameRing(self.num_frames, space.shape, space.dtype)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        obs, info = self.env.reset(seed=seed, options=options)
+        return self._ring.reset(obs), info
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        return self._ring.push(obs), reward, terminated, truncated, info

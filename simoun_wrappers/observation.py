@@ -1,0 +1,213 @@
+"""SimounObservation: the one-line entry point from any pixel or renderable env to Simoun inputs."""
+
+from __future__ import annotations
+
+from copy import deepcopy
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.envs.registration import EnvSpec, WrapperSpec
+from gymnasium.wrappers import (
+    AddRenderObservation,
+    GrayscaleObservation,
+    ResizeObservation,
+    TransformObservation,
+)
+
+from simoun_wrappers.frames import FrameTriplet
+from simoun_wrappers.motion import ResidualMotion
+
+_SOURCES = ("auto", "observation", "render")
+
+
+def image_layout(space: gym.Space) -> tuple[int, int, int] | None:
+    """``(H, W, C)`` of a channel-last ``(H, W, C)`` (C in 1, 3) or ``(H, W)`` Box, else None.
+
+    The dtype is not checked: callers decide what a non-uint8 image means.
+    """
+    if not isinstance(space, spaces.Box):
+        return None
+    if len(space.shape) == 3 and space.shape[-1] in (1, 3):
+        return space.shape
+    if len(space.shape) == 2:
+        return (*space.shape, 1)
+    return None
+
+
+def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
+    """``size`` as ``(H, W)``; an int means a square; None stays None (keep the image's size)."""
+    if size is None:
+        return None
+    pair = (size, size) if isinstance(size, (int, np.integer)) else tuple(size)
+    if len(pair) != 2 or not all(isinstance(v, (int, np.integer)) and v > 0 for v in pair):
+        raise ValueError(
+            f"size must be a positive int or an (H, W) pair of positive ints, got {size!r}; "
+            f"e.g. size=84 or size=(84, 252), or None to keep the image's size."
+        )
+    return int(pair[0]), int(pair[1])
+
+
+def _pixel_env(env: gym.Env, source: str) -> tuple[gym.Env, bool]:
+    """An env whose observation is the image to use, and whether it comes from ``render()``."""
+    layout = image_layout(env.observation_space)
+    use_observation = source == "observation" or (source == "auto" and layout is not None)
+    if use_observation:
+        if layout is None:
+            raise TypeError(
+                f"SimounObservation(source='observation') needs image observations (H, W, C) "
+                f"or (H, W), got {env.observation_space}; use source='render' with "
+                f"render_mode='rgb_array' instead."
+            )
+        if env.observation_space.dtype != np.uint8:
+            raise TypeError(
+                f"SimounObservation expects uint8 images in [0, 255], got "
+                f"{env.observation_space.dtype} observations of shape "
+                f"{env.observation_space.shape}; convert them first, e.g. TransformObservation("
+                f"env, lambda o: (o * 255).astype(np.uint8), Box(0, 255, shape, np.uint8)), or "
+                f"pass source='render' to use the env's rgb_array renders."
+            )
+        return env, False
+
+    if env.render_mode != "rgb_array":
+        raise ValueError(
+            f"SimounObservation needs pixels: the env has neither image observations "
+            f"(observation space {env.observation_space}) nor render_mode='rgb_array' "
+            f"(render_mode={env.render_mode!r}). Create it with "
+            f"gym.make(env_id, render_mode='rgb_array'), or wrap it so that it returns "
+            f"(H, W, 3) uint8 images."
+        )
+    pixels = AddRenderObservation(env, render_only=True)
+    frame = pixels.render()
+    if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8:
+        raise TypeError(
+            f"SimounObservation expects env.render() to return a uint8 image, got "
+            f"{getattr(frame, 'dtype', type(frame))}; use an env whose rgb_array render is "
+            f"an (H, W, 3) uint8 array."
+        )
+    if image_layout(pixels.observation_space) is None:
+        raise ValueError(
+            f"SimounObservation expects env.render() to return an (H, W, 3) image, got shape "
+            f"{frame.shape}; check the env's render_mode and render_kwargs."
+        )
+    return pixels, True
+
+
+class SimounObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Turn a pixel or renderable env into Simoun's inputs: frame triplet and motion channels.
+
+    Pixels come from the observation when it is an image (``(H, W, C)`` or ``(H, W)`` uint8),
+    otherwise from ``render()`` when ``render_mode="rgb_array"`` (gymnasium's
+    ``AddRenderObservation``). Frames are resized (``ResizeObservation``, OpenCV area
+    interpolation), optionally made grayscale (``GrayscaleObservation``), made channel-first
+    ``(C, H, W)``, stacked by ``FrameTriplet`` with reset padding, and given residual motion
+    channels by ``ResidualMotion``. The observation is
+
+    - ``{"frames": (k, C, H, W) uint8, "motion": ((k-1)*C, H, W) int16}`` (default),
+    - ``{"frames": (k, C, H, W) uint8}`` with ``motion=False``,
+    - a ``(k*C, H, W)`` uint8 Box with ``fold_frames=True``: the frames folded on the channel
+      axis, which Stable-Baselines3's ``CnnPolicy`` treats as an image. Motion is then left
+      out, whatever ``motion`` says: SB3 has no image form for int16 channels, and
+      ``simoun_wrappers.motion.residual_motion(obs.reshape(k, C, H, W))`` recovers it exactly.
+
+    ``env.spec`` records this wrapper alone (not its inner gymnasium wrappers), so
+    ``gym.make(env.spec)`` rebuilds the same chain. When pixels come from ``render()``,
+    ``metadata["render_modes"]`` is narrowed to ``["rgb_array"]``, the only mode it works with.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import SimounObservation
+        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=64)
+        >>> obs, _ = env.reset(seed=0)
+        >>> obs["frames"].shape, obs["motion"].shape, obs["motion"].dtype
+        ((3, 3, 64, 64), (6, 64, 64), dtype('int16'))
+        >>> folded = SimounObservation(
+        ...     gym.make("CartPole-v1", render_mode="rgb_array"), size=64, fold_frames=True
+        ... )
+        >>> folded.observation_space
+        Box(0, 255, (9, 64, 64), uint8)
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        size: int | tuple[int, int] | None = 84,
+        grayscale: bool = False,
+        num_frames: int = 3,
+        motion: bool = True,
+        fold_frames: bool = False,
+        source: str = "auto",
+    ) -> None:
+        """Wrap ``env``.
+
+        Args:
+            env: an env with image observations or ``render_mode="rgb_array"``.
+            size: frame size, an int (square) or ``(H, W)``; None keeps the image's size
+                (e.g. over ``MultiCamera``).
+            grayscale: convert RGB frames to one luminance channel.
+            num_frames: frames per stack (3: the triplet ``[o_{t-2}, o_{t-1}, o_t]``).
+            motion: add the residual motion channels (needs ``num_frames >= 2``).
+            fold_frames: return a ``(num_frames*C, H, W)`` uint8 Box for SB3's ``CnnPolicy``
+                (no motion key).
+            source: ``"auto"`` (image observation if there is one, else ``render()``),
+                ``"observation"`` or ``"render"``.
+        """
+        gym.utils.RecordConstructorArgs.__init__(
+            self,
+            size=size,
+            grayscale=grayscale,
+            num_frames=num_frames,
+            motion=motion,
+            fold_frames=fold_frames,
+            source=source,
+        )
+        if source not in _SOURCES:
+            raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
+        if motion and not fold_frames and num_frames < 2:
+            raise ValueError(
+                f"motion=True needs at least 2 frames to take differences, got "
+                f"num_frames={num_frames}; use num_frames=3 (the triplet) or motion=False."
+            )
+        hw = parse_size(size)
+        chain, from_render = _pixel_env(env, source)
+        height, width, channels = image_layout(chain.observation_space)
+        if hw is not None and hw != (height, width):
+            chain = ResizeObservation(chain, hw)
+            height, width = hw
+        if grayscale and channels == 3:
+            chain = GrayscaleObservation(chain, keep_dim=True)
+            channels = 1
+        frame_space = spaces.Box(0, 255, (channels, height, width), dtype=np.uint8)
+        chain = TransformObservation(
+            chain, lambda o: o.reshape(height, width, channels).transpose(2, 0, 1), frame_space
+        )
+        chain = FrameTriplet(chain, num_frames)
+        if fold_frames:
+            folded = spaces.Box(0, 255, (num_frames * channels, height, width), dtype=np.uint8)
+            chain = TransformObservation(chain, lambda o: o.reshape(folded.shape), folded)
+        elif motion:
+            chain = ResidualMotion(chain)
+        else:
+            chain = TransformObservation(
+                chain, lambda o: {"frames": o}, spaces.Dict({"frames": chain.observation_space})
+            )
+        gym.Wrapper.__init__(self, chain)
+        self._source_env = env
+        if from_render:
+            self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        """The wrapped env's spec plus this wrapper, without the inner chain it builds."""
+        # Recording the inner wrappers too would apply them twice when gym.make(spec) rebuilds.
+        if self._cached_spec is None and self._source_env.spec is not None:
+            spec = deepcopy(self._source_env.spec)
+            spec.additional_wrappers += (
+                WrapperSpec(
+                    name=self.class_name(),
+                    entry_point=f"{type(self).__module__}:{type(self).__name__}",
+                    kwargs=dict(self._saved_kwargs),
+                ),
+            )
+            self._cached_spec = spec
+        return self._cached_spec
