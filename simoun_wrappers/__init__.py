@@ -1,12 +1,18 @@
 """Gymnasium and PettingZoo wrappers for the Simoun method."""
 
 from simoun_wrappers import _headless  # noqa: F401  (must run before dm_control/pygame load)
+from simoun_wrappers.action_repeat import ActionRepeat
+from simoun_wrappers.augment import RandomConvolution
+from simoun_wrappers.cameras import MultiCamera
 from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.motion import ResidualMotion
 from simoun_wrappers.observation import SimounObservation
 
 __all__ = [
+    "ActionRepeat",
     "FrameTriplet",
+    "MultiCamera",
+    "RandomConvolution",
     "ResidualMotion",
     "SimounObservation",
 ]

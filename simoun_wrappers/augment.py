@@ -10,7 +10,13 @@ the image size and avoids the dark frame zero padding would draw.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.wrappers import TransformObservation
+
+from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
 if TYPE_CHECKING:
     import torch
@@ -88,3 +94,71 @@ def random_conv(
     if clamp is not None:
         out = out.clamp(clamp[0], clamp[1])
     return out.reshape(shape).contiguous()
+
+
+class RandomConvolution(ChainWrapper):
+    """Pass every frame through a random convolution whose kernel is resampled every episode.
+
+    Network randomization (Lee et al. 2020) as an env wrapper, for generalization training and
+    evaluation: the same ``C -> C`` kernel (Xavier-normal, see ``random_conv``) colours every
+    frame of an episode, and ``reset()`` draws a new one. Outputs are rounded and clipped to
+    [0, 255] uint8, so the wrapper composes with ``SimounObservation`` on top. Pixels come from
+    image observations (``(H, W, C)`` or ``(H, W)`` uint8) or from ``render()`` with
+    ``render_mode="rgb_array"``. Kernels come from the wrapper's own RNG: ``reset(seed=s)`` makes
+    them reproducible and the env's own RNG is left untouched.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import RandomConvolution, SimounObservation
+        >>> env = gym.make("CartPole-v1", render_mode="rgb_array")
+        >>> env = SimounObservation(RandomConvolution(env), size=64)
+        >>> obs, _ = env.reset(seed=0)
+        >>> obs["frames"].shape
+        (3, 3, 64, 64)
+    """
+
+    def __init__(self, env: gym.Env, kernel_size: int = 3, source: str = "auto") -> None:
+        """Wrap ``env``.
+
+        Args:
+            env: an env with image observations or ``render_mode="rgb_array"``.
+            kernel_size: odd kernel width; the image keeps its size.
+            source: ``"auto"``, ``"observation"`` or ``"render"``, as in ``SimounObservation``.
+        """
+        gym.utils.RecordConstructorArgs.__init__(self, kernel_size=kernel_size, source=source)
+        import torch
+
+        if not isinstance(kernel_size, int) or kernel_size < 1 or kernel_size % 2 == 0:
+            raise ValueError(
+                f"kernel_size must be a positive odd int, got {kernel_size!r}; use 3 as in "
+                f"Lee et al. 2020."
+            )
+        chain, from_render = pixel_env(env, source, owner="RandomConvolution")
+        self._layout = image_layout(chain.observation_space)
+        chain = TransformObservation(chain, self._convolve, chain.observation_space)
+        ChainWrapper.__init__(self, chain, env)
+        if from_render:
+            self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}
+        self.kernel_size = kernel_size
+        self._rng = np.random.default_rng()
+        self._generator = torch.Generator()
+        self._kernel_seed = 0
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+        self._kernel_seed = int(self._rng.integers(2**62))
+        return self.env.reset(seed=seed, options=options)
+
+    def _convolve(self, image: np.ndarray) -> np.ndarray:
+        import torch
+
+        height, width, channels = self._layout
+        chw = torch.from_numpy(np.ascontiguousarray(image).reshape(height, width, channels))
+        batch = chw.permute(2, 0, 1)[None].float()
+        # Re-seeding before each call makes random_conv draw the episode's kernel again.
+        self._generator.manual_seed(self._kernel_seed)
+        out = random_conv(batch, self.kernel_size, self._generator, clamp=(0.0, 255.0))
+        return out[0].round().to(torch.uint8).permute(1, 2, 0).reshape(image.shape).numpy()

@@ -48,20 +48,28 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     return int(pair[0]), int(pair[1])
 
 
-def _pixel_env(env: gym.Env, source: str) -> tuple[gym.Env, bool]:
-    """An env whose observation is the image to use, and whether it comes from ``render()``."""
+def pixel_env(
+    env: gym.Env, source: str = "auto", owner: str = "SimounObservation"
+) -> tuple[gym.Env, bool]:
+    """An env whose observation is the image to use, and whether it comes from ``render()``.
+
+    ``source`` is ``"auto"`` (the observation if it is an image, else ``render()``),
+    ``"observation"`` or ``"render"``; ``owner`` names the caller in error messages.
+    """
+    if source not in _SOURCES:
+        raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
     layout = image_layout(env.observation_space)
     use_observation = source == "observation" or (source == "auto" and layout is not None)
     if use_observation:
         if layout is None:
             raise TypeError(
-                f"SimounObservation(source='observation') needs image observations (H, W, C) "
+                f"{owner}(source='observation') needs image observations (H, W, C) "
                 f"or (H, W), got {env.observation_space}; use source='render' with "
                 f"render_mode='rgb_array' instead."
             )
         if env.observation_space.dtype != np.uint8:
             raise TypeError(
-                f"SimounObservation expects uint8 images in [0, 255], got "
+                f"{owner} expects uint8 images in [0, 255], got "
                 f"{env.observation_space.dtype} observations of shape "
                 f"{env.observation_space.shape}; convert them first, e.g. TransformObservation("
                 f"env, lambda o: (o * 255).astype(np.uint8), Box(0, 255, shape, np.uint8)), or "
@@ -71,7 +79,7 @@ def _pixel_env(env: gym.Env, source: str) -> tuple[gym.Env, bool]:
 
     if env.render_mode != "rgb_array":
         raise ValueError(
-            f"SimounObservation needs pixels: the env has neither image observations "
+            f"{owner} needs pixels: the env has neither image observations "
             f"(observation space {env.observation_space}) nor render_mode='rgb_array' "
             f"(render_mode={env.render_mode!r}). Create it with "
             f"gym.make(env_id, render_mode='rgb_array'), or wrap it so that it returns "
@@ -81,19 +89,47 @@ def _pixel_env(env: gym.Env, source: str) -> tuple[gym.Env, bool]:
     frame = pixels.render()
     if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8:
         raise TypeError(
-            f"SimounObservation expects env.render() to return a uint8 image, got "
+            f"{owner} expects env.render() to return a uint8 image, got "
             f"{getattr(frame, 'dtype', type(frame))}; use an env whose rgb_array render is "
             f"an (H, W, 3) uint8 array."
         )
     if image_layout(pixels.observation_space) is None:
         raise ValueError(
-            f"SimounObservation expects env.render() to return an (H, W, 3) image, got shape "
+            f"{owner} expects env.render() to return an (H, W, 3) image, got shape "
             f"{frame.shape}; check the env's render_mode and render_kwargs."
         )
     return pixels, True
 
 
-class SimounObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
+class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """A wrapper built as a chain of inner wrappers over ``source_env``, recorded as itself only.
+
+    Subclasses call ``RecordConstructorArgs.__init__`` with their own arguments, then
+    ``ChainWrapper.__init__(self, chain, source_env)``. ``spec`` is the source env's spec plus
+    this wrapper: recording the inner wrappers too would apply them twice when
+    ``gym.make(env.spec)`` rebuilds the chain.
+    """
+
+    def __init__(self, chain: gym.Env, source_env: gym.Env) -> None:
+        gym.Wrapper.__init__(self, chain)
+        self._source_env = source_env
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        if self._cached_spec is None and self._source_env.spec is not None:
+            spec = deepcopy(self._source_env.spec)
+            spec.additional_wrappers += (
+                WrapperSpec(
+                    name=self.class_name(),
+                    entry_point=f"{type(self).__module__}:{type(self).__name__}",
+                    kwargs=dict(self._saved_kwargs),
+                ),
+            )
+            self._cached_spec = spec
+        return self._cached_spec
+
+
+class SimounObservation(ChainWrapper):
     """Turn a pixel or renderable env into Simoun's inputs: frame triplet and motion channels.
 
     Pixels come from the observation when it is an image (``(H, W, C)`` or ``(H, W)`` uint8),
@@ -161,15 +197,13 @@ class SimounObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
             fold_frames=fold_frames,
             source=source,
         )
-        if source not in _SOURCES:
-            raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
         if motion and not fold_frames and num_frames < 2:
             raise ValueError(
                 f"motion=True needs at least 2 frames to take differences, got "
                 f"num_frames={num_frames}; use num_frames=3 (the triplet) or motion=False."
             )
         hw = parse_size(size)
-        chain, from_render = _pixel_env(env, source)
+        chain, from_render = pixel_env(env, source)
         height, width, channels = image_layout(chain.observation_space)
         if hw is not None and hw != (height, width):
             chain = ResizeObservation(chain, hw)
@@ -191,23 +225,6 @@ class SimounObservation(gym.Wrapper, gym.utils.RecordConstructorArgs):
             chain = TransformObservation(
                 chain, lambda o: {"frames": o}, spaces.Dict({"frames": chain.observation_space})
             )
-        gym.Wrapper.__init__(self, chain)
-        self._source_env = env
+        ChainWrapper.__init__(self, chain, env)
         if from_render:
             self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}
-
-    @property
-    def spec(self) -> EnvSpec | None:
-        """The wrapped env's spec plus this wrapper, without the inner chain it builds."""
-        # Recording the inner wrappers too would apply them twice when gym.make(spec) rebuilds.
-        if self._cached_spec is None and self._source_env.spec is not None:
-            spec = deepcopy(self._source_env.spec)
-            spec.additional_wrappers += (
-                WrapperSpec(
-                    name=self.class_name(),
-                    entry_point=f"{type(self).__module__}:{type(self).__name__}",
-                    kwargs=dict(self._saved_kwargs),
-                ),
-            )
-            self._cached_spec = spec
-        return self._cached_spec

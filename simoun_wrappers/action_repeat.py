@@ -1,0 +1,50 @@
+"""Action repeat: one agent step is ``repeat`` env steps with the same action."""
+
+from __future__ import annotations
+
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+
+
+class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Apply each action ``repeat`` times, summing the rewards; stop early when an episode ends.
+
+    Returns the observation and info of the last inner step taken. Put it under the pixel
+    wrappers (``SimounObservation(ActionRepeat(env, 8))``) so that the frame triplet holds
+    agent steps, as in DrQ: cartpole-swingup uses 8, walker-walk 2.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import ActionRepeat
+        >>> env = ActionRepeat(gym.make("CartPole-v1"), repeat=4)
+        >>> _ = env.reset(seed=0)
+        >>> env.step(0)[1]  # CartPole pays 1 per inner step
+        4.0
+    """
+
+    def __init__(self, env: gym.Env, repeat: int) -> None:
+        """Wrap ``env``.
+
+        Args:
+            env: the environment to wrap.
+            repeat: inner steps per agent step, a positive int (1 changes nothing).
+        """
+        gym.utils.RecordConstructorArgs.__init__(self, repeat=repeat)
+        gym.Wrapper.__init__(self, env)
+        if not isinstance(repeat, (int, np.integer)) or repeat < 1:
+            raise ValueError(
+                f"repeat must be a positive int, got {repeat!r}; e.g. ActionRepeat(env, 8) for "
+                f"cartpole-swingup, or leave the wrapper out for no repeat."
+            )
+        self.repeat = int(repeat)
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        total = 0.0
+        for _ in range(self.repeat):
+            obs, reward, terminated, truncated, info = self.env.step(action)
+            total += float(reward)
+            if terminated or truncated:
+                break
+        return obs, total, terminated, truncated, info

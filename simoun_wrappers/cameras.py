@@ -1,0 +1,176 @@
+"""MultiCamera: several views rendered at the same step, side by side in one image."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import cv2
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from simoun_wrappers.observation import parse_size
+
+Camera = int | str | Mapping[str, Any] | Callable[[gym.Env], np.ndarray]
+"""A dm_control camera id or name, a highway-env viewport dict, or a callable env -> image."""
+
+_VIEWPORT_KEYS = ("centering_position", "scaling")
+
+
+def _dm_control_view(env: gym.Env, camera: int | str, hw: tuple[int, int] | None) -> Callable:
+    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
+    if physics is None:
+        raise TypeError(
+            f"camera {camera!r} is a dm_control camera id or name, but {env.unwrapped} is not a "
+            f"dm_control env through shimmy; for other envs pass callables env -> (H, W, 3) "
+            f"uint8 image, or viewport dicts for highway-env."
+        )
+    model = physics.model
+    names = [model.id2name(i, "camera") for i in range(model.ncam)]
+    if isinstance(camera, str) and camera not in names:
+        raise ValueError(
+            f"unknown camera name {camera!r}; this env's cameras are {names} (or ids "
+            f"0..{model.ncam - 1}, and -1 for the free camera). Pass one of those."
+        )
+    if isinstance(camera, (int, np.integer)) and not -1 <= camera < model.ncam:
+        raise ValueError(
+            f"camera id {camera} out of range; this env has {model.ncam} cameras {names}, so "
+            f"use an id in -1..{model.ncam - 1} (-1 is the free camera) or a name."
+        )
+    kwargs = {} if hw is None else {"height": hw[0], "width": hw[1]}
+    return lambda: physics.render(camera_id=camera, **kwargs)
+
+
+def _highway_view(env: gym.Env, viewport: Mapping[str, Any], hw: tuple[int, int] | None):
+    unknown = sorted(set(viewport) - set(_VIEWPORT_KEYS))
+    if unknown:
+        raise ValueError(
+            f"viewport keys {unknown} not understood; a highway-env viewport dict takes "
+            f"{list(_VIEWPORT_KEYS)}, e.g. {{'centering_position': [0.3, 0.5], 'scaling': 3.0}}."
+        )
+    base = env.unwrapped
+    if not (hasattr(base, "road") and isinstance(getattr(base, "config", None), dict)):
+        raise TypeError(
+            f"viewport dict {dict(viewport)} describes a highway-env view, but {base} is not a "
+            f"highway-env env; for other envs pass callables env -> (H, W, 3) uint8 image."
+        )
+    from highway_env.envs.common.graphics import EnvViewer
+
+    config = {**base.config, "offscreen_rendering": True, **viewport}
+    if hw is not None:
+        config["screen_height"], config["screen_width"] = hw
+    viewer = EnvViewer(base, config=config)
+
+    def render() -> np.ndarray:
+        viewer.display()
+        return viewer.get_image()
+
+    return render
+
+
+class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
+    """Observe N views of the same step, resized to ``size`` and side by side: ``(H, N*W, 3)``.
+
+    Each entry of ``cameras`` is one view:
+
+    - an int or str: a dm_control camera id or name (envs made through shimmy; every DMC task
+      has at least two cameras, e.g. walker ``"side"`` and ``"back"``), rendered by the
+      physics at ``size``;
+    - a dict: a highway-env viewport with ``centering_position`` and/or ``scaling``, drawn by
+      its own offscreen ``EnvViewer`` at ``size`` (a few ms; ``env.render()`` is never called,
+      so highway-env's per-frame auto-rendering stays off);
+    - a callable ``env -> (H, W, 3) uint8``, resized to ``size`` with OpenCV area interpolation.
+
+    The paper's CARLA setup, three 84x84 cameras, gives an 84 x 252 image. ``size=None`` keeps
+    every view's own size, which must then agree. The wrapper's ``render()`` returns the same
+    side-by-side image, so its only render mode is ``"rgb_array"``. Compose with
+    ``SimounObservation(MultiCamera(env, ...), size=None)`` to stack the wide frames.
+    ``close()`` leaves the highway viewers alone: ``EnvViewer.close()`` quits pygame for all.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> import shimmy
+        >>> from simoun_wrappers import MultiCamera
+        >>> gym.register_envs(shimmy)
+        >>> env = MultiCamera(gym.make("dm_control/walker-walk-v0"), ["side", "back"], (64, 64))
+        >>> obs, _ = env.reset(seed=0)
+        >>> obs.shape, obs.dtype
+        ((64, 128, 3), dtype('uint8'))
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        cameras: Sequence[Camera],
+        size: int | tuple[int, int] | None = (84, 84),
+    ) -> None:
+        """Wrap ``env``.
+
+        Args:
+            env: the environment to render views of.
+            cameras: one entry per view (see the class docstring), left to right.
+            size: every view's ``(H, W)`` (an int means square); None keeps each view's size.
+        """
+        gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
+        gym.ObservationWrapper.__init__(self, env)
+        if isinstance(cameras, (str, bytes, Mapping)) or not isinstance(cameras, Sequence):
+            raise TypeError(
+                f"cameras must be a list of views, got {cameras!r}; e.g. ['side', 'back'] or "
+                f"[0, 1] for dm_control, a list of viewport dicts for highway-env."
+            )
+        if len(cameras) == 0:
+            raise ValueError("cameras is empty; pass at least one view, e.g. [0].")
+        self._hw = parse_size(size)
+        self._views = [self._make_view(camera) for camera in cameras]
+        self.env.reset()
+        shapes = [np.shape(view()) for view in self._views]
+        if len(set(shapes)) != 1 or len(shapes[0]) != 3 or shapes[0][2] != 3:
+            raise ValueError(
+                f"views of different sizes or not (H, W, 3): {shapes}; pass size=(H, W) so "
+                f"that every view is rendered or resized to the same size."
+            )
+        height, width, _ = shapes[0]
+        self.observation_space = spaces.Box(
+            0, 255, (height, width * len(cameras), 3), dtype=np.uint8
+        )
+        self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}
+
+    def _make_view(self, camera: Camera) -> Callable[[], np.ndarray]:
+        if isinstance(camera, (int, np.integer, str)):
+            return _dm_control_view(self.env, camera, self._hw)
+        if isinstance(camera, Mapping):
+            return _highway_view(self.env, camera, self._hw)
+        if callable(camera):
+            return lambda: self._checked(camera(self.env), camera)
+        raise TypeError(
+            f"camera {camera!r} not understood; use a dm_control camera id or name, a "
+            f"highway-env viewport dict, or a callable env -> (H, W, 3) uint8 image."
+        )
+
+    def _checked(self, image: Any, camera: Callable) -> np.ndarray:
+        if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
+            raise TypeError(
+                f"camera {camera!r} returned {getattr(image, 'dtype', type(image))}; a camera "
+                f"callable must return an (H, W, 3) uint8 image."
+            )
+        if self._hw is not None and image.shape[:2] != self._hw:
+            image = cv2.resize(image, self._hw[::-1], interpolation=cv2.INTER_AREA)
+        return image
+
+    @property
+    def render_mode(self) -> str:
+        return "rgb_array"
+
+    def render(self) -> np.ndarray:
+        """The current views side by side, as in the observation."""
+        return self.observation(None)
+
+    def observation(self, observation: Any) -> np.ndarray:
+        views = [view() for view in self._views]
+        if len({v.shape for v in views}) != 1:
+            raise ValueError(
+                f"views of different sizes: {[v.shape for v in views]}; pass size=(H, W) so "
+                f"that every view is resized to the same size."
+            )
+        return np.concatenate(views, axis=1)
