@@ -1,0 +1,152 @@
+"""Atomic checkpoints that make a resumed run continue exactly where it stopped.
+
+A checkpoint is two files in the run directory: ``checkpoint.pt`` (agent networks and
+optimizers, running maxima, counters, the RNG states of python, numpy, torch and the trainer,
+and the config) and ``replay-<step>.npz`` (the replay, with its own RNG state), named in the
+checkpoint. Each file is written to a temporary name in the same directory and renamed over
+the old one (``os.replace`` is atomic on POSIX and Windows), the replay first: a crash at any
+moment leaves the previous complete checkpoint in place.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import random
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from simoun_agent.presets import RESUMABLE_FIELDS, SetupError
+
+CHECKPOINT_NAME = "checkpoint.pt"
+FORMAT = "simoun-checkpoint/1"
+_REQUIRED = ("format", "config", "agent", "replay_file", "rng", "state")
+
+
+def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it to ``path``."""
+    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def capture_rng() -> dict[str, Any]:
+    """The global RNG states of python, numpy and torch (CPU and, when present, CUDA)."""
+    state = {
+        "python": random.getstate(),
+        "numpy": np.random.get_state(),  # noqa: NPY002  (libraries may draw from it)
+        "torch": torch.get_rng_state(),
+    }
+    if torch.cuda.is_available():
+        state["torch_cuda"] = torch.cuda.get_rng_state_all()
+    return state
+
+
+def restore_rng(state: dict[str, Any]) -> None:
+    """Inverse of :func:`capture_rng`."""
+    random.setstate(state["python"])
+    np.random.set_state(state["numpy"])  # noqa: NPY002
+    torch.set_rng_state(state["torch"])
+    if "torch_cuda" in state and torch.cuda.is_available():
+        torch.cuda.set_rng_state_all(state["torch_cuda"])
+
+
+def save_checkpoint(
+    run_dir: Path, *, config: dict, agent: Any, replay: Any, state: dict[str, Any]
+) -> Path:
+    """Write the checkpoint of a run atomically; return the path of ``checkpoint.pt``.
+
+    Args:
+        run_dir: the run directory.
+        config: the run's config as a dict (``presets.to_dict``).
+        agent: the SimounAgent (its ``state_dict()`` is saved).
+        replay: the FrameReplay (``replay.save(path)``).
+        state: the trainer's counters and its own RNG state, restored as given.
+    """
+    replay_path = run_dir / f"replay-{state['env_step']}.npz"
+    atomic_write(replay_path, replay.save)
+    payload = {
+        "format": FORMAT,
+        "config": config,
+        "agent": agent.state_dict(),
+        "replay_file": replay_path.name,
+        "rng": capture_rng(),
+        "state": state,
+    }
+    path = run_dir / CHECKPOINT_NAME
+    atomic_write(path, lambda tmp: torch.save(payload, tmp))
+    for old in run_dir.glob("replay-*.npz"):
+        if old != replay_path:
+            old.unlink(missing_ok=True)
+    return path
+
+
+def load_checkpoint(path: Path) -> dict[str, Any]:
+    """Read a checkpoint written by :func:`save_checkpoint`.
+
+    ``path`` is a run directory or a ``checkpoint.pt`` file. Raises ``SetupError`` naming the
+    problem and the fix for a missing, corrupt or foreign file.
+    """
+    path = Path(path)
+    if path.is_dir():
+        path = path / CHECKPOINT_NAME
+    if not path.is_file():
+        raise SetupError(
+            f"no checkpoint at {path}: the run stopped before its first checkpoint, or the path "
+            "is wrong. Pass a run directory that holds checkpoint.pt, or start a new run."
+        )
+    try:
+        # Checkpoints hold numpy RNG states and python objects, so they are full pickles:
+        # load only files you wrote yourself.
+        payload = torch.load(path, map_location="cpu", weights_only=False)
+    except (pickle.UnpicklingError, EOFError, RuntimeError, zipfile.BadZipFile, ValueError) as err:
+        raise SetupError(
+            f"checkpoint {path} is corrupt or incomplete ({type(err).__name__}: {err}). "
+            "Delete it and start a new run, or restore a good copy."
+        ) from None
+    if not isinstance(payload, dict) or payload.get("format") != FORMAT:
+        found = payload.get("format") if isinstance(payload, dict) else type(payload).__name__
+        raise SetupError(
+            f"{path} is not a simoun checkpoint (format {found!r}, expected {FORMAT!r}); "
+            "pass the checkpoint.pt that simoun-train wrote."
+        )
+    missing = [key for key in _REQUIRED if key not in payload]
+    if missing:
+        raise SetupError(f"checkpoint {path} lacks {missing}; it is incomplete, start a new run.")
+    replay_path = path.parent / payload["replay_file"]
+    payload["replay_path"] = replay_path
+    return payload
+
+
+def config_differences(saved: dict, current: dict, prefix: str = "") -> list[str]:
+    """``["agent.lr: 0.001 in the checkpoint, 0.0003 now", ...]`` ignoring resumable fields."""
+    differences = []
+    for key in sorted(set(saved) | set(current)):
+        name = prefix + key
+        if not prefix and key in (*RESUMABLE_FIELDS, "run_dir"):
+            continue
+        old, new = saved.get(key, "<missing>"), current.get(key, "<missing>")
+        if isinstance(old, dict) and isinstance(new, dict) and key == "agent":
+            differences += config_differences(old, new, prefix=name + ".")
+        elif old != new:
+            differences.append(f"{name}: {old!r} in the checkpoint, {new!r} now")
+    return differences
+
+
+def check_config(payload: dict, current: dict, path: Path) -> None:
+    """Refuse a checkpoint written under another config (resumable fields may differ)."""
+    differences = config_differences(payload["config"], current)
+    if differences:
+        listed = "; ".join(differences)
+        raise SetupError(
+            f"checkpoint {path} comes from another config ({listed}). Resume without those "
+            "overrides, or start a new run in another directory."
+        )

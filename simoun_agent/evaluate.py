@@ -1,0 +1,148 @@
+"""Evaluation episodes with deterministic actions, and the ``simoun-eval`` command.
+
+``simoun-eval RUN_DIR_OR_CHECKPOINT`` rebuilds the run's environment and agent from the
+checkpoint, plays evaluation episodes and writes ``eval-<step>/metrics.json`` and
+``eval-<step>/video.mp4`` next to the checkpoint (or under ``--out``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import torch
+
+from simoun_agent import driving_metrics
+from simoun_agent.presets import SetupError
+
+EVAL_SEED_OFFSET = 1_000_000
+"""Evaluation episode i resets with seed ``config.seed + EVAL_SEED_OFFSET + i``: the same
+episodes at every evaluation, never the training ones."""
+
+
+def evaluate(
+    agent: Any,
+    env: gym.Env,
+    episodes: int,
+    seed: int,
+    record: bool = False,
+) -> tuple[dict[str, float], list[np.ndarray]]:
+    """Play ``episodes`` episodes with deterministic actions.
+
+    Leaves every global RNG as it found it, so evaluating does not change what training does
+    next (a resumed run stays bit-exact). highway-env runs add the driving measures of
+    :mod:`simoun_agent.driving_metrics`.
+
+    Returns:
+        metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
+        ``record``, the first episode's frames as the agent saw them.
+    """
+    driving = driving_metrics.is_driving_env(env)
+    returns, lengths, drives, frames = [], [], [], []
+    with torch.random.fork_rng():
+        for episode in range(episodes):
+            obs, _ = env.reset(seed=seed + episode)
+            drive = driving_metrics.DrivingEpisode() if driving else None
+            if drive:
+                drive.start(env)
+            if record and episode == 0:
+                frames.append(obs["frames"][-1])
+            total, length, done = 0.0, 0, False
+            while not done:
+                action = agent.act(obs["frames"], deterministic=True)
+                obs, reward, terminated, truncated, info = env.step(action)
+                total += float(reward)
+                length += 1
+                done = terminated or truncated
+                if drive:
+                    drive.step(env, reward, info)
+                if record and episode == 0:
+                    frames.append(obs["frames"][-1])
+            returns.append(total)
+            lengths.append(length)
+            if drive:
+                drives.append(drive)
+    metrics = {
+        "return_mean": float(np.mean(returns)),
+        "return_std": float(np.std(returns)),
+        "return_min": float(np.min(returns)),
+        "return_max": float(np.max(returns)),
+        "length_mean": float(np.mean(lengths)),
+    }
+    if drives:
+        metrics.update(driving_metrics.summarize(drives))
+    return metrics, frames
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-eval",
+        description="Evaluate a simoun-train checkpoint: deterministic episodes, metrics and a "
+        "video.",
+        epilog="example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10",
+    )
+    parser.add_argument("checkpoint", help="a run directory or its checkpoint.pt")
+    parser.add_argument("--episodes", type=int, default=10, help="episodes to play (default 10)")
+    parser.add_argument(
+        "--seed", type=int, default=None, help="first episode seed (default: the run's eval seeds)"
+    )
+    parser.add_argument(
+        "--out", default=None, help="output directory (default: <run dir>/eval-<step>)"
+    )
+    parser.add_argument("--no-video", action="store_true", help="skip the video")
+    parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-eval``."""
+    from simoun_agent import SimounAgent
+    from simoun_agent.checkpoint import load_checkpoint
+    from simoun_agent.make_env import make_env, video_fps
+    from simoun_agent.presets import from_dict
+    from simoun_agent.video import write_video
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.episodes < 1:
+        parser.error("--episodes must be at least 1")
+    try:
+        payload = load_checkpoint(Path(args.checkpoint))
+        config = from_dict(payload["config"])
+        env = make_env(config)
+        step = payload["state"]["env_step"]
+        out = Path(args.out) if args.out else payload["replay_path"].parent / f"eval-{step}"
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise SetupError(
+                f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
+            ) from None
+        agent = SimounAgent(
+            env.observation_space["frames"].shape[1:],
+            env.action_space.shape[0],
+            config.agent,
+            device=args.device or config.device,
+        )
+        agent.load_state_dict(payload["agent"])
+    except SetupError as err:
+        parser.exit(2, f"simoun-eval: error: {err}\n")
+    seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
+    metrics, frames = evaluate(agent, env, args.episodes, seed, record=not args.no_video)
+    metrics.update(env_step=step, episodes=args.episodes, first_seed=seed)
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    if frames:
+        write_video(out / "video.mp4", frames, video_fps(env, config.resolved_action_repeat()))
+    env.close()
+    print(json.dumps(metrics, indent=2))
+    print(f"wrote {out}/metrics.json" + ("" if args.no_video else f" and {out}/video.mp4"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

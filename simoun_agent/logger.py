@@ -1,0 +1,129 @@
+"""Run logs: CSV files, TensorBoard scalars and the learning-curve PNG.
+
+``eval.csv`` holds one row per evaluation and ``train.csv`` one row per training episode; both
+are plain CSV for pandas or a spreadsheet. The same numbers go to TensorBoard under ``tb/``.
+``learning_curve.png`` is redrawn from ``eval.csv`` after every evaluation, so it always shows
+the whole run, resumed parts included.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any
+
+from simoun_agent.checkpoint import atomic_write
+
+EVAL_CSV = "eval.csv"
+TRAIN_CSV = "train.csv"
+CURVE_PNG = "learning_curve.png"
+
+
+class CsvLog:
+    """Append rows of a fixed set of columns to a CSV file, flushed at each row.
+
+    On resume (``resume_step`` given) rows logged after that step are dropped: they belong to
+    the part of the run that the checkpoint does not hold and that will be redone.
+    """
+
+    def __init__(self, path: Path, resume_step: int | None = None) -> None:
+        self.path = path
+        self.columns: list[str] | None = None
+        if resume_step is not None and path.exists():
+            with path.open(newline="") as f:
+                reader = csv.DictReader(f)
+                self.columns = reader.fieldnames
+                rows = [row for row in reader if int(row["env_step"]) <= resume_step]
+            self._rewrite(rows)
+        elif path.exists():
+            path.unlink()
+
+    def _rewrite(self, rows: list[dict[str, str]]) -> None:
+        def write(tmp: Path) -> None:
+            with tmp.open("w", newline="") as f:
+                writer = csv.DictWriter(f, self.columns)
+                writer.writeheader()
+                writer.writerows(rows)
+
+        atomic_write(self.path, write)
+
+    def write(self, row: dict[str, Any]) -> None:
+        if self.columns is None:
+            self.columns = list(row)
+            self._rewrite([])
+        with self.path.open("a", newline="") as f:
+            csv.DictWriter(f, self.columns, extrasaction="ignore").writerow(row)
+
+
+def read_csv(path: Path) -> list[dict[str, float]]:
+    """Rows of a CSV written by :class:`CsvLog`, numbers as floats."""
+    with path.open(newline="") as f:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:
+    """Draw mean evaluation return (with its min-max band) against environment steps."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = read_csv(eval_csv)
+    steps = [row["env_step"] for row in rows]
+    mean = [row["return_mean"] for row in rows]
+    fig, ax = plt.subplots(figsize=(6, 4), dpi=110)
+    ax.fill_between(
+        steps,
+        [row["return_min"] for row in rows],
+        [row["return_max"] for row in rows],
+        alpha=0.25,
+        label="min-max over episodes",
+    )
+    ax.plot(steps, mean, marker="o", label="mean evaluation return")
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best")
+    fig.tight_layout()
+    atomic_write(png, lambda tmp: fig.savefig(tmp, format="png"))
+    plt.close(fig)
+
+
+class RunLogger:
+    """Everything a training run logs, in one place.
+
+    Args:
+        run_dir: the run directory.
+        title: the learning curve's title (e.g. the env id and preset).
+        resume_step: the checkpoint's env step when resuming, else None.
+    """
+
+    def __init__(self, run_dir: Path, title: str, resume_step: int | None = None) -> None:
+        from torch.utils.tensorboard import SummaryWriter
+
+        self.run_dir = run_dir
+        self.title = title
+        self.eval_log = CsvLog(run_dir / EVAL_CSV, resume_step)
+        self.train_log = CsvLog(run_dir / TRAIN_CSV, resume_step)
+        self.tensorboard = SummaryWriter(run_dir / "tb", purge_step=resume_step)
+
+    def train_episode(self, env_step: int, row: dict[str, Any]) -> None:
+        """One finished training episode: return, length, speed and the last update's losses."""
+        self.train_log.write({"env_step": env_step, **row})
+        for key, value in row.items():
+            if isinstance(value, (int, float)) and math.isfinite(value):
+                self.tensorboard.add_scalar(f"train/{key}", value, env_step)
+
+    def evaluation(self, env_step: int, metrics: dict[str, float]) -> None:
+        """One evaluation: append to eval.csv, TensorBoard, and redraw the learning curve."""
+        self.eval_log.write({"env_step": env_step, **metrics})
+        for key, value in metrics.items():
+            if math.isfinite(value):
+                self.tensorboard.add_scalar(f"eval/{key}", value, env_step)
+        self.tensorboard.flush()
+        plot_learning_curve(self.run_dir / EVAL_CSV, self.run_dir / CURVE_PNG, self.title)
+
+    def close(self) -> None:
+        self.tensorboard.close()

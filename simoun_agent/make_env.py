@@ -1,0 +1,157 @@
+"""Build the environment stack a run trains on, from a Gymnasium id and a TrainConfig.
+
+``make_env(config)`` gives ``SimounObservation(MultiCamera?(ActionRepeat(RescaleAction(env))))``:
+the agent acts in ``[-1, 1]^n`` (rescaled to the env's bounds), each decision is repeated
+``action_repeat`` times, and observations are ``{"frames": (3, C, H, W) uint8}`` triplets (the
+agent computes the motion channels itself, so the wrapper's are switched off).
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.wrappers import RescaleAction
+
+import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+from simoun_agent.presets import SetupError, TrainConfig, is_highway
+from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
+from simoun_wrappers.observation import image_layout
+
+HIGHWAY_VIEWPORTS = (
+    {"centering_position": [0.5, 0.5], "scaling": 3.0},
+    {"centering_position": [0.3, 0.5], "scaling": 5.5},
+    {"centering_position": [-0.2, 0.5], "scaling": 5.5},
+)
+"""Three views around the ego vehicle, left to right: wide overview, ahead, behind (the
+paper's three roof cameras on CARLA become three highway-env viewports)."""
+
+_SUITES = {"dm_control/": ("shimmy", "dmc"), "": ("highway_env", "highway")}
+
+
+def ensure_registered(env_id: str) -> None:
+    """Import the suite that registers ``env_id``; raise SetupError with close matches if none.
+
+    dm_control ids are registered by shimmy and highway-env ids by highway_env, on import.
+    """
+    if env_id in gym.registry:
+        return
+    for prefix, (module, extra) in _SUITES.items():
+        if not env_id.startswith(prefix):
+            continue
+        try:
+            importlib.import_module(module)
+        except ImportError:
+            if prefix:
+                raise SetupError(
+                    f"{env_id!r} needs {module}, which is not installed; "
+                    f'pip install "simoun[{extra}]"'
+                ) from None
+        if env_id in gym.registry:
+            return
+    matches = difflib.get_close_matches(env_id, list(gym.registry), n=5, cutoff=0.6)
+    hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
+    raise SetupError(
+        f"unknown environment id {env_id!r}; {hint} Pass a registered Gymnasium id "
+        "(e.g. dm_control/cartpole-swingup-v0, highway-v0, simoun/PointReach-v0)."
+    )
+
+
+def _make_base(config: TrainConfig) -> gym.Env:
+    """``gym.make`` the env with rgb_array rendering at the run's image size."""
+    ensure_registered(config.env)
+    kwargs = dict(config.env_kwargs)
+    if config.env.startswith("dm_control/"):
+        render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
+        kwargs.setdefault("render_kwargs", render)
+    try:
+        return gym.make(config.env, render_mode="rgb_array", **kwargs)
+    except TypeError as err:
+        if "render_mode" not in str(err):
+            raise SetupError(f"gymnasium.make({config.env!r}, ...) failed: {err}") from None
+    return gym.make(config.env, **kwargs)
+
+
+def _check_env(env: gym.Env, env_id: str) -> None:
+    if not isinstance(env.action_space, spaces.Box) or len(env.action_space.shape) != 1:
+        raise SetupError(
+            f"{env_id} has action space {env.action_space}; the Simoun agent is a SAC agent for "
+            "continuous actions and needs a 1-D Box. Pick a continuous-control env (highway-env "
+            'takes config={"action": {"type": "ContinuousAction"}}).'
+        )
+    if not np.all(np.isfinite(env.action_space.low) & np.isfinite(env.action_space.high)):
+        raise SetupError(
+            f"{env_id} has unbounded actions {env.action_space}; rescaling [-1, 1] actions needs "
+            "finite bounds. Wrap the env with gymnasium.wrappers.ClipAction or bounds of your own."
+        )
+    has_pixels = image_layout(env.observation_space) is not None
+    renders = env.render_mode == "rgb_array" and "rgb_array" in env.metadata.get("render_modes", [])
+    if not (has_pixels or renders):
+        raise SetupError(
+            f"{env_id} has neither image observations (its observation space is "
+            f"{env.observation_space}) nor rgb_array rendering (render modes "
+            f"{env.metadata.get('render_modes', [])}); Simoun learns from pixels. Use an env "
+            "that renders rgb_array images, or wrap yours so it returns (H, W, 3) uint8 images."
+        )
+
+
+def make_env(config: TrainConfig) -> gym.Env:
+    """The wrapped environment for ``config``; raises SetupError for an unusable env."""
+    env = _make_base(config)
+    _check_env(env, config.env)
+    bound = np.ones(env.action_space.shape, dtype=env.action_space.dtype)
+    env = RescaleAction(env, -bound, bound)
+    env = ActionRepeat(env, config.resolved_action_repeat())
+    size: int | None = config.image_size
+    if config.cameras > 1 or is_highway(config.env):
+        env = MultiCamera(env, _cameras(config), size=config.image_size)
+        size = None
+    return SimounObservation(
+        env,
+        size=size,
+        grayscale=config.grayscale,
+        num_frames=config.agent.num_frames,
+        motion=False,
+    )
+
+
+def _cameras(config: TrainConfig) -> list:
+    if is_highway(config.env):
+        if config.cameras > len(HIGHWAY_VIEWPORTS):
+            raise SetupError(
+                f"highway-env runs have at most {len(HIGHWAY_VIEWPORTS)} viewports, got "
+                f"cameras={config.cameras}; set cameras to 1, 2 or 3."
+            )
+        return list(HIGHWAY_VIEWPORTS[: config.cameras])
+    if config.env.startswith("dm_control/"):
+        return list(range(config.cameras))
+    raise SetupError(
+        f"cameras={config.cameras} needs a dm_control or highway-env task, not {config.env}; "
+        "set cameras=1, or build a MultiCamera with your own view callables."
+    )
+
+
+def control_timestep(env: gym.Env) -> float | None:
+    """Seconds of simulated time per inner env step, or None when the env does not say.
+
+    shimmy's dm_control envs report a wrong ``render_fps`` (the control timestep x 1000), so
+    their timestep comes from dm_control itself; highway-env's from its policy frequency.
+    """
+    base = env.unwrapped
+    dm_env = getattr(base, "_env", None)
+    if dm_env is not None and hasattr(dm_env, "control_timestep"):
+        return float(dm_env.control_timestep())
+    config = getattr(base, "config", None)
+    if isinstance(config, dict) and "policy_frequency" in config:
+        return 1.0 / config["policy_frequency"]
+    fps = base.metadata.get("render_fps")
+    return 1.0 / fps if fps else None
+
+
+def video_fps(env: gym.Env, action_repeat: int) -> float:
+    """Frames per second of real-time video with one frame per agent decision."""
+    timestep = control_timestep(env)
+    return 1.0 / (timestep * action_repeat) if timestep else 30.0

@@ -1,0 +1,347 @@
+"""Training configuration: the ``TrainConfig`` dataclass, named presets and command-line overrides.
+
+A run's configuration is resolved in three layers: the dataclass defaults (the paper's DrQ-style
+setup), then a named preset, then the user's overrides (``--agent.batch-size 64`` or
+``--set agent.batch_size=64``). The resolved config is saved as ``config.json`` in the run
+directory and checked again when the run is resumed.
+"""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import inspect
+import itertools
+import json
+import textwrap
+import types
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+from simoun_agent.config import AgentConfig
+
+
+class SetupError(ValueError):
+    """A bad input the user can fix (unknown env or key, foreign checkpoint, ...).
+
+    The command-line tools print its message, which names the problem and the fix, without a
+    traceback.
+    """
+
+
+PAPER_ACTION_REPEAT = {
+    "cartpole-swingup": 8,
+    "reacher-easy": 4,
+    "cheetah-run": 4,
+    "ball_in_cup-catch": 4,
+    "walker-walk": 2,
+    "finger-spin": 2,
+}
+"""Action repeat of the paper's six DeepMind Control tasks (DESIGN.md, from DrQ)."""
+
+HIGHWAY_CONFIG = {
+    "action": {"type": "ContinuousAction"},
+    "lanes_count": 4,
+    "vehicles_count": 20,
+    "vehicles_density": 1.0,
+    "duration": 40,
+    "policy_frequency": 5,
+    "simulation_frequency": 15,
+}
+"""highway-env settings of the ``highway`` preset: continuous [acceleration, steering] control at
+5 decisions per simulated second, episodes of 40 s (200 decisions), 4 lanes and 20 other vehicles
+at highway-env's default density 1.0 (the paper's CARLA setup drives among 20 moving cars)."""
+
+
+@dataclass
+class TrainConfig:
+    """Everything a training run needs; saved with the run as ``config.json``."""
+
+    env: str = "dm_control/cartpole-swingup-v0"
+    """Gymnasium id: a dm_control task through shimmy, a highway-env id, any pixel/renderable env"""
+    env_kwargs: dict = field(default_factory=dict)
+    """extra keyword arguments for gymnasium.make (JSON on the command line)"""
+    preset: str | None = None
+    """name of the preset this config started from (informational)"""
+    seed: int = 1
+    """seed of the environments, the replay, torch, numpy and python"""
+    action_repeat: int | None = None
+    """env steps per agent decision; None: the paper's value for its six DMC tasks, else 1"""
+    image_size: int = 84
+    """height and width of each camera view fed to the agent"""
+    grayscale: bool = False
+    """feed grayscale frames (1 channel) instead of RGB"""
+    cameras: int = 1
+    """viewports concatenated along the width (dm_control camera ids 0..n-1; highway-env: 3 views
+    around the ego vehicle)"""
+    total_env_steps: int = 500_000
+    """length of the run in environment steps (agent decisions x action repeat)"""
+    warmup_agent_steps: int = 1000
+    """agent decisions taken uniformly at random before learning starts"""
+    updates_per_step: int = 1
+    """gradient updates per agent decision once learning has started"""
+    replay_capacity: int = 100_000
+    """transitions kept in the replay"""
+    eval_every: int = 10_000
+    """environment steps between evaluations"""
+    eval_episodes: int = 10
+    """episodes per evaluation (deterministic actions)"""
+    checkpoint_every: int = 50_000
+    """environment steps between checkpoints (written at the next episode end)"""
+    video: bool = True
+    """record one evaluation episode to video.mp4 at the end of the run"""
+    device: str | None = None
+    """torch device; None: cuda when available, else cpu"""
+    torch_threads: int | None = None
+    """torch intra-op threads; None: torch's default"""
+    run_dir: str | None = None
+    """output directory; None: runs/<env>-<preset>-s<seed>-<date>"""
+    progress: bool = True
+    """show a progress bar"""
+    agent: AgentConfig = field(default_factory=AgentConfig)
+    """the agent's hyperparameters (simoun_agent.config.AgentConfig)"""
+
+    def resolved_action_repeat(self) -> int:
+        """The action repeat to use: the explicit value, the paper's for a DMC task, or 1."""
+        if self.action_repeat is not None:
+            return self.action_repeat
+        return PAPER_ACTION_REPEAT.get(dmc_task(self.env), 1)
+
+
+RESUMABLE_FIELDS = ("total_env_steps", "eval_every", "checkpoint_every", "progress", "video")
+"""Fields a resumed run may change; every other field must match the saved config."""
+
+
+def dmc_task(env_id: str) -> str | None:
+    """``"dm_control/cartpole-swingup-v0"`` -> ``"cartpole-swingup"``; None for other ids."""
+    if not env_id.startswith("dm_control/"):
+        return None
+    return env_id.removeprefix("dm_control/").rsplit("-v", 1)[0]
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A named set of overrides and the environments it was tuned for."""
+
+    description: str
+    overrides: dict
+    envs: str = "any"
+    """"any", "highway" (any highway-env id) or one exact env id"""
+
+    def accepts(self, env_id: str) -> bool:
+        if self.envs == "any":
+            return True
+        if self.envs == "highway":
+            return is_highway(env_id)
+        return env_id == self.envs
+
+
+def is_highway(env_id: str) -> bool:
+    """True for ids registered by highway-env (``highway-v0``, ``merge-v0``, ...)."""
+    import gymnasium as gym
+
+    spec = gym.registry.get(env_id)
+    if spec is None:
+        return env_id.split("-v")[0] in {"highway", "highway-fast", "merge", "roundabout"}
+    entry = spec.entry_point if isinstance(spec.entry_point, str) else ""
+    return entry.startswith("highway_env")
+
+
+def _dmc_preset(task: str) -> Preset:
+    lr = 2e-4 if task == "cheetah-run" else 1e-3
+    return Preset(
+        description=f"paper setup for DMC {task}: action repeat {PAPER_ACTION_REPEAT[task]}, "
+        f"batch 512, lr {lr:g}, replay 100k, 500k env steps",
+        overrides={
+            "env": f"dm_control/{task}-v0",
+            "action_repeat": PAPER_ACTION_REPEAT[task],
+            "agent": {"batch_size": 512, "lr": lr},
+        },
+        envs=f"dm_control/{task}-v0",
+    )
+
+
+PRESETS: dict[str, Preset] = {task: _dmc_preset(task) for task in PAPER_ACTION_REPEAT}
+PRESETS["highway"] = Preset(
+    description="highway-env driving: 3 viewports around the ego vehicle -> 84x252, continuous "
+    "[acceleration, steering], 40 s episodes, 20 vehicles at density 1",
+    overrides={
+        "env": "highway-v0",
+        "env_kwargs": {"config": HIGHWAY_CONFIG},
+        "action_repeat": 1,
+        "cameras": 3,
+        "total_env_steps": 100_000,
+        "eval_every": 5_000,
+        "eval_episodes": 5,
+        "agent": {"batch_size": 128},
+    },
+    envs="highway",
+)
+PRESETS["cpu"] = Preset(
+    description="sized for a 2-core CPU: dm_control cartpole-swingup learns visibly in about "
+    "15 minutes",
+    overrides={
+        "total_env_steps": 40_000,
+        "warmup_agent_steps": 250,
+        "replay_capacity": 20_000,
+        "eval_every": 4_000,
+        "eval_episodes": 3,
+        "checkpoint_every": 10_000,
+        "image_size": 64,
+        "agent": {"batch_size": 64, "hidden_dim": 256},
+    },
+)
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """The docstring under each field of a dataclass (cleanrl style), read from its source."""
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
+    except (OSError, TypeError):
+        return {}
+    body = tree.body[0].body
+    docs = {}
+    for node, following in itertools.pairwise(body):
+        if (
+            isinstance(node, ast.AnnAssign)
+            and isinstance(node.target, ast.Name)
+            and isinstance(following, ast.Expr)
+            and isinstance(following.value, ast.Constant)
+            and isinstance(following.value.value, str)
+        ):
+            docs[node.target.id] = " ".join(following.value.value.split())
+    return docs
+
+
+def config_fields() -> dict[str, tuple[type, Any, str]]:
+    """Every overridable key (``"seed"``, ``"agent.lr"``, ...) -> (type, default, doc)."""
+    keys = {}
+    for cls, prefix in ((TrainConfig, ""), (AgentConfig, "agent.")):
+        hints = typing.get_type_hints(cls)
+        docs = field_docs(cls)
+        for f in dataclasses.fields(cls):
+            if f.name == "agent" and cls is TrainConfig:
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            keys[prefix + f.name] = (hints[f.name], default, docs.get(f.name, ""))
+    return keys
+
+
+def parse_value(key: str, text: str, kind: Any) -> Any:
+    """Convert a command-line string to the field's type, or raise SetupError naming the key."""
+    options = typing.get_args(kind) if _is_union(kind) else (kind,)
+    if type(None) in options and text.lower() in ("none", "null"):
+        return None
+    errors = []
+    for option in options:
+        if option is type(None):
+            continue
+        try:
+            return _parse_one(text, option)
+        except ValueError as error:
+            errors.append(str(error))
+    raise SetupError(f"cannot read {key}={text!r}: {'; '.join(errors)}")
+
+
+def _is_union(kind: Any) -> bool:
+    return typing.get_origin(kind) in (typing.Union, types.UnionType)
+
+
+def _parse_one(text: str, kind: Any) -> Any:
+    origin = typing.get_origin(kind) or kind
+    if origin is bool:
+        lowered = text.lower()
+        if lowered in ("1", "true", "yes", "on"):
+            return True
+        if lowered in ("0", "false", "no", "off"):
+            return False
+        raise ValueError("expected true or false")
+    if origin in (int, float, str):
+        try:
+            return origin(text)
+        except ValueError:
+            raise ValueError(f"expected {origin.__name__}") from None
+    if origin in (dict, list, tuple):
+        try:
+            value = json.loads(text)
+        except json.JSONDecodeError:
+            raise ValueError(f"expected JSON for a {origin.__name__}") from None
+        return tuple(value) if origin is tuple else value
+    raise ValueError(f"unsupported type {kind}")
+
+
+def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
+    """Build a TrainConfig from the defaults, a preset and ``{"agent.lr": 3e-4, ...}`` overrides.
+
+    Raises SetupError for an unknown preset or key, or a preset meant for another environment.
+    """
+    known = config_fields()
+    unknown = [key for key in overrides if key not in known]
+    if unknown:
+        import difflib
+
+        hints = [difflib.get_close_matches(key, known, n=1) for key in unknown]
+        named = ", ".join(
+            key + (f" (did you mean {hint[0]}?)" if hint else "")
+            for key, hint in zip(unknown, hints, strict=True)
+        )
+        raise SetupError(f"unknown config key {named}; `simoun-train --help` lists every key")
+    values: dict[str, Any] = {}
+    if preset is not None:
+        if preset not in PRESETS:
+            raise SetupError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+        chosen = PRESETS[preset]
+        values.update(_flatten(chosen.overrides))
+        values["preset"] = preset
+        env_id = overrides.get("env", values.get("env", TrainConfig.env))
+        if not chosen.accepts(env_id):
+            meant = "highway-env ids" if chosen.envs == "highway" else chosen.envs
+            fitting = [name for name, other in PRESETS.items() if other.envs != "any"]
+            fitting = [name for name in fitting if PRESETS[name].accepts(env_id)] + ["cpu"]
+            raise SetupError(
+                f"preset {preset!r} is meant for {meant}, not {env_id!r}; drop --env to train "
+                f"on {meant}, or use a preset for {env_id!r}: {' or '.join(fitting)} (or no "
+                "preset for the paper defaults)"
+            )
+    values.update(overrides)
+    return from_flat(values)
+
+
+def _flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
+    flat = {}
+    for key, value in nested.items():
+        if key == "agent" and not prefix:
+            flat.update(_flatten(value, "agent."))
+        else:
+            flat[prefix + key] = value
+    return flat
+
+
+def from_flat(values: dict[str, Any]) -> TrainConfig:
+    """TrainConfig from flat keys (``"agent.lr"``) over the dataclass defaults."""
+    agent_values = {k[6:]: v for k, v in values.items() if k.startswith("agent.")}
+    train_values = {k: v for k, v in values.items() if not k.startswith("agent.")}
+    try:
+        return TrainConfig(**train_values, agent=AgentConfig(**agent_values))
+    except ValueError as err:
+        raise SetupError(str(err)) from None
+
+
+def to_dict(config: TrainConfig) -> dict[str, Any]:
+    """JSON-ready nested dict of a config (tuples become lists)."""
+    return json.loads(json.dumps(dataclasses.asdict(config)))
+
+
+def from_dict(data: dict[str, Any]) -> TrainConfig:
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know."""
+    flat = _flatten(data)
+    known = config_fields()
+    unknown = sorted(set(flat) - set(known))
+    if unknown:
+        raise SetupError(f"saved config has keys this version does not know: {unknown}")
+    for key, value in flat.items():
+        kind = known[key][0]
+        if isinstance(value, list) and (typing.get_origin(kind) or kind) is tuple:
+            flat[key] = tuple(value)
+    return from_flat(flat)

@@ -1,0 +1,440 @@
+"""``simoun-train``: train the Simoun agent on any pixel or renderable Gymnasium env.
+
+    simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu
+    simoun-train --preset walker-walk --agent.encoder dual --agent.curiosity false
+    simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000
+
+A run directory holds ``config.json`` (the resolved config, written once set-up has
+succeeded), ``eval.csv`` / ``train.csv`` / ``tb/`` (logs), ``learning_curve.png`` (redrawn at
+each evaluation), ``checkpoint.pt`` + ``replay-<step>.npz`` (the latest checkpoint),
+``video.mp4`` (an evaluation episode) and ``summary.json`` (written only when the run ends).
+Ctrl-C finishes the current step, writes a checkpoint and exits; ``--resume`` continues.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import signal
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from simoun_agent import SimounAgent
+from simoun_agent.checkpoint import (
+    atomic_write,
+    check_config,
+    load_checkpoint,
+    restore_rng,
+    save_checkpoint,
+)
+from simoun_agent.evaluate import EVAL_SEED_OFFSET, evaluate
+from simoun_agent.logger import CURVE_PNG, RunLogger
+from simoun_agent.make_env import make_env, video_fps
+from simoun_agent.presets import (
+    PRESETS,
+    RESUMABLE_FIELDS,
+    SetupError,
+    TrainConfig,
+    config_fields,
+    dmc_task,
+    from_dict,
+    parse_value,
+    resolve,
+    to_dict,
+)
+from simoun_agent.replay import FrameReplay
+from simoun_agent.video import write_video
+
+CONFIG_NAME = "config.json"
+SUMMARY_NAME = "summary.json"
+
+
+@dataclass
+class Counters:
+    """Where a run stands; saved in every checkpoint."""
+
+    env_step: int = 0
+    """environment steps taken (agent decisions x action repeat)"""
+    agent_step: int = 0
+    """agent decisions taken"""
+    episode: int = 0
+    """training episodes begun; episode i resets with seed config.seed + i"""
+    updates: int = 0
+    """gradient updates done"""
+
+
+@dataclass
+class Run:
+    """A run ready to train: its config, directory, environments, agent and replay."""
+
+    config: TrainConfig
+    run_dir: Path
+    env: gym.Env
+    eval_env: gym.Env
+    agent: SimounAgent
+    replay: FrameReplay
+    rng: np.random.Generator
+    """the trainer's own generator (random warm-up actions)"""
+    counters: Counters
+
+
+def default_run_dir(config: TrainConfig) -> Path:
+    """``runs/<task>-<preset>-s<seed>-<UTC time>``, e.g. ``runs/cartpole-swingup-cpu-s1-...``."""
+    task = dmc_task(config.env) or config.env.replace("/", "-")
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    return Path("runs") / f"{task}-{config.preset or 'default'}-s{config.seed}-{stamp}"
+
+
+def build(config: TrainConfig) -> tuple[gym.Env, gym.Env, SimounAgent, FrameReplay]:
+    """Environments, agent and an empty replay; seeds python, numpy and torch first."""
+    if config.torch_threads:
+        torch.set_num_threads(config.torch_threads)
+    random.seed(config.seed)
+    np.random.seed(config.seed)  # noqa: NPY002  (for libraries that draw from it)
+    torch.manual_seed(config.seed)
+    env, eval_env = make_env(config), make_env(config)
+    frame_shape = env.observation_space["frames"].shape[1:]
+    action_dim = env.action_space.shape[0]
+    agent = SimounAgent(frame_shape, action_dim, config.agent, device=config.device)
+    replay = FrameReplay(
+        config.replay_capacity,
+        frame_shape,
+        action_dim,
+        num_frames=config.agent.num_frames,
+        seed=config.seed,
+    )
+    return env, eval_env, agent, replay
+
+
+def create_run(config: TrainConfig) -> Run:
+    """Set up a new run; the run directory gets ``config.json`` only once all of it worked."""
+    run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
+    if (run_dir / CONFIG_NAME).exists():
+        raise SetupError(
+            f"{run_dir} already holds a run; continue it with --resume {run_dir}, or pass "
+            "another --run-dir"
+        )
+    env, eval_env, agent, replay = build(config)
+    created = not run_dir.exists()
+    try:
+        run_dir.mkdir(parents=True, exist_ok=True)
+        probe = run_dir / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as err:
+        if created and run_dir.is_dir() and not any(run_dir.iterdir()):
+            run_dir.rmdir()
+        raise SetupError(
+            f"cannot write to the output directory {run_dir} ({err.strerror}); pass a "
+            "writable --run-dir"
+        ) from None
+    config.run_dir = str(run_dir)
+    write_config(run_dir, config)
+    rng = np.random.default_rng(config.seed)
+    return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters())
+
+
+def write_config(run_dir: Path, config: TrainConfig) -> None:
+    text = json.dumps(to_dict(config), indent=2) + "\n"
+    atomic_write(run_dir / CONFIG_NAME, lambda tmp: tmp.write_text(text))
+
+
+def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
+    """Reload a run from its directory; ``overrides`` may only change resumable fields."""
+    config_path = run_dir / CONFIG_NAME
+    if not config_path.is_file():
+        raise SetupError(
+            f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "
+            "that simoun-train created"
+        )
+    try:
+        saved = json.loads(config_path.read_text())
+    except json.JSONDecodeError as err:
+        raise SetupError(f"{config_path} is corrupt ({err}); start a new run") from None
+    fixed = {k: v for k, v in overrides.items() if k not in RESUMABLE_FIELDS}
+    if fixed:
+        raise SetupError(
+            f"a resumed run keeps its config; only {', '.join(RESUMABLE_FIELDS)} may change, "
+            f"but {', '.join(fixed)} was given. Start a new run to change it."
+        )
+    config = from_dict(saved)
+    for key, value in overrides.items():
+        setattr(config, key, value)
+    config.run_dir = str(run_dir)
+    payload = load_checkpoint(run_dir)
+    check_config(payload, to_dict(config), run_dir)
+    if not payload["replay_path"].is_file():
+        raise SetupError(
+            f"{payload['replay_path']} (the replay of the checkpoint) is missing; the run cannot "
+            "continue exactly. Start a new run."
+        )
+    env, eval_env, agent, _ = build(config)
+    try:
+        agent.load_state_dict(payload["agent"])
+        replay = FrameReplay.load(payload["replay_path"])
+    except (RuntimeError, KeyError, ValueError, OSError) as err:
+        raise SetupError(
+            f"the checkpoint in {run_dir} does not fit this agent ({type(err).__name__}: "
+            f"{err}); start a new run"
+        ) from None
+    restore_rng(payload["rng"])
+    rng = np.random.default_rng()
+    rng.bit_generator.state = payload["state"]["trainer_rng"]
+    counters = Counters(**payload["state"]["counters"])
+    write_config(run_dir, config)
+    return Run(config, run_dir, env, eval_env, agent, replay, rng, counters)
+
+
+def checkpoint(run: Run) -> None:
+    state = {
+        "env_step": run.counters.env_step,
+        "counters": asdict(run.counters),
+        "trainer_rng": run.rng.bit_generator.state,
+    }
+    save_checkpoint(
+        run.run_dir,
+        config=to_dict(run.config),
+        agent=run.agent,
+        replay=run.replay,
+        state=state,
+    )
+
+
+@contextmanager
+def deferred_interrupt() -> Iterator[threading.Event]:
+    """Turn the first Ctrl-C into a request the loop answers at a clean point (between steps).
+
+    A second Ctrl-C interrupts at once. Outside the main thread signals cannot be caught, so
+    the returned event is simply never set there.
+    """
+    requested = threading.Event()
+    if threading.current_thread() is not threading.main_thread():
+        yield requested
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        if requested.is_set():
+            raise KeyboardInterrupt
+        requested.set()
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield requested
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def train(run: Run) -> dict[str, Any]:
+    """The training loop; returns the final evaluation metrics (None if interrupted first)."""
+    config, counters, agent, replay, env = run.config, run.counters, run.agent, run.replay, run.env
+    repeat = config.resolved_action_repeat()
+    action_dim = env.action_space.shape[0]
+    eval_seed = config.seed + EVAL_SEED_OFFSET
+    title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
+    logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
+    next_eval = counters.env_step if counters.env_step == 0 else _next(counters, config.eval_every)
+    next_checkpoint = _next(counters, config.checkpoint_every)
+    last_eval: dict[str, float] | None = None
+    update_metrics: dict[str, Any] = {}
+
+    obs, _ = env.reset(seed=config.seed + counters.episode)
+    replay.start_episode(obs["frames"][-1])
+    episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
+    bar = tqdm(
+        total=config.total_env_steps,
+        initial=counters.env_step,
+        unit="step",
+        desc=title.split(" ")[0],
+        dynamic_ncols=True,
+        disable=not config.progress,
+    )
+    with deferred_interrupt() as interrupt:
+        while counters.env_step < config.total_env_steps and not interrupt.is_set():
+            if counters.agent_step < config.warmup_agent_steps:
+                action = run.rng.uniform(-1.0, 1.0, action_dim).astype(np.float32)
+            else:
+                action = agent.act(obs["frames"])
+            obs, reward, terminated, truncated, _ = env.step(action)
+            replay.add(action, reward, obs["frames"][-1], terminated, truncated)
+            counters.agent_step += 1
+            counters.env_step += repeat
+            episode_return += float(reward)
+            episode_length += 1
+            bar.update(repeat)
+
+            if counters.agent_step > config.warmup_agent_steps:
+                for _ in range(config.updates_per_step):
+                    update_metrics = agent.update(replay, counters.env_step)
+                    counters.updates += 1
+
+            if not (terminated or truncated):
+                continue
+            elapsed = time.perf_counter() - episode_start
+            logger.train_episode(
+                counters.env_step,
+                {
+                    "episode": counters.episode,
+                    "return": episode_return,
+                    "length": episode_length,
+                    "env_steps_per_s": episode_length * repeat / elapsed,
+                    **{key: float(value) for key, value in update_metrics.items()},
+                },
+            )
+            counters.episode += 1
+            if counters.env_step >= next_eval:
+                last_eval, _ = evaluate(agent, run.eval_env, config.eval_episodes, eval_seed)
+                logger.evaluation(counters.env_step, last_eval)
+                next_eval = _next(counters, config.eval_every)
+            if counters.env_step >= next_checkpoint:
+                checkpoint(run)
+                next_checkpoint = _next(counters, config.checkpoint_every)
+            bar.set_postfix(episode_return=f"{episode_return:.1f}", **_eval_postfix(last_eval))
+            obs, _ = env.reset(seed=config.seed + counters.episode)
+            replay.start_episode(obs["frames"][-1])
+            episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
+        bar.close()
+
+        if interrupt.is_set():
+            checkpoint(run)
+            logger.close()
+            tqdm.write(
+                f"interrupted at env step {counters.env_step}: checkpoint written; continue "
+                f"with: simoun-train --resume {run.run_dir}"
+            )
+            raise KeyboardInterrupt
+        return finish(run, logger, last_eval)
+
+
+def finish(run: Run, logger: RunLogger, last_eval: dict[str, float] | None) -> dict[str, Any]:
+    """Final evaluation (with video), checkpoint and ``summary.json``, the mark of a whole run."""
+    config, counters = run.config, run.counters
+    eval_seed = config.seed + EVAL_SEED_OFFSET
+    final, frames = evaluate(
+        run.agent, run.eval_env, config.eval_episodes, eval_seed, record=config.video
+    )
+    if last_eval is None or final != last_eval:
+        logger.evaluation(counters.env_step, final)
+    checkpoint(run)
+    logger.close()
+    files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
+    if frames:
+        fps = video_fps(run.eval_env, config.resolved_action_repeat())
+        write_video(run.run_dir / "video.mp4", frames, fps)
+        files["video"] = "video.mp4"
+    summary = {"env_step": counters.env_step, "final_eval": final, "files": files}
+    text = json.dumps(summary, indent=2) + "\n"
+    atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
+    return final
+
+
+def _next(counters: Counters, every: int) -> int:
+    return (counters.env_step // every + 1) * every
+
+
+def _eval_postfix(metrics: dict[str, float] | None) -> dict[str, str]:
+    return {} if metrics is None else {"eval_return": f"{metrics['return_mean']:.1f}"}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line: a few run options and one flag per config key."""
+    presets = "\n".join(f"  {name:18} {preset.description}" for name, preset in PRESETS.items())
+    parser = argparse.ArgumentParser(
+        prog="simoun-train",
+        description="Train the Simoun agent (vision-based SAC) on a Gymnasium environment.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=f"presets:\n{presets}\n\n"
+        "examples:\n"
+        "  simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu\n"
+        "  simoun-train --preset cheetah-run --agent.encoder dual --agent.curiosity false\n"
+        "  simoun-train --preset highway --set agent.batch_size=64\n"
+        "  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000\n\n"
+        "Values: booleans true/false, None as none, dicts as JSON (--env-kwargs '{\"a\": 1}').",
+    )
+    parser.add_argument("--preset", choices=list(PRESETS), help="start from a named preset")
+    parser.add_argument(
+        "--resume",
+        metavar="RUN_DIR",
+        help="continue a run from its last checkpoint (only "
+        f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
+    )
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config key, e.g. --set agent.lr=3e-4 (repeatable; like the flags below)",
+    )
+    group = parser.add_argument_group(
+        "config keys (defaults before any preset; each is also KEY for --set)"
+    )
+    for key, (_, default, doc) in config_fields().items():
+        shown = json.dumps(default) if isinstance(default, dict) else repr(default)
+        group.add_argument(
+            "--" + key.replace("_", "-"),
+            dest=key,
+            default=argparse.SUPPRESS,
+            metavar="",
+            help=f"{doc} (default: {shown})".replace("%", "%%"),
+        )
+    return parser
+
+
+def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
+    """``{"agent.lr": 3e-4, ...}`` from the config flags and ``--set`` pairs, typed."""
+    fields = config_fields()
+    given = {key: value for key, value in vars(args).items() if key in fields}
+    for pair in args.set:
+        key, sep, value = pair.partition("=")
+        if not sep:
+            raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
+        if key not in fields:
+            resolve(None, {key: value})  # raises the unknown-key error with suggestions
+        given[key] = value
+    return {key: parse_value(key, value, fields[key][0]) for key, value in given.items()}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-train``."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        overrides = overrides_from(args)
+        if args.resume:
+            if args.preset:
+                raise SetupError("--preset does not combine with --resume: a run keeps its config")
+            run = resume_run(Path(args.resume), overrides)
+        else:
+            config = resolve(args.preset, overrides)
+            run = create_run(config)
+    except SetupError as err:
+        parser.exit(2, f"simoun-train: error: {err}\n")
+    tqdm.write(f"run directory: {run.run_dir}")
+    try:
+        final = train(run)
+    except KeyboardInterrupt:
+        return 130
+    finally:
+        run.env.close()
+        run.eval_env.close()
+    tqdm.write(
+        f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
+        f"{run.counters.env_step} env steps; curve, logs, checkpoint and video in {run.run_dir}"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
