@@ -79,8 +79,9 @@ def _check_env(env: gym.Env, env_id: str) -> None:
     if not isinstance(env.action_space, spaces.Box) or len(env.action_space.shape) != 1:
         raise SetupError(
             f"{env_id} has action space {env.action_space}; the Simoun agent is a SAC agent for "
-            "continuous actions and needs a 1-D Box. Pick a continuous-control env (highway-env "
-            'takes config={"action": {"type": "ContinuousAction"}}).'
+            "continuous actions and needs a 1-D Box. Pick a continuous-control env; for "
+            "highway-env use --preset highway, or --env-kwargs "
+            '\'{"config": {"action": {"type": "ContinuousAction"}}}\'.'
         )
     if not np.all(np.isfinite(env.action_space.low) & np.isfinite(env.action_space.high)):
         raise SetupError(

@@ -1,0 +1,143 @@
+"""Environment construction, video, logs and driving measures of simoun-train."""
+
+import gymnasium as gym
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from simoun_agent.driving_metrics import DrivingEpisode, summarize
+from simoun_agent.envs import POINT_REACH_ID
+from simoun_agent.logger import CsvLog, plot_learning_curve, read_csv
+from simoun_agent.make_env import make_env, video_fps
+from simoun_agent.presets import SetupError, resolve
+from simoun_agent.video import write_video
+
+
+class StateOnly(gym.Env):
+    """A continuous-control env with vector observations and no rgb_array rendering."""
+
+    metadata = {"render_modes": ["human"]}  # noqa: RUF012
+
+    def __init__(self, render_mode=None):
+        self.render_mode = render_mode
+        self.observation_space = gym.spaces.Box(-1.0, 1.0, (4,), np.float32)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return np.zeros(4, np.float32), {}
+
+    def step(self, action):
+        return np.zeros(4, np.float32), 0.0, False, False, {}
+
+
+gym.register("simoun-test/StateOnly-v0", entry_point=StateOnly)
+
+
+def test_point_reach_passes_the_env_checker_and_rewards_reaching():
+    env = gym.make(POINT_REACH_ID).unwrapped
+    check_env(env)
+    returns = {}
+    for name in ("random", "reach"):
+        env.reset(seed=0)
+        total, done = 0.0, False
+        while not done:
+            toward = np.clip(-env._position / env.step_size, -1, 1)
+            action = env.action_space.sample() if name == "random" else toward
+            _, reward, terminated, truncated, _ = env.step(action)
+            total, done = total + reward, terminated or truncated
+        returns[name] = total
+    assert returns["reach"] > returns["random"] + 3
+
+
+def test_stack_gives_triplets_and_unit_actions():
+    env = make_env(resolve(None, {"env": "Pendulum-v1", "image_size": 32}))
+    assert env.observation_space["frames"].shape == (3, 3, 32, 32)
+    assert "motion" not in env.observation_space.spaces  # the agent computes motion itself
+    assert np.all(env.action_space.low == -1) and np.all(env.action_space.high == 1)
+    obs, _ = env.reset(seed=0)
+    assert obs["frames"].dtype == np.uint8 and (obs["frames"][0] == obs["frames"][2]).all()
+    env.step(np.array([1.0], np.float32))
+    assert env.unwrapped.last_u == pytest.approx(2.0)  # [-1, 1] rescaled to Pendulum's [-2, 2]
+
+
+def test_dm_control_video_fps_comes_from_the_control_timestep():
+    config = resolve("cpu", {"env": "dm_control/cartpole-swingup-v0"})
+    env = make_env(config)
+    assert env.observation_space["frames"].shape == (3, 3, 64, 64)
+    # control timestep 0.01 s x action repeat 8 -> 12.5 decisions per second of sim time;
+    # shimmy's render_fps would claim 10.
+    assert video_fps(env, config.resolved_action_repeat()) == pytest.approx(12.5)
+
+
+def test_unknown_env_id_suggests_close_matches():
+    with pytest.raises(SetupError, match="did you mean dm_control/cartpole-swingup-v0"):
+        make_env(resolve(None, {"env": "dm_control/cartpol-swingup-v0"}))
+    with pytest.raises(SetupError, match="did you mean Pendulum-v1"):
+        make_env(resolve(None, {"env": "Pendullum-v1"}))
+
+
+@pytest.mark.filterwarnings("ignore:.*render_mode='rgb_array' that is not in the possible")
+def test_env_without_pixels_or_rgb_array_is_refused():
+    with pytest.raises(SetupError, match=r"neither image observations.*rgb_array"):
+        make_env(resolve(None, {"env": "simoun-test/StateOnly-v0"}))
+
+
+def test_discrete_actions_are_refused_with_the_fix():
+    with pytest.raises(SetupError, match=r"continuous actions.*--preset highway"):
+        make_env(resolve(None, {"env": "highway-v0"}))
+
+
+def _drive(env, action, steps):
+    episode = DrivingEpisode()
+    env.reset(seed=3)
+    episode.start(env)
+    for _ in range(steps):
+        _, reward, terminated, truncated, info = env.step(np.asarray(action, np.float32))
+        episode.step(env, reward, info)
+        if terminated or truncated:
+            break
+    return episode
+
+
+def test_highway_preset_stack_and_driving_measures():
+    config = resolve("highway", {})
+    env = make_env(config)
+    assert env.observation_space["frames"].shape == (3, 3, 84, 252)
+    assert video_fps(env, config.resolved_action_repeat()) == pytest.approx(5.0)
+
+    braking = _drive(env, [-1.0, 0.5], steps=5)
+    speed_m_per_decision = braking.distance_m / len(braking.steer)
+    assert 0.5 < speed_m_per_decision < 8  # under ~40 m/s at 5 decisions per second
+    stats = summarize([braking])
+    assert stats["brake_fraction"] > 0.5
+    assert stats["mean_abs_steer"] == pytest.approx(0.5, abs=0.05)
+
+    cruising = _drive(env, [0.0, 0.0], steps=5)
+    assert summarize([cruising])["brake_fraction"] == 0.0
+    crash = DrivingEpisode(crashed=True, crash_speed=20.0, steer=[0.0], brake=[0.0])
+    both = summarize([cruising, crash])
+    assert both["crash_rate"] == 0.5 and both["crash_speed"] == 20.0
+
+
+def test_video_is_written_at_the_given_fps(tmp_path):
+    frames = [np.full((3, 32, 32), i * 20, np.uint8) for i in range(6)]
+    path = write_video(tmp_path / "video.mp4", frames, fps=12.5)
+    reader = imageio.get_reader(path)
+    assert reader.get_meta_data()["fps"] == pytest.approx(12.5)
+    first = reader.get_data(0)
+    assert first.shape[0] >= 256 and first.shape[0] == first.shape[1]
+    assert list(tmp_path.iterdir()) == [path]  # no temporary file left behind
+
+
+def test_csv_log_drops_rows_after_the_resumed_step_and_curve_is_drawn(tmp_path):
+    log = CsvLog(tmp_path / "eval.csv")
+    for step in (0, 100, 200):
+        row = {"env_step": step, "return_mean": step / 10}
+        log.write({**row, "return_min": step / 20, "return_max": step / 5})
+    resumed = CsvLog(tmp_path / "eval.csv", resume_step=100)
+    resumed.write({"env_step": 150, "return_mean": 1.0, "return_min": 0.0, "return_max": 2.0})
+    assert [row["env_step"] for row in read_csv(tmp_path / "eval.csv")] == [0, 100, 150]
+    plot_learning_curve(tmp_path / "eval.csv", tmp_path / "curve.png", "test")
+    assert (tmp_path / "curve.png").read_bytes()[:4] == b"\x89PNG"
