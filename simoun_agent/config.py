@@ -1,0 +1,92 @@
+"""Hyperparameters of the Simoun SAC agent (defaults: DESIGN.md, following DrQ / CURL)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+ENCODERS = ("single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide")
+
+
+@dataclass
+class AgentConfig:
+    """Everything the agent needs besides the frame shape and the action size."""
+
+    encoder: str = "dual_interactive"
+    """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6)"""
+    feature_dim: int = 50
+    """size of each path's feature vector (f_m and f_a); single-path encoders output this size"""
+    num_filters: int = 32
+    """filters of every conv layer ("stacked_wide" doubles it)"""
+    hidden_dim: int = 1024
+    """hidden units of the actor and critic MLPs"""
+    aux_hidden_dim: int = 256
+    """hidden units of the two-layer transition model G (Eq. 2) and reward model R (Eq. 7)"""
+    batch_size: int = 512
+    """transitions per gradient step"""
+    lr: float = 1e-3
+    """Adam learning rate of the encoder, critic, actor and auxiliary heads"""
+    alpha_lr: float = 1e-4
+    """Adam learning rate of the temperature (CURL / SAC-AE value)"""
+    alpha_beta: float = 0.5
+    """Adam beta1 of the temperature optimiser (CURL / SAC-AE value)"""
+    discount: float = 0.99
+    """gamma of the TD target (Eq. 9)"""
+    critic_tau: float = 0.01
+    """EMA rate of the target Q heads"""
+    encoder_tau: float = 0.05
+    """EMA rate of the target (momentum) encoder"""
+    actor_update_every: int = 2
+    """update the actor and temperature every this many gradient steps"""
+    target_update_every: int = 2
+    """update the EMA targets every this many gradient steps"""
+    init_temperature: float = 0.1
+    """initial SAC temperature alpha"""
+    log_std_min: float = -10.0
+    """lower bound of the policy's log standard deviation"""
+    log_std_max: float = 2.0
+    """upper bound of the policy's log standard deviation"""
+    curiosity: bool = True
+    """add the consistency-guided intrinsic reward (Eq. 13) to the TD target (dual encoders only)"""
+    curiosity_scale: float = 0.2
+    """C of Eq. 13"""
+    curiosity_decay: float = 2e-5
+    """lambda of Eq. 13, per environment step"""
+    r_e_max_init: float = 1.0
+    """initial running maximum of the extrinsic reward (Eq. 13)"""
+    r_i_max_init: float = 1.0
+    """initial running maximum of the raw consistency distance (Eq. 13)"""
+    transition_weight: float = 1.0
+    """weight of L_tran in Eq. 14 (encoders with a motion path)"""
+    contrastive_weight: float = 1.0
+    """weight of L_con in Eq. 14"""
+    reward_weight: float = 1.0
+    """weight of L_re in Eq. 14"""
+    num_frames: int = 3
+    """frames per observation (the paper uses 3: o_{t-2}, o_{t-1}, o_t)"""
+    reduce_kernel: int = 5
+    """kernel of the reducing convs of the interactive module (35x35 -> 11x11 with stride 3)"""
+    reduce_stride: int = 3
+    """stride of the reducing convs of the interactive module"""
+    random_conv_kernel: int = 3
+    """kernel size of the random convolution that makes contrastive positives (Eq. 3)"""
+    channels_last: bool = True
+    """run convolutions in channels-last memory format (measured faster on CPU and GPU)"""
+
+    def __post_init__(self) -> None:
+        if self.encoder not in ENCODERS:
+            raise ValueError(
+                f"AgentConfig.encoder={self.encoder!r} is not known; choose one of {ENCODERS}"
+            )
+        if self.num_frames != 3 and self.encoder in ("dual", "dual_interactive"):
+            raise ValueError(
+                f"the dual-path encoders need num_frames=3 (o_t-2, o_t-1, o_t), got "
+                f"{self.num_frames}; set num_frames=3"
+            )
+        if self.curiosity and self.encoder not in ("dual", "dual_interactive"):
+            raise ValueError(
+                f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
+                f"{self.encoder!r} does not have; set curiosity=False or use a dual encoder"
+            )
+        for name in ("batch_size", "actor_update_every", "target_update_every", "num_frames"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"AgentConfig.{name} must be >= 1, got {getattr(self, name)}")

@@ -1,0 +1,87 @@
+"""The structural interactive module between the motion and appearance paths (Eq. 4-6)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+
+class StructureMasks(NamedTuple):
+    """Inter-frame attention X ``(N, hw, hw)`` and masks X^m, X^a ``(N, c, h, w)`` (Fig. 7)."""
+
+    attention: torch.Tensor
+    motion: torch.Tensor
+    appearance: torch.Tensor
+
+
+def inter_frame_attention(
+    key_prev2: torch.Tensor, query: torch.Tensor, key_cur: torch.Tensor
+) -> torch.Tensor:
+    """Eq. 4: X = softmax(softmax(Fh_{t-2}^T Fh_{t-1}) + softmax(Fh_t^T Fh_{t-1})).
+
+    Inputs are reduced maps ``(N, c, h, w)``; ``query`` is frame t-1, the keys frames t-2 and t.
+    Returns ``X`` of shape ``(N, hw, hw)``: one row per query position, a distribution over key
+    positions (rows sum to 1). Scores are scaled by 1/sqrt(c) as in dot-product attention so the
+    inner softmaxes do not saturate at initialisation.
+    """
+    q = query.flatten(2).transpose(1, 2)
+    scale = q.shape[-1] ** -0.5
+    s_prev2 = torch.softmax(scale * (q @ key_prev2.flatten(2)), dim=-1)
+    s_cur = torch.softmax(scale * (q @ key_cur.flatten(2)), dim=-1)
+    return torch.softmax(s_prev2 + s_cur, dim=-1)
+
+
+def structure_mask(attention: torch.Tensor, reduced: torch.Tensor) -> torch.Tensor:
+    """Eq. 5: X . Fh, spatial gating of a reduced map ``(N, c, h, w)`` by ``X`` ``(N, hw, hw)``."""
+    n, c, h, w = reduced.shape
+    gated = attention @ reduced.flatten(2).transpose(1, 2)
+    return gated.transpose(1, 2).reshape(n, c, h, w)
+
+
+class StructuralInteraction(nn.Module):
+    """Inter-frame attention between the two paths, modulating both feature maps (Eq. 4-6).
+
+    Two reducing convs (one for the appearance maps, shared by the three frames, one for the motion
+    map) keep the channel count and shrink the maps, e.g. 35x35 -> 11x11 with kernel 5 / stride 3,
+    so X is 121 x 121. The masks X.Fh are resized back to the feature-map size bilinearly and added
+    with a learnable scale per path initialised to 0 (Eq. 6), so the module starts as the identity.
+
+    Example:
+        >>> import torch
+        >>> sim = StructuralInteraction(channels=32)
+        >>> f_m, f_a = torch.rand(2, 32, 35, 35), torch.rand(2, 3, 32, 35, 35)
+        >>> out_m, out_a, masks = sim(f_m, f_a)
+        >>> out_m.shape, masks.attention.shape
+        (torch.Size([2, 32, 35, 35]), torch.Size([2, 121, 121]))
+    """
+
+    def __init__(self, channels: int, kernel_size: int = 5, stride: int = 3) -> None:
+        super().__init__()
+        self.reduce_appearance = nn.Conv2d(channels, channels, kernel_size, stride)
+        self.reduce_motion = nn.Conv2d(channels, channels, kernel_size, stride)
+        self.beta_motion = nn.Parameter(torch.zeros(()))
+        self.beta_appearance = nn.Parameter(torch.zeros(()))
+
+    def forward(
+        self, motion: torch.Tensor, appearance: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor, StructureMasks]:
+        """Modulate F^m_t ``(N, c, h, w)`` and frame t of ``appearance`` ``(N, 3, c, h, w)``.
+
+        Returns the enhanced F^m_t, the enhanced F^a_t and the masks (attention X, X^m, X^a).
+        """
+        n, k, c, h, w = appearance.shape
+        reduced = self.reduce_appearance(appearance.reshape(n * k, c, h, w))
+        reduced = reduced.reshape(n, k, *reduced.shape[1:])
+        attention = inter_frame_attention(reduced[:, 0], reduced[:, 1], reduced[:, 2])
+        mask_m = structure_mask(attention, self.reduce_motion(motion))
+        mask_a = structure_mask(attention, reduced[:, 2])
+        up = F.interpolate(
+            torch.cat([mask_m, mask_a]), size=(h, w), mode="bilinear", align_corners=False
+        )
+        up_m, up_a = up[:n], up[n:]
+        enhanced_m = motion + self.beta_motion * up_m
+        enhanced_a = appearance[:, 2] + self.beta_appearance * up_a
+        return enhanced_m, enhanced_a, StructureMasks(attention, mask_m, mask_a)

@@ -1,0 +1,248 @@
+"""A replay buffer that stores each frame once and rebuilds frame triplets at sample time."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import IO
+
+import numpy as np
+
+_MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
+
+
+class FrameReplay:
+    """Ring buffer of single uint8 frames with the transitions between them.
+
+    Each environment step stores one frame (the next observation), its action, reward and the
+    terminated / truncated flags; each reset stores the first frame. ``sample`` rebuilds the
+    observation triplets ``[o_{t-2}, o_{t-1}, o_t]`` and ``[o_{t-1}, o_t, o_{t+1}]`` with the
+    reset padding of ``simoun_wrappers.FrameTriplet`` (the first frame of an episode repeated),
+    so nothing is stored twice: about one frame per transition instead of CURL's two stacks.
+
+    The ring holds ``capacity + capacity // 50 + num_frames`` frames so that ``capacity``
+    transitions fit along with the reset frames of episodes of 50 steps or more. Sampling
+    (uniform, with replacement) uses the buffer's own ``numpy.random.Generator``, which
+    :meth:`save` stores, so a reloaded buffer samples exactly what the original would have.
+
+    Example:
+        >>> import numpy as np
+        >>> replay = FrameReplay(capacity=100, frame_shape=(3, 8, 8), action_dim=2, seed=0)
+        >>> replay.start_episode(np.zeros((3, 8, 8), np.uint8))
+        >>> for t in range(5):
+        ...     replay.add(np.zeros(2), 1.0, np.full((3, 8, 8), t, np.uint8), False, False)
+        >>> batch = replay.sample(4)
+        >>> batch["obs"].shape, batch["next_obs"].shape, len(replay)
+        ((4, 3, 3, 8, 8), (4, 3, 3, 8, 8), 5)
+    """
+
+    def __init__(
+        self,
+        capacity: int,
+        frame_shape: tuple[int, ...],
+        action_dim: int,
+        num_frames: int = 3,
+        seed: int | None = None,
+    ) -> None:
+        if capacity < 1 or num_frames < 1:
+            raise ValueError(f"capacity and num_frames must be >= 1, got {capacity}, {num_frames}")
+        self.capacity = int(capacity)
+        self.frame_shape = tuple(int(s) for s in frame_shape)
+        self.action_dim = int(action_dim)
+        self.num_frames = int(num_frames)
+        self.slots = self.capacity + self.capacity // 50 + self.num_frames
+        self.frames = np.zeros((self.slots, *self.frame_shape), np.uint8)
+        self.actions = np.zeros((self.slots, self.action_dim), np.float32)
+        self.rewards = np.zeros(self.slots, np.float32)
+        self.terminated = np.zeros(self.slots, bool)
+        self.truncated = np.zeros(self.slots, bool)
+        self.steps = np.zeros(self.slots, np.uint8)
+        """position of each frame in its episode (0 = reset frame), saturating at 255"""
+        self.written = 0
+        """frames written since creation; absolute index of the next frame"""
+        self.transitions = 0
+        """transition frames (step >= 1) in the ring, including up to num_frames whose window
+        lost its oldest frames"""
+        self.episode_step: int | None = None
+        """step of the open episode, None between an episode's end and the next start_episode"""
+        self.rng = np.random.default_rng(seed)
+
+    # -- writing -------------------------------------------------------------------------------
+
+    def _check_frame(self, frame: np.ndarray, name: str) -> np.ndarray:
+        frame = np.asarray(frame)
+        if frame.shape != self.frame_shape or frame.dtype != np.uint8:
+            raise ValueError(
+                f"{name} must be a uint8 array of shape {self.frame_shape} (C, H, W), got "
+                f"{frame.dtype} {frame.shape}; pass one frame (not the triplet) as uint8"
+            )
+        return frame
+
+    def _write(self, frame, action, reward, terminated, truncated, step) -> None:
+        slot = self.written % self.slots
+        if self.written >= self.slots and self.steps[slot] >= 1:
+            self.transitions -= 1
+        self.transitions += step >= 1
+        self.frames[slot] = frame
+        self.actions[slot] = action
+        self.rewards[slot] = reward
+        self.terminated[slot] = terminated
+        self.truncated[slot] = truncated
+        self.steps[slot] = min(step, _MAX_STEP)
+        self.written += 1
+
+    def start_episode(self, frame: np.ndarray) -> None:
+        """Store the first frame of an episode (call after every ``reset``)."""
+        frame = self._check_frame(frame, "start_episode(frame)")
+        self._write(frame, 0.0, 0.0, False, False, 0)
+        self.episode_step = 0
+
+    def add(
+        self,
+        action: np.ndarray,
+        reward: float,
+        next_frame: np.ndarray,
+        terminated: bool,
+        truncated: bool,
+    ) -> None:
+        """Store one step: the action taken, the reward received and the frame it led to."""
+        if self.episode_step is None:
+            raise RuntimeError(
+                "FrameReplay.add() called with no open episode; call start_episode(first_frame) "
+                "after each env.reset() (and after an episode terminated or was truncated)"
+            )
+        reward = float(reward)
+        if not np.isfinite(reward):
+            raise ValueError(
+                f"reward {reward} is not finite; the replay only stores finite rewards - check "
+                "the environment or the reward wrappers (clip or drop the step)"
+            )
+        action = np.asarray(action, dtype=np.float32)
+        if action.size != self.action_dim or not np.all(np.isfinite(action)):
+            raise ValueError(
+                f"action must hold {self.action_dim} finite numbers, got {action.shape} {action}"
+            )
+        next_frame = self._check_frame(next_frame, "add(next_frame)")
+        self.episode_step += 1
+        self._write(
+            next_frame, action.reshape(-1), reward, terminated, truncated, self.episode_step
+        )
+        if terminated or truncated:
+            self.episode_step = None
+
+    # -- reading -------------------------------------------------------------------------------
+
+    @property
+    def oldest(self) -> int:
+        """Absolute index of the oldest frame still in the ring."""
+        return max(0, self.written - self.slots)
+
+    def _valid(self, index: np.ndarray) -> np.ndarray:
+        """Transitions whose next frame is at ``index`` and whose whole window is still stored."""
+        step = self.steps[index % self.slots]
+        return (step >= 1) & (index - np.minimum(step, self.num_frames) >= self.oldest)
+
+    def __len__(self) -> int:
+        head = np.arange(self.oldest, min(self.oldest + self.num_frames, self.written))
+        broken = np.count_nonzero((self.steps[head % self.slots] >= 1) & ~self._valid(head))
+        return self.transitions - int(broken)
+
+    def sample(self, batch_size: int) -> dict[str, np.ndarray]:
+        """Sample ``batch_size`` transitions uniformly (with replacement).
+
+        Returns uint8 ``obs`` and ``next_obs`` ``(B, k, C, H, W)`` (views of ``window``
+        ``(B, k+1, C, H, W)`` = frames t-k+1 .. t+1), float32 ``action`` ``(B, A)``, ``reward``
+        ``(B,)``, ``discount`` ``(B,)`` (0 where the episode terminated, 1 otherwise; truncated
+        transitions bootstrap) and bool ``truncated``.
+        """
+        available = len(self)
+        if batch_size > available:
+            raise ValueError(
+                f"cannot sample {batch_size} transitions: the replay holds {available}; collect "
+                "more steps first (a warm-up of at least batch_size steps) or lower batch_size"
+            )
+        chosen = np.empty(0, np.int64)
+        while chosen.size < batch_size:
+            need = batch_size - chosen.size
+            candidates = self.rng.integers(self.oldest, self.written, size=2 * need + 8)
+            chosen = np.concatenate([chosen, candidates[self._valid(candidates)]])
+        chosen = chosen[:batch_size]
+        slot = chosen % self.slots
+        back = np.arange(self.num_frames, -1, -1)
+        clamp = np.minimum(back[None, :], self.steps[slot][:, None].astype(np.int64))
+        window = self.frames[(chosen[:, None] - clamp) % self.slots]
+        return {
+            "obs": window[:, :-1],
+            "next_obs": window[:, 1:],
+            "window": window,
+            "action": self.actions[slot],
+            "reward": self.rewards[slot],
+            "discount": 1.0 - self.terminated[slot].astype(np.float32),
+            "truncated": self.truncated[slot],
+        }
+
+    # -- size and persistence ------------------------------------------------------------------
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the buffer's arrays."""
+        arrays = (
+            self.frames,
+            self.actions,
+            self.rewards,
+            self.terminated,
+            self.truncated,
+            self.steps,
+        )
+        return sum(a.nbytes for a in arrays)
+
+    @property
+    def bytes_per_transition(self) -> float:
+        """``nbytes / capacity``."""
+        return self.nbytes / self.capacity
+
+    def save(self, path: str | os.PathLike | IO[bytes]) -> None:
+        """Write the buffer (frames stored so far, flags, counters, RNG state) as an ``.npz`` to
+        exactly ``path`` (no suffix is added, so callers can write a temporary file and rename)."""
+        used = min(self.written, self.slots)
+        meta = {
+            "capacity": self.capacity,
+            "frame_shape": self.frame_shape,
+            "action_dim": self.action_dim,
+            "num_frames": self.num_frames,
+            "written": self.written,
+            "transitions": self.transitions,
+            "episode_step": self.episode_step,
+            "rng": self.rng.bit_generator.state,
+        }
+        arrays = {
+            "frames": self.frames[:used],
+            "actions": self.actions[:used],
+            "rewards": self.rewards[:used],
+            "terminated": self.terminated[:used],
+            "truncated": self.truncated[:used],
+            "steps": self.steps[:used],
+            "meta": np.frombuffer(json.dumps(meta).encode(), np.uint8),
+        }
+        if hasattr(path, "write"):
+            np.savez(path, **arrays)
+        else:
+            with open(path, "wb") as f:
+                np.savez(f, **arrays)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike | IO[bytes]) -> FrameReplay:
+        """Rebuild a buffer written by :meth:`save`, RNG state included."""
+        with np.load(path) as data:
+            meta = json.loads(data["meta"].tobytes().decode())
+            replay = cls(
+                meta["capacity"], tuple(meta["frame_shape"]), meta["action_dim"], meta["num_frames"]
+            )
+            used = data["frames"].shape[0]
+            for name in ("frames", "actions", "rewards", "terminated", "truncated", "steps"):
+                getattr(replay, name)[:used] = data[name]
+        replay.written = meta["written"]
+        replay.transitions = meta["transitions"]
+        replay.episode_step = meta["episode_step"]
+        replay.rng.bit_generator.state = meta["rng"]
+        return replay
