@@ -53,13 +53,19 @@ def pixel_env(
 ) -> tuple[gym.Env, bool]:
     """An env whose observation is the image to use, and whether it comes from ``render()``.
 
-    ``source`` is ``"auto"`` (the observation if it is an image, else ``render()``),
-    ``"observation"`` or ``"render"``; ``owner`` names the caller in error messages.
+    ``source`` is ``"auto"``, ``"observation"`` or ``"render"``; ``owner`` names the caller in
+    error messages. ``"auto"`` takes a uint8 image observation, else ``render()`` when the
+    render mode is ``"rgb_array"``; an image-shaped observation that is not uint8 (say a float
+    (H, W) state matrix such as highway-env's kinematics) then goes to ``render()`` too, and is
+    an error only when there is nothing to render.
     """
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
     layout = image_layout(env.observation_space)
-    use_observation = source == "observation" or (source == "auto" and layout is not None)
+    is_uint8 = layout is not None and env.observation_space.dtype == np.uint8
+    use_observation = source == "observation" or (
+        source == "auto" and layout is not None and (is_uint8 or env.render_mode != "rgb_array")
+    )
     if use_observation:
         if layout is None:
             raise TypeError(
@@ -67,7 +73,7 @@ def pixel_env(
                 f"or (H, W), got {env.observation_space}; use source='render' with "
                 f"render_mode='rgb_array' instead."
             )
-        if env.observation_space.dtype != np.uint8:
+        if not is_uint8:
             raise TypeError(
                 f"{owner} expects uint8 images in [0, 255], got "
                 f"{env.observation_space.dtype} observations of shape "

@@ -31,9 +31,10 @@ class SimounParallelObservation(BaseParallelWrapper):
     cached object on every call, as ``parallel_api_test`` requires.
 
     Example:
-        >>> from pettingzoo.butterfly import pistonball_v6
+        >>> import pettingzoo
         >>> from simoun_wrappers.pettingzoo import SimounParallelObservation
-        >>> env = SimounParallelObservation(pistonball_v6.parallel_env(n_pistons=3), size=32)
+        >>> pistons = pettingzoo.make("parallel", "butterfly/pistonball-v6", n_pistons=3)
+        >>> env = SimounParallelObservation(pistons, size=32)
         >>> obs, _ = env.reset(seed=0)
         >>> obs["piston_0"]["frames"].shape, obs["piston_0"]["motion"].shape
         ((3, 3, 32, 32), (6, 32, 32))

@@ -1,0 +1,109 @@
+"""MultiCamera on dm_control named cameras, highway-env viewports and callables."""
+
+import gymnasium as gym
+import highway_env
+import numpy as np
+import pytest
+import shimmy
+
+from simoun_wrappers import MultiCamera
+
+gym.register_envs(shimmy)
+gym.register_envs(highway_env)
+
+
+def _views(obs: np.ndarray, n: int) -> list[np.ndarray]:
+    return np.split(obs, n, axis=1)
+
+
+def _assert_distinct_non_black(views: list[np.ndarray]) -> None:
+    for view in views:
+        assert view.max() > 50 and view.std() > 5, "a view is black or blank"
+    for i in range(len(views)):
+        for j in range(i + 1, len(views)):
+            assert np.abs(views[i].astype(int) - views[j]).mean() > 1, f"views {i}, {j} identical"
+
+
+def test_dm_control_two_named_cameras():
+    env = MultiCamera(gym.make("dm_control/walker-walk-v0"), ["side", "back"], size=(32, 40))
+    assert env.observation_space == gym.spaces.Box(0, 255, (32, 80, 3), np.uint8)
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (32, 80, 3) and obs.dtype == np.uint8
+    _assert_distinct_non_black(_views(obs, 2))
+    obs2, *_ = env.step(env.action_space.sample())
+    assert not np.shares_memory(obs, obs2)
+    np.testing.assert_array_equal(env.render(), obs2)
+
+
+def test_dm_control_camera_ids_and_unknown_name():
+    env = gym.make("dm_control/cartpole-swingup-v0")
+    obs, _ = MultiCamera(env, [0, 1, -1], size=24).reset(seed=0)
+    assert obs.shape == (24, 72, 3)
+    with pytest.raises(ValueError, match=r"unknown camera name 'front'.*\['fixed', 'lookatcart'\]"):
+        MultiCamera(env, ["fixed", "front"])
+    with pytest.raises(ValueError, match=r"camera id 5 out of range"):
+        MultiCamera(env, [5])
+
+
+def test_highway_three_viewports():
+    env = gym.make("highway-fast-v0", config={"vehicles_count": 8, "simulation_frequency": 5})
+    viewports = [
+        {"scaling": 2.5},
+        {"scaling": 6.0},
+        {"centering_position": [0.2, 0.5], "scaling": 3.5},
+    ]
+    env = MultiCamera(env, viewports, size=(32, 48))
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (32, 144, 3)
+    _assert_distinct_non_black(_views(obs, 3))
+    for _ in range(2):
+        obs, *_ = env.step(env.action_space.sample())
+    _assert_distinct_non_black(_views(obs, 3))
+    env.close()
+    # Closing must not quit pygame under other viewers still in use.
+    other = MultiCamera(gym.make("highway-fast-v0"), viewports[:2], size=16)
+    assert other.reset(seed=0)[0].shape == (16, 32, 3)
+
+
+def test_callables_are_resized():
+    env = gym.make("CartPole-v1", render_mode="rgb_array")
+
+    def left_half(e):
+        return e.unwrapped.render()[:, :300]
+
+    def full(e):
+        return e.unwrapped.render()
+
+    cams = MultiCamera(env, [left_half, full], size=(20, 30))
+    obs, _ = cams.reset(seed=0)
+    assert obs.shape == (20, 60, 3)
+    _assert_distinct_non_black(_views(obs, 2))
+
+
+def test_error_views_of_different_sizes_names_size():
+    env = gym.make("CartPole-v1", render_mode="rgb_array")
+
+    def small(e):
+        return np.full((10, 10, 3), 100, np.uint8)
+
+    def large(e):
+        return np.full((12, 10, 3), 100, np.uint8)
+
+    with pytest.raises(ValueError, match=r"views of different sizes.*\(10, 10, 3\).*size=\(H, W\)"):
+        MultiCamera(env, [small, large], size=None)
+    ok = MultiCamera(env, [small, large], size=(8, 8))
+    assert ok.reset(seed=0)[0].shape == (8, 16, 3)
+
+
+def test_error_bad_cameras():
+    cartpole = gym.make("CartPole-v1")
+    with pytest.raises(TypeError, match=r"not a dm_control env.*callables"):
+        MultiCamera(cartpole, ["side"])
+    with pytest.raises(TypeError, match=r"not a highway-env env"):
+        MultiCamera(cartpole, [{"scaling": 2.0}])
+    with pytest.raises(ValueError, match=r"viewport keys \['zoom'\]"):
+        MultiCamera(gym.make("highway-fast-v0"), [{"zoom": 2.0}])
+    with pytest.raises(TypeError, match=r"list of views"):
+        MultiCamera(cartpole, "side")
+    with pytest.raises(TypeError, match=r"must return an \(H, W, 3\) uint8 image"):
+        MultiCamera(cartpole, [lambda e: np.zeros((4, 4, 3), np.float32)], size=4)

@@ -1,0 +1,101 @@
+"""SimounParallelObservation on PettingZoo butterfly envs and on agents that join mid-episode."""
+
+from typing import ClassVar
+
+import gymnasium as gym
+import numpy as np
+import pettingzoo
+import pytest
+from pettingzoo import ParallelEnv
+from pettingzoo.test import parallel_api_test
+
+from simoun_wrappers.motion import residual_motion
+from simoun_wrappers.pettingzoo import SimounParallelObservation
+
+
+class JoiningAgents(ParallelEnv):
+    """Agent ``a0`` from the start, ``a1`` joins at step 2; ``a0`` leaves at step 4; 6 steps.
+
+    Each agent sees an 8x8 RGB image whose brightness encodes the step and the agent.
+    """
+
+    metadata: ClassVar[dict] = {"name": "joining_agents_v0", "render_modes": []}
+
+    def __init__(self, observation_space: gym.Space | None = None):
+        self.possible_agents = ["a0", "a1"]
+        self.agents = []
+        self.t = 0
+        space = observation_space or gym.spaces.Box(0, 255, (8, 8, 3), np.uint8)
+        self._observation_spaces = dict.fromkeys(self.possible_agents, space)
+        self._action_spaces = {a: gym.spaces.Discrete(2) for a in self.possible_agents}
+
+    def observation_space(self, agent):
+        return self._observation_spaces[agent]
+
+    def action_space(self, agent):
+        return self._action_spaces[agent]
+
+    def _obs(self):
+        return {a: np.full((8, 8, 3), 20 * self.t + 7 * int(a[1]), np.uint8) for a in self.agents}
+
+    def reset(self, seed=None, options=None):
+        self.t, self.agents = 0, ["a0"]
+        return self._obs(), {a: {} for a in self.agents}
+
+    def step(self, actions):
+        self.t += 1
+        if self.t == 2:
+            self.agents = ["a0", "a1"]
+        obs = self._obs()
+        terminated = {a: a == "a0" and self.t == 4 for a in self.agents}
+        truncated = {a: self.t == 6 for a in self.agents}
+        rewards = dict.fromkeys(self.agents, 0.0)
+        infos = {a: {} for a in self.agents}
+        self.agents = [a for a in self.agents if not (terminated[a] or truncated[a])]
+        return obs, rewards, terminated, truncated, infos
+
+
+def test_parallel_api_test_pistonball():
+    env = SimounParallelObservation(
+        pettingzoo.make("parallel", "butterfly/pistonball-v6", n_pistons=3, max_cycles=30), 24
+    )
+    parallel_api_test(env, num_cycles=30)
+    obs, _ = env.reset(seed=0)
+    for agent, o in obs.items():
+        assert env.observation_space(agent).contains(o)
+        assert o["frames"].shape == (3, 3, 24, 24)
+
+
+def test_parallel_api_test_cooperative_pong_grayscale_folded():
+    env = SimounParallelObservation(
+        pettingzoo.make(
+            "parallel", "butterfly/cooperative_pong-v6", max_cycles=30, render_mode="rgb_array"
+        ),
+        size=(20, 24),
+        grayscale=True,
+        fold_frames=True,
+    )
+    parallel_api_test(env, num_cycles=30)
+    assert env.observation_space("paddle_0") == gym.spaces.Box(0, 255, (3, 20, 24), np.uint8)
+
+
+def test_agents_joining_mid_episode_get_reset_padded_triplets():
+    env = SimounParallelObservation(JoiningAgents(), size=None)
+    parallel_api_test(env, num_cycles=10)
+    obs, _ = env.reset()
+    obs, *_ = env.step({"a0": 0})
+    obs, *_ = env.step({"a0": 0})
+    joined = obs["a1"]["frames"]
+    assert (joined == joined[0]).all() and joined[0, 0, 0, 0] == 20 * 2 + 7
+    assert not obs["a1"]["motion"].any()
+    np.testing.assert_array_equal(obs["a0"]["frames"][:, 0, 0, 0], [0, 20, 40])
+    np.testing.assert_array_equal(obs["a0"]["motion"], residual_motion(obs["a0"]["frames"]))
+    obs, *_ = env.step({"a0": 0, "a1": 1})
+    np.testing.assert_array_equal(obs["a1"]["frames"][:, 0, 0, 0], [47, 47, 67])
+
+
+def test_errors_name_the_fix():
+    with pytest.raises(ValueError, match=r"at least 2 frames.*motion=False"):
+        SimounParallelObservation(JoiningAgents(), num_frames=1)
+    with pytest.raises(ValueError, match=r"neither image observations.*render_mode='rgb_array'"):
+        SimounParallelObservation(JoiningAgents(gym.spaces.Box(-1.0, 1.0, (4,), np.float32)))
