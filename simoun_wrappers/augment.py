@@ -4,8 +4,8 @@ Weight initialisation: every kernel is drawn from a Xavier/Glorot normal distrib
 ``N(0, 2 / (fan_in + fan_out))`` with ``fan_in = fan_out = C * k * k``, as in the authors'
 netrand code. Its gain is 1, so an output pixel has about the same mean square as the input
 pixels; the convolution is linear and unclamped, so outputs may leave the input's range
-(negative values included) unless ``clamp`` is given. Borders use replicate padding, which keeps
-the image size and avoids the dark frame zero padding would draw.
+(negative values included) unless ``clamp`` is given. Borders are zero-padded ("same"
+padding, as in netrand), so the image keeps its size.
 """
 
 from __future__ import annotations
@@ -87,9 +87,7 @@ def random_conv(
     # Frames go on the conv's batch axis and samples on its channel axis, so groups=b gives each
     # sample its own kernel while all T frames of a sample see the same one.
     stacked = frames.transpose(0, 1).reshape(t, b * c, h, w)
-    pad = kernel_size // 2
-    stacked = F.pad(stacked, (pad, pad, pad, pad), mode="replicate")
-    out = F.conv2d(stacked, weight, groups=b)
+    out = F.conv2d(stacked, weight, padding=kernel_size // 2, groups=b)
     out = out.reshape(t, b, c, h, w).transpose(0, 1)
     if clamp is not None:
         out = out.clamp(clamp[0], clamp[1])
