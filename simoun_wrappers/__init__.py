@@ -2,10 +2,10 @@
 
 from simoun_wrappers import _headless  # noqa: F401  (must run before dm_control/pygame load)
 from simoun_wrappers.action_repeat import ActionRepeat
-from simoun_wrappers.augment import RandomConvolution
+from simoun_wrappers.augment import RandomConvolution, random_conv
 from simoun_wrappers.cameras import MultiCamera
 from simoun_wrappers.frames import FrameTriplet
-from simoun_wrappers.motion import ResidualMotion
+from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
 
 __all__ = [
@@ -15,4 +15,6 @@ __all__ = [
     "RandomConvolution",
     "ResidualMotion",
     "SimounObservation",
+    "random_conv",
+    "residual_motion",
 ]
