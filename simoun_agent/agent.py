@@ -32,11 +32,12 @@ from simoun_wrappers.curiosity import RunningMax, consistency_distance, consiste
 class SimounAgent:
     """SAC on the dual-path (or ablation) encoder with Simoun's auxiliary losses and curiosity.
 
-    One :meth:`update` encodes each frame of the batch once per network: the online encoder
-    runs on the triplet at t (with gradient), the momentum encoder on the triplet at t+1 and on
-    the random-conv view of o_t, in one conv call. The next state's features for the TD target,
-    the transition target f^m_{t+1} and the contrastive keys all come from that momentum pass;
-    the actor and the curiosity reward reuse the online features, detached.
+    One :meth:`update` runs each unique frame of the batch through each path once: the online
+    encoder sees frames t-2 .. t+1 and the residual pairs of t and t+1 (gradient only where a
+    loss needs it, see ``AgentConfig.detach_past_frames``), which gives the state at t and, with
+    the target Q heads, the TD target at t+1 (DrQ-v2 style); the momentum (EMA) encoder sees only
+    the random-conv view of o_t, for the contrastive keys. The actor update and the curiosity
+    reward reuse the online features of t, detached.
 
     Example:
         >>> import numpy as np
@@ -146,14 +147,12 @@ class SimounAgent:
         (no host sync here); call ``float()`` on the ones you log.
         """
         batch = replay.sample(self.config.batch_size)
-        window = torch.from_numpy(batch["window"]).to(self.device, non_blocking=True)
-        return self.update_batch(
-            window[:, :-1],
-            torch.from_numpy(batch["action"]).to(self.device, non_blocking=True),
-            torch.from_numpy(batch["reward"]).to(self.device, non_blocking=True),
-            window[:, 1:],
-            torch.from_numpy(batch["discount"]).to(self.device, non_blocking=True),
-            step,
+
+        def put(name: str) -> torch.Tensor:
+            return torch.from_numpy(batch[name]).to(self.device, non_blocking=True)
+
+        return self.update_window(
+            put("window"), put("action"), put("reward"), put("discount"), step
         )
 
     def intrinsic_reward(
@@ -184,19 +183,30 @@ class SimounAgent:
         step: int,
     ) -> dict[str, torch.Tensor]:
         """:meth:`update` on a batch already on the device: uint8 ``obs`` / ``next_obs``
-        ``(B, 3, C, H, W)``, float ``action`` ``(B, A)``, ``reward`` and ``discount`` ``(B,)``."""
+        ``(B, 3, C, H, W)`` (``next_obs`` is ``obs`` shifted by one frame, as in a replay),
+        float ``action`` ``(B, A)``, ``reward`` and ``discount`` ``(B,)``."""
+        window = torch.cat([obs, next_obs[:, -1:]], dim=1)
+        return self.update_window(window, action, reward, discount, step)
+
+    def update_window(
+        self,
+        window: torch.Tensor,
+        action: torch.Tensor,
+        reward: torch.Tensor,
+        discount: torch.Tensor,
+        step: int,
+    ) -> dict[str, torch.Tensor]:
+        """:meth:`update_batch` on the uint8 window ``(B, 4, C, H, W)`` of frames t-2 .. t+1."""
         cfg = self.config
         contrastive = cfg.contrastive_weight != 0
-        enc = self.encoder(obs, frame_features=cfg.curiosity)
+        enc, following = self.encoder.encode_transition(window, frame_features=cfg.curiosity)
         with torch.no_grad():
-            key_view = None
             if contrastive:
-                key_view = random_conv(self.encoder.key_frames(obs), cfg.random_conv_kernel)
-            target = self.encoder_target(next_obs, key_view=key_view)
-            next_action, next_log_prob = self.actor(target.state)
-            value = soft_value(
-                *self.critic_target(target.state, next_action), next_log_prob, self.alpha
-            )
+                view = random_conv(self.encoder.key_frames(window[:, :-1]), cfg.random_conv_kernel)
+                key = self.encoder_target.encode_key(view)
+            next_action, next_log_prob = self.actor(following.state)
+            next_q = self.critic_target(following.state, next_action)
+            value = soft_value(*next_q, next_log_prob, self.alpha)
             metrics = {}
             td_reward = reward
             if cfg.curiosity:
@@ -208,11 +218,11 @@ class SimounAgent:
         q1, q2 = self.critic(enc.state, action)
         l_q = critic_loss(q1, q2, q_target)
         l_tran = (
-            transition_loss(self.transition, enc.motion, action, target.motion)
+            transition_loss(self.transition, enc.motion, action, following.motion)
             if self.transition is not None
             else None
         )
-        l_con = contrastive_loss(enc.anchor, target.key, self.similarity) if contrastive else None
+        l_con = contrastive_loss(enc.anchor, key, self.similarity) if contrastive else None
         l_re = (
             reward_loss(self.reward_model, enc.state, action, reward) if cfg.reward_weight else None
         )

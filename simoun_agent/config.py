@@ -69,8 +69,13 @@ class AgentConfig:
     """stride of the reducing convs of the interactive module"""
     random_conv_kernel: int = 3
     """kernel size of the random convolution that makes contrastive positives (Eq. 3)"""
-    channels_last: bool = True
-    """run convolutions in channels-last memory format (measured faster on CPU and GPU)"""
+    detach_past_frames: bool = True
+    """dual encoders: frames t-2 and t-1 go through the appearance path without gradient (as
+    Flare detaches earlier frames); the interactive module and frame t still get gradients.
+    False backpropagates through all three frames (about 4 more batch-sized conv backward passes
+    per update)"""
+    channels_last: bool = False
+    """run the convs in channels-last memory format (try it on GPU; not faster on our CPU)"""
 
     def __post_init__(self) -> None:
         if self.encoder not in ENCODERS:

@@ -23,15 +23,13 @@ class Encoding(NamedTuple):
 
     state: torch.Tensor
     """(B, repr_dim) the state representation f_t fed to the actor and critic"""
-    anchor: torch.Tensor
-    """(B, feature_dim) contrastive anchor (Eq. 3): f^a_t without interaction, or the state"""
-    key: torch.Tensor | None = None
-    """(B, feature_dim) features of ``key_view`` when one was given"""
+    anchor: torch.Tensor | None = None
+    """(B, feature_dim) contrastive anchor (Eq. 3): f^a_t before interaction, or the state"""
     motion: torch.Tensor | None = None
     """(B, feature_dim) f^m_t as used in the state (after the interactive module)"""
     appearance: torch.Tensor | None = None
-    """(B, 3, feature_dim) f^a of frames t-2, t-1, t without interaction (no gradient for t-2,
-    t-1); only when ``frame_features=True``"""
+    """(B, 3, feature_dim) f^a of frames t-2, t-1, t before interaction, detached; only with
+    ``frame_features=True``"""
     masks: StructureMasks | None = None
     """attention X and masks X^m, X^a of the interactive module"""
 
@@ -45,10 +43,8 @@ def conv_trunk(in_channels: int, num_filters: int) -> nn.Sequential:
     """Four 3x3 convs with ReLU, strides 2, 1, 1, 1 (the paths of Sec. 3.2, CURL's encoder)."""
     layers: list[nn.Module] = []
     for i in range(4):
-        layers += [
-            nn.Conv2d(in_channels if i == 0 else num_filters, num_filters, 3, 2 if i == 0 else 1),
-            nn.ReLU(),
-        ]
+        conv = nn.Conv2d(num_filters if i else in_channels, num_filters, 3, 1 if i else 2)
+        layers += [conv, nn.ReLU()]
     return nn.Sequential(*layers)
 
 
@@ -76,32 +72,48 @@ def weight_init(module: nn.Module) -> None:
 
 
 class PixelEncoder(nn.Module):
-    """Base class: uint8 frames in, :class:`Encoding` out."""
+    """Base class: uint8 frames ``(B, k, C, H, W)`` in, :class:`Encoding` out.
+
+    Subclasses define :meth:`forward` and :meth:`encode_key`, and may override
+    :meth:`encode_transition` to share frames between the states at t and t+1.
+    """
 
     repr_dim: int
     key_is_frame: bool
     """True: the contrastive view is frame t ``(B, C, H, W)``; False: the whole stack"""
 
-    def __init__(self, channels_last: bool = True) -> None:
+    def __init__(self, channels_last: bool = False) -> None:
         super().__init__()
         self.memory_format = torch.channels_last if channels_last else torch.contiguous_format
 
-    def to_float(self, obs: torch.Tensor) -> torch.Tensor:
+    @staticmethod
+    def to_float(obs: torch.Tensor) -> torch.Tensor:
         """uint8 -> float in [0, 1]."""
         return obs.float().div_(255.0)
-
-    def key_frames(self, obs: torch.Tensor) -> torch.Tensor:
-        """The float frames whose augmented view is the contrastive positive (Eq. 3)."""
-        x = self.to_float(obs[:, -1] if self.key_is_frame else obs)
-        return x
 
     def trunk_input(self, x: torch.Tensor) -> torch.Tensor:
         return x.contiguous(memory_format=self.memory_format)
 
-    def forward(
-        self, obs: torch.Tensor, key_view: torch.Tensor | None = None, frame_features: bool = False
-    ) -> Encoding:
+    def key_frames(self, obs: torch.Tensor) -> torch.Tensor:
+        """The float frames whose augmented view gives the contrastive positive (Eq. 3)."""
+        return self.to_float(obs[:, -1] if self.key_is_frame else obs)
+
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         raise NotImplementedError
+
+    def encode_key(self, view: torch.Tensor) -> torch.Tensor:
+        """Contrastive features ``(B, feature_dim)`` of an augmented float view (Eq. 3)."""
+        raise NotImplementedError
+
+    def encode_transition(
+        self, window: torch.Tensor, frame_features: bool = False
+    ) -> tuple[Encoding, Encoding]:
+        """Encodings of the triplets at t (with gradient) and t+1 (without) from the uint8 window
+        ``(B, k+1, C, H, W)`` of frames t-k+1 .. t+1."""
+        current = self(window[:, :-1], frame_features)
+        with torch.no_grad():
+            following = self(window[:, 1:])
+        return current, following
 
 
 class SingleFrameEncoder(PixelEncoder):
@@ -114,7 +126,7 @@ class SingleFrameEncoder(PixelEncoder):
         frame_shape: tuple[int, int, int],
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = True,
+        channels_last: bool = False,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -122,18 +134,17 @@ class SingleFrameEncoder(PixelEncoder):
         self.head = Head(num_filters * conv_output_size(h) * conv_output_size(w), feature_dim)
         self.repr_dim = feature_dim
 
-    def forward(self, obs, key_view=None, frame_features=False):
-        x = self.to_float(obs[:, -1])
-        if key_view is not None:
-            x = torch.cat([x, key_view])
-        f = self.head(self.convs(self.trunk_input(x)))
-        n = obs.shape[0]
-        return Encoding(state=f[:n], anchor=f[:n], key=None if key_view is None else f[n:])
+    def encode_key(self, view):
+        return self.head(self.convs(self.trunk_input(view)))
+
+    def forward(self, obs, frame_features=False):
+        f = self.encode_key(self.to_float(obs[:, -1]))
+        return Encoding(state=f, anchor=f)
 
 
 class StackedEncoder(PixelEncoder):
     """Ablations "stacked" / "stacked_wide": one conv path on the k frames folded into kC
-    channels."""
+    channels (CURL / DrQ's encoder)."""
 
     key_is_frame = False
 
@@ -143,7 +154,7 @@ class StackedEncoder(PixelEncoder):
         num_frames: int,
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = True,
+        channels_last: bool = False,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -151,13 +162,12 @@ class StackedEncoder(PixelEncoder):
         self.head = Head(num_filters * conv_output_size(h) * conv_output_size(w), feature_dim)
         self.repr_dim = feature_dim
 
-    def forward(self, obs, key_view=None, frame_features=False):
-        x = self.to_float(obs)
-        if key_view is not None:
-            x = torch.cat([x, key_view])
-        f = self.head(self.convs(self.trunk_input(x.flatten(1, 2))))
-        n = obs.shape[0]
-        return Encoding(state=f[:n], anchor=f[:n], key=None if key_view is None else f[n:])
+    def encode_key(self, view):
+        return self.head(self.convs(self.trunk_input(view.flatten(1, 2))))
+
+    def forward(self, obs, frame_features=False):
+        f = self.encode_key(self.to_float(obs))
+        return Encoding(state=f, anchor=f)
 
 
 class FlareEncoder(PixelEncoder):
@@ -172,7 +182,7 @@ class FlareEncoder(PixelEncoder):
         num_frames: int,
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = True,
+        channels_last: bool = False,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -182,17 +192,16 @@ class FlareEncoder(PixelEncoder):
         self.norm = nn.LayerNorm(feature_dim)
         self.repr_dim = feature_dim
 
-    def forward(self, obs, key_view=None, frame_features=False):
-        x = self.to_float(obs)
-        if key_view is not None:
-            x = torch.cat([x, key_view])
-        n, k = x.shape[:2]
-        maps = self.convs(self.trunk_input(x.flatten(0, 1)))
+    def encode_key(self, view):
+        n, k = view.shape[:2]
+        maps = self.convs(self.trunk_input(view.flatten(0, 1)))
         z = maps.permute(0, 2, 3, 1).reshape(n, k, -1)
         flow = z[:, 1:] - z[:, :-1].detach()
-        f = self.norm(self.fc(torch.cat([z.flatten(1), flow.flatten(1)], dim=1)))
-        b = obs.shape[0]
-        return Encoding(state=f[:b], anchor=f[:b], key=None if key_view is None else f[b:])
+        return self.norm(self.fc(torch.cat([z.flatten(1), flow.flatten(1)], dim=1)))
+
+    def forward(self, obs, frame_features=False):
+        f = self.encode_key(self.to_float(obs))
+        return Encoding(state=f, anchor=f)
 
 
 class DualPathEncoder(PixelEncoder):
@@ -200,8 +209,8 @@ class DualPathEncoder(PixelEncoder):
     interactive module (Eq. 4-6); the state is f = [f^m_t, f^a_t].
 
     The motion path sees the residuals [o_{t-1} - o_{t-2}, o_t - o_{t-1}] computed on the fly from
-    the uint8 triplet; the appearance path sees the three frames (and the contrastive view) in
-    one batched conv call.
+    the uint8 frames (as float); the appearance path sees each frame. f^a in the state is that of
+    frame t (after the interactive module when there is one).
 
     Example:
         >>> import torch
@@ -221,7 +230,8 @@ class DualPathEncoder(PixelEncoder):
         interactive: bool = True,
         reduce_kernel: int = 5,
         reduce_stride: int = 3,
-        channels_last: bool = True,
+        detach_past_frames: bool = True,
+        channels_last: bool = False,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -235,69 +245,109 @@ class DualPathEncoder(PixelEncoder):
             if interactive
             else None
         )
+        self.detach_past_frames = detach_past_frames
         self.repr_dim = 2 * feature_dim
 
-    def forward(self, obs, key_view=None, frame_features=False):
-        b, k = obs.shape[:2]
-        if k != 3:
-            raise ValueError(
-                f"DualPathEncoder needs 3 frames per observation, got shape {tuple(obs.shape)}"
-            )
-        x = self.to_float(obs)
-        frames = x.flatten(0, 1)
-        if key_view is not None:
-            frames = torch.cat([frames, key_view])
-        maps = self.appearance(self.trunk_input(frames))
-        per_frame = maps[: b * k].unflatten(0, (b, k))
-        motion_maps = self.motion(
-            self.trunk_input(torch.cat([x[:, 1] - x[:, 0], x[:, 2] - x[:, 1]], 1))
+    def appearance_maps(self, frames: torch.Tensor) -> torch.Tensor:
+        """E^a on float frames ``(B, n, C, H, W)`` in one conv call -> ``(B, n, c, h, w)``."""
+        return self.appearance(self.trunk_input(frames.flatten(0, 1))).unflatten(
+            0, frames.shape[:2]
         )
+
+    def motion_maps(self, x: torch.Tensor) -> torch.Tensor:
+        """E^m on the residual pairs of float frames ``(B, n+2, C, H, W)``: one conv call over the
+        n pairs [(o_{j+1} - o_j), (o_{j+2} - o_{j+1})] -> ``(B, n, c, h, w)``."""
+        residual = x[:, 1:] - x[:, :-1]
+        pairs = torch.cat([residual[:, :-1], residual[:, 1:]], dim=2)
+        return self.motion(self.trunk_input(pairs.flatten(0, 1))).unflatten(0, pairs.shape[:2])
+
+    def encode_key(self, view):
+        return self.head_appearance(self.appearance(self.trunk_input(view)))
+
+    def encode_maps(
+        self,
+        motion: torch.Tensor,
+        frames: torch.Tensor,
+        anchor: bool = True,
+        frame_features: bool = False,
+    ) -> Encoding:
+        """From F^m_t ``(B, c, h, w)`` and F^a of frames t-2, t-1, t ``(B, 3, c, h, w)`` to the
+        features: interactive module (Eq. 4-6), then FC + LayerNorm per path (Alg. 1, 6-14)."""
+        b = motion.shape[0]
         masks = None
-        heads_in = [per_frame[:, 2]]
+        heads_in = [frames[:, 2]]
         if self.interaction is not None:
-            motion_maps, enhanced, masks = self.interaction(motion_maps, per_frame)
-            heads_in.insert(0, enhanced)
-        if key_view is not None:
-            heads_in.append(maps[b * k :])
+            motion, enhanced, masks = self.interaction(motion, frames)
+            heads_in = [enhanced, frames[:, 2]] if anchor else [enhanced]
         f_a = self.head_appearance(torch.cat(heads_in)).split(b)
-        f_m = self.head_motion(motion_maps)
-        anchor = f_a[1] if self.interaction is not None else f_a[0]
+        f_m = self.head_motion(motion)
+        plain = f_a[-1]
         appearance = None
         if frame_features:
             with torch.no_grad():
-                earlier = self.head_appearance(per_frame[:, :2].flatten(0, 1)).unflatten(0, (b, 2))
-            appearance = torch.cat([earlier, anchor.detach().unsqueeze(1)], dim=1)
+                earlier = self.head_appearance(frames[:, :2].flatten(0, 1)).unflatten(0, (b, 2))
+            appearance = torch.cat([earlier, plain.detach().unsqueeze(1)], dim=1)
         return Encoding(
             state=torch.cat([f_m, f_a[0]], dim=1),
-            anchor=anchor,
-            key=f_a[-1] if key_view is not None else None,
+            anchor=plain if anchor else None,
             motion=f_m,
             appearance=appearance,
             masks=masks,
         )
 
+    def forward(self, obs, frame_features=False):
+        if obs.shape[1] != 3:
+            raise ValueError(
+                f"DualPathEncoder needs 3 frames (t-2, t-1, t) per observation, got shape "
+                f"{tuple(obs.shape)}; use FrameTriplet / SimounObservation with num_frames=3"
+            )
+        x = self.to_float(obs)
+        return self.encode_maps(
+            self.motion_maps(x)[:, 0], self.appearance_maps(x), True, frame_features
+        )
+
+    def encode_transition(self, window, frame_features=False):
+        """Each unique frame through each path once: frame t with gradient, frames t-2, t-1
+        (unless ``detach_past_frames`` is off) and t+1 without; the residual pair of t with
+        gradient, that of t+1 without."""
+        x = self.to_float(window)
+        if self.detach_past_frames:
+            with torch.no_grad():
+                others = self.appearance_maps(x[:, [0, 1, 3]])
+            current = self.appearance_maps(x[:, 2:3])
+            frames = torch.cat([others[:, :2], current], dim=1)
+        else:
+            frames = self.appearance_maps(x[:, :3])
+            with torch.no_grad():
+                others = torch.cat([frames[:, :2], self.appearance_maps(x[:, 3:])], dim=1)
+        encoding = self.encode_maps(self.motion_maps(x[:, :3])[:, 0], frames, True, frame_features)
+        with torch.no_grad():
+            next_frames = torch.cat([others[:, 1:2], frames[:, 2:3], others[:, 2:3]], dim=1)
+            following = self.encode_maps(self.motion_maps(x[:, 1:])[:, 0], next_frames, False)
+        return encoding, following
+
 
 def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:
     """Build the encoder named by ``config.encoder`` (the variants of Fig. 6)."""
     kind, cl = config.encoder, config.channels_last
+    filters, dim = config.num_filters, config.feature_dim
     if kind in ("dual", "dual_interactive"):
-        encoder = DualPathEncoder(
+        encoder: PixelEncoder = DualPathEncoder(
             frame_shape,
-            config.num_filters,
-            config.feature_dim,
-            kind == "dual_interactive",
-            config.reduce_kernel,
-            config.reduce_stride,
-            cl,
+            filters,
+            dim,
+            interactive=kind == "dual_interactive",
+            reduce_kernel=config.reduce_kernel,
+            reduce_stride=config.reduce_stride,
+            detach_past_frames=config.detach_past_frames,
+            channels_last=cl,
         )
     elif kind == "single":
-        encoder = SingleFrameEncoder(frame_shape, config.num_filters, config.feature_dim, cl)
+        encoder = SingleFrameEncoder(frame_shape, filters, dim, cl)
     elif kind == "flare":
-        encoder = FlareEncoder(
-            frame_shape, config.num_frames, config.num_filters, config.feature_dim, cl
-        )
+        encoder = FlareEncoder(frame_shape, config.num_frames, filters, dim, cl)
     else:
-        filters = config.num_filters * (2 if kind == "stacked_wide" else 1)
-        encoder = StackedEncoder(frame_shape, config.num_frames, filters, config.feature_dim, cl)
+        wide = 2 if kind == "stacked_wide" else 1
+        encoder = StackedEncoder(frame_shape, config.num_frames, wide * filters, dim, cl)
     encoder.apply(weight_init)
     return encoder.to(memory_format=encoder.memory_format)

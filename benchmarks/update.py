@@ -1,0 +1,115 @@
+"""Speed of one Simoun training step against a CURL-equivalent step, in one process.
+
+Both steps sample their batch from their own replay and run every loss and optimiser of their
+method; step counts are even so the averages cover the steps where the actor and the targets do
+and do not update. Baseline and Simoun alternate in each repeat and the medians are reported, so
+a machine shared with other work slows both alike. Also prints the act latency for one
+observation and the replay bytes per transition at 84x84 RGB.
+
+    python benchmarks/update.py                      # batch 32 and 128, all threads
+    python benchmarks/update.py --threads 1 --batch-sizes 128 --repeats 7
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from curl_baseline import CurlBaseline
+
+from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+
+FRAME = (3, 84, 84)
+ACTION_DIM = 6
+
+
+def filled_replay(transitions: int, episode_length: int = 100, seed: int = 0) -> FrameReplay:
+    """A replay of random frames, in episodes of ``episode_length`` steps."""
+    rng = np.random.default_rng(seed)
+    replay = FrameReplay(transitions, FRAME, ACTION_DIM, seed=seed)
+    for t in range(transitions):
+        if t % episode_length == 0:
+            replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
+        end = (t + 1) % episode_length == 0
+        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
+        replay.add(rng.uniform(-1, 1, ACTION_DIM), rng.random(), frame, False, end)
+    return replay
+
+
+def stepper(agent: SimounAgent, replay: FrameReplay):
+    """A no-argument call doing one ``agent.update`` at the next environment step."""
+    counter = itertools.count()
+    return lambda: agent.update(replay, next(counter))
+
+
+def time_steps(fn, steps: int) -> float:
+    """Milliseconds per call of ``fn`` over ``steps`` calls."""
+    start = time.perf_counter()
+    for _ in range(steps):
+        fn()
+    return 1e3 * (time.perf_counter() - start) / steps
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--batch-sizes", type=int, nargs="+", default=[32, 128])
+    parser.add_argument("--steps", type=int, default=4, help="steps per timing (even)")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--threads", type=int, default=torch.get_num_threads())
+    parser.add_argument("--encoder", default="dual_interactive")
+    parser.add_argument("--no-channels-last", action="store_true")
+    args = parser.parse_args()
+    torch.set_num_threads(args.threads)
+    torch.manual_seed(0)
+    replay = filled_replay(1000)
+
+    print(
+        f"torch {torch.__version__}, {args.threads} threads, 84x84 RGB, {ACTION_DIM} actions, "
+        f"encoder {args.encoder}, {args.steps} steps x {args.repeats} repeats (medians)"
+    )
+    print(f"{'batch':>5} {'CURL ms/step':>13} {'Simoun ms/step':>15} {'ratio':>6}")
+    for batch in args.batch_sizes:
+        config = AgentConfig(
+            encoder=args.encoder,
+            batch_size=batch,
+            curiosity=args.encoder.startswith("dual"),
+            channels_last=not args.no_channels_last,
+        )
+        agent = SimounAgent(FRAME, ACTION_DIM, config, device="cpu")
+        curl = CurlBaseline(ACTION_DIM, batch)
+        ours = stepper(agent, replay)
+        curl.update()
+        ours()
+        curl_ms, ours_ms = [], []
+        for _ in range(args.repeats):
+            curl_ms.append(time_steps(curl.update, args.steps))
+            ours_ms.append(time_steps(ours, args.steps))
+        c, o = statistics.median(curl_ms), statistics.median(ours_ms)
+        print(f"{batch:>5} {c:>13.1f} {o:>15.1f} {o / c:>6.2f}")
+
+    obs = replay.sample(1)["obs"][0]
+    agent.act(obs)
+    act_ms = statistics.median(time_steps(lambda: agent.act(obs), 20) for _ in range(5))
+    curl_obs = curl.obs[0, :, :84, :84]
+    curl.act(curl_obs)
+    curl_act_ms = statistics.median(time_steps(lambda: curl.act(curl_obs), 20) for _ in range(5))
+    print(f"act latency, one observation: Simoun {act_ms:.2f} ms, CURL {curl_act_ms:.2f} ms")
+    big = FrameReplay(100_000, FRAME, ACTION_DIM)
+    curl_bytes = 2 * 9 * 100 * 100 + 4 * ACTION_DIM + 4 + 4
+    print(
+        f"replay bytes per transition (capacity 100,000): Simoun {big.bytes_per_transition:,.0f}, "
+        f"CURL {curl_bytes:,}"
+    )
+
+
+if __name__ == "__main__":
+    main()

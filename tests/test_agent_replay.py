@@ -1,0 +1,109 @@
+"""FrameReplay against the triplets FrameTriplet produced along real CartPole episodes."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from simoun_agent import FrameReplay
+from simoun_wrappers import SimounObservation
+
+SIZE = 16
+
+
+def collect(replay: FrameReplay, steps: int, seed: int = 0) -> dict[int, tuple]:
+    """Run random CartPole episodes (pixels via render) into ``replay``; the action stored is the
+    transition's id, and the returned dict maps it to (obs, next_obs, reward, terminated)."""
+    env = SimounObservation(
+        gym.make("CartPole-v1", render_mode="rgb_array"), size=SIZE, motion=False
+    )
+    rng = np.random.default_rng(seed)
+    obs, _ = env.reset(seed=seed)
+    replay.start_episode(obs["frames"][-1])
+    expected = {}
+    for t in range(steps):
+        next_obs, reward, terminated, truncated, _ = env.step(int(rng.integers(2)))
+        truncated = truncated or rng.random() < 0.05
+        reward = float(reward) + t
+        replay.add(np.array([t], np.float32), reward, next_obs["frames"][-1], terminated, truncated)
+        expected[t] = (obs["frames"], next_obs["frames"], reward, terminated)
+        obs = next_obs
+        if terminated or truncated:
+            obs, _ = env.reset()
+            replay.start_episode(obs["frames"][-1])
+    env.close()
+    return expected
+
+
+def test_triplets_match_frame_triplet_across_episodes_and_wraparound():
+    replay = FrameReplay(capacity=50, frame_shape=(3, SIZE, SIZE), action_dim=1, seed=0)
+    expected = collect(replay, steps=160)
+    assert replay.written > replay.slots, "the ring must have wrapped around"
+    batches = [replay.sample(len(replay)) for _ in range(60)]
+    batch = {key: np.concatenate([b[key] for b in batches]) for key in batches[0]}
+    ids = batch["action"][:, 0].astype(int)
+    episode_starts = sum(1 for o, _, _, _ in expected.values() if (o[0] == o[2]).all())
+    assert episode_starts > 3, "the data must cross several episode boundaries"
+    for i, t in enumerate(ids):
+        obs, next_obs, reward, terminated = expected[t]
+        np.testing.assert_array_equal(batch["obs"][i], obs)
+        np.testing.assert_array_equal(batch["next_obs"][i], next_obs)
+        assert batch["reward"][i] == np.float32(reward)
+        assert batch["discount"][i] == (0.0 if terminated else 1.0)
+    # every transition still fully stored is sampled; none of the evicted ones
+    assert set(ids) == set(range(160 - len(replay), 160))
+    assert batch["obs"].dtype == np.uint8 and batch["obs"].shape[1:] == (3, 3, SIZE, SIZE)
+
+
+def test_terminated_does_not_bootstrap_truncated_does():
+    replay = FrameReplay(capacity=10, frame_shape=(1, 2, 2), action_dim=1, seed=1)
+    frame = np.zeros((1, 2, 2), np.uint8)
+    replay.start_episode(frame)
+    replay.add([0.0], 1.0, frame, terminated=True, truncated=False)
+    replay.start_episode(frame)
+    replay.add([1.0], 1.0, frame, terminated=False, truncated=True)
+    pairs = set()
+    for _ in range(30):
+        batch = replay.sample(2)
+        pairs |= set(zip(batch["action"][:, 0].tolist(), batch["discount"].tolist(), strict=True))
+    discount = dict(pairs)
+    assert discount == {0.0: 0.0, 1.0: 1.0}
+
+
+def test_save_load_resumes_the_same_samples(tmp_path):
+    replay = FrameReplay(capacity=40, frame_shape=(3, SIZE, SIZE), action_dim=1, seed=3)
+    collect(replay, steps=70, seed=1)
+    replay.sample(5)
+    path = tmp_path / "replay.tmp"
+    replay.save(path)
+    loaded = FrameReplay.load(path)
+    assert len(loaded) == len(replay)
+    for _ in range(3):
+        a, b = replay.sample(16), loaded.sample(16)
+        for key in a:
+            np.testing.assert_array_equal(a[key], b[key])
+
+
+def test_bytes_per_transition_at_84x84_rgb():
+    replay = FrameReplay(capacity=100_000, frame_shape=(3, 84, 84), action_dim=6)
+    measured = replay.nbytes / replay.capacity
+    assert measured == replay.bytes_per_transition
+    assert measured <= 22_000, measured
+
+
+def test_bad_inputs_are_refused_with_a_fix():
+    replay = FrameReplay(capacity=10, frame_shape=(3, 4, 4), action_dim=2)
+    frame = np.zeros((3, 4, 4), np.uint8)
+    with pytest.raises(RuntimeError, match="start_episode"):
+        replay.add([0, 0], 0.0, frame, False, False)
+    replay.start_episode(frame)
+    for bad in (np.nan, np.inf, -np.inf):
+        with pytest.raises(ValueError, match="not finite"):
+            replay.add([0, 0], bad, frame, False, False)
+    with pytest.raises(ValueError, match="uint8 array of shape"):
+        replay.add([0, 0], 0.0, frame.astype(np.float32), False, False)
+    with pytest.raises(ValueError, match="uint8 array of shape"):
+        replay.start_episode(np.zeros((3, 3, 4, 4), np.uint8))
+    replay.add([0, 0], 0.0, frame, False, False)
+    assert len(replay) == 1
+    with pytest.raises(ValueError, match="holds 1; collect more"):
+        replay.sample(2)
