@@ -26,12 +26,12 @@ from simoun_wrappers.curiosity import (
 __all__ = ["ConsistencyCuriosityReward", "ConsistencyCuriosityVectorReward"]
 
 
-def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
-    """A function taking a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``.
+def triplet_shape(space: spaces.Space) -> tuple[int, int, int, int]:
+    """``(3, C, H, W)``: the frame triplet held by one observation of ``space``.
 
-    Accepted single-observation layouts: a ``Dict`` with a ``"frames"`` Box ``(3, C, H, W)``
-    (``SimounObservation``), a Box ``(3, C, H, W)`` (``FrameTriplet`` on channel-first frames), or
-    the folded Box ``(3C, H, W)`` (``SimounObservation(fold_frames=True)``, for SB3).
+    Accepted layouts: a ``Dict`` with a ``"frames"`` Box ``(3, C, H, W)`` (``SimounObservation``),
+    a Box ``(3, C, H, W)`` (``FrameTriplet`` on channel-first frames), or the folded Box
+    ``(3C, H, W)`` (``SimounObservation(fold_frames=True)``, for SB3).
     """
     frames = (
         space["frames"] if isinstance(space, spaces.Dict) and "frames" in space.spaces else space
@@ -43,21 +43,25 @@ def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
             "env in SimounObservation(env) (or SimounObservation(env, fold_frames=True) for SB3)."
         )
     if len(shape) == 4 and shape[0] == 3:
-        triplet_shape = shape
-    elif len(shape) == 3 and shape[0] % 3 == 0:
-        triplet_shape = (3, shape[0] // 3, *shape[1:])
-    else:
-        raise ValueError(
-            f"Consistency curiosity needs a triplet of frames t-2, t-1, t: a (3, C, H, W) or "
-            f"folded (3C, H, W) uint8 observation; got shape {shape}. Use SimounObservation(env, "
-            "num_frames=3)."
-        )
-    use_key = frames is not space
+        return shape
+    if len(shape) == 3 and shape[0] % 3 == 0:
+        return (3, shape[0] // 3, *shape[1:])
+    raise ValueError(
+        f"Consistency curiosity needs a triplet of frames t-2, t-1, t: a (3, C, H, W) or folded "
+        f"(3C, H, W) uint8 observation; got shape {shape}. Use SimounObservation(env, "
+        "num_frames=3)."
+    )
+
+
+def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
+    """A function taking a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``."""
+    shape = triplet_shape(space)
+    use_key = isinstance(space, spaces.Dict)
 
     def read(batch: Any) -> np.ndarray:
         # A copy: the wrappers keep the previous triplet, and the caller owns the observation.
         array = np.array(batch["frames"] if use_key else batch, dtype=np.uint8)
-        return array.reshape(-1, *triplet_shape)
+        return array.reshape(-1, *shape)
 
     return read
 

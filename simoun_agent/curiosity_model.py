@@ -1,0 +1,396 @@
+"""Feature sources for the consistency-curiosity wrappers (``simoun_wrappers.curiosity_reward``).
+
+- :class:`CuriosityModel`: a dual-path encoder trained online, with L_tran (Eq. 2) and L_con
+  (Eq. 3) only, on the transitions the wrapper shows it. No agent needed: a PPO, SAC or DQN user
+  of any library gets Simoun's curiosity from it.
+- :class:`AgentFeatures`: a (trained) :class:`~simoun_agent.SimounAgent`'s own encoder, so its
+  features can shape another learner's reward.
+
+Both follow :class:`simoun_wrappers.curiosity.FeatureSource`.
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import torch
+from gymnasium import spaces
+
+from simoun_agent.config import AgentConfig
+from simoun_agent.encoder import make_encoder
+from simoun_agent.losses import contrastive_loss, transition_loss
+from simoun_agent.networks import BilinearSimilarity, TransitionModel
+from simoun_wrappers.augment import random_conv
+from simoun_wrappers.curiosity_reward import triplet_shape
+
+__all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions"]
+
+
+@dataclass
+class CuriosityConfig:
+    """Hyperparameters of :class:`CuriosityModel` (encoder sizes as in ``AgentConfig``)."""
+
+    feature_dim: int = 50
+    """size of f_m and of each f_a"""
+    num_filters: int = 32
+    """filters of every conv layer of both paths"""
+    interactive: bool = True
+    """use the structural interactive module (Eq. 4-6) between the paths"""
+    aux_hidden_dim: int = 256
+    """hidden units of the transition model G (Eq. 2)"""
+    capacity: int = 1000
+    """transitions kept in the internal buffer (4 uint8 frames each: 85 MB at 84x84 RGB)"""
+    batch_size: int = 64
+    """transitions per gradient step; one step blocks the env step that triggers it"""
+    update_every: int = 4
+    """one gradient step every this many ``watch`` calls (env steps, or vector steps)"""
+    learning_starts: int = 256
+    """transitions stored before the first gradient step"""
+    lr: float = 1e-3
+    """Adam learning rate"""
+    encoder_tau: float = 0.05
+    """EMA rate of the momentum encoder that encodes the L_con keys"""
+    transition_weight: float = 1.0
+    """weight of L_tran (Eq. 2)"""
+    contrastive_weight: float = 1.0
+    """weight of L_con (Eq. 3)"""
+    motion_contrastive_weight: float = 3.0
+    """weight of L_tran's InfoNCE form (G's prediction against the batch's f_m_{t+1}). Not in the
+    paper, whose motion path also gets the critic's gradient: with L_tran alone the motion path
+    collapsed to a constant on PointReach and Pendulum (measured; weight 1 was not enough
+    either). 0 gives exactly L_tran + L_con"""
+    random_conv_kernel: int = 3
+    """kernel of the random convolution making the contrastive positives"""
+    channels_last: bool = True
+    """channels-last convolutions (the agent's default)"""
+    seed: int | None = None
+    """seeds the weights, the buffer sampling and the augmentation (None: nondeterministic)"""
+
+    def __post_init__(self) -> None:
+        for name in ("feature_dim", "num_filters", "capacity", "batch_size", "update_every"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"CuriosityConfig.{name} must be >= 1, got {getattr(self, name)}")
+        if self.batch_size < 2:
+            raise ValueError(
+                f"CuriosityConfig.batch_size must be >= 2: the contrastive loss needs negatives "
+                f"from the batch; got {self.batch_size}."
+            )
+        if not self.batch_size <= self.learning_starts <= self.capacity:
+            raise ValueError(
+                f"CuriosityConfig needs batch_size <= learning_starts <= capacity, got "
+                f"{self.batch_size}, {self.learning_starts}, {self.capacity}."
+            )
+
+
+def action_dim(space: spaces.Space) -> int:
+    """Width of :func:`encode_actions`' output for ``space``."""
+    if isinstance(space, spaces.Discrete):
+        return int(space.n)
+    if isinstance(space, spaces.MultiDiscrete):
+        return int(np.sum(space.nvec))
+    if isinstance(space, (spaces.Box, spaces.MultiBinary)):
+        return int(np.prod(space.shape))
+    raise TypeError(
+        f"CuriosityModel handles Discrete, MultiDiscrete, MultiBinary and Box action spaces, got "
+        f"{space}; flatten it first (gymnasium.wrappers.FlattenObservation-style) or pass a Box."
+    )
+
+
+def encode_actions(space: spaces.Space, actions: np.ndarray) -> np.ndarray:
+    """A batch of actions as float32 ``(B, action_dim(space))`` for the transition model G.
+
+    Discrete actions become one-hot vectors (MultiDiscrete: concatenated one-hots); bounded Box
+    actions are rescaled to [-1, 1]; MultiBinary and unbounded Box actions are used as they are.
+    """
+    actions = np.asarray(actions)
+    if isinstance(space, spaces.Discrete):
+        return np.eye(space.n, dtype=np.float32)[actions.reshape(-1) - space.start]
+    if isinstance(space, spaces.MultiDiscrete):
+        flat = actions.reshape(len(actions), -1)
+        parts = [np.eye(n, dtype=np.float32)[flat[:, i]] for i, n in enumerate(space.nvec.ravel())]
+        return np.concatenate(parts, axis=1)
+    flat = actions.reshape(len(actions), -1).astype(np.float32)
+    if isinstance(space, spaces.Box) and space.is_bounded():
+        low, high = space.low.reshape(-1), space.high.reshape(-1)
+        flat = 2.0 * (flat - low) / (high - low) - 1.0
+    return flat
+
+
+def default_device(device: str | torch.device | None) -> torch.device:
+    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+
+
+class CuriosityModel:
+    """A dual-path encoder trained online with L_tran + L_con, as a curiosity ``FeatureSource``.
+
+    Calling it encodes a batch of triplets (one batched, gradient-free forward pass) and returns
+    ``f_m (B, D)`` and ``f_a (B, 3, D)`` as numpy float32. The wrappers hand it every transition
+    through :meth:`watch`; it keeps the last ``capacity`` of them (frames t-2 .. t+1, uint8, any
+    number of sub-envs interleaved) and, once ``learning_starts`` are stored, takes one Adam step
+    on a batch of ``batch_size`` every ``update_every`` calls to ``watch``:
+
+    - L_tran (Eq. 2): G(f_m_t, a_t) predicts f_m_{t+1} (no gradient into the target), plus the
+      same prediction in InfoNCE form against the batch (``motion_contrastive_weight``);
+    - L_con (Eq. 3): f_a_t must pick, among the batch, the momentum encoder's features of a
+      random-convolution view of the same frame.
+
+    The encoder is the agent's ``DualPathEncoder`` and its ``encode_transition`` (each of the
+    four frames through each path once); the losses are ``simoun_agent.losses``'.
+
+    The step runs inside ``watch``, so it blocks the env step that triggers it: measured on
+    2 CPU cores (torch 2.13), 32x32 RGB frames, batch 64: about 25 ms; 84x84 RGB, batch 64:
+    about 200 ms (see ``benchmarks/curiosity.py`` for the per-step overhead averaged over steps).
+    ``last_metrics`` holds the losses and the duration of the last step.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import SimounObservation
+        >>> from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+        >>> from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
+        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=32)
+        >>> model = CuriosityModel.for_env(env, CuriosityConfig(batch_size=8, learning_starts=8,
+        ...                                                     seed=0), device="cpu")
+        >>> env = ConsistencyCuriosityReward(env, model)
+        >>> _ = env.reset(seed=0)
+        >>> for _ in range(12):
+        ...     *_, terminated, truncated, info = env.step(env.action_space.sample())
+        ...     if terminated or truncated:
+        ...         _ = env.reset()
+        >>> model.updates, sorted(model.last_metrics)[:2]
+        (2, ['contrastive_loss', 'motion_contrastive_loss'])
+    """
+
+    def __init__(
+        self,
+        frame_shape: tuple[int, int, int],
+        action_space: spaces.Space,
+        config: CuriosityConfig | None = None,
+        device: str | torch.device | None = None,
+    ) -> None:
+        """Build the model.
+
+        Args:
+            frame_shape: ``(C, H, W)`` of one frame (H, W >= 23; >= 15 without the interactive
+                module).
+            action_space: the env's action space (Discrete, MultiDiscrete, MultiBinary or Box).
+            config: hyperparameters; ``CuriosityConfig()`` when None.
+            device: torch device; None picks cuda when available, else cpu.
+        """
+        self.config = config = config or CuriosityConfig()
+        self.frame_shape = tuple(int(v) for v in frame_shape)
+        smallest = 23 if config.interactive else 15
+        if len(self.frame_shape) != 3 or min(self.frame_shape[1:]) < smallest:
+            raise ValueError(
+                f"frame_shape must be one frame's (C, H, W) with H, W >= {smallest} (the conv "
+                f"paths{' and the interactive module' if config.interactive else ''} need it), "
+                f"got {frame_shape}; resize with SimounObservation(env, size=32) or larger."
+            )
+        self.action_space = action_space
+        self.device = default_device(device)
+        with torch.random.fork_rng(devices=[]):
+            if config.seed is not None:
+                torch.manual_seed(config.seed)
+            encoder_config = AgentConfig(
+                encoder="dual_interactive" if config.interactive else "dual",
+                feature_dim=config.feature_dim,
+                num_filters=config.num_filters,
+                channels_last=config.channels_last,
+            )
+            self.encoder = make_encoder(encoder_config, self.frame_shape)
+            self.transition = TransitionModel(
+                config.feature_dim, action_dim(action_space), config.aux_hidden_dim
+            )
+        self.encoder.to(self.device)
+        self.momentum = copy.deepcopy(self.encoder).requires_grad_(False)
+        self.transition.to(self.device)
+        self.similarity = BilinearSimilarity(config.feature_dim).to(self.device)
+        self.optimizer = torch.optim.Adam(
+            [
+                *self.encoder.parameters(),
+                *self.transition.parameters(),
+                *self.similarity.parameters(),
+            ],
+            lr=config.lr,
+        )
+        self.generator = torch.Generator(self.device)
+        self.rng = np.random.default_rng(config.seed)
+        self.generator.manual_seed(int(self.rng.integers(2**62)))
+        self._windows = np.zeros((config.capacity, 4, *self.frame_shape), dtype=np.uint8)
+        self._actions = np.zeros((config.capacity, action_dim(action_space)), dtype=np.float32)
+        self.size = 0
+        self._head = 0
+        self.watch_calls = 0
+        self.updates = 0
+        self.last_metrics: dict[str, float] = {}
+
+    @classmethod
+    def for_env(
+        cls,
+        env: gym.Env | gym.vector.VectorEnv,
+        config: CuriosityConfig | None = None,
+        device: str | torch.device | None = None,
+    ) -> CuriosityModel:
+        """A model sized for ``env``'s Simoun observations and action space (single or vector)."""
+        vector = isinstance(env, gym.vector.VectorEnv)
+        obs_space = env.single_observation_space if vector else env.observation_space
+        act_space = env.single_action_space if vector else env.action_space
+        return cls(triplet_shape(obs_space)[1:], act_space, config, device)
+
+    def _check(self, triplets: np.ndarray, name: str) -> np.ndarray:
+        triplets = np.asarray(triplets)
+        if triplets.dtype != np.uint8 or triplets.shape[1:] != (3, *self.frame_shape):
+            expected = ", ".join(map(str, (3, *self.frame_shape)))
+            raise ValueError(
+                f"CuriosityModel expects {name} as uint8 (B, {expected}), "
+                f"got {triplets.dtype} {triplets.shape}; it was built for frames of shape "
+                f"{self.frame_shape} (build it with CuriosityModel.for_env(env))."
+            )
+        return triplets
+
+    @torch.no_grad()
+    def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``f_m (B, D)`` and ``f_a (B, 3, D)`` (frames t-2, t-1, t) of uint8 triplets."""
+        obs = torch.as_tensor(self._check(triplets, "triplets"), device=self.device)
+        encoding = self.encoder(obs, frame_features=True)
+        return (
+            encoding.motion.float().cpu().numpy(),
+            encoding.appearance.float().cpu().numpy(),
+        )
+
+    def watch(
+        self,
+        triplets: np.ndarray,
+        actions: np.ndarray,
+        next_triplets: np.ndarray,
+        terminated: np.ndarray,
+        truncated: np.ndarray,
+    ) -> None:
+        """Store a batch of transitions; take a gradient step when one is due.
+
+        ``next_triplets`` must continue ``triplets`` (same episode), as the curiosity wrappers
+        guarantee; only its newest frame is stored. ``terminated``/``truncated`` are accepted
+        for the FeatureSource hook and not needed: G is trained on every stored transition.
+        """
+        triplets = self._check(triplets, "triplets")
+        next_triplets = self._check(next_triplets, "next_triplets")
+        n = len(triplets)
+        slots = (self._head + np.arange(n)) % self.config.capacity
+        self._windows[slots, :3] = triplets
+        self._windows[slots, 3] = next_triplets[:, -1]
+        self._actions[slots] = encode_actions(self.action_space, actions)
+        self._head = int((self._head + n) % self.config.capacity)
+        self.size = min(self.size + n, self.config.capacity)
+        self.watch_calls += 1
+        due = self.watch_calls % self.config.update_every == 0
+        if due and self.size >= self.config.learning_starts:
+            self.last_metrics = self.update()
+
+    def update(self) -> dict[str, float]:
+        """One Adam step of L_tran + L_con on a batch from the buffer; returns python floats."""
+        if self.size < self.config.batch_size:
+            raise RuntimeError(
+                f"CuriosityModel.update needs {self.config.batch_size} stored transitions, has "
+                f"{self.size}; call watch() more first."
+            )
+        start = time.perf_counter()
+        cfg = self.config
+        idx = self.rng.integers(0, self.size, size=cfg.batch_size)
+        window = torch.as_tensor(self._windows[idx], device=self.device)
+        action = torch.as_tensor(self._actions[idx], device=self.device)
+        enc, following = self.encoder.encode_transition(window)
+        with torch.no_grad():
+            view = random_conv(
+                self.encoder.to_float(window[:, 2]), cfg.random_conv_kernel, self.generator
+            )
+            key = self.momentum.encode_key(view)
+        l_tran = transition_loss(self.transition, enc.motion, action, following.motion)
+        l_con = contrastive_loss(enc.anchor, key, self.similarity)
+        # Eq. 2 in InfoNCE form: G's prediction must pick its own f_m_{t+1} out of the batch.
+        # Without it the motion path can collapse to a constant that G predicts exactly.
+        l_motion = contrastive_loss(self.transition(enc.motion, action), following.motion)
+        loss = (
+            cfg.transition_weight * l_tran
+            + cfg.contrastive_weight * l_con
+            + cfg.motion_contrastive_weight * l_motion
+        )
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        self.optimizer.step()
+        with torch.no_grad():
+            for ema, online_param in zip(
+                self.momentum.parameters(), self.encoder.parameters(), strict=True
+            ):
+                ema.lerp_(online_param, cfg.encoder_tau)
+        self.updates += 1
+        metrics = {
+            "transition_loss": float(l_tran.detach()),
+            "contrastive_loss": float(l_con.detach()),
+            "motion_contrastive_loss": float(l_motion.detach()),
+            "motion_std": float(enc.motion.detach().std(0).mean()),
+        }
+        metrics["update_ms"] = 1000.0 * (time.perf_counter() - start)
+        return metrics
+
+    def state_dict(self) -> dict[str, Any]:
+        """Weights, optimizer, counters and RNG states (not the frame buffer)."""
+        return {
+            "encoder": self.encoder.state_dict(),
+            "momentum": self.momentum.state_dict(),
+            "transition": self.transition.state_dict(),
+            "similarity": self.similarity.state_dict(),
+            "optimizer": self.optimizer.state_dict(),
+            "watch_calls": self.watch_calls,
+            "updates": self.updates,
+            "rng": self.rng.bit_generator.state,
+            "generator": self.generator.get_state(),
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore what :meth:`state_dict` returned (the buffer refills from new transitions)."""
+        self.encoder.load_state_dict(state["encoder"])
+        self.momentum.load_state_dict(state["momentum"])
+        self.transition.load_state_dict(state["transition"])
+        self.similarity.load_state_dict(state["similarity"])
+        self.optimizer.load_state_dict(state["optimizer"])
+        self.watch_calls = int(state["watch_calls"])
+        self.updates = int(state["updates"])
+        self.rng.bit_generator.state = state["rng"]
+        self.generator.set_state(state["generator"])
+
+
+class AgentFeatures:
+    """A Simoun agent's encoder as a curiosity ``FeatureSource`` (frozen: it never trains here).
+
+    Example:
+        >>> import numpy as np
+        >>> from simoun_agent import AgentConfig, SimounAgent
+        >>> from simoun_agent.curiosity_model import AgentFeatures
+        >>> agent = SimounAgent((3, 32, 32), action_dim=1, config=AgentConfig(), device="cpu")
+        >>> f_m, f_a = AgentFeatures(agent)(np.zeros((2, 3, 3, 32, 32), np.uint8))
+        >>> f_m.shape, f_a.shape
+        ((2, 50), (2, 3, 50))
+    """
+
+    def __init__(self, agent: Any) -> None:
+        """Wrap ``agent``, which must have a dual-path encoder (``encoder_features``)."""
+        if not callable(getattr(agent, "encoder_features", None)):
+            raise TypeError(
+                f"AgentFeatures needs an object with encoder_features(triplets) -> (f_m, f_a), "
+                f"e.g. simoun_agent.SimounAgent; got {type(agent).__name__}."
+            )
+        self.agent = agent
+
+    def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        f_m, f_a = self.agent.encoder_features(triplets)
+        return _to_numpy(f_m), _to_numpy(f_a)
+
+
+def _to_numpy(x: Any) -> np.ndarray:
+    if isinstance(x, torch.Tensor):
+        return x.detach().float().cpu().numpy()
+    return np.asarray(x, dtype=np.float32)
