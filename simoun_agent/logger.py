@@ -49,17 +49,23 @@ class CsvLog:
         atomic_write(self.path, write)
 
     def write(self, row: dict[str, Any]) -> None:
+        """Append ``row``; a key not seen before adds a column (the file is rewritten once)."""
         if self.columns is None:
             self.columns = list(row)
             self._rewrite([])
+        elif any(key not in self.columns for key in row):
+            with self.path.open(newline="") as f:
+                rows = list(csv.DictReader(f))
+            self.columns += [key for key in row if key not in self.columns]
+            self._rewrite(rows)
         with self.path.open("a", newline="") as f:
-            csv.DictWriter(f, self.columns, extrasaction="ignore").writerow(row)
+            csv.DictWriter(f, self.columns).writerow(row)
 
 
 def read_csv(path: Path) -> list[dict[str, float]]:
-    """Rows of a CSV written by :class:`CsvLog`, numbers as floats."""
+    """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty)."""
     with path.open(newline="") as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+        return [{k: float(v or "nan") for k, v in row.items()} for row in csv.DictReader(f)]
 
 
 def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:
@@ -108,6 +114,8 @@ class RunLogger:
         self.eval_log = CsvLog(run_dir / EVAL_CSV, resume_step)
         self.train_log = CsvLog(run_dir / TRAIN_CSV, resume_step)
         self.tensorboard = SummaryWriter(run_dir / "tb", purge_step=resume_step)
+        self.last_eval_step: int | None = None
+        """env step of the latest evaluation logged by this logger"""
 
     def train_episode(self, env_step: int, row: dict[str, Any]) -> None:
         """One finished training episode: return, length, speed and the last update's losses."""
@@ -119,6 +127,7 @@ class RunLogger:
     def evaluation(self, env_step: int, metrics: dict[str, float]) -> None:
         """One evaluation: append to eval.csv, TensorBoard, and redraw the learning curve."""
         self.eval_log.write({"env_step": env_step, **metrics})
+        self.last_eval_step = env_step
         for key, value in metrics.items():
             if math.isfinite(value):
                 self.tensorboard.add_scalar(f"eval/{key}", value, env_step)

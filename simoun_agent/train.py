@@ -245,14 +245,15 @@ def train(run: Run) -> dict[str, Any]:
     eval_seed = config.seed + EVAL_SEED_OFFSET
     title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
     logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
-    next_eval = counters.env_step if counters.env_step == 0 else _next(counters, config.eval_every)
+    next_eval = _next(counters, config.eval_every)
     next_checkpoint = _next(counters, config.checkpoint_every)
     last_eval: dict[str, float] | None = None
+    if counters.env_step == 0:
+        last_eval, _ = evaluate(agent, run.eval_env, config.eval_episodes, eval_seed)
+        logger.evaluation(0, last_eval)
     update_metrics: dict[str, Any] = {}
 
-    obs, _ = env.reset(seed=config.seed + counters.episode)
-    replay.start_episode(obs["frames"][-1])
-    episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
+    obs = None  # an episode starts at the top of the loop, so checkpoints fall between episodes
     bar = tqdm(
         total=config.total_env_steps,
         initial=counters.env_step,
@@ -263,6 +264,10 @@ def train(run: Run) -> dict[str, Any]:
     )
     with deferred_interrupt() as interrupt:
         while counters.env_step < config.total_env_steps and not interrupt.is_set():
+            if obs is None:
+                obs, _ = env.reset(seed=config.seed + counters.episode)
+                replay.start_episode(obs["frames"][-1])
+                episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
             if counters.agent_step < config.warmup_agent_steps:
                 action = run.rng.uniform(-1.0, 1.0, action_dim).astype(np.float32)
             else:
@@ -302,9 +307,7 @@ def train(run: Run) -> dict[str, Any]:
                 checkpoint(run)
                 next_checkpoint = _next(counters, config.checkpoint_every)
             bar.set_postfix(episode_return=f"{episode_return:.1f}", **_eval_postfix(last_eval))
-            obs, _ = env.reset(seed=config.seed + counters.episode)
-            replay.start_episode(obs["frames"][-1])
-            episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
+            obs = None
         bar.close()
 
         if interrupt.is_set():
@@ -322,22 +325,22 @@ def finish(run: Run, logger: RunLogger, last_eval: dict[str, float] | None) -> d
     """Final evaluation (with video), checkpoint and ``summary.json``, the mark of a whole run."""
     config, counters = run.config, run.counters
     eval_seed = config.seed + EVAL_SEED_OFFSET
-    final, frames = evaluate(
-        run.agent, run.eval_env, config.eval_episodes, eval_seed, record=config.video
-    )
-    if last_eval is None or final != last_eval:
-        logger.evaluation(counters.env_step, final)
+    logged = logger.last_eval_step == counters.env_step and last_eval is not None
+    if not logged:
+        last_eval, _ = evaluate(run.agent, run.eval_env, config.eval_episodes, eval_seed)
+        logger.evaluation(counters.env_step, last_eval)
     checkpoint(run)
     logger.close()
     files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
-    if frames:
+    if config.video:
+        _, frames = evaluate(run.agent, run.eval_env, 1, eval_seed, record=True)
         fps = video_fps(run.eval_env, config.resolved_action_repeat())
         write_video(run.run_dir / "video.mp4", frames, fps)
         files["video"] = "video.mp4"
-    summary = {"env_step": counters.env_step, "final_eval": final, "files": files}
+    summary = {"env_step": counters.env_step, "final_eval": last_eval, "files": files}
     text = json.dumps(summary, indent=2) + "\n"
     atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
-    return final
+    return last_eval
 
 
 def _next(counters: Counters, every: int) -> int:
@@ -381,6 +384,8 @@ def build_parser() -> argparse.ArgumentParser:
         "config keys (defaults before any preset; each is also KEY for --set)"
     )
     for key, (_, default, doc) in config_fields().items():
+        if key == "preset":
+            continue
         shown = json.dumps(default) if isinstance(default, dict) else repr(default)
         group.add_argument(
             "--" + key.replace("_", "-"),
@@ -395,7 +400,7 @@ def build_parser() -> argparse.ArgumentParser:
 def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
     """``{"agent.lr": 3e-4, ...}`` from the config flags and ``--set`` pairs, typed."""
     fields = config_fields()
-    given = {key: value for key, value in vars(args).items() if key in fields}
+    given = {k: v for k, v in vars(args).items() if k in fields and k != "preset"}
     for pair in args.set:
         key, sep, value = pair.partition("=")
         if not sep:

@@ -1,0 +1,130 @@
+"""Checkpoints and resume of simoun-train: bit-exact continuation and refused bad inputs."""
+
+import json
+
+import pytest
+import torch
+
+from simoun_agent import train
+from simoun_agent.checkpoint import load_checkpoint
+from simoun_agent.presets import SetupError, resolve
+
+TINY = {
+    "env": "simoun/PointReach-v0",
+    "image_size": 32,
+    "total_env_steps": 160,
+    "warmup_agent_steps": 40,
+    "replay_capacity": 1000,
+    "eval_every": 80,
+    "eval_episodes": 1,
+    "checkpoint_every": 80,
+    "video": False,
+    "progress": False,
+    "device": "cpu",
+    "torch_threads": 1,
+    "seed": 3,
+    "agent.batch_size": 8,
+    "agent.num_filters": 8,
+    "agent.feature_dim": 16,
+    "agent.hidden_dim": 32,
+    "agent.aux_hidden_dim": 32,
+}
+
+
+def tiny_config(run_dir, **overrides):
+    return resolve(None, {**TINY, "run_dir": str(run_dir), **overrides})
+
+
+def weights(agent):
+    return {
+        f"{name}.{key}": value
+        for name, module in agent.modules().items()
+        for key, value in module.state_dict().items()
+    }
+
+
+def test_stopped_and_resumed_run_ends_with_the_same_weights(tmp_path):
+    straight = train.create_run(tiny_config(tmp_path / "straight"))
+    train.train(straight)
+
+    stopped = train.create_run(tiny_config(tmp_path / "stopped", total_env_steps=80))
+    train.train(stopped)
+    resumed = train.resume_run(tmp_path / "stopped", {"total_env_steps": 160})
+    assert resumed.counters.env_step == 80
+    train.train(resumed)
+
+    assert resumed.counters == straight.counters
+    expected, got = weights(straight.agent), weights(resumed.agent)
+    assert expected.keys() == got.keys()
+    different = [key for key in expected if not torch.equal(expected[key], got[key])]
+    assert different == []
+    assert torch.equal(straight.agent.log_alpha, resumed.agent.log_alpha)
+    # A resumed run's logs hold each evaluation once, as the straight run's do.
+    straight_eval = (tmp_path / "straight" / "eval.csv").read_text()
+    assert (tmp_path / "stopped" / "eval.csv").read_text() == straight_eval
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    run_dir = tmp_path_factory.mktemp("runs") / "finished"
+    train.train(train.create_run(tiny_config(run_dir, total_env_steps=40, warmup_agent_steps=10)))
+    return run_dir
+
+
+def test_finished_run_directory_is_complete(finished_run):
+    names = {path.name for path in finished_run.iterdir()}
+    assert {"config.json", "checkpoint.pt", "replay-40.npz", "summary.json"} <= names
+    assert {"eval.csv", "train.csv", "learning_curve.png", "tb"} <= names
+    assert json.loads((finished_run / "summary.json").read_text())["env_step"] == 40
+    assert not [name for name in names if ".tmp" in name]
+
+
+def test_resume_with_another_config_is_refused(finished_run):
+    with pytest.raises(SetupError, match=r"only total_env_steps.*agent\.lr"):
+        train.resume_run(finished_run, {"agent.lr": 3e-4})
+
+
+def test_checkpoint_from_another_config_is_refused(finished_run, tmp_path):
+    other = tmp_path / "other"
+    config = json.loads((finished_run / "config.json").read_text())
+    config["agent"]["lr"] = 5e-4
+    other.mkdir()
+    (other / "config.json").write_text(json.dumps(config))
+    (other / "checkpoint.pt").write_bytes((finished_run / "checkpoint.pt").read_bytes())
+    with pytest.raises(SetupError, match=r"another config \(agent\.lr: 0\.001 in the checkpoint"):
+        train.resume_run(other, {})
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garbage"])
+def test_corrupt_checkpoint_is_refused(finished_run, tmp_path, damage):
+    data = (finished_run / "checkpoint.pt").read_bytes()
+    broken = tmp_path / "checkpoint.pt"
+    broken.write_bytes(data[: len(data) // 2] if damage == "truncate" else b"not a checkpoint")
+    with pytest.raises(SetupError, match=r"corrupt or incomplete.*start a new run"):
+        load_checkpoint(broken)
+
+
+def test_resume_of_a_directory_without_a_run_is_refused(tmp_path):
+    with pytest.raises(SetupError, match="not a simoun run directory"):
+        train.resume_run(tmp_path, {})
+
+
+def test_existing_run_directory_is_not_overwritten(finished_run):
+    with pytest.raises(SetupError, match=r"already holds a run.*--resume"):
+        train.create_run(tiny_config(finished_run))
+
+
+def test_unwritable_output_directory_leaves_nothing_behind(tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    with pytest.raises(SetupError, match="cannot write to the output directory"):
+        train.create_run(tiny_config(blocker / "run"))
+
+
+def test_cli_reports_bad_input_without_a_traceback_and_creates_no_run(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    with pytest.raises(SystemExit) as exit_info:
+        train.main(["--env", "dm_control/cartpole-swingup-v9", "--run-dir", str(run_dir)])
+    assert exit_info.value.code == 2
+    assert "did you mean dm_control/cartpole-swingup-v0" in capsys.readouterr().err
+    assert not run_dir.exists()
