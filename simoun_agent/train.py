@@ -436,7 +436,8 @@ def main(argv: list[str] | None = None) -> int:
         run.eval_env.close()
     tqdm.write(
         f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
-        f"{run.counters.env_step} env steps; curve, logs, checkpoint and video in {run.run_dir}"
+        f"{run.counters.env_step} env steps; learning curve, logs, checkpoint"
+        f"{' and video' if run.config.video else ''} in {run.run_dir}"
     )
     return 0
 

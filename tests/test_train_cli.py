@@ -1,0 +1,87 @@
+"""The simoun-train / simoun-eval commands end to end: Ctrl-C, resume, evaluation output."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from simoun_agent import evaluate, train
+
+TINY_FLAGS = [
+    "--env", "simoun/PointReach-v0",
+    "--image-size", "32",
+    "--warmup-agent-steps", "20",
+    "--eval-every", "1000",
+    "--eval-episodes", "1",
+    "--checkpoint-every", "1000",
+    "--progress", "false",
+    "--device", "cpu",
+    "--torch-threads", "1",
+    "--agent.batch-size", "8",
+    "--agent.num-filters", "8",
+    "--agent.feature-dim", "16",
+    "--agent.hidden-dim", "32",
+    "--agent.aux-hidden-dim", "32",
+]  # fmt: skip
+
+
+def test_ctrl_c_writes_a_checkpoint_and_resume_finishes_the_run(tmp_path):
+    run_dir = tmp_path / "run"
+    command = [sys.executable, "-m", "simoun_agent.train", *TINY_FLAGS, "--run-dir", str(run_dir)]
+    process = subprocess.Popen(
+        [*command, "--total-env-steps", "100000", "--video", "false"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    deadline = time.monotonic() + 120
+    while not (run_dir / "train.csv").exists() and process.poll() is None:
+        assert time.monotonic() < deadline, "training did not start within 120 s"
+        time.sleep(0.2)
+    process.send_signal(signal.SIGINT)
+    output, _ = process.communicate(timeout=120)
+    assert process.returncode == 130, output
+    assert "checkpoint written" in output and "--resume" in output
+    assert (run_dir / "checkpoint.pt").exists()
+    assert not (run_dir / "summary.json").exists()  # an interrupted run does not look finished
+    stopped_at = json.loads((run_dir / "config.json").read_text())["total_env_steps"]
+    assert stopped_at == 100000
+
+    resume = ["--resume", str(run_dir), "--total-env-steps", "60", "--video", "true"]
+    assert train.main(resume) == 0
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["env_step"] >= 60
+    assert (run_dir / "video.mp4").stat().st_size > 0
+
+
+def test_simoun_eval_writes_metrics_and_video(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    flags = [*TINY_FLAGS, "--run-dir", str(run_dir), "--total-env-steps", "40", "--video", "false"]
+    assert train.main(flags) == 0
+    assert evaluate.main([str(run_dir), "--episodes", "2", "--out", str(tmp_path / "ev")]) == 0
+    metrics = json.loads((tmp_path / "ev" / "metrics.json").read_text())
+    assert metrics["episodes"] == 2 and metrics["env_step"] == 40
+    assert -40 < metrics["return_mean"] <= 0  # PointReach pays -distance for 20 steps
+    assert (tmp_path / "ev" / "video.mp4").stat().st_size > 0
+    assert '"return_mean"' in capsys.readouterr().out
+
+
+def test_simoun_eval_refuses_a_corrupt_checkpoint(tmp_path, capsys):
+    (tmp_path / "checkpoint.pt").write_bytes(b"\x00" * 100)
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.main([str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert "corrupt or incomplete" in capsys.readouterr().err
+
+
+def test_help_lists_every_preset_and_config_key(capsys):
+    with pytest.raises(SystemExit):
+        train.main(["--help"])
+    text = capsys.readouterr().out
+    for name in ("cartpole-swingup", "highway", "cpu", "--agent.batch-size", "--action-repeat"):
+        assert name in text
