@@ -1,0 +1,67 @@
+"""A short Stable-Baselines3 PPO run from pixels through ConsistencyCuriosityReward."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
+from simoun_wrappers import SimounObservation
+from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+
+sb3 = pytest.importorskip("stable_baselines3")
+callbacks = pytest.importorskip("stable_baselines3.common.callbacks")
+
+
+class RewardsSeen(callbacks.BaseCallback):
+    """The reward PPO stores at each step, next to the wrapper's two parts of it."""
+
+    def __init__(self):
+        super().__init__()
+        self.steps = []
+
+    def _on_step(self) -> bool:
+        info = self.locals["infos"][0]
+        reward = float(self.locals["rewards"][0])
+        self.steps.append((reward, info["reward_extrinsic"], info["reward_intrinsic"]))
+        return True
+
+
+@pytest.fixture(autouse=True)
+def one_torch_thread():
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+def test_ppo_learns_for_a_few_hundred_steps_through_the_wrapper():
+    # SB3's NatureCNN needs frames of at least 36x36; the folded triplet is its (9, H, W) image.
+    env = SimounObservation(gym.make("simoun/PointReach-v0"), size=36, fold_frames=True)
+    config = CuriosityConfig(
+        num_filters=8, feature_dim=16, aux_hidden_dim=32, batch_size=16,
+        capacity=128, learning_starts=32, update_every=8, seed=0,
+    )  # fmt: skip
+    model = CuriosityModel.for_env(env, config, device="cpu")
+    env = ConsistencyCuriosityReward(env, model)
+    ppo = sb3.PPO(
+        "CnnPolicy",
+        env,
+        n_steps=64,
+        batch_size=32,
+        n_epochs=1,
+        policy_kwargs={"features_extractor_kwargs": {"features_dim": 32}},
+        device="cpu",
+        seed=0,
+    )
+    seen = RewardsSeen()
+    ppo.learn(total_timesteps=192, callback=seen)
+    assert ppo.num_timesteps == 192
+    assert env.state_dict()["step"] == 192
+    assert model.updates == (192 - 32) // 8 + 1
+    rewards, extrinsic, intrinsic = (np.array(v) for v in zip(*seen.steps, strict=True))
+    assert len(rewards) == 192
+    # PPO was trained on r_e + r_i (Eq. 12), r_i from Eq. 13 at every step
+    np.testing.assert_allclose(rewards, extrinsic + intrinsic, rtol=1e-6)
+    assert np.all(intrinsic > 0) and np.all(intrinsic <= 0.2 * env.state_dict()["r_e_max"] + 1e-6)
