@@ -18,3 +18,11 @@ __all__ = [
     "random_conv",
     "residual_motion",
 ]
+
+from simoun_wrappers.curiosity import FeatureSource
+from simoun_wrappers.curiosity_reward import (
+    ConsistencyCuriosityReward,
+    ConsistencyCuriosityVectorReward,
+)
+
+__all__ += ["ConsistencyCuriosityReward", "ConsistencyCuriosityVectorReward", "FeatureSource"]
