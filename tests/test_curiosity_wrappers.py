@@ -6,6 +6,7 @@ import cloudpickle
 import gymnasium as gym
 import numpy as np
 import pytest
+from gymnasium.utils.env_checker import check_env
 from gymnasium.vector import AutoresetMode
 from gymnasium.wrappers import TransformReward
 
@@ -231,3 +232,12 @@ def test_vector_same_step_mode_scores_the_final_observation():
     else:
         pytest.fail("CartPole pushed left never ended within 200 steps")
     envs.close()
+
+
+def test_passes_check_env_and_rebuilds_from_its_spec():
+    env = ConsistencyCuriosityReward(cartpole(), ProjectionFeatures(3 * SIZE * SIZE), scale=0.5)
+    check_env(env, skip_render_check=True)
+    rebuilt = gym.make(env.spec)
+    assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.curiosity.scale == 0.5
+    rebuilt.reset(seed=0)
+    assert "reward_intrinsic" in rebuilt.step(0)[4]
