@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -79,6 +80,17 @@ def evaluate(
     return metrics, frames
 
 
+def metrics_json(data: dict[str, Any]) -> str:
+    """``data`` as strict JSON: NaN (e.g. the crash speed of a run without crashes) as null."""
+
+    def clean(value: Any) -> Any:
+        if isinstance(value, dict):
+            return {key: clean(item) for key, item in value.items()}
+        return None if isinstance(value, float) and math.isnan(value) else value
+
+    return json.dumps(clean(data), indent=2, allow_nan=False) + "\n"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="simoun-eval",
@@ -135,11 +147,12 @@ def main(argv: list[str] | None = None) -> int:
     seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
     metrics, frames = evaluate(agent, env, args.episodes, seed, record=not args.no_video)
     metrics.update(env_step=step, episodes=args.episodes, first_seed=seed)
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2) + "\n")
+    text = metrics_json(metrics)
+    (out / "metrics.json").write_text(text)
     if frames:
         write_video(out / "video.mp4", frames, video_fps(env, config.resolved_action_repeat()))
     env.close()
-    print(json.dumps(metrics, indent=2))
+    print(text, end="")
     print(f"wrote {out}/metrics.json" + ("" if args.no_video else f" and {out}/video.mp4"))
     return 0
 

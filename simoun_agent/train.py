@@ -40,7 +40,7 @@ from simoun_agent.checkpoint import (
     restore_rng,
     save_checkpoint,
 )
-from simoun_agent.evaluate import EVAL_SEED_OFFSET, evaluate
+from simoun_agent.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
 from simoun_agent.logger import CURVE_PNG, RunLogger
 from simoun_agent.make_env import make_env, video_fps
 from simoun_agent.presets import (
@@ -338,7 +338,7 @@ def finish(run: Run, logger: RunLogger, last_eval: dict[str, float] | None) -> d
         write_video(run.run_dir / "video.mp4", frames, fps)
         files["video"] = "video.mp4"
     summary = {"env_step": counters.env_step, "final_eval": last_eval, "files": files}
-    text = json.dumps(summary, indent=2) + "\n"
+    text = metrics_json(summary)
     atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
     return last_eval
 

@@ -12,12 +12,12 @@ from simoun_agent.presets import SetupError, resolve
 TINY = {
     "env": "simoun/PointReach-v0",
     "image_size": 32,
-    "total_env_steps": 160,
-    "warmup_agent_steps": 40,
+    "total_env_steps": 120,
+    "warmup_agent_steps": 20,
     "replay_capacity": 1000,
-    "eval_every": 80,
+    "eval_every": 60,
     "eval_episodes": 1,
-    "checkpoint_every": 80,
+    "checkpoint_every": 60,
     "video": False,
     "progress": False,
     "device": "cpu",
@@ -47,10 +47,10 @@ def test_stopped_and_resumed_run_ends_with_the_same_weights(tmp_path):
     straight = train.create_run(tiny_config(tmp_path / "straight"))
     train.train(straight)
 
-    stopped = train.create_run(tiny_config(tmp_path / "stopped", total_env_steps=80))
+    stopped = train.create_run(tiny_config(tmp_path / "stopped", total_env_steps=60))
     train.train(stopped)
-    resumed = train.resume_run(tmp_path / "stopped", {"total_env_steps": 160})
-    assert resumed.counters.env_step == 80
+    resumed = train.resume_run(tmp_path / "stopped", {"total_env_steps": 120})
+    assert resumed.counters.env_step == 60
     train.train(resumed)
 
     assert resumed.counters == straight.counters
