@@ -22,12 +22,14 @@ from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import image_layout
 
 HIGHWAY_VIEWPORTS = (
-    {"centering_position": [0.5, 0.5], "scaling": 3.0},
-    {"centering_position": [0.3, 0.5], "scaling": 5.5},
-    {"centering_position": [-0.2, 0.5], "scaling": 5.5},
+    {"centering_position": [0.85, 0.5], "scaling": 2.0},
+    {"centering_position": [0.5, 0.5], "scaling": 1.0},
+    {"centering_position": [0.15, 0.5], "scaling": 2.0},
 )
-"""Three views around the ego vehicle, left to right: wide overview, ahead, behind (the
-paper's three roof cameras on CARLA become three highway-env viewports)."""
+"""Three 84x84 views around the ego vehicle, left to right: about 36 m behind it, an 84 m
+overview, about 36 m ahead (traffic drives to the right). They stand in for the paper's three
+roof cameras on CARLA. ``centering_position`` is where the ego vehicle sits in a view (fractions
+of its size) and ``scaling`` is pixels per metre, scaled with the image size."""
 
 _SUITES = {"dm_control/": ("shimmy", "dmc"), "": ("highway_env", "highway")}
 
@@ -126,7 +128,9 @@ def _cameras(config: TrainConfig) -> list:
                 f"highway-env runs have at most {len(HIGHWAY_VIEWPORTS)} viewports, got "
                 f"cameras={config.cameras}; set cameras to 1, 2 or 3."
             )
-        return list(HIGHWAY_VIEWPORTS[: config.cameras])
+        zoom = config.image_size / 84
+        views = HIGHWAY_VIEWPORTS[: config.cameras]
+        return [{**view, "scaling": view["scaling"] * zoom} for view in views]
     if config.env.startswith("dm_control/"):
         return list(range(config.cameras))
     raise SetupError(
