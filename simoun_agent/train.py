@@ -20,6 +20,7 @@ import signal
 import sys
 import threading
 import time
+import typing
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass
@@ -356,6 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     presets = "\n".join(f"  {name:18} {preset.description}" for name, preset in PRESETS.items())
     parser = argparse.ArgumentParser(
         prog="simoun-train",
+        usage="simoun-train [--preset NAME | --resume RUN_DIR] [--KEY VALUE ...] [--set KEY=VALUE]",
         description="Train the Simoun agent (vision-based SAC) on a Gymnasium environment.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog=f"presets:\n{presets}\n\n"
@@ -383,7 +385,7 @@ def build_parser() -> argparse.ArgumentParser:
     group = parser.add_argument_group(
         "config keys (defaults before any preset; each is also KEY for --set)"
     )
-    for key, (_, default, doc) in config_fields().items():
+    for key, (kind, default, doc) in config_fields().items():
         if key == "preset":
             continue
         shown = json.dumps(default) if isinstance(default, dict) else repr(default)
@@ -391,10 +393,16 @@ def build_parser() -> argparse.ArgumentParser:
             "--" + key.replace("_", "-"),
             dest=key,
             default=argparse.SUPPRESS,
-            metavar="",
+            metavar=_metavar(kind),
             help=f"{doc} (default: {shown})".replace("%", "%%"),
         )
     return parser
+
+
+def _metavar(kind: Any) -> str:
+    names = {int: "INT", float: "FLOAT", str: "STR", bool: "BOOL", dict: "JSON"}
+    options = [option for option in typing.get_args(kind) or (kind,) if option is not type(None)]
+    return "|".join(names.get(typing.get_origin(o) or o, "VALUE") for o in options)
 
 
 def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
