@@ -243,6 +243,7 @@ def train(run: Run) -> dict[str, Any]:
     config, counters, agent, replay, env = run.config, run.counters, run.agent, run.replay, run.env
     repeat = config.resolved_action_repeat()
     action_dim = env.action_space.shape[0]
+    learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
     eval_seed = config.seed + EVAL_SEED_OFFSET
     title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
     logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
@@ -281,7 +282,7 @@ def train(run: Run) -> dict[str, Any]:
             episode_length += 1
             bar.update(repeat)
 
-            if counters.agent_step > config.warmup_agent_steps:
+            if counters.agent_step > learning_starts:
                 for _ in range(config.updates_per_step):
                     update_metrics = agent.update(replay, counters.env_step)
                     counters.updates += 1
