@@ -15,6 +15,7 @@ from __future__ import annotations
 import copy
 import math
 
+import numpy as np
 import torch
 import torch.nn.functional as F
 from torch import nn
@@ -51,6 +52,7 @@ class CurlBaseline:
         image_size: int = 84,
         pre_crop_size: int = 100,
         device: str = "cpu",
+        channels_last: bool = False,
     ) -> None:
         self.device = torch.device(device)
         self.batch_size = batch_size
@@ -83,6 +85,9 @@ class CurlBaseline:
             self.critic_target,
         ):
             module.to(self.device)
+        self.memory_format = torch.channels_last if channels_last else torch.contiguous_format
+        for module in (self.critic_encoder, self.actor_encoder, self.critic_encoder_target):
+            module.to(memory_format=self.memory_format)
         self.W.data = self.W.data.to(self.device)
         self.log_alpha.data = self.log_alpha.data.to(self.device)
         self.target_entropy = -float(action_dim)
@@ -97,28 +102,27 @@ class CurlBaseline:
         self.cpc_optimizer = torch.optim.Adam([self.W], lr=1e-3)
         self.step = 0
 
-    def _crop(self, stacks: torch.Tensor, gen: torch.Generator | None = None) -> torch.Tensor:
-        b, _, size, _ = stacks.shape
-        top = torch.randint(0, size - self.image_size + 1, (b, 1), generator=gen)
-        left = torch.randint(0, size - self.image_size + 1, (b, 1), generator=gen)
-        offsets = torch.arange(self.image_size)
-        rows = (top + offsets)[:, None, :, None]
-        cols = (left + offsets)[:, None, None, :]
-        chans = torch.arange(stacks.shape[1])[None, :, None, None]
-        return stacks[torch.arange(b)[:, None, None, None], chans, rows, cols]
+    def _crop(self, stacks: np.ndarray) -> torch.Tensor:
+        """CURL's random crop (numpy, like CURL): an independent window of each stack."""
+        s = self.image_size
+        top, left = torch.randint(0, stacks.shape[-1] - s + 1, (2, stacks.shape[0])).tolist()
+        out = np.empty((*stacks.shape[:2], s, s), np.uint8)
+        for i, (y, x) in enumerate(zip(top, left, strict=True)):
+            out[i] = stacks[i, :, y : y + s, x : x + s]
+        return torch.from_numpy(out)
 
     def sample(self):
         """CURL's ``sample_cpc``: crops of obs, next_obs and a second crop of obs (positive)."""
         idx = torch.randint(0, self.obs.shape[0], (self.batch_size,))
-        obs, next_obs = self.obs[idx], self.next_obs[idx]
-        to = self.device
+        obs, next_obs = self.obs[idx].numpy(), self.next_obs[idx].numpy()
+        to, fmt = self.device, self.memory_format
         return (
-            self._crop(obs).to(to).float(),
+            self._crop(obs).to(to).float().contiguous(memory_format=fmt),
             self.actions[idx].to(to),
             self.rewards[idx].to(to).unsqueeze(-1),
-            self._crop(next_obs).to(to).float(),
+            self._crop(next_obs).to(to).float().contiguous(memory_format=fmt),
             self.not_done[idx].to(to).unsqueeze(-1),
-            self._crop(obs).to(to).float(),
+            self._crop(obs).to(to).float().contiguous(memory_format=fmt),
         )
 
     def update(self) -> None:

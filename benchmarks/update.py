@@ -51,12 +51,12 @@ def stepper(agent: SimounAgent, replay: FrameReplay):
     return lambda: agent.update(replay, next(counter))
 
 
-def time_steps(fn, steps: int) -> float:
-    """Milliseconds per call of ``fn`` over ``steps`` calls."""
-    start = time.perf_counter()
+def time_steps(fn, steps: int) -> tuple[float, float]:
+    """Wall-clock and process CPU milliseconds per call of ``fn`` over ``steps`` calls."""
+    wall, cpu = time.perf_counter(), time.process_time()
     for _ in range(steps):
         fn()
-    return 1e3 * (time.perf_counter() - start) / steps
+    return 1e3 * (time.perf_counter() - wall) / steps, 1e3 * (time.process_time() - cpu) / steps
 
 
 def main() -> None:
@@ -66,7 +66,10 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--threads", type=int, default=torch.get_num_threads())
     parser.add_argument("--encoder", default="dual_interactive")
-    parser.add_argument("--no-channels-last", action="store_true")
+    parser.add_argument("--no-channels-last", action="store_true", help="Simoun in NCHW")
+    parser.add_argument(
+        "--curl-channels-last", action="store_true", help="give the baseline channels-last too"
+    )
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     torch.manual_seed(0)
@@ -74,9 +77,12 @@ def main() -> None:
 
     print(
         f"torch {torch.__version__}, {args.threads} threads, 84x84 RGB, {ACTION_DIM} actions, "
-        f"encoder {args.encoder}, {args.steps} steps x {args.repeats} repeats (medians)"
+        f"encoder {args.encoder}, channels-last: Simoun {not args.no_channels_last}, CURL "
+        f"{args.curl_channels_last}; {args.steps} steps x {args.repeats} interleaved repeats"
     )
-    print(f"{'batch':>5} {'CURL ms/step':>13} {'Simoun ms/step':>15} {'ratio':>6}")
+    print("ms per training step: median (min) of the repeats; wall clock and process CPU time")
+    header = ("batch", "CURL wall", "Simoun wall", "ratio", "CURL cpu", "Simoun cpu", "ratio")
+    print("{:>5} {:>17} {:>17} {:>11} {:>17} {:>17} {:>11}".format(*header))
     for batch in args.batch_sizes:
         config = AgentConfig(
             encoder=args.encoder,
@@ -85,7 +91,7 @@ def main() -> None:
             channels_last=not args.no_channels_last,
         )
         agent = SimounAgent(FRAME, ACTION_DIM, config, device="cpu")
-        curl = CurlBaseline(ACTION_DIM, batch)
+        curl = CurlBaseline(ACTION_DIM, batch, channels_last=args.curl_channels_last)
         ours = stepper(agent, replay)
         curl.update()
         ours()
@@ -93,15 +99,21 @@ def main() -> None:
         for _ in range(args.repeats):
             curl_ms.append(time_steps(curl.update, args.steps))
             ours_ms.append(time_steps(ours, args.steps))
-        c, o = statistics.median(curl_ms), statistics.median(ours_ms)
-        print(f"{batch:>5} {c:>13.1f} {o:>15.1f} {o / c:>6.2f}")
+        row = [f"{batch:>5}"]
+        for kind in (0, 1):
+            c = [m[kind] for m in curl_ms]
+            o = [m[kind] for m in ours_ms]
+            cm, om = statistics.median(c), statistics.median(o)
+            row += [f"{cm:>8.0f} ({min(c):>6.0f})", f"{om:>8.0f} ({min(o):>6.0f})"]
+            row.append(f"{om / cm:>4.2f} ({min(o) / min(c):.2f})")
+        print(" ".join(row), flush=True)
 
     obs = replay.sample(1)["obs"][0]
     agent.act(obs)
-    act_ms = statistics.median(time_steps(lambda: agent.act(obs), 20) for _ in range(5))
+    act_ms = statistics.median(time_steps(lambda: agent.act(obs), 20)[0] for _ in range(5))
     curl_obs = curl.obs[0, :, :84, :84]
     curl.act(curl_obs)
-    curl_act_ms = statistics.median(time_steps(lambda: curl.act(curl_obs), 20) for _ in range(5))
+    curl_act_ms = statistics.median(time_steps(lambda: curl.act(curl_obs), 20)[0] for _ in range(5))
     print(f"act latency, one observation: Simoun {act_ms:.2f} ms, CURL {curl_act_ms:.2f} ms")
     big = FrameReplay(100_000, FRAME, ACTION_DIM)
     curl_bytes = 2 * 9 * 100 * 100 + 4 * ACTION_DIM + 4 + 4

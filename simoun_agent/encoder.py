@@ -9,6 +9,7 @@ the momentum encoder to get the contrastive positives without a second conv call
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import torch
@@ -44,14 +45,14 @@ def conv_trunk(in_channels: int, num_filters: int) -> nn.Sequential:
     layers: list[nn.Module] = []
     for i in range(4):
         conv = nn.Conv2d(num_filters if i else in_channels, num_filters, 3, 1 if i else 2)
-        layers += [conv, nn.ReLU()]
+        layers += [conv, nn.ReLU(inplace=True)]
     return nn.Sequential(*layers)
 
 
 class Head(nn.Module):
     """FC + LayerNorm from a feature map ``(N, c, h, w)`` to a vector (Alg. 1, lines 11-12).
 
-    The map is flattened in (h, w, c) order: a free view of a channels-last tensor.
+    The map is flattened in (h, w, c) order, a free view of a channels-last map.
     """
 
     def __init__(self, in_features: int, feature_dim: int) -> None:
@@ -82,7 +83,7 @@ class PixelEncoder(nn.Module):
     key_is_frame: bool
     """True: the contrastive view is frame t ``(B, C, H, W)``; False: the whole stack"""
 
-    def __init__(self, channels_last: bool = False) -> None:
+    def __init__(self, channels_last: bool = True) -> None:
         super().__init__()
         self.memory_format = torch.channels_last if channels_last else torch.contiguous_format
 
@@ -126,7 +127,7 @@ class SingleFrameEncoder(PixelEncoder):
         frame_shape: tuple[int, int, int],
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = False,
+        channels_last: bool = True,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -154,7 +155,7 @@ class StackedEncoder(PixelEncoder):
         num_frames: int,
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = False,
+        channels_last: bool = True,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -182,7 +183,7 @@ class FlareEncoder(PixelEncoder):
         num_frames: int,
         num_filters: int,
         feature_dim: int,
-        channels_last: bool = False,
+        channels_last: bool = True,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -228,10 +229,10 @@ class DualPathEncoder(PixelEncoder):
         num_filters: int = 32,
         feature_dim: int = 50,
         interactive: bool = True,
-        reduce_kernel: int = 5,
+        reduce_kernel: int = 3,
         reduce_stride: int = 3,
         detach_past_frames: bool = True,
-        channels_last: bool = False,
+        channels_last: bool = True,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
@@ -248,47 +249,43 @@ class DualPathEncoder(PixelEncoder):
         self.detach_past_frames = detach_past_frames
         self.repr_dim = 2 * feature_dim
 
-    def appearance_maps(self, frames: torch.Tensor) -> torch.Tensor:
-        """E^a on float frames ``(B, n, C, H, W)`` in one conv call -> ``(B, n, c, h, w)``."""
-        return self.appearance(self.trunk_input(frames.flatten(0, 1))).unflatten(
-            0, frames.shape[:2]
-        )
+    def appearance_maps(self, frame: torch.Tensor) -> torch.Tensor:
+        """E^a on float frames ``(B, C, H, W)`` -> F^a ``(B, c, h, w)``."""
+        return self.appearance(self.trunk_input(frame))
 
     def motion_maps(self, x: torch.Tensor) -> torch.Tensor:
-        """E^m on the residual pairs of float frames ``(B, n+2, C, H, W)``: one conv call over the
-        n pairs [(o_{j+1} - o_j), (o_{j+2} - o_{j+1})] -> ``(B, n, c, h, w)``."""
-        residual = x[:, 1:] - x[:, :-1]
-        pairs = torch.cat([residual[:, :-1], residual[:, 1:]], dim=2)
-        return self.motion(self.trunk_input(pairs.flatten(0, 1))).unflatten(0, pairs.shape[:2])
+        """E^m on the residual pair [(o_{t-1} - o_{t-2}), (o_t - o_{t-1})] of float frames
+        ``(B, 3, C, H, W)``, channels concatenated -> F^m_t ``(B, c, h, w)``."""
+        pair = torch.cat([x[:, 1] - x[:, 0], x[:, 2] - x[:, 1]], dim=1)
+        return self.motion(self.trunk_input(pair))
 
     def encode_key(self, view):
-        return self.head_appearance(self.appearance(self.trunk_input(view)))
+        return self.head_appearance(self.appearance_maps(view))
 
     def encode_maps(
         self,
         motion: torch.Tensor,
-        frames: torch.Tensor,
+        frames: Sequence[torch.Tensor],
+        reduced: Sequence[torch.Tensor] | None = None,
         anchor: bool = True,
         frame_features: bool = False,
     ) -> Encoding:
-        """From F^m_t ``(B, c, h, w)`` and F^a of frames t-2, t-1, t ``(B, 3, c, h, w)`` to the
-        features: interactive module (Eq. 4-6), then FC + LayerNorm per path (Alg. 1, 6-14)."""
-        b = motion.shape[0]
+        """From F^m_t and the F^a of frames t-2, t-1, t (each ``(B, c, h, w)``) to the features:
+        the interactive module (Eq. 4-6, reusing ``reduced`` appearance maps when given), then
+        FC + LayerNorm per path (Alg. 1, lines 6-14)."""
         masks = None
-        heads_in = [frames[:, 2]]
         if self.interaction is not None:
-            motion, enhanced, masks = self.interaction(motion, frames)
-            heads_in = [enhanced, frames[:, 2]] if anchor else [enhanced]
-        f_a = self.head_appearance(torch.cat(heads_in)).split(b)
+            motion, enhanced, masks = self.interaction(motion, frames, reduced)
+        plain = self.head_appearance(frames[2]) if anchor or self.interaction is None else None
+        f_a = plain if self.interaction is None else self.head_appearance(enhanced)
         f_m = self.head_motion(motion)
-        plain = f_a[-1]
         appearance = None
         if frame_features:
             with torch.no_grad():
-                earlier = self.head_appearance(frames[:, :2].flatten(0, 1)).unflatten(0, (b, 2))
-            appearance = torch.cat([earlier, plain.detach().unsqueeze(1)], dim=1)
+                earlier = [self.head_appearance(frames[0]), self.head_appearance(frames[1])]
+            appearance = torch.stack([*earlier, plain.detach()], dim=1)
         return Encoding(
-            state=torch.cat([f_m, f_a[0]], dim=1),
+            state=torch.cat([f_m, f_a], dim=1),
             anchor=plain if anchor else None,
             motion=f_m,
             appearance=appearance,
@@ -302,29 +299,37 @@ class DualPathEncoder(PixelEncoder):
                 f"{tuple(obs.shape)}; use FrameTriplet / SimounObservation with num_frames=3"
             )
         x = self.to_float(obs)
-        return self.encode_maps(
-            self.motion_maps(x)[:, 0], self.appearance_maps(x), True, frame_features
-        )
+        frames = self.appearance_maps(x.flatten(0, 1)).unflatten(0, x.shape[:2]).unbind(1)
+        return self.encode_maps(self.motion_maps(x), frames, frame_features=frame_features)
 
     def encode_transition(self, window, frame_features=False):
-        """Each unique frame through each path once: frame t with gradient, frames t-2, t-1
-        (unless ``detach_past_frames`` is off) and t+1 without; the residual pair of t with
-        gradient, that of t+1 without."""
+        """Each unique frame through each path once, with gradient only where a loss needs it:
+        F^a of frame t with gradient, of t+1 without, of t-2 and t-1 without when
+        ``detach_past_frames`` (else with); F^m of the pair ending at t with gradient, of the pair
+        ending at t+1 without; each reduced appearance map of the interactive module once."""
         x = self.to_float(window)
-        if self.detach_past_frames:
-            with torch.no_grad():
-                others = self.appearance_maps(x[:, [0, 1, 3]])
-            current = self.appearance_maps(x[:, 2:3])
-            frames = torch.cat([others[:, :2], current], dim=1)
-        else:
-            frames = self.appearance_maps(x[:, :3])
-            with torch.no_grad():
-                others = torch.cat([frames[:, :2], self.appearance_maps(x[:, 3:])], dim=1)
-        encoding = self.encode_maps(self.motion_maps(x[:, :3])[:, 0], frames, True, frame_features)
+        with torch.set_grad_enabled(torch.is_grad_enabled() and not self.detach_past_frames):
+            past = [self.appearance_maps(x[:, 0]), self.appearance_maps(x[:, 1])]
+        frames = [*past, self.appearance_maps(x[:, 2])]
+        reduced = None
+        if self.interaction is not None:
+            reduced = [self.interaction.reduce_appearance(f) for f in frames]
+        current = self.encode_maps(
+            self.motion_maps(x[:, :3]), frames, reduced, True, frame_features
+        )
         with torch.no_grad():
-            next_frames = torch.cat([others[:, 1:2], frames[:, 2:3], others[:, 2:3]], dim=1)
-            following = self.encode_maps(self.motion_maps(x[:, 1:])[:, 0], next_frames, False)
-        return encoding, following
+            frames_next = [frames[1], frames[2].detach(), self.appearance_maps(x[:, 3])]
+            reduced_next = None
+            if reduced is not None:
+                reduced_next = [
+                    reduced[1].detach(),
+                    reduced[2].detach(),
+                    self.interaction.reduce_appearance(frames_next[2]),
+                ]
+            following = self.encode_maps(
+                self.motion_maps(x[:, 1:]), frames_next, reduced_next, anchor=False
+            )
+        return current, following
 
 
 def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:

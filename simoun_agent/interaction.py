@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import torch
@@ -41,24 +43,43 @@ def structure_mask(attention: torch.Tensor, reduced: torch.Tensor) -> torch.Tens
     return gated.transpose(1, 2).reshape(n, c, h, w)
 
 
+@functools.lru_cache(maxsize=16)
+def _linear_resize_matrix(
+    out_size: int, in_size: int, device: torch.device, dtype: torch.dtype
+) -> torch.Tensor:
+    with torch.inference_mode(False), torch.no_grad():  # cached: must not be an inference tensor
+        eye = torch.eye(in_size, device=device, dtype=dtype).unsqueeze(1)
+        weights = F.interpolate(eye, size=out_size, mode="linear", align_corners=False)
+        return weights.squeeze(1).T.contiguous()
+
+
+def resize_bilinear(maps: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
+    """Bilinear resize of ``(N, c, h, w)`` to ``size`` (same result as ``F.interpolate(...,
+    mode="bilinear", align_corners=False)``) as two small matmuls, whose backward on CPU is far
+    cheaper than interpolate's."""
+    rows = _linear_resize_matrix(size[0], maps.shape[-2], maps.device, maps.dtype)
+    cols = _linear_resize_matrix(size[1], maps.shape[-1], maps.device, maps.dtype)
+    return rows @ maps @ cols.T
+
+
 class StructuralInteraction(nn.Module):
     """Inter-frame attention between the two paths, modulating both feature maps (Eq. 4-6).
 
     Two reducing convs (one for the appearance maps, shared by the three frames, one for the motion
-    map) keep the channel count and shrink the maps, e.g. 35x35 -> 11x11 with kernel 5 / stride 3,
+    map) keep the channel count and shrink the maps, e.g. 35x35 -> 11x11 with kernel 3 / stride 3,
     so X is 121 x 121. The masks X.Fh are resized back to the feature-map size bilinearly and added
     with a learnable scale per path initialised to 0 (Eq. 6), so the module starts as the identity.
 
     Example:
         >>> import torch
         >>> sim = StructuralInteraction(channels=32)
-        >>> f_m, f_a = torch.rand(2, 32, 35, 35), torch.rand(2, 3, 32, 35, 35)
-        >>> out_m, out_a, masks = sim(f_m, f_a)
+        >>> f_m, frames = torch.rand(2, 32, 35, 35), [torch.rand(2, 32, 35, 35) for _ in range(3)]
+        >>> out_m, out_a, masks = sim(f_m, frames)
         >>> out_m.shape, masks.attention.shape
         (torch.Size([2, 32, 35, 35]), torch.Size([2, 121, 121]))
     """
 
-    def __init__(self, channels: int, kernel_size: int = 5, stride: int = 3) -> None:
+    def __init__(self, channels: int, kernel_size: int = 3, stride: int = 3) -> None:
         super().__init__()
         self.reduce_appearance = nn.Conv2d(channels, channels, kernel_size, stride)
         self.reduce_motion = nn.Conv2d(channels, channels, kernel_size, stride)
@@ -66,22 +87,23 @@ class StructuralInteraction(nn.Module):
         self.beta_appearance = nn.Parameter(torch.zeros(()))
 
     def forward(
-        self, motion: torch.Tensor, appearance: torch.Tensor
+        self,
+        motion: torch.Tensor,
+        frames: Sequence[torch.Tensor],
+        reduced: Sequence[torch.Tensor] | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor, StructureMasks]:
-        """Modulate F^m_t ``(N, c, h, w)`` and frame t of ``appearance`` ``(N, 3, c, h, w)``.
+        """Modulate F^m_t ``(N, c, h, w)`` and F^a_t, the last of the appearance maps ``frames``
+        of t-2, t-1, t (each ``(N, c, h, w)``). ``reduced`` may give the three reduced
+        appearance maps (``reduce_appearance`` of each) when they are already computed.
 
         Returns the enhanced F^m_t, the enhanced F^a_t and the masks (attention X, X^m, X^a).
         """
-        n, k, c, h, w = appearance.shape
-        reduced = self.reduce_appearance(appearance.reshape(n * k, c, h, w))
-        reduced = reduced.reshape(n, k, *reduced.shape[1:])
-        attention = inter_frame_attention(reduced[:, 0], reduced[:, 1], reduced[:, 2])
+        if reduced is None:
+            reduced = [self.reduce_appearance(f) for f in frames]
+        attention = inter_frame_attention(*reduced)
         mask_m = structure_mask(attention, self.reduce_motion(motion))
-        mask_a = structure_mask(attention, reduced[:, 2])
-        up = F.interpolate(
-            torch.cat([mask_m, mask_a]), size=(h, w), mode="bilinear", align_corners=False
-        )
-        up_m, up_a = up[:n], up[n:]
-        enhanced_m = motion + self.beta_motion * up_m
-        enhanced_a = appearance[:, 2] + self.beta_appearance * up_a
+        mask_a = structure_mask(attention, reduced[2])
+        size = motion.shape[-2:]
+        enhanced_m = motion + self.beta_motion * resize_bilinear(mask_m, size)
+        enhanced_a = frames[2] + self.beta_appearance * resize_bilinear(mask_a, size)
         return enhanced_m, enhanced_a, StructureMasks(attention, mask_m, mask_a)

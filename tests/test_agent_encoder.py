@@ -1,0 +1,97 @@
+"""Encoders (every ablation of Fig. 6) and the structural interactive module (Eq. 4-6)."""
+
+import pytest
+import torch
+
+from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
+from simoun_agent.interaction import inter_frame_attention
+
+FRAME = (3, 32, 32)
+ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
+
+
+@pytest.fixture(autouse=True, scope="module")
+def one_thread():
+    """These tensors are tiny: a second thread only adds spin-waiting on a shared machine."""
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(threads)
+
+
+def triplets(batch: int = 4, seed: int = 0) -> torch.Tensor:
+    gen = torch.Generator().manual_seed(seed)
+    return torch.randint(0, 256, (batch, 3, *FRAME), generator=gen, dtype=torch.uint8)
+
+
+@pytest.mark.parametrize("kind", ENCODERS)
+def test_every_encoder_shapes_and_dtypes(kind):
+    config = AgentConfig(encoder=kind, curiosity=False, feature_dim=8, num_filters=4)
+    encoder = make_encoder(config, FRAME)
+    obs = triplets()
+    enc = encoder(obs)
+    width = 16 if kind.startswith("dual") else 8
+    assert encoder.repr_dim == width
+    assert enc.state.shape == (4, width) and enc.state.dtype == torch.float32
+    assert enc.anchor.shape == (4, 8)
+    view = encoder.key_frames(obs)
+    assert view.dtype == torch.float32 and view.shape == (
+        (4, *FRAME) if encoder.key_is_frame else (4, 3, *FRAME)
+    )
+    assert encoder.encode_key(view).shape == (4, 8)
+    window = torch.cat([obs, triplets(seed=1)[:, :1]], dim=1)
+    current, following = encoder.encode_transition(window)
+    assert current.state.shape == following.state.shape == (4, width)
+    assert current.state.requires_grad and not following.state.requires_grad
+    # the state at t+1 is what a plain forward on the shifted triplet gives
+    torch.testing.assert_close(following.state, encoder(window[:, 1:]).state)
+    torch.testing.assert_close(current.state, encoder(window[:, :-1]).state)
+    assert torch.isfinite(current.state).all()
+
+
+def test_dual_encoder_curiosity_features_and_masks():
+    encoder = DualPathEncoder(FRAME, num_filters=4, feature_dim=8, reduce_kernel=3, reduce_stride=2)
+    enc = encoder(triplets(), frame_features=True)
+    assert enc.motion.shape == (4, 8) and enc.appearance.shape == (4, 3, 8)
+    torch.testing.assert_close(enc.appearance[:, 2], enc.anchor.detach())
+    # f^a of frame t-2 is what the appearance path gives on that frame alone
+    alone = encoder.encode_key(encoder.to_float(triplets()[:, 0]))
+    torch.testing.assert_close(enc.appearance[:, 0], alone)
+    # 32 -> 15 -> 13 -> 11 -> 9, reduced with kernel 3 stride 2 -> 4x4: X is 16 x 16
+    assert enc.masks.attention.shape == (4, 16, 16)
+    assert enc.masks.motion.shape == enc.masks.appearance.shape == (4, 4, 4, 4)
+
+
+def test_attention_rows_sum_to_one():
+    gen = torch.Generator().manual_seed(0)
+    maps = [torch.randn(2, 8, 5, 5, generator=gen) for _ in range(3)]
+    x = inter_frame_attention(*maps)
+    assert x.shape == (2, 25, 25)
+    torch.testing.assert_close(x.sum(-1), torch.ones(2, 25))
+    assert (x > 0).all()
+
+
+def test_beta_zero_leaves_features_unchanged_and_beta_changes_them():
+    module = StructuralInteraction(channels=6)
+    gen = torch.Generator().manual_seed(0)
+    motion = torch.randn(2, 6, 11, 11, generator=gen)
+    appearance = [torch.randn(2, 6, 11, 11, generator=gen) for _ in range(3)]
+    out_m, out_a, masks = module(motion, appearance)
+    assert module.beta_motion.item() == 0 and module.beta_appearance.item() == 0
+    torch.testing.assert_close(out_m, motion, rtol=0, atol=0)
+    torch.testing.assert_close(out_a, appearance[2], rtol=0, atol=0)
+    with torch.no_grad():
+        module.beta_motion.fill_(0.5)
+        module.beta_appearance.fill_(0.5)
+    out_m, out_a, _ = module(motion, appearance)
+    assert not torch.allclose(out_m, motion) and not torch.allclose(out_a, appearance[2])
+    assert masks.attention.shape == (2, 9, 9)  # 11x11 -> kernel 3 stride 3 -> 3x3
+
+
+def test_default_reduction_at_84x84_is_11x11():
+    encoder = DualPathEncoder((3, 84, 84))
+    obs = torch.zeros(1, 3, 3, 84, 84, dtype=torch.uint8)
+    with torch.no_grad():
+        enc = encoder(obs)
+    assert enc.masks.attention.shape == (1, 121, 121)
+    assert enc.state.shape == (1, 100)
