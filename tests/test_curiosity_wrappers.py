@@ -234,6 +234,7 @@ def test_vector_same_step_mode_scores_the_final_observation():
     envs.close()
 
 
+@pytest.mark.filterwarnings("ignore:.*different from the unwrapped version")
 def test_passes_check_env_and_rebuilds_from_its_spec():
     env = ConsistencyCuriosityReward(cartpole(), ProjectionFeatures(3 * SIZE * SIZE), scale=0.5)
     check_env(env, skip_render_check=True)
