@@ -284,7 +284,8 @@ def train(run: Run) -> dict[str, Any]:
 
             if counters.agent_step > learning_starts:
                 for _ in range(config.updates_per_step):
-                    update_metrics = agent.update(replay, counters.env_step)
+                    # Actor metrics come every actor_update_every updates: keep the latest of each.
+                    update_metrics.update(agent.update(replay, counters.env_step))
                     counters.updates += 1
 
             if not (terminated or truncated):
