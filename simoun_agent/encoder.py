@@ -16,7 +16,7 @@ import torch
 from torch import nn
 
 from simoun_agent.config import AgentConfig
-from simoun_agent.interaction import StructuralInteraction, StructureMasks
+from simoun_agent.interaction import StructuralInteraction, StructureMasks, resized_linear
 
 
 class Encoding(NamedTuple):
@@ -60,8 +60,16 @@ class Head(nn.Module):
         self.fc = nn.Linear(in_features, feature_dim)
         self.norm = nn.LayerNorm(feature_dim)
 
+    def linear(self, maps: torch.Tensor) -> torch.Tensor:
+        """The FC layer alone."""
+        return self.fc(maps.permute(0, 2, 3, 1).flatten(1))
+
+    def modulation(self, mask: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
+        """FC weights (no bias) applied to ``mask`` resized bilinearly to ``size``."""
+        return resized_linear(mask, self.fc.weight, size)
+
     def forward(self, maps: torch.Tensor) -> torch.Tensor:
-        return self.norm(self.fc(maps.permute(0, 2, 3, 1).flatten(1)))
+        return self.norm(self.linear(maps))
 
 
 def weight_init(module: nn.Module) -> None:
@@ -91,6 +99,15 @@ class PixelEncoder(nn.Module):
     def to_float(obs: torch.Tensor) -> torch.Tensor:
         """uint8 -> float in [0, 1]."""
         return obs.float().div_(255.0)
+
+    def frame_stack(self, obs: torch.Tensor) -> torch.Tensor:
+        """uint8 ``(B, n, C, H, W)`` -> float ``(n, B, C, H, W)`` in [0, 1] whose frames ``[j]``
+        are already in the conv memory format (one uint8 transpose instead of a float copy per
+        frame)."""
+        if self.memory_format == torch.channels_last:
+            x = obs.permute(1, 0, 3, 4, 2).contiguous().float().div_(255.0)
+            return x.permute(0, 1, 4, 2, 3)
+        return obs.transpose(0, 1).contiguous().float().div_(255.0)
 
     def trunk_input(self, x: torch.Tensor) -> torch.Tensor:
         return x.contiguous(memory_format=self.memory_format)
@@ -253,10 +270,10 @@ class DualPathEncoder(PixelEncoder):
         """E^a on float frames ``(B, C, H, W)`` -> F^a ``(B, c, h, w)``."""
         return self.appearance(self.trunk_input(frame))
 
-    def motion_maps(self, x: torch.Tensor) -> torch.Tensor:
-        """E^m on the residual pair [(o_{t-1} - o_{t-2}), (o_t - o_{t-1})] of float frames
-        ``(B, 3, C, H, W)``, channels concatenated -> F^m_t ``(B, c, h, w)``."""
-        pair = torch.cat([x[:, 1] - x[:, 0], x[:, 2] - x[:, 1]], dim=1)
+    def motion_maps(self, frames: Sequence[torch.Tensor]) -> torch.Tensor:
+        """E^m on the residual pair [(o_{t-1} - o_{t-2}), (o_t - o_{t-1})] of three float frames
+        ``(B, C, H, W)``, channels concatenated -> F^m_t ``(B, c, h, w)``."""
+        pair = torch.cat([frames[1] - frames[0], frames[2] - frames[1]], dim=1)
         return self.motion(self.trunk_input(pair))
 
     def encode_key(self, view):
@@ -274,11 +291,20 @@ class DualPathEncoder(PixelEncoder):
         the interactive module (Eq. 4-6, reusing ``reduced`` appearance maps when given), then
         FC + LayerNorm per path (Alg. 1, lines 6-14)."""
         masks = None
-        if self.interaction is not None:
-            motion, enhanced, masks = self.interaction(motion, frames, reduced)
-        plain = self.head_appearance(frames[2]) if anchor or self.interaction is None else None
-        f_a = plain if self.interaction is None else self.head_appearance(enhanced)
-        f_m = self.head_motion(motion)
+        if self.interaction is None:
+            plain = f_a = self.head_appearance(frames[2])
+            f_m = self.head_motion(motion)
+        else:
+            # Eq. 6 then FC + LN: FC(F + beta * resize(X.Fh)) = FC(F) + beta * (W R)(X.Fh), so the
+            # enhanced maps are never built and f^a_t before / after interaction share FC(F^a_t)
+            masks = self.interaction.masks(motion, frames, reduced)
+            size = tuple(motion.shape[-2:])
+            beta_m, beta_a = self.interaction.beta_motion, self.interaction.beta_appearance
+            hm, ha = self.head_motion, self.head_appearance
+            f_m = hm.norm(hm.linear(motion) + beta_m * hm.modulation(masks.motion, size))
+            linear_a = ha.linear(frames[2])
+            f_a = ha.norm(linear_a + beta_a * ha.modulation(masks.appearance, size))
+            plain = ha.norm(linear_a)
         appearance = None
         if frame_features:
             with torch.no_grad():
@@ -298,8 +324,8 @@ class DualPathEncoder(PixelEncoder):
                 f"DualPathEncoder needs 3 frames (t-2, t-1, t) per observation, got shape "
                 f"{tuple(obs.shape)}; use FrameTriplet / SimounObservation with num_frames=3"
             )
-        x = self.to_float(obs)
-        frames = self.appearance_maps(x.flatten(0, 1)).unflatten(0, x.shape[:2]).unbind(1)
+        x = self.frame_stack(obs)
+        frames = self.appearance_maps(x.flatten(0, 1)).unflatten(0, x.shape[:2]).unbind(0)
         return self.encode_maps(self.motion_maps(x), frames, frame_features=frame_features)
 
     def encode_transition(self, window, frame_features=False):
@@ -307,18 +333,16 @@ class DualPathEncoder(PixelEncoder):
         F^a of frame t with gradient, of t+1 without, of t-2 and t-1 without when
         ``detach_past_frames`` (else with); F^m of the pair ending at t with gradient, of the pair
         ending at t+1 without; each reduced appearance map of the interactive module once."""
-        x = self.to_float(window)
+        x = self.frame_stack(window)
         with torch.set_grad_enabled(torch.is_grad_enabled() and not self.detach_past_frames):
-            past = [self.appearance_maps(x[:, 0]), self.appearance_maps(x[:, 1])]
-        frames = [*past, self.appearance_maps(x[:, 2])]
+            past = [self.appearance_maps(x[0]), self.appearance_maps(x[1])]
+        frames = [*past, self.appearance_maps(x[2])]
         reduced = None
         if self.interaction is not None:
             reduced = [self.interaction.reduce_appearance(f) for f in frames]
-        current = self.encode_maps(
-            self.motion_maps(x[:, :3]), frames, reduced, True, frame_features
-        )
+        current = self.encode_maps(self.motion_maps(x[:3]), frames, reduced, True, frame_features)
         with torch.no_grad():
-            frames_next = [frames[1], frames[2].detach(), self.appearance_maps(x[:, 3])]
+            frames_next = [frames[1], frames[2].detach(), self.appearance_maps(x[3])]
             reduced_next = None
             if reduced is not None:
                 reduced_next = [
@@ -327,7 +351,7 @@ class DualPathEncoder(PixelEncoder):
                     self.interaction.reduce_appearance(frames_next[2]),
                 ]
             following = self.encode_maps(
-                self.motion_maps(x[:, 1:]), frames_next, reduced_next, anchor=False
+                self.motion_maps(x[1:]), frames_next, reduced_next, anchor=False
             )
         return current, following
 

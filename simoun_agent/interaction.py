@@ -62,6 +62,18 @@ def resize_bilinear(maps: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
     return rows @ maps @ cols.T
 
 
+def resized_linear(mask: torch.Tensor, weight: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
+    """``resize_bilinear(mask, size)`` flattened in (h, w, c) order, times ``weight.T``, without
+    building the resized map: the resize is linear, so it folds into the weight (``weight`` is
+    ``(D, H*W*c)`` for the full-size map; the folded weight is ``(D, h*w*c)``)."""
+    d = weight.shape[0]
+    c, h, w = mask.shape[1:]
+    rows = _linear_resize_matrix(size[0], h, mask.device, mask.dtype)
+    cols = _linear_resize_matrix(size[1], w, mask.device, mask.dtype)
+    folded = torch.einsum("dHWc,Hh,Ww->dhwc", weight.view(d, size[0], size[1], c), rows, cols)
+    return mask.permute(0, 2, 3, 1).flatten(1) @ folded.reshape(d, -1).T
+
+
 class StructuralInteraction(nn.Module):
     """Inter-frame attention between the two paths, modulating both feature maps (Eq. 4-6).
 
@@ -86,24 +98,33 @@ class StructuralInteraction(nn.Module):
         self.beta_motion = nn.Parameter(torch.zeros(()))
         self.beta_appearance = nn.Parameter(torch.zeros(()))
 
+    def masks(
+        self,
+        motion: torch.Tensor,
+        frames: Sequence[torch.Tensor],
+        reduced: Sequence[torch.Tensor] | None = None,
+    ) -> StructureMasks:
+        """Eq. 4-5 from F^m_t ``(N, c, h, w)`` and the appearance maps ``frames`` of t-2, t-1, t
+        (each ``(N, c, h, w)``); ``reduced`` may give their reduced maps when already computed."""
+        if reduced is None:
+            reduced = [self.reduce_appearance(f) for f in frames]
+        attention = inter_frame_attention(*reduced)
+        mask_m = structure_mask(attention, self.reduce_motion(motion))
+        mask_a = structure_mask(attention, reduced[2])
+        return StructureMasks(attention, mask_m, mask_a)
+
     def forward(
         self,
         motion: torch.Tensor,
         frames: Sequence[torch.Tensor],
         reduced: Sequence[torch.Tensor] | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor, StructureMasks]:
-        """Modulate F^m_t ``(N, c, h, w)`` and F^a_t, the last of the appearance maps ``frames``
-        of t-2, t-1, t (each ``(N, c, h, w)``). ``reduced`` may give the three reduced
-        appearance maps (``reduce_appearance`` of each) when they are already computed.
+        """Eq. 6: the enhanced F^m_t and F^a_t (``frames[2]``) as maps, and the masks.
 
-        Returns the enhanced F^m_t, the enhanced F^a_t and the masks (attention X, X^m, X^a).
-        """
-        if reduced is None:
-            reduced = [self.reduce_appearance(f) for f in frames]
-        attention = inter_frame_attention(*reduced)
-        mask_m = structure_mask(attention, self.reduce_motion(motion))
-        mask_a = structure_mask(attention, reduced[2])
+        ``DualPathEncoder`` computes the same features without building these maps (it folds the
+        resize into its FC layers, see :func:`resized_linear`)."""
+        masks = self.masks(motion, frames, reduced)
         size = motion.shape[-2:]
-        enhanced_m = motion + self.beta_motion * resize_bilinear(mask_m, size)
-        enhanced_a = frames[2] + self.beta_appearance * resize_bilinear(mask_a, size)
-        return enhanced_m, enhanced_a, StructureMasks(attention, mask_m, mask_a)
+        enhanced_m = motion + self.beta_motion * resize_bilinear(masks.motion, size)
+        enhanced_a = frames[2] + self.beta_appearance * resize_bilinear(masks.appearance, size)
+        return enhanced_m, enhanced_a, masks

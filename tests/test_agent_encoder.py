@@ -2,9 +2,10 @@
 
 import pytest
 import torch
+import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
-from simoun_agent.interaction import inter_frame_attention
+from simoun_agent.interaction import inter_frame_attention, resize_bilinear
 
 FRAME = (3, 32, 32)
 ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
@@ -95,3 +96,25 @@ def test_default_reduction_at_84x84_is_11x11():
         enc = encoder(obs)
     assert enc.masks.attention.shape == (1, 121, 121)
     assert enc.state.shape == (1, 100)
+
+
+def test_folded_resize_matches_explicit_eq6_maps():
+    torch.manual_seed(0)
+    encoder = DualPathEncoder(FRAME, num_filters=4, feature_dim=8, reduce_kernel=3, reduce_stride=2)
+    with torch.no_grad():
+        encoder.interaction.beta_motion.fill_(0.7)
+        encoder.interaction.beta_appearance.fill_(-0.3)
+    obs = triplets()
+    x = encoder.frame_stack(obs)
+    frames = [encoder.appearance_maps(x[j]) for j in range(3)]
+    enhanced_m, enhanced_a, _ = encoder.interaction(encoder.motion_maps(x), frames)
+    enc = encoder(obs)
+    torch.testing.assert_close(enc.motion, encoder.head_motion(enhanced_m))
+    torch.testing.assert_close(enc.state[:, 8:], encoder.head_appearance(enhanced_a))
+    torch.testing.assert_close(enc.anchor, encoder.head_appearance(frames[2]))
+
+
+def test_resize_bilinear_matches_interpolate():
+    x = torch.randn(2, 3, 4, 7)
+    expected = F.interpolate(x, size=(9, 17), mode="bilinear", align_corners=False)
+    torch.testing.assert_close(resize_bilinear(x, (9, 17)), expected)
