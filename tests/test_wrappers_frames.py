@@ -95,13 +95,17 @@ def test_residual_motion_errors_name_the_fix():
 
 
 def test_action_repeat_sums_rewards_and_stops_at_episode_end():
-    env = ActionRepeat(gym.make("CartPole-v1"), repeat=4)
+    # The time limit ends the episode at inner step 6, in the middle of the second agent step.
+    env = ActionRepeat(gym.make("CartPole-v1", max_episode_steps=6), repeat=4)
+    ref = gym.make("CartPole-v1", max_episode_steps=6)
     env.reset(seed=0)
-    assert env.step(0)[1] == 4.0
-    total, done, steps = 0.0, False, 0
-    while not done:
-        _, reward, terminated, truncated, _ = env.step(0)
-        total, done, steps = total + reward, terminated or truncated, steps + 1
-    assert total < 4 * steps  # the last agent step stopped early
-    with pytest.raises(ValueError, match=r"positive int"):
+    ref.reset(seed=0)
+    obs, reward, terminated, truncated, _ = env.step(1)
+    assert (reward, terminated, truncated) == (4.0, False, False)
+    obs, reward, terminated, truncated, _ = env.step(0)
+    assert (reward, terminated, truncated) == (2.0, False, True)  # 2 inner steps, not 4
+    for action in [1] * 4 + [0] * 2:
+        expected, *_ = ref.step(action)
+    np.testing.assert_array_equal(obs, expected)  # the last inner step's observation
+    with pytest.raises(ValueError, match=r"positive int.*ActionRepeat\(env, 8\)"):
         ActionRepeat(gym.make("CartPole-v1"), repeat=0)
