@@ -163,3 +163,25 @@ def test_error_bad_size_and_source():
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), source="camera")
     with pytest.raises(TypeError, match=r"needs image observations.*source='render'"):
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), source="observation")
+
+
+@pytest.mark.parametrize("grayscale", [False, True])
+def test_frames_equal_gymnasiums_own_chain_channel_first(grayscale):
+    def render_env() -> gym.Env:
+        return gym.make("CartPole-v1", render_mode="rgb_array", max_episode_steps=8)
+
+    ours = SimounObservation(render_env(), size=(20, 30), grayscale=grayscale)
+    ref = gym.wrappers.ResizeObservation(gym.wrappers.AddRenderObservation(render_env()), (20, 30))
+    if grayscale:
+        ref = gym.wrappers.GrayscaleObservation(ref, keep_dim=True)
+    ref = gym.wrappers.FrameStackObservation(ref, 3, padding_type="reset")
+    obs, _ = ours.reset(seed=0)
+    expected, _ = ref.reset(seed=0)
+    for t in range(12):  # past the time limit: one reset inside the loop
+        np.testing.assert_array_equal(obs["frames"], expected.transpose(0, 3, 1, 2))
+        np.testing.assert_array_equal(obs["motion"], residual_motion(obs["frames"]))
+        obs, _, terminated, truncated, _ = ours.step(t % 2)
+        expected, *_ = ref.step(t % 2)
+        if terminated or truncated:
+            obs, _ = ours.reset(seed=1)
+            expected, _ = ref.reset(seed=1)
