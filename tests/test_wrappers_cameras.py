@@ -33,6 +33,10 @@ def test_dm_control_two_named_cameras():
     obs2, *_ = env.step(env.action_space.sample())
     assert not np.shares_memory(obs, obs2)
     np.testing.assert_array_equal(env.render(), obs2)
+    # each view is that camera's rendering of the current step, in the order given
+    physics = env.unwrapped._env.physics
+    for view, name in zip(_views(obs2, 2), ["side", "back"], strict=True):
+        np.testing.assert_array_equal(view, physics.render(32, 40, camera_id=name))
 
 
 def test_dm_control_camera_ids_and_unknown_name():
