@@ -242,3 +242,23 @@ def test_passes_check_env_and_rebuilds_from_its_spec():
     assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.curiosity.scale == 0.5
     rebuilt.reset(seed=0)
     assert "reward_intrinsic" in rebuilt.step(0)[4]
+
+
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+def test_vector_version_watches_only_transitions_within_an_episode(mode):
+    source = ProjectionFeatures(3 * SIZE * SIZE)
+    envs = ConsistencyCuriosityVectorReward(make_vec(2, autoreset_mode=mode), source)
+    envs.reset(seed=[0, 5])
+    rng = np.random.default_rng(1)
+    episodes_ended = 0
+    for _ in range(60):
+        *_, terminated, truncated, _ = envs.step(rng.integers(0, 2, size=2))
+        episodes_ended += int(np.logical_or(terminated, truncated).sum())
+    assert episodes_ended >= 2
+    # every (triplet, next triplet) pair handed to the source is one step of one episode: the
+    # next triplet is the triplet shifted by one frame (across an episode end it would not be)
+    pairs = [(a, b) for triplets, nexts, _ in source.watched for a, b in zip(triplets, nexts)]
+    assert len(pairs) == envs.state_dict()["step"]
+    for triplet, following in pairs:
+        np.testing.assert_array_equal(following[:2], triplet[1:])
+    envs.close()
