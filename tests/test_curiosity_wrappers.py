@@ -257,7 +257,11 @@ def test_vector_version_watches_only_transitions_within_an_episode(mode):
     assert episodes_ended >= 2
     # every (triplet, next triplet) pair handed to the source is one step of one episode: the
     # next triplet is the triplet shifted by one frame (across an episode end it would not be)
-    pairs = [(a, b) for triplets, nexts, _ in source.watched for a, b in zip(triplets, nexts)]
+    pairs = [
+        (a, b)
+        for triplets, nexts, _ in source.watched
+        for a, b in zip(triplets, nexts, strict=True)
+    ]
     assert len(pairs) == envs.state_dict()["step"]
     for triplet, following in pairs:
         np.testing.assert_array_equal(following[:2], triplet[1:])
