@@ -68,6 +68,9 @@ def main() -> None:
     parser.add_argument("--encoder", default="dual_interactive")
     parser.add_argument("--no-channels-last", action="store_true", help="Simoun in NCHW")
     parser.add_argument(
+        "--full-gradient", action="store_true", help="Simoun with detach_past_frames=False"
+    )
+    parser.add_argument(
         "--curl-channels-last", action="store_true", help="give the baseline channels-last too"
     )
     args = parser.parse_args()
@@ -77,7 +80,8 @@ def main() -> None:
 
     print(
         f"torch {torch.__version__}, {args.threads} threads, 84x84 RGB, {ACTION_DIM} actions, "
-        f"encoder {args.encoder}, channels-last: Simoun {not args.no_channels_last}, CURL "
+        f"encoder {args.encoder}, gradient through frames t-2, t-1: {args.full_gradient}, "
+        f"channels-last: Simoun {not args.no_channels_last}, CURL "
         f"{args.curl_channels_last}; {args.steps} steps x {args.repeats} interleaved repeats"
     )
     print("ms per training step: median (min) of the repeats; wall clock and process CPU time")
@@ -89,6 +93,7 @@ def main() -> None:
             batch_size=batch,
             curiosity=args.encoder.startswith("dual"),
             channels_last=not args.no_channels_last,
+            detach_past_frames=not args.full_gradient,
         )
         agent = SimounAgent(FRAME, ACTION_DIM, config, device="cpu")
         curl = CurlBaseline(ACTION_DIM, batch, channels_last=args.curl_channels_last)

@@ -70,8 +70,11 @@ def resized_linear(mask: torch.Tensor, weight: torch.Tensor, size: tuple[int, in
     c, h, w = mask.shape[1:]
     rows = _linear_resize_matrix(size[0], h, mask.device, mask.dtype)
     cols = _linear_resize_matrix(size[1], w, mask.device, mask.dtype)
-    folded = torch.einsum("dHWc,Hh,Ww->dhwc", weight.view(d, size[0], size[1], c), rows, cols)
-    return mask.permute(0, 2, 3, 1).flatten(1) @ folded.reshape(d, -1).T
+    # sum over H then W as two batched matmuls on views: (h, H) @ (d, H, W*c) -> (d, h, W*c),
+    # then (w, W) @ (d*h, W, c) -> (d*h, w, c); no copy of the (D, H*W*c) weight
+    folded = rows.T @ weight.view(d, size[0], size[1] * c)
+    folded = cols.T @ folded.view(d * h, size[1], c)
+    return mask.permute(0, 2, 3, 1).flatten(1) @ folded.view(d, h * w * c).T
 
 
 class StructuralInteraction(nn.Module):
