@@ -113,7 +113,7 @@ def encode_actions(space: spaces.Space, actions: np.ndarray) -> np.ndarray:
     if isinstance(space, spaces.Discrete):
         return np.eye(space.n, dtype=np.float32)[actions.reshape(-1) - space.start]
     if isinstance(space, spaces.MultiDiscrete):
-        flat = actions.reshape(len(actions), -1)
+        flat = actions.reshape(len(actions), -1) - space.start.reshape(-1)
         parts = [np.eye(n, dtype=np.float32)[flat[:, i]] for i, n in enumerate(space.nvec.ravel())]
         return np.concatenate(parts, axis=1)
     flat = actions.reshape(len(actions), -1).astype(np.float32)

@@ -108,6 +108,8 @@ def test_state_dict_restores_the_features_and_counters():
 def test_actions_are_encoded_for_the_transition_model():
     one_hot = encode_actions(gym.spaces.Discrete(3, start=1), np.array([1, 3]))
     np.testing.assert_array_equal(one_hot, [[1, 0, 0], [0, 0, 1]])
+    multi = encode_actions(gym.spaces.MultiDiscrete([3, 2], start=[1, -1]), np.array([[3, -1]]))
+    np.testing.assert_array_equal(multi, [[0, 0, 1, 1, 0]])
     scaled = encode_actions(gym.spaces.Box(0.0, 4.0, (2,)), np.array([[0.0, 2.0], [4.0, 1.0]]))
     np.testing.assert_allclose(scaled, [[-1, 0], [1, -0.5]])
     with pytest.raises(TypeError, match="action spaces"):
