@@ -27,7 +27,8 @@ class SimounParallelObservation(BaseParallelWrapper):
     added or the stack is folded. Agents that appear mid-episode start with their own
     reset-padded stack, and an agent's stack is dropped when it terminates or truncates.
     With ``source="render"`` (or ``"auto"`` when observations are not images) every agent
-    sees the env's global ``render()`` frame. ``observation_space(agent)`` returns the same
+    sees the env's global ``render()`` frame (then, with ``size=None``, ``observation_space``
+    needs a render, so call ``reset()`` first). ``observation_space(agent)`` returns the same
     cached object on every call, as ``parallel_api_test`` requires.
 
     Example:
@@ -106,14 +107,18 @@ class SimounParallelObservation(BaseParallelWrapper):
 
     def _layout(self, agent: Any, frame: np.ndarray | None = None) -> tuple[int, int, int]:
         if agent not in self._layouts:
-            if self._from_render:
+            if self._from_render and self._size is not None:
+                # rgb_array renders are (H, W, 3) and get resized: no render needed, which lets
+                # observation_space() answer before reset() (PettingZoo envs cannot render yet).
+                height, width, channels = (*self._size, 3)
+            elif self._from_render:
                 frame = self.env.render() if frame is None else frame
-                layout = (*frame.shape[:2], frame.shape[2] if frame.ndim == 3 else 1)
+                height, width = frame.shape[:2]
+                channels = frame.shape[2] if frame.ndim == 3 else 1
             else:
-                layout = image_layout(self.env.observation_space(agent))
-            height, width, channels = layout
-            if self._size is not None:
-                height, width = self._size
+                height, width, channels = image_layout(self.env.observation_space(agent))
+                if self._size is not None:
+                    height, width = self._size
             if self._grayscale:
                 channels = 1
             self._layouts[agent] = (channels, height, width)

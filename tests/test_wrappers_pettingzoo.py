@@ -86,6 +86,21 @@ def test_parallel_api_test_cooperative_pong_grayscale_folded():
     assert env.observation_space("paddle_0") == gym.spaces.Box(0, 255, (3, 20, 24), np.uint8)
 
 
+def test_render_source_gives_every_agent_the_global_frame():
+    pistons = pettingzoo.make(
+        "parallel", "butterfly/pistonball-v6", n_pistons=3, max_cycles=10, render_mode="rgb_array"
+    )
+    env = SimounParallelObservation(pistons, size=(20, 28), source="render")
+    space = env.observation_space("piston_0")  # answered before reset: no render needed
+    assert space["frames"].shape == (3, 3, 20, 28)
+    parallel_api_test(env, num_cycles=10)
+    obs, _ = env.reset(seed=0)
+    obs, *_ = env.step({agent: env.action_space(agent).sample() for agent in env.agents})
+    first, second = obs["piston_0"]["frames"], obs["piston_1"]["frames"]
+    np.testing.assert_array_equal(first, second)
+    assert not np.shares_memory(first, second) and first.std() > 5
+
+
 def test_agents_joining_mid_episode_get_reset_padded_triplets():
     env = SimounParallelObservation(JoiningAgents(), size=None)
     parallel_api_test(env, num_cycles=10)
