@@ -48,6 +48,21 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     return int(pair[0]), int(pair[1])
 
 
+def check_stack_options(num_frames: int, motion: bool, fold_frames: bool, source: str) -> None:
+    """Reject bad ``SimounObservation`` options (shared with ``SimounParallelObservation``)."""
+    if source not in _SOURCES:
+        raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
+    if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
+        raise ValueError(
+            f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
+        )
+    if motion and not fold_frames and num_frames < 2:
+        raise ValueError(
+            f"motion=True needs at least 2 frames to take differences, got "
+            f"num_frames={num_frames}; use num_frames=3 (the triplet) or motion=False."
+        )
+
+
 def pixel_env(
     env: gym.Env, source: str = "auto", owner: str = "SimounObservation"
 ) -> tuple[gym.Env, bool]:
@@ -203,11 +218,7 @@ class SimounObservation(ChainWrapper):
             fold_frames=fold_frames,
             source=source,
         )
-        if motion and not fold_frames and num_frames < 2:
-            raise ValueError(
-                f"motion=True needs at least 2 frames to take differences, got "
-                f"num_frames={num_frames}; use num_frames=3 (the triplet) or motion=False."
-            )
+        check_stack_options(num_frames, motion, fold_frames, source)
         hw = parse_size(size)
         chain, from_render = pixel_env(env, source)
         height, width, channels = image_layout(chain.observation_space)

@@ -12,7 +12,7 @@ from pettingzoo.utils.wrappers import BaseParallelWrapper
 
 from simoun_wrappers.frames import FrameRing
 from simoun_wrappers.motion import residual_motion
-from simoun_wrappers.observation import image_layout, parse_size
+from simoun_wrappers.observation import check_stack_options, image_layout, parse_size
 
 # gymnasium.wrappers.GrayscaleObservation's weights, so single- and multi-agent frames agree.
 _LUMA = np.array([0.2125, 0.7154, 0.0721])
@@ -63,17 +63,7 @@ class SimounParallelObservation(BaseParallelWrapper):
             source: ``"auto"``, ``"observation"`` (each agent's image) or ``"render"``.
         """
         super().__init__(env)
-        if source not in ("auto", "observation", "render"):
-            raise ValueError(f"source must be 'auto', 'observation' or 'render', got {source!r}.")
-        if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
-            raise ValueError(
-                f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
-            )
-        if motion and not fold_frames and num_frames < 2:
-            raise ValueError(
-                f"motion=True needs at least 2 frames to take differences, got "
-                f"num_frames={num_frames}; use num_frames=3 (the triplet) or motion=False."
-            )
+        check_stack_options(num_frames, motion, fold_frames, source)
         self._size = parse_size(size)
         self._grayscale = grayscale
         self._num_frames = int(num_frames)

@@ -161,6 +161,8 @@ def test_error_bad_size_and_source():
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=(0, 4))
     with pytest.raises(ValueError, match=r"source must be one of"):
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), source="camera")
+    with pytest.raises(ValueError, match=r"num_frames must be a positive int.*use 3"):
+        SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), num_frames=0)
     with pytest.raises(TypeError, match=r"needs image observations.*source='render'"):
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), source="observation")
 

@@ -119,5 +119,7 @@ def test_agents_joining_mid_episode_get_reset_padded_triplets():
 def test_errors_name_the_fix():
     with pytest.raises(ValueError, match=r"at least 2 frames.*motion=False"):
         SimounParallelObservation(JoiningAgents(), num_frames=1)
+    with pytest.raises(ValueError, match=r"source must be one of"):
+        SimounParallelObservation(JoiningAgents(), source="camera")
     with pytest.raises(ValueError, match=r"neither image observations.*render_mode='rgb_array'"):
         SimounParallelObservation(JoiningAgents(gym.spaces.Box(-1.0, 1.0, (4,), np.float32)))
