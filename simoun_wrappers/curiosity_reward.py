@@ -123,7 +123,14 @@ class IntrinsicReward:
         self.step += len(triplets)
         return reward.astype(np.float64)
 
-    def watch(self, triplets, actions, next_triplets, terminated, truncated) -> None:
+    def watch(
+        self,
+        triplets: np.ndarray,
+        actions: np.ndarray,
+        next_triplets: np.ndarray,
+        terminated: np.ndarray,
+        truncated: np.ndarray,
+    ) -> None:
         """Hand the transitions to the feature source when it learns online."""
         watch = getattr(self.features, "watch", None)
         if watch is not None and len(triplets):
@@ -137,7 +144,23 @@ class IntrinsicReward:
         self.step = int(state["step"])
 
 
-class ConsistencyCuriosityReward(gym.RewardWrapper, gym.utils.RecordConstructorArgs):
+class CuriosityState:
+    """The wrappers' ``state_dict`` / ``load_state_dict``: step and maxima of ``curiosity``."""
+
+    curiosity: IntrinsicReward
+
+    def state_dict(self) -> dict[str, Any]:
+        """The global step and both running maxima (the feature source keeps its own state)."""
+        return self.curiosity.state_dict()
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore what :meth:`state_dict` returned."""
+        self.curiosity.load_state_dict(state)
+
+
+class ConsistencyCuriosityReward(
+    CuriosityState, gym.RewardWrapper, gym.utils.RecordConstructorArgs
+):
     """Add Simoun's consistency-guided intrinsic reward (Eq. 13) to the env's reward.
 
     At every step the wrapper encodes the new observation's triplet ``[o_{t-1}, o_t, o_{t+1}]``
@@ -236,16 +259,10 @@ class ConsistencyCuriosityReward(gym.RewardWrapper, gym.utils.RecordConstructorA
         """The extrinsic part, passed through (Eq. 12 adds r_i to it in :meth:`step`)."""
         return float(reward)
 
-    def state_dict(self) -> dict[str, Any]:
-        """The global step and both running maxima (the feature source keeps its own state)."""
-        return self.curiosity.state_dict()
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned."""
-        self.curiosity.load_state_dict(state)
-
-
-class ConsistencyCuriosityVectorReward(VectorWrapper, gym.utils.RecordConstructorArgs):
+class ConsistencyCuriosityVectorReward(
+    CuriosityState, VectorWrapper, gym.utils.RecordConstructorArgs
+):
     """Eq. 13's intrinsic reward for every sub-env of a vector env, in one batched feature call.
 
     Same reward as :class:`ConsistencyCuriosityReward`, but one feature source and one running
@@ -352,11 +369,3 @@ class ConsistencyCuriosityVectorReward(VectorWrapper, gym.utils.RecordConstructo
             "_reward_intrinsic": everywhere,
         }
         return obs, extrinsic + intrinsic, terminated, truncated, info
-
-    def state_dict(self) -> dict[str, Any]:
-        """The global step and both running maxima (the feature source keeps its own state)."""
-        return self.curiosity.state_dict()
-
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned."""
-        self.curiosity.load_state_dict(state)
