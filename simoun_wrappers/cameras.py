@@ -87,6 +87,8 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     side-by-side image, so its only render mode is ``"rgb_array"``. Compose with
     ``SimounObservation(MultiCamera(env, ...), size=None)`` to stack the wide frames.
     ``close()`` leaves the highway viewers alone: ``EnvViewer.close()`` quits pygame for all.
+    The constructor resets ``env`` once (unseeded) to learn the views' sizes: highway-env has
+    no road to draw before a reset.
 
     Example:
         >>> import gymnasium as gym

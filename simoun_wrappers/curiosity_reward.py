@@ -270,7 +270,10 @@ class ConsistencyCuriosityVectorReward(
     call. With ``AutoresetMode.NEXT_STEP`` (Gymnasium's default) the step after a sub-env's
     episode ended only resets it: that dummy step gets no intrinsic reward, does not move the
     statistics and is not handed to the feature source (as Gymnasium's vector ``NormalizeReward``
-    skips it). The global step ``t`` counts sub-env transitions (``num_envs`` per vector step).
+    skips it). With ``AutoresetMode.SAME_STEP`` the ending step is scored on the episode's last
+    triplet, ``info["final_obs"]``, since the returned observation already starts the next one.
+    The global step ``t`` counts the sub-env transitions scored (one per sub-env per vector
+    step, autoreset steps left out).
     ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` arrays of shape ``(num_envs,)``.
 
     Example:
