@@ -1,10 +1,22 @@
 """Pixel encoders: the dual-path encoder (Sec. 3.2) and the ablation variants of Fig. 6.
 
 Every encoder maps a uint8 observation ``(B, k, C, H, W)`` (k frames, oldest first) to an
-:class:`Encoding`. Frames become float (x / 255) on the device inside ``forward``, so the replay
-and the environment only ever hold uint8. An optional ``key_view`` (augmented input, float) is run
-through the same convs in the same call and returned as ``Encoding.key``: the agent passes it to
-the momentum encoder to get the contrastive positives without a second conv call.
+:class:`Encoding`. Frames become float (x / 255) on the device inside the encoder, so the replay
+and the environment only ever hold uint8. ``encode_transition`` encodes the states at t and t+1
+from one window of k+1 frames, sharing frames; ``encode_key`` encodes an augmented float view
+(the contrastive positive, run through the momentum copy of the encoder).
+
+Ablations (Fig. 6), all built by :func:`make_encoder` from ``AgentConfig.encoder``:
+
+========================  ================================================================
+``single``                one conv path on frame t only
+``stacked``               one conv path on the k frames folded into kC channels (CURL, DrQ)
+``stacked_wide``          ``stacked`` with twice the filters
+``flare``                 per-frame convs, flattened latents and their differences with the
+                          earlier frame detached, FC + LayerNorm (Shang et al. 2021)
+``dual``                  motion path on the residuals + appearance path per frame
+``dual_interactive``      ``dual`` with the structural interactive module (the paper's model)
+========================  ================================================================
 """
 
 from __future__ import annotations
