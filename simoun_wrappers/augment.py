@@ -89,9 +89,10 @@ def random_conv(
     weight = weight.reshape(b, 1, c, c, kernel_size, kernel_size).expand(b, t, -1, -1, -1, -1)
     weight = weight.reshape(b * t * c, c, kernel_size, kernel_size)
     stacked = frames.reshape(1, b * t * c, h, w)
-    if stacked.device.type == "cpu" and torch.backends.mkldnn.enabled:
+    if stacked.device.type == "cpu" and torch.backends.mkldnn.enabled and b * t > 1:
         # oneDNN's grouped convolution with 3 channels per group runs about 2x slower than
         # PyTorch's native kernel on CPU (benchmarks/wrappers.py), so it sits out this call.
+        # With one group (RandomConvolution's single frame) oneDNN is 2-7x the faster one.
         torch.backends.mkldnn.enabled = False
         try:
             out = F.conv2d(stacked, weight, padding=kernel_size // 2, groups=b * t)
