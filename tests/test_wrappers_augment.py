@@ -37,11 +37,12 @@ def test_frames_of_a_sample_share_one_kernel_and_samples_differ():
             assert (out[i, 0] - out[j, 0]).abs().mean() > 1e-3
 
 
-def test_matches_a_per_sample_loop_with_the_documented_init():
-    x = torch.rand(5, 2, 3, 10, 10)
+@pytest.mark.parametrize("batch, frames", [(5, 2), (1, 1)])  # grouped and single-group paths
+def test_matches_a_per_sample_loop_with_the_documented_init(batch, frames):
+    x = torch.rand(batch, frames, 3, 10, 10)
     out = random_conv(x, generator=_gen(7))
-    weights = torch.randn(15, 3, 3, 3, generator=_gen(7)) * (2.0 / (27 + 27)) ** 0.5
-    for i in range(5):
+    weights = torch.randn(3 * batch, 3, 3, 3, generator=_gen(7)) * (2.0 / (27 + 27)) ** 0.5
+    for i in range(batch):
         expected = F.conv2d(x[i], weights[3 * i : 3 * i + 3], padding=1)
         torch.testing.assert_close(out[i], expected)
 
