@@ -88,8 +88,11 @@ class IntrinsicReward:
                 f"f_a (B, 3, D)), got {type(features).__name__}. Use e.g. "
                 "simoun_agent.curiosity_model.CuriosityModel."
             )
-        if scale < 0 or decay < 0:
-            raise ValueError(f"scale and decay must be >= 0, got scale={scale}, decay={decay}.")
+        if not (scale >= 0 and decay >= 0):  # also refuses NaN
+            raise ValueError(
+                f"scale and decay must be numbers >= 0, got scale={scale}, decay={decay}; use "
+                "the paper's scale=0.2, decay=2e-5, or decay=0 for a reward that never fades."
+            )
         self.features = features
         self.scale = float(scale)
         self.decay = float(decay)

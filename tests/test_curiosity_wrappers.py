@@ -130,6 +130,11 @@ def test_wrong_observations_are_refused_with_the_fix():
         ConsistencyCuriosityReward(gym.make("CartPole-v1"), ProjectionFeatures(4))
     with pytest.raises(TypeError, match="FeatureSource"):
         ConsistencyCuriosityReward(cartpole(), features="encoder")
+    source = ProjectionFeatures(3 * SIZE * SIZE)
+    with pytest.raises(ValueError, match=r"scale and decay must be numbers >= 0.*scale=0.2"):
+        ConsistencyCuriosityReward(cartpole(), source, scale=-0.2)
+    with pytest.raises(ValueError, match=r"scale and decay must be numbers >= 0"):
+        ConsistencyCuriosityVectorReward(make_vec(1), source, decay=float("nan"))
 
 
 def test_state_survives_pickling_and_async_vector_env():
