@@ -66,6 +66,25 @@ def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
     return read
 
 
+class SharedSource:
+    """A feature source as recorded in ``env.spec``: kept by reference, never deep-copied.
+
+    Every wrapper stacked above ours deep-copies the spec (SB3's ``Monitor`` reads ``env.spec``),
+    which would copy a ``CuriosityModel``'s weights and frame buffer (about 1 s and 85 MB at
+    84x84). ``gym.make(env.spec)`` hands this holder back to the constructor, which unwraps it,
+    so a rebuilt env shares the original source, as it does when nothing is stacked above.
+    """
+
+    def __init__(self, source: FeatureSource) -> None:
+        self.source = source
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> SharedSource:
+        return self
+
+    def __repr__(self) -> str:
+        return f"SharedSource({self.source!r})"
+
+
 class IntrinsicReward:
     """The bookkeeping shared by both wrappers: features -> Eq. 13, the running maxima, the step.
 
@@ -76,12 +95,14 @@ class IntrinsicReward:
 
     def __init__(
         self,
-        features: FeatureSource,
+        features: FeatureSource | SharedSource,
         scale: float,
         decay: float,
         r_e_max_init: float,
         r_i_max_init: float,
     ) -> None:
+        if isinstance(features, SharedSource):
+            features = features.source
         if not isinstance(features, FeatureSource):
             raise TypeError(
                 f"features must be a FeatureSource (callable: uint8 (B, 3, C, H, W) -> f_m (B, D), "
@@ -222,7 +243,7 @@ class ConsistencyCuriosityReward(
         """
         gym.utils.RecordConstructorArgs.__init__(
             self,
-            features=features,
+            features=SharedSource(features),
             scale=scale,
             decay=decay,
             r_e_max_init=r_e_max_init,
@@ -310,7 +331,7 @@ class ConsistencyCuriosityVectorReward(
         """Wrap the vector env ``env``; arguments as in :class:`ConsistencyCuriosityReward`."""
         gym.utils.RecordConstructorArgs.__init__(
             self,
-            features=features,
+            features=SharedSource(features),
             scale=scale,
             decay=decay,
             r_e_max_init=r_e_max_init,

@@ -241,10 +241,14 @@ def test_vector_same_step_mode_scores_the_final_observation():
 
 @pytest.mark.filterwarnings("ignore:.*different from the unwrapped version")
 def test_passes_check_env_and_rebuilds_from_its_spec():
-    env = ConsistencyCuriosityReward(cartpole(), ProjectionFeatures(3 * SIZE * SIZE), scale=0.5)
+    source = ProjectionFeatures(3 * SIZE * SIZE)
+    env = ConsistencyCuriosityReward(cartpole(), source, scale=0.5)
     check_env(env, skip_render_check=True)
     rebuilt = gym.make(env.spec)
     assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.curiosity.scale == 0.5
+    # a wrapper above deep-copies the spec, but not the feature source (a model's weights, buffer)
+    above = gym.make(gym.wrappers.RecordEpisodeStatistics(env).spec)
+    assert above.env.curiosity.features is source and rebuilt.curiosity.features is source
     rebuilt.reset(seed=0)
     assert "reward_intrinsic" in rebuilt.step(0)[4]
 
