@@ -4,12 +4,20 @@ from simoun_wrappers import _headless  # noqa: F401  (must run before dm_control
 from simoun_wrappers.action_repeat import ActionRepeat
 from simoun_wrappers.augment import RandomConvolution, random_conv
 from simoun_wrappers.cameras import MultiCamera
+from simoun_wrappers.curiosity import FeatureSource
+from simoun_wrappers.curiosity_reward import (
+    ConsistencyCuriosityReward,
+    ConsistencyCuriosityVectorReward,
+)
 from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
 
 __all__ = [
     "ActionRepeat",
+    "ConsistencyCuriosityReward",
+    "ConsistencyCuriosityVectorReward",
+    "FeatureSource",
     "FrameTriplet",
     "MultiCamera",
     "RandomConvolution",
@@ -18,11 +26,3 @@ __all__ = [
     "random_conv",
     "residual_motion",
 ]
-
-from simoun_wrappers.curiosity import FeatureSource
-from simoun_wrappers.curiosity_reward import (
-    ConsistencyCuriosityReward,
-    ConsistencyCuriosityVectorReward,
-)
-
-__all__ += ["ConsistencyCuriosityReward", "ConsistencyCuriosityVectorReward", "FeatureSource"]
