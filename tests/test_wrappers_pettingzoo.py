@@ -9,6 +9,7 @@ import pettingzoo
 import pytest
 from pettingzoo import ParallelEnv
 
+from simoun_wrappers import SimounObservation
 from simoun_wrappers.motion import residual_motion
 from simoun_wrappers.pettingzoo import SimounParallelObservation
 
@@ -123,3 +124,43 @@ def test_errors_name_the_fix():
         SimounParallelObservation(JoiningAgents(), source="camera")
     with pytest.raises(ValueError, match=r"neither image observations.*render_mode='rgb_array'"):
         SimounParallelObservation(JoiningAgents(gym.spaces.Box(-1.0, 1.0, (4,), np.float32)))
+
+
+class Replay(gym.Env):
+    """Replays one agent's recorded images, so SimounObservation sees exactly what it saw."""
+
+    def __init__(self, images: list[np.ndarray]):
+        self.images = images
+        self.observation_space = gym.spaces.Box(0, 255, images[0].shape, np.uint8)
+        self.action_space = gym.spaces.Discrete(1)
+
+    def reset(self, *, seed=None, options=None):
+        self.t = 0
+        return self.images[0], {}
+
+    def step(self, action):
+        self.t += 1
+        return self.images[self.t], 0.0, False, False, {}
+
+
+@pytest.mark.parametrize("options", [{"grayscale": True, "fold_frames": True}, {}])
+def test_per_agent_frames_equal_simoun_observation(options):
+    def pong():
+        return pettingzoo.make(
+            "parallel", "butterfly/cooperative_pong-v6", max_cycles=30, render_mode="rgb_array"
+        )
+
+    raw, ours = pong(), SimounParallelObservation(pong(), size=(20, 24), **options)
+    images, stacks = [raw.reset(seed=3)[0]["paddle_1"]], [ours.reset(seed=3)[0]["paddle_1"]]
+    for _ in range(6):
+        actions = {agent: 1 for agent in raw.agents}
+        images.append(raw.step(actions)[0]["paddle_1"])
+        stacks.append(ours.step(actions)[0]["paddle_1"])
+    single = SimounObservation(Replay(images), size=(20, 24), **options)
+    expected = [single.reset()[0]] + [single.step(0)[0] for _ in range(6)]
+    assert single.observation_space == ours.observation_space("paddle_1")
+    for got, want in zip(stacks, expected, strict=True):
+        for key in want if isinstance(want, dict) else [None]:
+            np.testing.assert_array_equal(
+                got if key is None else got[key], want if key is None else want[key]
+            )
