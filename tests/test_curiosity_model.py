@@ -23,15 +23,6 @@ from simoun_wrappers.curiosity_reward import (
 TINY = dict(num_filters=8, feature_dim=16, aux_hidden_dim=64, seed=0)
 
 
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    """Tiny convs gain nothing from threads, and on a busy CPU torch's spinning threads cost 10x."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 def point_reach():
     return SimounObservation(gym.make("simoun/PointReach-v0"), size=None)
 

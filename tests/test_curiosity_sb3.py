@@ -3,7 +3,6 @@
 import gymnasium as gym
 import numpy as np
 import pytest
-import torch
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
@@ -26,14 +25,6 @@ class RewardsSeen(callbacks.BaseCallback):
         reward = float(self.locals["rewards"][0])
         self.steps.append((reward, info["reward_extrinsic"], info["reward_intrinsic"]))
         return True
-
-
-@pytest.fixture(autouse=True)
-def one_torch_thread():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
 
 
 def test_ppo_learns_for_a_few_hundred_steps_through_the_wrapper():
