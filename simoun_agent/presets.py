@@ -180,17 +180,17 @@ PRESETS["highway"] = Preset(
 )
 PRESETS["cpu"] = Preset(
     description="sized for 2 CPU cores: dm_control/cartpole-swingup-v0 (action repeat 8) for "
-    "40k env steps, 64x64 frames, 16 filters, batch 32, one torch thread",
+    "32k env steps, 48x48 frames, 16 filters, batch 64, one torch thread",
     overrides={
-        "total_env_steps": 40_000,
+        "total_env_steps": 32_000,
         "warmup_agent_steps": 250,
-        "replay_capacity": 40_000,
-        "eval_every": 5_000,
+        "replay_capacity": 32_000,
+        "eval_every": 4_000,
         "eval_episodes": 2,
-        "checkpoint_every": 10_000,
-        "image_size": 64,
+        "checkpoint_every": 8_000,
+        "image_size": 48,
         "torch_threads": 1,
-        "agent": {"batch_size": 32, "num_filters": 16, "hidden_dim": 256},
+        "agent": {"batch_size": 64, "num_filters": 16, "hidden_dim": 256},
     },
 )
 
