@@ -65,7 +65,8 @@ def test_stack_gives_triplets_and_unit_actions():
 def test_dm_control_video_fps_comes_from_the_control_timestep():
     config = resolve("cpu", {"env": "dm_control/cartpole-swingup-v0"})
     env = make_env(config)
-    assert env.observation_space["frames"].shape == (3, 3, 64, 64)
+    size = config.image_size
+    assert env.observation_space["frames"].shape == (3, 3, size, size)
     # control timestep 0.01 s x action repeat 8 -> 12.5 decisions per second of sim time;
     # shimmy's render_fps would claim 10.
     assert video_fps(env, config.resolved_action_repeat()) == pytest.approx(12.5)
