@@ -337,8 +337,12 @@ class DualPathEncoder(PixelEncoder):
                 f"{tuple(obs.shape)}; use FrameTriplet / SimounObservation with num_frames=3"
             )
         x = self.frame_stack(obs)
-        frames = self.appearance_maps(x.flatten(0, 1)).unflatten(0, x.shape[:2]).unbind(0)
-        return self.encode_maps(self.motion_maps(x), frames, frame_features=frame_features)
+        stack = self.appearance_maps(x.flatten(0, 1))
+        frames = stack.unflatten(0, x.shape[:2]).unbind(0)
+        reduced = None
+        if self.interaction is not None:  # one call for the three frames, not three
+            reduced = self.interaction.reduce_appearance(stack).unflatten(0, x.shape[:2]).unbind(0)
+        return self.encode_maps(self.motion_maps(x), frames, reduced, True, frame_features)
 
     def encode_transition(self, window, frame_features=False):
         """Each unique frame through each path once, with gradient only where a loss needs it:

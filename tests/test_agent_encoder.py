@@ -5,7 +5,7 @@ import torch
 import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
-from simoun_agent.interaction import inter_frame_attention, resize_bilinear
+from simoun_agent.interaction import inter_frame_attention, resize_bilinear, resized_linear
 
 FRAME = (3, 32, 32)
 ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
@@ -98,13 +98,16 @@ def test_default_reduction_at_84x84_is_11x11():
     assert enc.state.shape == (1, 100)
 
 
-def test_folded_resize_matches_explicit_eq6_maps():
+@pytest.mark.parametrize("batch", [1, 4])
+@torch.no_grad()
+def test_folded_resize_matches_explicit_eq6_maps(batch):
+    """Batch 1 without gradient (act) resizes the masks, batch 4 folds the resize into FC."""
     torch.manual_seed(0)
     encoder = DualPathEncoder(FRAME, num_filters=4, feature_dim=8, reduce_kernel=3, reduce_stride=2)
     with torch.no_grad():
         encoder.interaction.beta_motion.fill_(0.7)
         encoder.interaction.beta_appearance.fill_(-0.3)
-    obs = triplets()
+    obs = triplets(batch)
     x = encoder.frame_stack(obs)
     frames = [encoder.appearance_maps(x[j]) for j in range(3)]
     enhanced_m, enhanced_a, _ = encoder.interaction(encoder.motion_maps(x), frames)
@@ -118,3 +121,15 @@ def test_resize_bilinear_matches_interpolate():
     x = torch.randn(2, 3, 4, 7)
     expected = F.interpolate(x, size=(9, 17), mode="bilinear", align_corners=False)
     torch.testing.assert_close(resize_bilinear(x, (9, 17)), expected)
+
+
+@pytest.mark.parametrize("batch", [1, 2, 5])
+@pytest.mark.parametrize("grad", [False, True])
+def test_resized_linear_equals_resize_then_linear(batch, grad):
+    """Both ways (weight folded for training batches, map resized for act's one observation)."""
+    gen = torch.Generator().manual_seed(batch)
+    mask = torch.randn(batch, 4, 3, 5, generator=gen)
+    weight = torch.randn(6, 7 * 9 * 4, generator=gen, requires_grad=grad)
+    resized = F.interpolate(mask, size=(7, 9), mode="bilinear", align_corners=False)
+    expected = resized.permute(0, 2, 3, 1).flatten(1) @ weight.T
+    torch.testing.assert_close(resized_linear(mask, weight, (7, 9)), expected)
