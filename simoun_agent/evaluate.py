@@ -80,6 +80,21 @@ def evaluate(
     return metrics, frames
 
 
+class RandomPolicy:
+    """Uniform actions in [-1, 1]^action_dim: the baseline a trained agent has to beat.
+
+    It has the agent's ``act`` signature, so :func:`evaluate` plays it on the same episodes
+    (``simoun-eval RUN_DIR --random-policy``).
+    """
+
+    def __init__(self, action_dim: int, seed: int) -> None:
+        self.action_dim = action_dim
+        self._rng = np.random.default_rng(seed)
+
+    def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:
+        return self._rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32)
+
+
 def metrics_json(data: dict[str, Any]) -> str:
     """``data`` as strict JSON: NaN (e.g. the crash speed of a run without crashes) as null."""
 
@@ -107,6 +122,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", default=None, help="output directory (default: <run dir>/eval-<step>)"
     )
     parser.add_argument("--no-video", action="store_true", help="skip the video")
+    parser.add_argument(
+        "--random-policy",
+        action="store_true",
+        help="play uniformly random actions on the same episodes instead of the agent "
+        "(the baseline; writes to <run dir>/eval-<step>-random)",
+    )
     parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
     return parser
 
@@ -128,25 +149,32 @@ def main(argv: list[str] | None = None) -> int:
         config = from_dict(payload["config"])
         env = make_env(config)
         step = payload["state"]["env_step"]
-        out = Path(args.out) if args.out else payload["replay_path"].parent / f"eval-{step}"
+        suffix = "-random" if args.random_policy else ""
+        default_out = payload["replay_path"].parent / f"eval-{step}{suffix}"
+        out = Path(args.out) if args.out else default_out
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as err:
             raise SetupError(
                 f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
             ) from None
-        agent = SimounAgent(
-            env.observation_space["frames"].shape[1:],
-            env.action_space.shape[0],
-            config.agent,
-            device=args.device or config.device,
-        )
-        agent.load_state_dict(payload["agent"])
+        seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
+        if args.random_policy:
+            agent = RandomPolicy(env.action_space.shape[0], seed)
+        else:
+            agent = SimounAgent(
+                env.observation_space["frames"].shape[1:],
+                env.action_space.shape[0],
+                config.agent,
+                device=args.device or config.device,
+            )
+            agent.load_state_dict(payload["agent"])
     except SetupError as err:
         parser.exit(2, f"simoun-eval: error: {err}\n")
-    seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
     metrics, frames = evaluate(agent, env, args.episodes, seed, record=not args.no_video)
-    metrics.update(env_step=step, episodes=args.episodes, first_seed=seed)
+    metrics.update(
+        env_step=step, episodes=args.episodes, first_seed=seed, random_policy=args.random_policy
+    )
     text = metrics_json(metrics)
     (out / "metrics.json").write_text(text)
     if frames:

@@ -71,6 +71,21 @@ def test_simoun_eval_writes_metrics_and_video(tmp_path, capsys):
     assert '"return_mean"' in capsys.readouterr().out
 
 
+def test_simoun_eval_random_policy_is_a_seeded_baseline_on_the_same_episodes(tmp_path):
+    run_dir = tmp_path / "run"
+    flags = [*TINY_FLAGS, "--run-dir", str(run_dir), "--total-env-steps", "40", "--video", "false"]
+    assert train.main(flags) == 0
+    returns = []
+    for _ in range(2):
+        argv = [str(run_dir), "--episodes", "2", "--random-policy", "--no-video"]
+        assert evaluate.main(argv) == 0
+        metrics = json.loads((run_dir / "eval-40-random" / "metrics.json").read_text())
+        assert metrics["random_policy"] is True and metrics["episodes"] == 2
+        returns.append(metrics["return_mean"])
+    assert returns[0] == returns[1]  # seeded: the same actions on the same episodes
+    assert not (run_dir / "eval-40-random" / "video.mp4").exists()
+
+
 def test_simoun_eval_refuses_a_corrupt_checkpoint(tmp_path, capsys):
     (tmp_path / "checkpoint.pt").write_bytes(b"\x00" * 100)
     with pytest.raises(SystemExit) as exit_info:
