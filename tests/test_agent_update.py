@@ -5,6 +5,7 @@ import io
 import numpy as np
 import pytest
 import torch
+import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
 
@@ -150,11 +151,15 @@ def test_ema_targets_move_by_tau():
         assert not changed(on_before, online)
 
 
-def test_curiosity_reward_in_the_td_target_is_eq13_on_the_batch():
+def test_losses_of_one_update_match_eq_2_7_9_13_on_terminal_transitions():
+    """Terminated transitions: the TD target is r_e + r_i (Eq. 9, 13) with no bootstrap; L_re
+    (Eq. 7) fits r_e alone; L_tran (Eq. 2) predicts f^m of the triplet shifted by one frame."""
     torch.manual_seed(0)
     config = small_config(r_e_max_init=0.5, r_i_max_init=1e-3)
     agent = SimounAgent(FRAME, ACTIONS, config, "cpu")
-    window, action, reward, discount = random_window()
+    assert float(agent.alpha.detach()) == pytest.approx(0.1)
+    window, action, reward, _ = random_window()
+    terminated = torch.zeros(len(reward))
     f_m, f_a = (x.numpy().astype(np.float64) for x in agent.encoder_features(window[:, :3]))
     flow = np.abs(f_a[:, 1] - f_a[:, 0]) + np.abs(f_a[:, 2] - f_a[:, 1])
     distance = np.sqrt(((np.abs(f_m) - flow) ** 2).sum(-1))
@@ -162,8 +167,19 @@ def test_curiosity_reward_in_the_td_target_is_eq13_on_the_batch():
     r_i_max = max(1e-3, distance.max())
     step = 10_000
     expected = 0.2 * np.exp(-2e-5 * step) * distance * r_e_max / r_i_max
-    metrics = agent.update_window(window, action, reward, discount, step)
+    with torch.no_grad():
+        state = agent.encoder(window[:, :3]).state
+        q1, q2 = agent.critic(state, action)
+        target = (reward + torch.from_numpy(expected).float()).unsqueeze(-1)
+        l_q = F.mse_loss(q1, target) + F.mse_loss(q2, target)
+        l_re = F.mse_loss(agent.reward_model(state, action), reward)
+        next_motion = agent.encoder(window[:, 1:]).motion
+        l_tran = (agent.transition(state[:, :16], action) - next_motion).pow(2).sum(-1).mean()
+    metrics = agent.update_window(window, action, reward, terminated, step)
     np.testing.assert_allclose(float(metrics["intrinsic_reward"]), expected.mean(), rtol=1e-4)
+    np.testing.assert_allclose(float(metrics["critic_loss"]), float(l_q), rtol=1e-4)
+    np.testing.assert_allclose(float(metrics["reward_loss"]), float(l_re), rtol=1e-4)
+    np.testing.assert_allclose(float(metrics["transition_loss"]), float(l_tran), rtol=1e-4)
     np.testing.assert_allclose(float(agent.running_max.r_i_max), r_i_max, rtol=1e-5)
     np.testing.assert_allclose(float(agent.running_max.r_e_max), r_e_max, rtol=1e-6)
     assert expected.max() <= 0.2 * np.exp(-2e-5 * step) * r_e_max + 1e-9
