@@ -1,11 +1,13 @@
 """Encoders (every ablation of Fig. 6) and the structural interactive module (Eq. 4-6)."""
 
+import numpy as np
 import pytest
 import torch
 import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
 from simoun_agent.interaction import inter_frame_attention, resize_bilinear, resized_linear
+from simoun_wrappers import residual_motion
 
 FRAME = (3, 32, 32)
 ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
@@ -133,3 +135,35 @@ def test_resized_linear_equals_resize_then_linear(batch, grad):
     resized = F.interpolate(mask, size=(7, 9), mode="bilinear", align_corners=False)
     expected = resized.permute(0, 2, 3, 1).flatten(1) @ weight.T
     torch.testing.assert_close(resized_linear(mask, weight, (7, 9)), expected)
+
+
+def test_motion_path_sees_the_residuals_of_the_frames():
+    """f^m is FC + LN of E^m on [o_{t-1} - o_{t-2}, o_t - o_{t-1}] / 255 (ResidualMotion's
+    channels), f^a of frame t is FC + LN of E^a on o_t / 255."""
+    encoder = make_encoder(AgentConfig(encoder="dual", curiosity=False, num_filters=4), FRAME)
+    obs = triplets()
+    residuals = torch.from_numpy(residual_motion(obs.numpy())).float() / 255
+    with torch.no_grad():
+        enc = encoder(obs)
+        f_m = encoder.head_motion(encoder.motion(residuals))
+        f_a = encoder.head_appearance(encoder.appearance(obs[:, 2].float() / 255))
+    torch.testing.assert_close(enc.motion, f_m)
+    torch.testing.assert_close(enc.state, torch.cat([f_m, f_a], dim=1))
+
+
+def test_inter_frame_attention_by_hand():
+    """Eq. 4 with query t-1 and keys t-2, t, scores scaled by 1/sqrt(c), one loop per position."""
+    gen = torch.Generator().manual_seed(1)
+    prev2, query, cur = (torch.randn(1, 4, 2, 3, generator=gen, dtype=torch.float64) for _ in "abc")
+    q, k2, k0 = (m[0].flatten(1).numpy() for m in (query, prev2, cur))  # (c, hw)
+
+    def softmax(v):
+        e = np.exp(np.asarray(v) - np.max(v))
+        return e / e.sum()
+
+    expected = np.zeros((6, 6))
+    for i in range(6):
+        s2 = softmax([q[:, i] @ k2[:, j] / 2 for j in range(6)])
+        s0 = softmax([q[:, i] @ k0[:, j] / 2 for j in range(6)])
+        expected[i] = softmax(s2 + s0)
+    np.testing.assert_allclose(inter_frame_attention(prev2, query, cur)[0].numpy(), expected)
