@@ -146,32 +146,6 @@ class PixelEncoder(nn.Module):
         return current, following
 
 
-class SingleFrameEncoder(PixelEncoder):
-    """Ablation "single": one conv path on frame t only."""
-
-    key_is_frame = True
-
-    def __init__(
-        self,
-        frame_shape: tuple[int, int, int],
-        num_filters: int,
-        feature_dim: int,
-        channels_last: bool = True,
-    ) -> None:
-        super().__init__(channels_last)
-        c, h, w = frame_shape
-        self.convs = conv_trunk(c, num_filters)
-        self.head = Head(num_filters * conv_output_size(h) * conv_output_size(w), feature_dim)
-        self.repr_dim = feature_dim
-
-    def encode_key(self, view):
-        return self.head(self.convs(self.trunk_input(view)))
-
-    def forward(self, obs, frame_features=False):
-        f = self.encode_key(self.to_float(obs[:, -1]))
-        return Encoding(state=f, anchor=f)
-
-
 class StackedEncoder(PixelEncoder):
     """Ablations "stacked" / "stacked_wide": one conv path on the k frames folded into kC
     channels (CURL / DrQ's encoder)."""
@@ -193,11 +167,30 @@ class StackedEncoder(PixelEncoder):
         self.repr_dim = feature_dim
 
     def encode_key(self, view):
-        return self.head(self.convs(self.trunk_input(view.flatten(1, 2))))
+        stack = view if view.ndim == 4 else view.flatten(1, 2)
+        return self.head(self.convs(self.trunk_input(stack)))
 
     def forward(self, obs, frame_features=False):
         f = self.encode_key(self.to_float(obs))
         return Encoding(state=f, anchor=f)
+
+
+class SingleFrameEncoder(StackedEncoder):
+    """Ablation "single": one conv path on frame t only (a stack of one frame)."""
+
+    key_is_frame = True
+
+    def __init__(
+        self,
+        frame_shape: tuple[int, int, int],
+        num_filters: int,
+        feature_dim: int,
+        channels_last: bool = True,
+    ) -> None:
+        super().__init__(frame_shape, 1, num_filters, feature_dim, channels_last)
+
+    def forward(self, obs, frame_features=False):
+        return super().forward(obs[:, -1:], frame_features)
 
 
 class FlareEncoder(PixelEncoder):

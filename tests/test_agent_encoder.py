@@ -50,6 +50,12 @@ def test_every_encoder_shapes_and_dtypes(kind):
     torch.testing.assert_close(following.state, encoder(window[:, 1:]).state)
     torch.testing.assert_close(current.state, encoder(window[:, :-1]).state)
     assert torch.isfinite(current.state).all()
+    # only "single" ignores the earlier frames
+    older_changed = obs.clone()
+    older_changed[:, 0] = 255 - older_changed[:, 0]
+    with torch.no_grad():
+        same = torch.equal(encoder(older_changed).state, encoder(obs).state)
+    assert same == (kind == "single")
 
 
 def test_dual_encoder_curiosity_features_and_masks():
