@@ -8,6 +8,8 @@ import torch
 import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+from simoun_agent.losses import contrastive_loss
+from simoun_wrappers.augment import random_conv
 
 FRAME = (3, 32, 32)
 ACTIONS = 2
@@ -183,6 +185,37 @@ def test_losses_of_one_update_match_eq_2_7_9_13_on_terminal_transitions():
     np.testing.assert_allclose(float(agent.running_max.r_i_max), r_i_max, rtol=1e-5)
     np.testing.assert_allclose(float(agent.running_max.r_e_max), r_e_max, rtol=1e-6)
     assert expected.max() <= 0.2 * np.exp(-2e-5 * step) * r_e_max + 1e-9
+
+
+def test_contrastive_loss_pairs_online_f_a_with_momentum_keys_of_random_conv_views():
+    """Eq. 3 in the update: anchor f^a(o_t) of the online appearance path before the interactive
+    module, key from the momentum encoder on random_conv(o_t / 255), scored by the bilinear W."""
+    torch.manual_seed(0)
+    agent = SimounAgent(FRAME, ACTIONS, small_config(curiosity=False), "cpu")
+    with torch.no_grad():
+        agent.encoder.interaction.beta_appearance.fill_(0.5)
+        for p in agent.encoder_target.parameters():  # make the momentum encoder differ
+            p.mul_(1.5)
+        agent.similarity.weight.add_(torch.randn(16, 16) * 0.1)
+    window, action, reward, discount = random_window()
+    obs = window[:, :3]
+    torch.manual_seed(7)
+    with torch.no_grad():
+        key = agent.encoder_target.encode_key(random_conv(obs[:, -1].float() / 255, 3))
+        anchor = agent.encoder.head_appearance(agent.encoder.appearance(obs[:, -1].float() / 255))
+        logits = (anchor @ agent.similarity.weight @ key.T).double()
+        expected = (logits.logsumexp(1) - logits.diagonal()).mean()
+    torch.manual_seed(7)
+    metrics = agent.update_window(window, action, reward, discount, step=0)
+    np.testing.assert_allclose(float(metrics["contrastive_loss"]), float(expected), rtol=1e-4)
+
+
+def test_contrastive_loss_sends_no_gradient_to_the_keys():
+    gen = torch.Generator().manual_seed(0)
+    anchor = torch.randn(5, 3, generator=gen, requires_grad=True)
+    key = torch.randn(5, 3, generator=gen, requires_grad=True)
+    contrastive_loss(anchor, key).backward()
+    assert key.grad is None and anchor.grad.abs().sum() > 0
 
 
 def test_resume_from_state_dict_is_bit_exact(tmp_path):
