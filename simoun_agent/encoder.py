@@ -166,11 +166,11 @@ class StackedEncoder(PixelEncoder):
         self.head = Head(num_filters * conv_output_size(h) * conv_output_size(w), feature_dim)
         self.repr_dim = feature_dim
 
-    def encode_key(self, view):
+    def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         stack = view if view.ndim == 4 else view.flatten(1, 2)
         return self.head(self.convs(self.trunk_input(stack)))
 
-    def forward(self, obs, frame_features=False):
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         f = self.encode_key(self.to_float(obs))
         return Encoding(state=f, anchor=f)
 
@@ -189,7 +189,7 @@ class SingleFrameEncoder(StackedEncoder):
     ) -> None:
         super().__init__(frame_shape, 1, num_filters, feature_dim, channels_last)
 
-    def forward(self, obs, frame_features=False):
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         return super().forward(obs[:, -1:], frame_features)
 
 
@@ -215,14 +215,14 @@ class FlareEncoder(PixelEncoder):
         self.norm = nn.LayerNorm(feature_dim)
         self.repr_dim = feature_dim
 
-    def encode_key(self, view):
+    def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         n, k = view.shape[:2]
         maps = self.convs(self.trunk_input(view.flatten(0, 1)))
         z = maps.permute(0, 2, 3, 1).reshape(n, k, -1)
         flow = z[:, 1:] - z[:, :-1].detach()
         return self.norm(self.fc(torch.cat([z.flatten(1), flow.flatten(1)], dim=1)))
 
-    def forward(self, obs, frame_features=False):
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         f = self.encode_key(self.to_float(obs))
         return Encoding(state=f, anchor=f)
 
@@ -281,7 +281,7 @@ class DualPathEncoder(PixelEncoder):
         pair = torch.cat([frames[1] - frames[0], frames[2] - frames[1]], dim=1)
         return self.motion(self.trunk_input(pair))
 
-    def encode_key(self, view):
+    def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         return self.head_appearance(self.appearance_maps(view))
 
     def encode_maps(
@@ -323,7 +323,7 @@ class DualPathEncoder(PixelEncoder):
             masks=masks,
         )
 
-    def forward(self, obs, frame_features=False):
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         if obs.shape[1] != 3:
             raise ValueError(
                 f"DualPathEncoder needs 3 frames (t-2, t-1, t) per observation, got shape "
@@ -337,7 +337,9 @@ class DualPathEncoder(PixelEncoder):
             reduced = self.interaction.reduce_appearance(stack).unflatten(0, x.shape[:2]).unbind(0)
         return self.encode_maps(self.motion_maps(x), frames, reduced, True, frame_features)
 
-    def encode_transition(self, window, frame_features=False):
+    def encode_transition(
+        self, window: torch.Tensor, frame_features: bool = False
+    ) -> tuple[Encoding, Encoding]:
         """Each unique frame through each path once, with gradient only where a loss needs it:
         F^a of frame t with gradient, of t+1 without, of t-2 and t-1 without when
         ``detach_past_frames`` (else with); F^m of the pair ending at t with gradient, of the pair
