@@ -13,15 +13,6 @@ FRAME = (3, 32, 32)
 ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """These tensors are tiny: a second thread only adds spin-waiting on a shared machine."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 def triplets(batch: int = 4, seed: int = 0) -> torch.Tensor:
     gen = torch.Generator().manual_seed(seed)
     return torch.randint(0, 256, (batch, 3, *FRAME), generator=gen, dtype=torch.uint8)

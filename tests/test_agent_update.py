@@ -16,15 +16,6 @@ ACTIONS = 2
 ENCODERS = ["single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide"]
 
 
-@pytest.fixture(autouse=True, scope="module")
-def one_thread():
-    """These tensors are tiny: a second thread only adds spin-waiting on a shared machine."""
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(threads)
-
-
 def small_config(**overrides) -> AgentConfig:
     values = dict(
         batch_size=8,
