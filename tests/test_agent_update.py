@@ -128,6 +128,21 @@ def test_actor_loss_leaves_the_encoder_and_critic_untouched():
     assert all(p.requires_grad for p in agent.critic.parameters())
 
 
+@pytest.mark.parametrize(("raw", "bound"), [(100.0, 2.0), (-100.0, -10.0)])
+def test_policy_log_std_stays_in_its_bounds(raw, bound):
+    """With mu = 0 the deterministic action is 0, so log pi = -(log_std + log(2 pi) / 2) per
+    dimension: the log-std must saturate at log_std_max = 2 and log_std_min = -10."""
+    agent = SimounAgent(FRAME, ACTIONS, small_config(curiosity=False), "cpu")
+    last = agent.actor.trunk[-1]
+    with torch.no_grad():
+        last.weight.zero_()
+        last.bias.copy_(torch.tensor([0.0] * ACTIONS + [raw] * ACTIONS))
+        action, log_prob = agent.actor(torch.randn(3, agent.encoder.repr_dim), deterministic=True)
+    assert torch.equal(action, torch.zeros(3, ACTIONS))
+    expected = -ACTIONS * (bound + 0.5 * np.log(2 * np.pi))
+    torch.testing.assert_close(log_prob, torch.full((3, 1), expected), atol=1e-4, rtol=0)
+
+
 def test_ema_targets_move_by_tau():
     agent = SimounAgent(FRAME, ACTIONS, small_config(curiosity=False), "cpu")
     with torch.no_grad():
