@@ -2,15 +2,13 @@
 
 import gymnasium as gym
 import numpy as np
-import pytest
+import stable_baselines3 as sb3
+from stable_baselines3.common import callbacks
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
 from simoun_wrappers import SimounObservation
 from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
-
-sb3 = pytest.importorskip("stable_baselines3")
-callbacks = pytest.importorskip("stable_baselines3.common.callbacks")
 
 
 class RewardsSeen(callbacks.BaseCallback):
