@@ -10,7 +10,6 @@ import numpy as np
 import torch
 
 from simoun_agent.config import AgentConfig
-from simoun_agent.encoder import DualPathEncoder, Encoding, make_encoder, weight_init
 from simoun_agent.losses import (
     actor_loss,
     contrastive_loss,
@@ -22,9 +21,10 @@ from simoun_agent.losses import (
     total_loss,
     transition_loss,
 )
-from simoun_agent.networks import BilinearSimilarity, RewardModel, TransitionModel
+from simoun_agent.models.encoder import DualPathEncoder, Encoding, make_encoder, weight_init
+from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
+from simoun_agent.models.sac import Actor, Critic
 from simoun_agent.replay import FrameReplay
-from simoun_agent.sac import Actor, Critic
 from simoun_wrappers.augment import random_conv
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
 

@@ -22,9 +22,9 @@ import torch
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
-from simoun_agent.encoder import make_encoder
 from simoun_agent.losses import contrastive_loss, transition_loss
-from simoun_agent.networks import BilinearSimilarity, TransitionModel
+from simoun_agent.models.encoder import make_encoder
+from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
 from simoun_wrappers.augment import random_conv
 from simoun_wrappers.curiosity_reward import triplet_shape
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import torch
 import torch.nn.functional as F
 
-from simoun_agent.networks import BilinearSimilarity, RewardModel, TransitionModel
+from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 
 
 def transition_loss(

@@ -6,7 +6,7 @@ import torch
 import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
-from simoun_agent.interaction import inter_frame_attention, resize_bilinear, resized_linear
+from simoun_agent.models.interaction import inter_frame_attention, resize_bilinear, resized_linear
 from simoun_wrappers import residual_motion
 
 FRAME = (3, 32, 32)

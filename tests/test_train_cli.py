@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from simoun_agent import evaluate, train
+from simoun_agent.run import evaluate, train
 
 TINY_FLAGS = [
     "--env", "simoun/PointReach-v0",
@@ -31,7 +31,14 @@ TINY_FLAGS = [
 
 def test_ctrl_c_writes_a_checkpoint_and_resume_finishes_the_run(tmp_path):
     run_dir = tmp_path / "run"
-    command = [sys.executable, "-m", "simoun_agent.train", *TINY_FLAGS, "--run-dir", str(run_dir)]
+    command = [
+        sys.executable,
+        "-m",
+        "simoun_agent.run.train",
+        *TINY_FLAGS,
+        "--run-dir",
+        str(run_dir),
+    ]
     process = subprocess.Popen(
         [*command, "--total-env-steps", "100000", "--video", "false"],
         stdout=subprocess.PIPE,

@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from simoun_agent.presets import (
+from simoun_agent.run.presets import (
     PAPER_ACTION_REPEAT,
     PRESETS,
     SetupError,

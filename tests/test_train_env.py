@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from simoun_agent.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.envs import POINT_REACH_ID
-from simoun_agent.logger import CsvLog, plot_learning_curve, read_csv
-from simoun_agent.make_env import make_env, video_fps
-from simoun_agent.presets import SetupError, resolve
-from simoun_agent.video import write_video
+from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
+from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
+from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.presets import SetupError, resolve
+from simoun_agent.run.video import write_video
 
 
 class StateOnly(gym.Env):

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from simoun_agent import train
-from simoun_agent.evaluate import EVAL_SEED_OFFSET, evaluate
-from simoun_agent.presets import resolve
+from simoun_agent.run import train
+from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate
+from simoun_agent.run.presets import resolve
 
 EPISODES = 20
 MARGIN = 6.0

@@ -5,9 +5,9 @@ import json
 import pytest
 import torch
 
-from simoun_agent import train
-from simoun_agent.checkpoint import load_checkpoint
-from simoun_agent.presets import SetupError, resolve
+from simoun_agent.run import train
+from simoun_agent.run.checkpoint import load_checkpoint
+from simoun_agent.run.presets import SetupError, resolve
 
 TINY = {
     "env": "simoun/PointReach-v0",

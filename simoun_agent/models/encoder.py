@@ -28,7 +28,7 @@ import torch
 from torch import nn
 
 from simoun_agent.config import AgentConfig
-from simoun_agent.interaction import StructuralInteraction, StructureMasks, resized_linear
+from simoun_agent.models.interaction import StructuralInteraction, StructureMasks, resized_linear
 
 
 class Encoding(NamedTuple):

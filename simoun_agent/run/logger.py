@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.checkpoint import atomic_write
+from simoun_agent.run.checkpoint import atomic_write
 
 EVAL_CSV = "eval.csv"
 TRAIN_CSV = "train.csv"

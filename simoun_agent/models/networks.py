@@ -5,7 +5,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from simoun_agent.sac import mlp
+from simoun_agent.models.sac import mlp
 
 
 class TransitionModel(nn.Module):

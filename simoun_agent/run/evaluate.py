@@ -18,8 +18,8 @@ import gymnasium as gym
 import numpy as np
 import torch
 
-from simoun_agent import driving_metrics
-from simoun_agent.presets import SetupError
+from simoun_agent.run import driving_metrics
+from simoun_agent.run.presets import SetupError
 
 EVAL_SEED_OFFSET = 1_000_000
 """Evaluation episode i resets with seed ``config.seed + EVAL_SEED_OFFSET + i``: the same
@@ -37,7 +37,7 @@ def evaluate(
 
     Leaves every global RNG as it found it, so evaluating does not change what training does
     next (a resumed run stays bit-exact). highway-env runs add the driving measures of
-    :mod:`simoun_agent.driving_metrics`.
+    :mod:`simoun_agent.run.driving_metrics`.
 
     Returns:
         metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
@@ -135,10 +135,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
     from simoun_agent import SimounAgent
-    from simoun_agent.checkpoint import load_checkpoint
-    from simoun_agent.make_env import make_env, video_fps
-    from simoun_agent.presets import from_dict
-    from simoun_agent.video import write_video
+    from simoun_agent.run.checkpoint import load_checkpoint
+    from simoun_agent.run.make_env import make_env, video_fps
+    from simoun_agent.run.presets import from_dict
+    from simoun_agent.run.video import write_video
 
     parser = build_parser()
     args = parser.parse_args(argv)

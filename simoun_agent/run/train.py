@@ -34,17 +34,18 @@ import torch
 from tqdm import tqdm
 
 from simoun_agent import SimounAgent
-from simoun_agent.checkpoint import (
+from simoun_agent.replay import FrameReplay
+from simoun_agent.run.checkpoint import (
     atomic_write,
     check_config,
     load_checkpoint,
     restore_rng,
     save_checkpoint,
 )
-from simoun_agent.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
-from simoun_agent.logger import CURVE_PNG, RunLogger
-from simoun_agent.make_env import make_env, video_fps
-from simoun_agent.presets import (
+from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
+from simoun_agent.run.logger import CURVE_PNG, RunLogger
+from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.presets import (
     PRESETS,
     RESUMABLE_FIELDS,
     SetupError,
@@ -56,8 +57,7 @@ from simoun_agent.presets import (
     resolve,
     to_dict,
 )
-from simoun_agent.replay import FrameReplay
-from simoun_agent.video import write_video
+from simoun_agent.run.video import write_video
 
 CONFIG_NAME = "config.json"
 SUMMARY_NAME = "summary.json"

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from simoun_agent.presets import RESUMABLE_FIELDS, SetupError
+from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError
 
 CHECKPOINT_NAME = "checkpoint.pt"
 FORMAT = "simoun-checkpoint/1"

@@ -17,7 +17,7 @@ from gymnasium import spaces
 from gymnasium.wrappers import RescaleAction
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
-from simoun_agent.presets import SetupError, TrainConfig, is_highway
+from simoun_agent.run.presets import SetupError, TrainConfig, is_highway
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import image_layout
 
