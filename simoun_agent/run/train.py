@@ -21,9 +21,9 @@ import sys
 import threading
 import time
 import typing
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -75,6 +75,8 @@ class Counters:
     """training episodes begun; episode i resets with seed config.seed + i"""
     updates: int = 0
     """gradient updates done"""
+    wall_time_s: float = field(default=0.0, compare=False)
+    """seconds spent in the training loop, summed over resumed parts (evaluations included)"""
 
 
 @dataclass
@@ -90,6 +92,24 @@ class Run:
     rng: np.random.Generator
     """the trainer's own generator (random warm-up actions)"""
     counters: Counters
+
+
+class TrainCallback:
+    """Hooks into :func:`train`; subclass and override what you need (all do nothing here).
+
+    Ray Tune's reporter (``simoun_agent.sweep``) and extra evaluation environments plug in here
+    instead of editing the loop.
+    """
+
+    def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
+        """After each evaluation (env step ``run.counters.env_step``), before it is logged; may
+        add entries to ``metrics``, which then go to eval.csv and TensorBoard too."""
+
+    def on_logged(self, run: Run, metrics: dict[str, float]) -> None:
+        """After each evaluation has been logged (``metrics`` as written to eval.csv)."""
+
+    def on_end(self, run: Run, metrics: dict[str, float]) -> None:
+        """Once, after the final evaluation, checkpoint, video and summary.json."""
 
 
 def default_run_dir(config: TrainConfig) -> Path:
@@ -238,21 +258,49 @@ def deferred_interrupt() -> Iterator[threading.Event]:
         signal.signal(signal.SIGINT, previous)
 
 
-def train(run: Run) -> dict[str, Any]:
+def evaluate_and_log(
+    run: Run, logger: RunLogger, callbacks: Sequence[TrainCallback], clock: WallClock
+) -> dict[str, float]:
+    """Evaluate the agent, let the callbacks see (and extend) the metrics, log them."""
+    config = run.config
+    metrics, _ = evaluate(
+        run.agent, run.eval_env, config.eval_episodes, config.seed + EVAL_SEED_OFFSET
+    )
+    for callback in callbacks:
+        callback.on_evaluation(run, metrics)
+    run.counters.wall_time_s = clock.total()
+    metrics["wall_time_s"] = run.counters.wall_time_s
+    logger.evaluation(run.counters.env_step, metrics)
+    for callback in callbacks:
+        callback.on_logged(run, metrics)
+    return metrics
+
+
+class WallClock:
+    """Seconds of training-loop time, continuing from what a resumed run had already spent."""
+
+    def __init__(self, already: float) -> None:
+        self.already = already
+        self.start = time.perf_counter()
+
+    def total(self) -> float:
+        return self.already + time.perf_counter() - self.start
+
+
+def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     """The training loop; returns the final evaluation metrics (None if interrupted first)."""
     config, counters, agent, replay, env = run.config, run.counters, run.agent, run.replay, run.env
+    clock = WallClock(counters.wall_time_s)
     repeat = config.resolved_action_repeat()
     action_dim = env.action_space.shape[0]
     learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
-    eval_seed = config.seed + EVAL_SEED_OFFSET
     title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
     logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
     next_eval = _next(counters, config.eval_every)
     next_checkpoint = _next(counters, config.checkpoint_every)
     last_eval: dict[str, float] | None = None
     if counters.env_step == 0:
-        last_eval, _ = evaluate(agent, run.eval_env, config.eval_episodes, eval_seed)
-        logger.evaluation(0, last_eval)
+        last_eval = evaluate_and_log(run, logger, callbacks, clock)
     update_metrics: dict[str, Any] = {}
 
     obs = None  # an episode starts at the top of the loop, so checkpoints fall between episodes
@@ -303,10 +351,10 @@ def train(run: Run) -> dict[str, Any]:
             )
             counters.episode += 1
             if counters.env_step >= next_eval:
-                last_eval, _ = evaluate(agent, run.eval_env, config.eval_episodes, eval_seed)
-                logger.evaluation(counters.env_step, last_eval)
+                last_eval = evaluate_and_log(run, logger, callbacks, clock)
                 next_eval = _next(counters, config.eval_every)
             if counters.env_step >= next_checkpoint:
+                counters.wall_time_s = clock.total()
                 checkpoint(run)
                 next_checkpoint = _next(counters, config.checkpoint_every)
             bar.set_postfix(episode_return=f"{episode_return:.1f}", **_eval_postfix(last_eval))
@@ -314,6 +362,7 @@ def train(run: Run) -> dict[str, Any]:
         bar.close()
 
         if interrupt.is_set():
+            counters.wall_time_s = clock.total()
             checkpoint(run)
             logger.close()
             tqdm.write(
@@ -321,17 +370,23 @@ def train(run: Run) -> dict[str, Any]:
                 f"with: simoun-train --resume {run.run_dir}"
             )
             raise KeyboardInterrupt
-        return finish(run, logger, last_eval)
+        return finish(run, logger, last_eval, callbacks, clock)
 
 
-def finish(run: Run, logger: RunLogger, last_eval: dict[str, float] | None) -> dict[str, Any]:
+def finish(
+    run: Run,
+    logger: RunLogger,
+    last_eval: dict[str, float] | None,
+    callbacks: Sequence[TrainCallback],
+    clock: WallClock,
+) -> dict[str, Any]:
     """Final evaluation (with video), checkpoint and ``summary.json``, the mark of a whole run."""
     config, counters = run.config, run.counters
     eval_seed = config.seed + EVAL_SEED_OFFSET
     logged = logger.last_eval_step == counters.env_step and last_eval is not None
     if not logged:
-        last_eval, _ = evaluate(run.agent, run.eval_env, config.eval_episodes, eval_seed)
-        logger.evaluation(counters.env_step, last_eval)
+        last_eval = evaluate_and_log(run, logger, callbacks, clock)
+    counters.wall_time_s = clock.total()
     checkpoint(run)
     logger.close()
     files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
@@ -340,9 +395,16 @@ def finish(run: Run, logger: RunLogger, last_eval: dict[str, float] | None) -> d
         fps = video_fps(run.eval_env, config.resolved_action_repeat())
         write_video(run.run_dir / "video.mp4", frames, fps)
         files["video"] = "video.mp4"
-    summary = {"env_step": counters.env_step, "final_eval": last_eval, "files": files}
+    summary = {
+        "env_step": counters.env_step,
+        "wall_time_s": counters.wall_time_s,
+        "final_eval": last_eval,
+        "files": files,
+    }
     text = metrics_json(summary)
     atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
+    for callback in callbacks:
+        callback.on_end(run, last_eval)
     return last_eval
 
 
