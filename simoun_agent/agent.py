@@ -174,21 +174,6 @@ class SimounAgent:
             )
         return r_i, distance
 
-    def update_batch(
-        self,
-        obs: torch.Tensor,
-        action: torch.Tensor,
-        reward: torch.Tensor,
-        next_obs: torch.Tensor,
-        discount: torch.Tensor,
-        step: int,
-    ) -> dict[str, torch.Tensor]:
-        """:meth:`update` on a batch already on the device: uint8 ``obs`` / ``next_obs``
-        ``(B, 3, C, H, W)`` (``next_obs`` is ``obs`` shifted by one frame, as in a replay),
-        float ``action`` ``(B, A)``, ``reward`` and ``discount`` ``(B,)``."""
-        window = torch.cat([obs, next_obs[:, -1:]], dim=1)
-        return self.update_window(window, action, reward, discount, step)
-
     def update_window(
         self,
         window: torch.Tensor,
@@ -197,7 +182,12 @@ class SimounAgent:
         discount: torch.Tensor,
         step: int,
     ) -> dict[str, torch.Tensor]:
-        """:meth:`update_batch` on the uint8 window ``(B, 4, C, H, W)`` of frames t-2 .. t+1."""
+        """One gradient step on a batch already on the device (what :meth:`update` samples).
+
+        ``window`` is uint8 ``(B, 4, C, H, W)``, frames t-2 .. t+1 (the triplet at t and, shifted
+        by one frame, the one at t+1); ``action`` float ``(B, A)``; ``reward`` and ``discount``
+        ``(B,)``; ``step`` the global environment step.
+        """
         cfg = self.config
         contrastive = cfg.contrastive_weight != 0
         enc, following = self.encoder.encode_transition(window, frame_features=cfg.curiosity)
