@@ -1,4 +1,4 @@
-"""Hyperparameters of the Simoun SAC agent (defaults: DESIGN.md, following DrQ / CURL)."""
+"""Hyperparameters of the Simoun SAC agent (defaults: the paper's, i.e. DrQ's setup, and CURL's)."""
 
 from __future__ import annotations
 

@@ -1,24 +1,11 @@
 """Learning evidence: a short CPU run on the tiny pixel task must beat a random policy."""
 
-import numpy as np
-
 from simoun_agent.run import train
-from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate
+from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, RandomPolicy, evaluate
 from simoun_agent.run.presets import resolve
 
 EPISODES = 20
 MARGIN = 6.0
-
-
-class RandomPolicy:
-    """Uniform actions in [-1, 1]^n, the agent interface of evaluate()."""
-
-    def __init__(self, action_dim: int, seed: int) -> None:
-        self.action_dim = action_dim
-        self.rng = np.random.default_rng(seed)
-
-    def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:
-        return self.rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32)
 
 
 def test_short_run_on_point_reach_beats_a_random_policy(tmp_path):
