@@ -432,13 +432,20 @@ def build_parser() -> argparse.ArgumentParser:
         "  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000\n\n"
         "Values: booleans true/false, None as none, dicts as JSON (--env-kwargs '{\"a\": 1}').",
     )
-    parser.add_argument("--preset", choices=list(PRESETS), help="start from a named preset")
     parser.add_argument(
         "--resume",
         metavar="RUN_DIR",
         help="continue a run from its last checkpoint (only "
         f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
     )
+    add_config_arguments(parser)
+    return parser
+
+
+def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--preset``, ``--set KEY=VALUE`` and one flag per config key (read by
+    :func:`overrides_from`); shared by ``simoun-train`` and ``simoun-sweep``."""
+    parser.add_argument("--preset", choices=list(PRESETS), help="start from a named preset")
     parser.add_argument(
         "--set",
         action="append",
@@ -460,7 +467,6 @@ def build_parser() -> argparse.ArgumentParser:
             metavar=_metavar(kind),
             help=f"{doc} (default: {shown})".replace("%", "%%"),
         )
-    return parser
 
 
 def _metavar(kind: Any) -> str:
