@@ -21,11 +21,11 @@ from simoun_agent.losses import (
     total_loss,
     transition_loss,
 )
-from simoun_agent.models.encoder import DualPathEncoder, Encoding, make_encoder, weight_init
+from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight_init
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Actor, Critic
 from simoun_agent.replay import FrameReplay
-from simoun_wrappers.augment import random_conv
+from simoun_wrappers.augment import random_conv, random_shift, shift_pad
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
 
 
@@ -65,14 +65,27 @@ class SimounAgent:
         self.actor = Actor(
             repr_dim, action_dim, config.hidden_dim, config.log_std_min, config.log_std_max
         ).to(self.device)
-        has_motion = isinstance(self.encoder, DualPathEncoder)
+        self.motion_path = ENCODERS[config.encoder].motion_path
+        # L_tran predicts f^m of a dual encoder, or the whole state of a single-path one (whose
+        # size is feature_dim too), so every Fig. 6 encoder trains with the same losses
         self.transition = (
             TransitionModel(config.feature_dim, action_dim, config.aux_hidden_dim).to(self.device)
-            if has_motion and config.transition_weight
+            if config.transition_weight
             else None
         )
-        self.reward_model = RewardModel(repr_dim, action_dim, config.aux_hidden_dim).to(self.device)
-        self.similarity = BilinearSimilarity(config.feature_dim).to(self.device)
+        self.reward_model = (
+            RewardModel(repr_dim, action_dim, config.aux_hidden_dim).to(self.device)
+            if config.reward_weight
+            else None
+        )
+        self.similarity = (
+            BilinearSimilarity(config.feature_dim).to(self.device)
+            if config.contrastive_weight
+            else None
+        )
+        self.shift_pad = (
+            config.shift_pad if config.shift_pad is not None else shift_pad(self.frame_shape[1])
+        )
         for net in (self.critic, self.actor, self.transition, self.reward_model):
             if net is not None:
                 net.apply(weight_init)
@@ -83,9 +96,8 @@ class SimounAgent:
         )
         self.target_entropy = -float(action_dim)
 
-        representation = [self.encoder, self.critic, self.reward_model, self.similarity]
-        if self.transition is not None:
-            representation.append(self.transition)
+        heads = (self.critic, self.reward_model, self.similarity, self.transition)
+        representation = [self.encoder, *(net for net in heads if net is not None)]
         # fused Adam: one kernel per tensor, measured ~7x faster than foreach on our CPU
         self.critic_optimizer = torch.optim.Adam(
             [p for m in representation for p in m.parameters()], lr=config.lr, fused=True
@@ -129,7 +141,7 @@ class SimounAgent:
         """Curiosity features of the online encoder for ``uint8 (B, 3, C, H, W)``: f^m_t ``(B, D)``
         (as in the state) and f^a of frames t-2, t-1, t ``(B, 3, D)`` (before interaction), as
         detached tensors on the agent's device — exactly what Eq. 13 uses in :meth:`update`."""
-        if not isinstance(self.encoder, DualPathEncoder):
+        if not self.motion_path:
             raise ValueError(
                 f"encoder_features needs a dual-path encoder; this agent uses "
                 f"{self.config.encoder!r} (set AgentConfig.encoder to 'dual' or 'dual_interactive')"
@@ -187,13 +199,25 @@ class SimounAgent:
         ``window`` is uint8 ``(B, 4, C, H, W)``, frames t-2 .. t+1 (the triplet at t and, shifted
         by one frame, the one at t+1); ``action`` float ``(B, A)``; ``reward`` and ``discount``
         ``(B,)``; ``step`` the global environment step.
+
+        With ``augmentation="shift"`` the critic and actor see the window shifted by one random
+        offset per sample (all four frames alike); the contrastive key is a random convolution
+        of those same frames (Eq. 3), or, with ``contrastive_view="shift"`` (CURL), an
+        independently shifted view of the unshifted window.
         """
         cfg = self.config
-        contrastive = cfg.contrastive_weight != 0
-        enc, following = self.encoder.encode_transition(window, frame_features=cfg.curiosity)
+        contrastive = self.similarity is not None
+        seen = random_shift(window, self.shift_pad) if cfg.augmentation == "shift" else window
+        enc, following = self.encoder.encode_transition(seen, frame_features=cfg.curiosity)
         with torch.no_grad():
             if contrastive:
-                view = random_conv(self.encoder.key_frames(window[:, :-1]), cfg.random_conv_kernel)
+                if cfg.contrastive_view == "shift":
+                    other = random_shift(window[:, :-1], self.shift_pad)
+                    view = self.encoder.key_frames(other)
+                else:
+                    view = random_conv(
+                        self.encoder.key_frames(seen[:, :-1]), cfg.random_conv_kernel
+                    )
                 key = self.encoder_target.encode_key(view)
             next_action, next_log_prob = self.actor(following.state)
             next_q = self.critic_target(following.state, next_action)
@@ -209,13 +233,17 @@ class SimounAgent:
         q1, q2 = self.critic(enc.state, action)
         l_q = critic_loss(q1, q2, q_target)
         l_tran = (
-            transition_loss(self.transition, enc.motion, action, following.motion)
+            transition_loss(
+                self.transition, self.dynamics(enc), action, self.dynamics(following)
+            )
             if self.transition is not None
             else None
         )
         l_con = contrastive_loss(enc.anchor, key, self.similarity) if contrastive else None
         l_re = (
-            reward_loss(self.reward_model, enc.state, action, reward) if cfg.reward_weight else None
+            reward_loss(self.reward_model, enc.state, action, reward)
+            if self.reward_model is not None
+            else None
         )
         loss = total_loss(
             l_q,
@@ -245,6 +273,10 @@ class SimounAgent:
             self.update_targets()
         self.num_updates += 1
         return metrics
+
+    def dynamics(self, enc: Encoding) -> torch.Tensor:
+        """What L_tran predicts the next value of: f^m with a motion path, else the state."""
+        return enc.motion if self.motion_path else enc.state
 
     def update_actor(self, state: torch.Tensor) -> dict[str, torch.Tensor]:
         """Eq. 11 on detached features, then the temperature; the critic is held fixed."""
@@ -286,10 +318,9 @@ class SimounAgent:
             "actor": self.actor,
             "reward_model": self.reward_model,
             "similarity": self.similarity,
+            "transition": self.transition,
         }
-        if self.transition is not None:
-            nets["transition"] = self.transition
-        return nets
+        return {name: net for name, net in nets.items() if net is not None}
 
     def state_dict(self) -> dict:
         """Networks, targets, optimisers, temperature, running maxima, update counter, config."""

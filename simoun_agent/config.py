@@ -4,15 +4,29 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-ENCODERS = ("single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide")
+AUGMENTATIONS = ("none", "shift")
+CONTRASTIVE_VIEWS = ("random_conv", "shift")
 
 
 @dataclass
 class AgentConfig:
     """Everything the agent needs besides the frame shape and the action size."""
 
+    recipe: str | None = None
+    """name of the agent recipe these values started from (simoun_agent.recipes: simoun, drq,
+    curl, sac and the Fig. 6 encoders); applied before the user's overrides. None: these
+    dataclass defaults"""
     encoder: str = "dual_interactive"
-    """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6)"""
+    """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6;
+    the registry simoun_agent.models.encoder.ENCODERS)"""
+    augmentation: str = "none"
+    """augmentation of the frames the critic and actor see: "none", or "shift" (DrQ's random
+    shift: replicate-pad, random crop back, one offset per sample for its whole window)"""
+    shift_pad: int | None = None
+    """padding of the "shift" augmentation in pixels; None: 4 px per 84 px of image height"""
+    contrastive_view: str = "random_conv"
+    """positive view of L_con: "random_conv" (Eq. 3, a random convolution of the same frames)
+    or "shift" (CURL: an independently shifted view of the same input)"""
     feature_dim: int = 50
     """size of each path's feature vector (f_m and f_a); single-path encoders output this size"""
     num_filters: int = 32
@@ -81,16 +95,29 @@ class AgentConfig:
     on our AVX-512 CPU; benchmarks/update.py --no-channels-last compares)"""
 
     def __post_init__(self) -> None:
+        from simoun_agent.models.encoder import ENCODERS  # the registry needs torch: load late
+
         if self.encoder not in ENCODERS:
             raise ValueError(
-                f"AgentConfig.encoder={self.encoder!r} is not known; choose one of {ENCODERS}"
+                f"AgentConfig.encoder={self.encoder!r} is not known; choose one of "
+                f"{', '.join(ENCODERS)}"
             )
-        if self.num_frames != 3 and self.encoder in ("dual", "dual_interactive"):
+        for name, options in (
+            ("augmentation", AUGMENTATIONS),
+            ("contrastive_view", CONTRASTIVE_VIEWS),
+        ):
+            if getattr(self, name) not in options:
+                raise ValueError(
+                    f"AgentConfig.{name}={getattr(self, name)!r} is not known; choose one of "
+                    f"{', '.join(options)}"
+                )
+        motion_path = ENCODERS[self.encoder].motion_path
+        if self.num_frames != 3 and motion_path:
             raise ValueError(
                 f"the dual-path encoders need num_frames=3 (o_t-2, o_t-1, o_t), got "
                 f"{self.num_frames}; set num_frames=3"
             )
-        if self.curiosity and self.encoder not in ("dual", "dual_interactive"):
+        if self.curiosity and not motion_path:
             raise ValueError(
                 f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
                 f"{self.encoder!r} does not have; set curiosity=False or use a dual encoder"

@@ -1,4 +1,5 @@
-"""Random convolution (Lee et al. 2020, "network randomization") for batches and for envs.
+"""Random convolution (Lee et al. 2020, "network randomization") for batches and for envs, and
+DrQ's random shift for batches.
 
 Weight initialisation: every kernel is drawn from a Xavier/Glorot normal distribution,
 ``N(0, 2 / (fan_in + fan_out))`` with ``fan_in = fan_out = C * k * k``, as in the authors'
@@ -16,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
+from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
 if TYPE_CHECKING:
@@ -105,6 +107,55 @@ def random_conv(
     return out.reshape(shape)
 
 
+def shift_pad(image_size: int) -> int:
+    """DrQ's random-shift padding scaled with the image: 4 px at 84 px, at least 1 px."""
+    return max(1, round(4 * image_size / 84))
+
+
+def random_shift(
+    batch: torch.Tensor, pad: int, generator: torch.Generator | None = None
+) -> torch.Tensor:
+    """DrQ's random shift: replicate-pad every image by ``pad`` pixels, crop back at a random
+    integer offset, one offset per sample for all of its frames.
+
+    Replicate padding followed by a crop equals indexing with clamped coordinates, which is
+    what this does: exact on any dtype (uint8 frames stay uint8), no float copy, no Python loop
+    over the batch. Sharing the offset across a sample's frames keeps the residuals between
+    them (the motion path's input) the residuals of the shifted frames.
+
+    Args:
+        batch: ``(B, T, C, H, W)`` frames (or ``(B, C, H, W)``), any dtype.
+        pad: maximum shift in pixels in each direction (DrQ: 4 at 84 px, see :func:`shift_pad`).
+        generator: source of the offsets; ``None`` uses torch's global RNG.
+
+    Example:
+        >>> import torch
+        >>> from simoun_wrappers.augment import random_shift
+        >>> frames = torch.randint(0, 256, (8, 4, 3, 48, 48), dtype=torch.uint8)
+        >>> shifted = random_shift(frames, pad=2, generator=torch.Generator().manual_seed(0))
+        >>> shifted.shape, shifted.dtype
+        (torch.Size([8, 4, 3, 48, 48]), torch.uint8)
+    """
+    import torch
+
+    if not isinstance(batch, torch.Tensor) or batch.ndim not in (4, 5):
+        raise TypeError(
+            f"random_shift expects a torch.Tensor (B, T, C, H, W) or (B, C, H, W), got "
+            f"{type(batch).__name__} {tuple(getattr(batch, 'shape', ()))}"
+        )
+    if pad < 0:
+        raise ValueError(f"random_shift needs pad >= 0, got {pad}")
+    n, (h, w) = batch.shape[0], batch.shape[-2:]
+    offsets = torch.randint(0, 2 * pad + 1, (2, n, 1), generator=generator)
+    offsets = offsets.to(batch.device) - pad
+    rows = (torch.arange(h, device=batch.device) + offsets[0]).clamp_(0, h - 1)
+    cols = (torch.arange(w, device=batch.device) + offsets[1]).clamp_(0, w - 1)
+    index = torch.arange(n, device=batch.device)[:, None, None]
+    # (B, H, W, ...) after advanced indexing of the last two axes: move them back
+    moved = batch.movedim((-2, -1), (1, 2))[index, rows[:, :, None], cols[:, None, :]]
+    return moved.movedim((1, 2), (-2, -1))
+
+
 class RandomConvolution(ChainWrapper):
     """Pass every frame through a random convolution whose kernel is resampled every episode.
 
@@ -114,7 +165,9 @@ class RandomConvolution(ChainWrapper):
     [0, 255] uint8, so the wrapper composes with ``SimounObservation`` on top. Pixels come from
     image observations (``(H, W, C)`` or ``(H, W)`` uint8) or from ``render()`` with
     ``render_mode="rgb_array"``. Kernels come from the wrapper's own RNG: ``reset(seed=s)`` makes
-    them reproducible and the env's own RNG is left untouched.
+    them reproducible and the env's own RNG is left untouched. It goes *under* the frame stack
+    (``SimounObservation(RandomConvolution(env))``); over a stacked env it raises, since it would
+    replace the triplet and its motion channels with a convolved ``render()``.
 
     Example:
         >>> import gymnasium as gym
@@ -142,6 +195,7 @@ class RandomConvolution(ChainWrapper):
                 f"kernel_size must be a positive odd int, got {kernel_size!r}; use 3 as in "
                 f"Lee et al. 2020."
             )
+        check_not_stacked(env)
         chain, from_render = pixel_env(env, source, owner="RandomConvolution")
         self._layout = image_layout(chain.observation_space)
         chain = TransformObservation(chain, self._convolve, chain.observation_space)
@@ -171,3 +225,22 @@ class RandomConvolution(ChainWrapper):
         self._generator.manual_seed(self._kernel_seed)
         out = random_conv(batch, self.kernel_size, self._generator, clamp=(0.0, 255.0))
         return out[0].round().to(torch.uint8).permute(1, 2, 0).reshape(image.shape).numpy()
+
+
+def check_not_stacked(env: gym.Env) -> None:
+    """Refuse an env whose observations are already frame stacks (``FrameTriplet`` inside).
+
+    ``RandomConvolution`` convolves one image: over ``SimounObservation`` it would fall back to
+    ``render()`` and silently drop the triplet and its motion channels.
+    """
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if isinstance(inner, FrameTriplet):
+            raise TypeError(
+                f"RandomConvolution goes under the frame stack, not over it: {env} already stacks "
+                f"frames, and convolving its render() would drop the triplet and its motion "
+                f"channels. Swap the order: SimounObservation(RandomConvolution(env), ...) "
+                f"convolves every frame of the triplet with the episode's kernel, and motion is "
+                f"computed from the convolved frames."
+            )
+        inner = inner.env

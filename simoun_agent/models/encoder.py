@@ -6,7 +6,8 @@ and the environment only ever hold uint8. ``encode_transition`` encodes the stat
 from one window of k+1 frames, sharing frames; ``encode_key`` encodes an augmented float view
 (the contrastive positive, run through the momentum copy of the encoder).
 
-Ablations (Fig. 6), all built by :func:`make_encoder` from ``AgentConfig.encoder``:
+Ablations (Fig. 6), registered in :data:`ENCODERS` and built by :func:`make_encoder` from
+``AgentConfig.encoder``:
 
 ========================  ================================================================
 ``single``                one conv path on frame t only
@@ -21,7 +22,8 @@ Ablations (Fig. 6), all built by :func:`make_encoder` from ``AgentConfig.encoder
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import torch
@@ -367,27 +369,79 @@ class DualPathEncoder(PixelEncoder):
         return current, following
 
 
-def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:
-    """Build the encoder named by ``config.encoder`` (the variants of Fig. 6)."""
-    kind, cl = config.encoder, config.channels_last
-    filters, dim = config.num_filters, config.feature_dim
-    if kind in ("dual", "dual_interactive"):
-        encoder: PixelEncoder = DualPathEncoder(
-            frame_shape,
-            filters,
-            dim,
-            interactive=kind == "dual_interactive",
-            reduce_kernel=config.reduce_kernel,
-            reduce_stride=config.reduce_stride,
-            detach_past_frames=config.detach_past_frames,
-            channels_last=cl,
+@dataclass(frozen=True)
+class EncoderEntry:
+    """How to build one registered encoder, and what it offers the losses."""
+
+    build: Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]
+    """(config, frame shape (C, H, W)) -> the encoder"""
+    motion_path: bool
+    """True: separate motion and appearance paths, so L_tran acts on f^m and the consistency
+    curiosity (Eq. 13) can compare them; False: one path, L_tran acts on the state"""
+    description: str
+    """one line for help texts"""
+
+
+def _dual(interactive: bool) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]:
+    def build(c: AgentConfig, shape: tuple[int, int, int]) -> PixelEncoder:
+        return DualPathEncoder(
+            shape,
+            c.num_filters,
+            c.feature_dim,
+            interactive=interactive,
+            reduce_kernel=c.reduce_kernel,
+            reduce_stride=c.reduce_stride,
+            detach_past_frames=c.detach_past_frames,
+            channels_last=c.channels_last,
         )
-    elif kind == "single":
-        encoder = SingleFrameEncoder(frame_shape, filters, dim, cl)
-    elif kind == "flare":
-        encoder = FlareEncoder(frame_shape, config.num_frames, filters, dim, cl)
-    else:
-        wide = 2 if kind == "stacked_wide" else 1
-        encoder = StackedEncoder(frame_shape, config.num_frames, wide * filters, dim, cl)
+
+    return build
+
+
+ENCODERS: dict[str, EncoderEntry] = {
+    "single": EncoderEntry(
+        lambda c, shape: SingleFrameEncoder(shape, c.num_filters, c.feature_dim, c.channels_last),
+        motion_path=False,
+        description="one conv path on frame t only",
+    ),
+    "stacked": EncoderEntry(
+        lambda c, shape: StackedEncoder(
+            shape, c.num_frames, c.num_filters, c.feature_dim, c.channels_last
+        ),
+        motion_path=False,
+        description="one conv path on the frames folded into channels (CURL, DrQ)",
+    ),
+    "stacked_wide": EncoderEntry(
+        lambda c, shape: StackedEncoder(
+            shape, c.num_frames, 2 * c.num_filters, c.feature_dim, c.channels_last
+        ),
+        motion_path=False,
+        description="stacked with twice the filters (about the dual path's parameter count)",
+    ),
+    "flare": EncoderEntry(
+        lambda c, shape: FlareEncoder(
+            shape, c.num_frames, c.num_filters, c.feature_dim, c.channels_last
+        ),
+        motion_path=False,
+        description="per-frame convs with latent differences (Flare, Shang et al. 2021)",
+    ),
+    "dual": EncoderEntry(
+        _dual(interactive=False),
+        motion_path=True,
+        description="motion path on residuals + appearance path per frame (Sec. 3.2)",
+    ),
+    "dual_interactive": EncoderEntry(
+        _dual(interactive=True),
+        motion_path=True,
+        description="dual with the structural interactive module (Eq. 4-6), the paper's model",
+    ),
+}
+"""The encoders of Fig. 6 by ``AgentConfig.encoder`` name; a new encoder is one entry."""
+
+
+def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:
+    """Build the encoder named by ``config.encoder`` (the variants of Fig. 6) from
+    :data:`ENCODERS`, with orthogonal initialisation, in its conv memory format."""
+    encoder = ENCODERS[config.encoder].build(config, tuple(frame_shape))
     encoder.apply(weight_init)
     return encoder.to(memory_format=encoder.memory_format)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError
+from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError, config_sections
 
 CHECKPOINT_NAME = "checkpoint.pt"
 FORMAT = "simoun-checkpoint/1"
@@ -134,7 +134,7 @@ def config_differences(saved: dict, current: dict, prefix: str = "") -> list[str
         if not prefix and key in (*RESUMABLE_FIELDS, "run_dir"):
             continue
         old, new = saved.get(key, "<missing>"), current.get(key, "<missing>")
-        if isinstance(old, dict) and isinstance(new, dict) and key == "agent":
+        if isinstance(old, dict) and isinstance(new, dict) and name + "." in config_sections():
             differences += config_differences(old, new, prefix=name + ".")
         elif old != new:
             differences.append(f"{name}: {old!r} in the checkpoint, {new!r} now")

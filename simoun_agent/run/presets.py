@@ -1,7 +1,8 @@
 """Training configuration: the ``TrainConfig`` dataclass, named presets and command-line overrides.
 
-A run's configuration is resolved in three layers: the dataclass defaults (the paper's DrQ-style
-setup), then a named preset, then the user's overrides (``--agent.batch-size 64`` or
+A run's configuration is resolved in four layers: the dataclass defaults (the paper's DrQ-style
+setup), then a named preset, then a named agent recipe (``--agent.recipe drq``,
+:mod:`simoun_agent.recipes`), then the user's overrides (``--agent.batch-size 64`` or
 ``--set agent.batch_size=64``). The resolved config is saved as ``config.json`` in the run
 directory and checked again when the run is resumed.
 """
@@ -215,14 +216,29 @@ def field_docs(cls: type) -> dict[str, str]:
     return docs
 
 
+def config_sections(cls: type | None = None) -> dict[str, type]:
+    """Nested config sections by key prefix: ``{"": TrainConfig, "agent.": AgentConfig, ...}``.
+
+    A field whose type is a dataclass is a section; a new section is one such field.
+    """
+    cls = cls or TrainConfig
+    sections = {"": cls}
+    for name, kind in typing.get_type_hints(cls).items():
+        if dataclasses.is_dataclass(kind):
+            sections.update(
+                {name + "." + sub: inner for sub, inner in config_sections(kind).items()}
+            )
+    return sections
+
+
 def config_fields() -> dict[str, tuple[type, Any, str]]:
     """Every overridable key (``"seed"``, ``"agent.lr"``, ...) -> (type, default, doc)."""
     keys = {}
-    for cls, prefix in ((TrainConfig, ""), (AgentConfig, "agent.")):
+    for prefix, cls in config_sections().items():
         hints = typing.get_type_hints(cls)
         docs = field_docs(cls)
         for f in dataclasses.fields(cls):
-            if f.name == "agent" and cls is TrainConfig:
+            if dataclasses.is_dataclass(hints[f.name]):
                 continue
             default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
             keys[prefix + f.name] = (hints[f.name], default, docs.get(f.name, ""))
@@ -305,15 +321,37 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
                 f"on {meant}, or use a preset for {env_id!r}: {' or '.join(fitting)} (or no "
                 "preset for the paper defaults)"
             )
+    recipe = overrides.get("agent.recipe", values.get("agent.recipe"))
+    if recipe is not None:
+        values.update(recipe_values(recipe))
     values.update(overrides)
     return from_flat(values)
 
 
+def recipe_values(name: str) -> dict[str, Any]:
+    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name``."""
+    from simoun_agent.recipes import RECIPES
+
+    if name not in RECIPES:
+        import difflib
+
+        hint = difflib.get_close_matches(name, RECIPES, n=1)
+        raise SetupError(
+            f"unknown recipe --agent.recipe {name!r}"
+            + (f" (did you mean {hint[0]!r}?)" if hint else "")
+            + f"; choose one of {', '.join(RECIPES)}"
+        )
+    return {"agent." + key: value for key, value in RECIPES[name].values.items()}
+
+
 def _flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
+    """``{"agent": {"lr": 1e-3}, "seed": 1}`` -> ``{"agent.lr": 1e-3, "seed": 1}``: the dicts
+    of config sections are walked, any other dict (``env_kwargs``) is a value."""
+    sections = config_sections()
     flat = {}
     for key, value in nested.items():
-        if key == "agent" and not prefix:
-            flat.update(_flatten(value, "agent."))
+        if isinstance(value, dict) and prefix + key + "." in sections:
+            flat.update(_flatten(value, prefix + key + "."))
         else:
             flat[prefix + key] = value
     return flat
@@ -321,12 +359,21 @@ def _flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
 
 def from_flat(values: dict[str, Any]) -> TrainConfig:
     """TrainConfig from flat keys (``"agent.lr"``) over the dataclass defaults."""
-    agent_values = {k[6:]: v for k, v in values.items() if k.startswith("agent.")}
-    train_values = {k: v for k, v in values.items() if not k.startswith("agent.")}
     try:
-        return TrainConfig(**train_values, agent=AgentConfig(**agent_values))
+        return _build(TrainConfig, "", values)
     except ValueError as err:
         raise SetupError(str(err)) from None
+
+
+def _build(cls: type, prefix: str, values: dict[str, Any]) -> Any:
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if dataclasses.is_dataclass(hints[f.name]):
+            kwargs[f.name] = _build(hints[f.name], prefix + f.name + ".", values)
+        elif prefix + f.name in values:
+            kwargs[f.name] = values[prefix + f.name]
+    return cls(**kwargs)
 
 
 def to_dict(config: TrainConfig) -> dict[str, Any]:

@@ -34,6 +34,7 @@ import torch
 from tqdm import tqdm
 
 from simoun_agent import SimounAgent
+from simoun_agent.recipes import RECIPES
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.checkpoint import (
     atomic_write,
@@ -419,16 +420,18 @@ def _eval_postfix(metrics: dict[str, float] | None) -> dict[str, str]:
 def build_parser() -> argparse.ArgumentParser:
     """The command line: a few run options and one flag per config key."""
     presets = "\n".join(f"  {name:18} {preset.description}" for name, preset in PRESETS.items())
+    recipes = "\n".join(f"  {name:18} {recipe.description}" for name, recipe in RECIPES.items())
     parser = argparse.ArgumentParser(
         prog="simoun-train",
         usage="simoun-train [--preset NAME | --resume RUN_DIR] [--KEY VALUE ...] [--set KEY=VALUE]",
         description="Train the Simoun agent (vision-based SAC) on a Gymnasium environment.",
         formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog=f"presets:\n{presets}\n\n"
+        epilog=f"presets:\n{presets}\n\nagent recipes (--agent.recipe NAME):\n{recipes}\n\n"
         "examples:\n"
         "  simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu\n"
         "  simoun-train --preset cheetah-run --agent.encoder dual --agent.curiosity false\n"
         "  simoun-train --preset highway --set agent.batch_size=64\n"
+        "  simoun-train --preset cpu --agent.recipe drq --seed 2\n"
         "  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000\n\n"
         "Values: booleans true/false, None as none, dicts as JSON (--env-kwargs '{\"a\": 1}').",
     )
