@@ -7,6 +7,7 @@ from typing import Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
 
 
@@ -48,7 +49,8 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
     padding_type="reset")``, with the same observation space, but each step writes one frame
     into a ring buffer and copies the stack once (no deepcopy of the whole stack). Every
     returned array is fresh. With the default ``num_frames=3`` the observation is Simoun's
-    triplet ``[o_{t-2}, o_{t-1}, o_t]``.
+    triplet ``[o_{t-2}, o_{t-1}, o_t]``. ``step()`` before the first ``reset()`` raises
+    gymnasium's ``ResetNeeded`` (``OrderEnforcing``'s convention): there is no stack to push to.
 
     Example:
         >>> import gymnasium as gym
@@ -83,13 +85,21 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.num_frames = int(num_frames)
         self.observation_space = batch_space(space, n=self.num_frames)
         self._ring = FrameRing(self.num_frames, space.shape, space.dtype)
+        self._has_reset = False
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         obs, info = self.env.reset(seed=seed, options=options)
+        self._has_reset = True
         return self._ring.reset(obs), info
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        if not self._has_reset:
+            # The ring holds no frames yet: stepping would return a stack of zero frames.
+            raise ResetNeeded(
+                "Cannot call env.step() before calling env.reset(): FrameTriplet fills its "
+                "frame stack in reset(); call env.reset(seed=...) first."
+            )
         obs, reward, terminated, truncated, info = self.env.step(action)
         return self._ring.push(obs), reward, terminated, truncated, info

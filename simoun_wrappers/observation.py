@@ -170,6 +170,7 @@ class SimounObservation(ChainWrapper):
     ``env.spec`` records this wrapper alone (not its inner gymnasium wrappers), so
     ``gym.make(env.spec)`` rebuilds the same chain. When pixels come from ``render()``,
     ``metadata["render_modes"]`` is narrowed to ``["rgb_array"]``, the only mode it works with.
+    ``step()`` before the first ``reset()`` raises gymnasium's ``ResetNeeded``.
 
     Example:
         >>> import gymnasium as gym

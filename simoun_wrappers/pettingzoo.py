@@ -7,7 +7,7 @@ from typing import Any
 import cv2
 import numpy as np
 from gymnasium import spaces
-from pettingzoo.utils.env import ParallelEnv
+from pettingzoo.utils.env import AECEnv, ParallelEnv
 from pettingzoo.utils.wrappers import BaseParallelWrapper
 
 from simoun_wrappers.frames import FrameRing
@@ -62,6 +62,13 @@ class SimounParallelObservation(BaseParallelWrapper):
             fold_frames: return ``(num_frames*C, H, W)`` uint8 boxes (no motion key).
             source: ``"auto"``, ``"observation"`` (each agent's image) or ``"render"``.
         """
+        if isinstance(env, AECEnv):
+            raise TypeError(
+                f"SimounParallelObservation wraps a PettingZoo ParallelEnv, got the AEC env {env}; "
+                f"create the parallel version (e.g. pistonball_v6.parallel_env(...) or "
+                f"pettingzoo.make('parallel', ...)), or convert it with "
+                f"pettingzoo.utils.conversions.aec_to_parallel(env)."
+            )
         super().__init__(env)
         check_stack_options(num_frames, motion, fold_frames, source)
         self._size = parse_size(size)
