@@ -67,7 +67,8 @@ def test_single_path_encoders_train_l_tran_on_their_state():
     before = [p.detach().clone() for p in agent.transition.parameters()]
     metrics = agent.update_window(*window(), step=0)
     assert metrics["transition_loss"] > 0
-    assert any(not torch.equal(b, p) for b, p in zip(before, agent.transition.parameters(), strict=True))
+    after = agent.transition.parameters()
+    assert any(not torch.equal(b, p) for b, p in zip(before, after, strict=True))
 
 
 class Spy:
