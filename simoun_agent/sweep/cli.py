@@ -1,0 +1,310 @@
+"""``simoun-sweep``: a grid of training runs on Ray Tune, on this machine or a Ray cluster.
+
+    simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl --seeds 0-4 --sweep-dir sw
+    simoun-sweep --resume --sweep-dir sw              # after Ctrl-C: finish what is unfinished
+    simoun-sweep --address auto --preset cheetah-run --grid agent.recipe=simoun,drq --seeds 0-4
+
+The base config is given exactly as to ``simoun-train`` (``--preset``, every config flag,
+``--set KEY=VALUE``). Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``;
+the report (:mod:`simoun_agent.sweep.report`) is written when the sweep ends.
+"""
+
+from __future__ import annotations
+
+import argparse
+import socket
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+from types import ModuleType
+
+from simoun_agent.run import train
+from simoun_agent.run.presets import SetupError
+from simoun_agent.sweep import report
+from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, Trial
+from simoun_agent.sweep.trainable import ERROR_FILE, run_trial, trial_table
+
+CONNECT_TIMEOUT_S = 5.0
+"""How long ``--address HOST:PORT`` may take to answer before the sweep gives up."""
+
+
+def load_ray() -> ModuleType:
+    """Ray, or a SetupError saying how to install it."""
+    try:
+        import ray
+        from ray import tune  # noqa: F401  (fails too when ray is there without the tune extra)
+    except ImportError:
+        raise SetupError(
+            "simoun-sweep runs on Ray Tune, which is not installed; install it with: "
+            "pip install 'simoun[sweep]'"
+        ) from None
+    return ray
+
+
+def connect(ray: ModuleType, address: str | None, num_cpus: int | None) -> None:
+    """Start a local Ray instance (``address`` None) or join a cluster (``auto``, ``HOST:PORT``,
+    ``ray://HOST:PORT``); an address where nothing answers fails within seconds."""
+    if address is None:
+        ray.init(address="local", num_cpus=num_cpus, include_dashboard=False)
+        return
+    fix = (
+        "start a cluster with `ray start --head` (and `ray start --address HEAD:6379` on the "
+        "other machines), or drop --address to run on a local Ray instance"
+    )
+    if address != "auto":
+        host, _, port = address.removeprefix("ray://").rpartition(":")
+        if not host or not port.isdigit():
+            raise SetupError(f"--address {address!r} is not HOST:PORT, ray://HOST:PORT or auto")
+        try:
+            socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S).close()
+        except OSError as err:
+            raise SetupError(
+                f"--address {address}: no Ray cluster answers at {host}:{port} "
+                f"({err.strerror or err}); {fix}"
+            ) from None
+    try:
+        ray.init(address=address)
+    except (ConnectionError, RuntimeError, ValueError) as err:
+        raise SetupError(f"--address {address}: cannot join a Ray cluster ({err}); {fix}") from None
+
+
+def gpus_per_trial(ray: ModuleType, wanted: str) -> float:
+    """``auto``: one GPU per trial when the cluster has GPUs, else none; or the number given."""
+    if wanted == "auto":
+        return 1.0 if ray.cluster_resources().get("GPU", 0) > 0 else 0.0
+    try:
+        gpus = float(wanted)
+    except ValueError:
+        raise SetupError(f"--gpus-per-trial takes a number or auto, got {wanted!r}") from None
+    if gpus < 0:
+        raise SetupError(f"--gpus-per-trial must be 0 or more, got {wanted}")
+    return gpus
+
+
+def check_fits(ray: ModuleType, cpus: int, gpus: float) -> None:
+    """A trial that no machine can hold would wait forever: refuse it now."""
+    have = ray.cluster_resources()
+    for name, need, flag in (("CPU", cpus, "--cpus-per-trial"), ("GPU", gpus, "--gpus-per-trial")):
+        if need > have.get(name, 0):
+            raise SetupError(
+                f"each trial asks for {need:g} {name}s ({flag}) but the Ray cluster has "
+                f"{have.get(name, 0):g}; lower {flag} or add machines"
+            )
+
+
+def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
+    """The sweep to run: from the flags, or the saved one on ``--resume`` (which the flags, when
+    given, must match)."""
+    base = train.overrides_from(args)
+    given = bool(args.grid or args.seeds or args.envs or base or args.preset)
+    if not args.resume:
+        if (sweep_dir / SWEEP_FILE).exists():
+            raise SetupError(
+                f"{sweep_dir} already holds a sweep; continue it with --resume, or pass another "
+                "--sweep-dir"
+            )
+        if sweep_dir.exists() and any(sweep_dir.iterdir()):
+            raise SetupError(f"{sweep_dir} is not empty; pass a new --sweep-dir")
+        return SweepSpec.create(
+            args.preset, base, args.grid, args.seeds, args.envs, args.cpus_per_trial or 1
+        )
+    saved = SweepSpec.load(sweep_dir)
+    if not given and args.cpus_per_trial in (None, saved.cpus_per_trial):
+        return saved
+    spec = SweepSpec.create(
+        args.preset,
+        base,
+        args.grid,
+        args.seeds,
+        args.envs,
+        args.cpus_per_trial or saved.cpus_per_trial,
+    )
+    differences = spec.describe_differences(saved)
+    if differences:
+        raise SetupError(
+            f"the sweep in {sweep_dir} was started with another grid, so --resume cannot continue "
+            f"it ({'; '.join(differences)}); give the flags it was started with (or only "
+            f"--resume --sweep-dir {sweep_dir}), or start a new sweep in another --sweep-dir"
+        )
+    return saved
+
+
+def finished(trial: Trial) -> bool:
+    return (Path(trial.run_dir) / train.SUMMARY_NAME).is_file()
+
+
+def run_sweep(
+    ray: ModuleType, spec: SweepSpec, sweep_dir: Path, gpus: float, verbose: int
+) -> dict[str, list[Trial]]:
+    """Run the unfinished trials on Tune; returns them grouped as finished / failed / stopped."""
+    from ray import tune
+
+    trials = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    tuner = tune.Tuner(
+        tune.with_resources(
+            tune.with_parameters(run_trial, trials=trial_table(trials)),
+            {"cpu": spec.cpus_per_trial, "gpu": gpus},
+        ),
+        param_space={"trial": tune.grid_search([trial.name for trial in trials])},
+        tune_config=tune.TuneConfig(trial_name_creator=lambda t: t.config["trial"]),
+        run_config=tune.RunConfig(
+            name=stamp,
+            storage_path=str((sweep_dir / "tune").resolve()),
+            failure_config=tune.FailureConfig(max_failures=0, fail_fast=False),
+            verbose=verbose,
+        ),
+    )
+    results = tuner.fit()
+    errors = {result.config["trial"]: result.error for result in results if result.error}
+    outcome: dict[str, list[Trial]] = {"finished": [], "failed": [], "stopped": []}
+    for trial in trials:
+        if finished(trial):
+            outcome["finished"].append(trial)
+        elif trial.name in errors or (Path(trial.run_dir) / ERROR_FILE).is_file():
+            outcome["failed"].append(trial)
+        else:
+            outcome["stopped"].append(trial)
+    return outcome
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-sweep",
+        usage="simoun-sweep --sweep-dir DIR [--grid KEY=V1,V2 ...] [--seeds 0-4] [--envs A,B] "
+        "[--preset NAME] [--KEY VALUE ...] [--resume] [--address auto|HOST:PORT]",
+        description="Run a grid of simoun-train runs (variants x envs x seeds) on Ray Tune, on "
+        "this machine or a Ray cluster, then write the report (simoun-report).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        allow_abbrev=False,
+        epilog="examples:\n"
+        "  simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 "
+        "--sweep-dir sweeps/baselines\n"
+        "  simoun-sweep --resume --sweep-dir sweeps/baselines\n"
+        "  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq "
+        "--seeds 0-4 --sweep-dir /shared/sweeps/walker\n\n"
+        "Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.",
+    )
+    sweep = parser.add_argument_group("sweep")
+    sweep.add_argument(
+        "--sweep-dir",
+        metavar="DIR",
+        help="where the runs and the report go (default: sweeps/<UTC time>; required with "
+        "--resume); on a cluster, a directory every machine sees",
+    )
+    sweep.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2",
+        help="a config key and the values to try (repeatable: the variants are the product), "
+        "e.g. --grid agent.recipe=simoun,drq",
+    )
+    sweep.add_argument(
+        "--seeds",
+        metavar="SEEDS",
+        help="seeds of each variant, e.g. 0-4 or 0,2,5 (default: --seed)",
+    )
+    sweep.add_argument(
+        "--envs", metavar="ID,ID", help="Gymnasium ids to run every variant on (default: --env)"
+    )
+    sweep.add_argument(
+        "--cpus-per-trial",
+        type=int,
+        metavar="N",
+        help="CPUs per trial; the trial uses as many torch threads (default: 1)",
+    )
+    sweep.add_argument(
+        "--gpus-per-trial",
+        default="auto",
+        metavar="N|auto",
+        help="GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs, else 0",
+    )
+    sweep.add_argument(
+        "--address",
+        metavar="auto|HOST:PORT|ray://HOST:PORT",
+        help="run on a Ray cluster (auto: the one `ray start` made on this machine); default: a "
+        "local Ray instance",
+    )
+    sweep.add_argument(
+        "--num-cpus",
+        type=int,
+        metavar="N",
+        help="CPUs of the local Ray instance (default: this machine's)",
+    )
+    sweep.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the sweep in --sweep-dir: finished trials are skipped, the others go on "
+        "from their checkpoints",
+    )
+    sweep.add_argument(
+        "--verbose", type=int, default=1, choices=(0, 1, 2), help="Tune's output (default: 1)"
+    )
+    train.add_config_arguments(parser)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-sweep``."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.resume and not args.sweep_dir:
+        parser.exit(2, "simoun-sweep: error: --resume needs the --sweep-dir of the sweep\n")
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp)
+    try:
+        ray = load_ray()
+        spec = sweep_spec(args, sweep_dir)
+    except SetupError as err:
+        parser.exit(2, f"simoun-sweep: error: {err}\n")
+    todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
+    done = len(spec.trials(sweep_dir)) - len(todo)
+    print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
+    if todo:
+        try:
+            connect(ray, args.address, args.num_cpus)
+            gpus = gpus_per_trial(ray, args.gpus_per_trial)
+            check_fits(ray, spec.cpus_per_trial, gpus)
+            sweep_dir.mkdir(parents=True, exist_ok=True)
+            if not (sweep_dir / SWEEP_FILE).exists():
+                spec.save(sweep_dir)
+            outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
+        except SetupError as err:
+            parser.exit(2, f"simoun-sweep: error: {err}\n")
+        except KeyboardInterrupt:
+            outcome = {"stopped": todo}
+        finally:
+            ray.shutdown()
+    else:
+        outcome = {}
+    written = report.write_report(sweep_dir)
+    return summarize(outcome, sweep_dir, written)
+
+
+def summarize(outcome: dict[str, list[Trial]], sweep_dir: Path, written: list[Path]) -> int:
+    """Say what happened to each trial and how to go on; the exit status."""
+    for trial in outcome.get("failed", []):
+        error = Path(trial.run_dir) / ERROR_FILE
+        last = error.read_text().strip().splitlines()[-1] if error.is_file() else "see Tune's log"
+        print(f"FAILED {trial.name}: {last} (traceback: {error})", file=sys.stderr)
+    print(f"report: {', '.join(map(str, written))}")
+    if outcome.get("stopped"):
+        print(
+            f"stopped with {len(outcome['stopped'])} trials unfinished; continue with: "
+            f"simoun-sweep --resume --sweep-dir {sweep_dir}",
+            file=sys.stderr,
+        )
+        return 130
+    if outcome.get("failed"):
+        print(
+            f"{len(outcome['failed'])} trials failed, the others finished; fix the cause and "
+            f"rerun them with: simoun-sweep --resume --sweep-dir {sweep_dir}",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,312 @@
+"""The grid of a sweep: ``--grid KEY=V1,V2`` (repeatable), ``--seeds 0-4``, ``--envs A,B`` over a
+base config, expanded into one :class:`Trial` (one ordinary training run) per combination.
+
+No Ray here: the grid is parsed, checked and saved (``sweep.json``) before Ray starts, so bad
+input fails fast and a resumed sweep can be compared with the one it continues.
+
+Example:
+    >>> spec = SweepSpec.create(
+    ...     None, {"agent.curiosity": False}, ["agent.encoder=stacked,single"], "0-1", None
+    ... )
+    >>> [(t.variant, t.seed) for t in spec.trials("sweep")]  # doctest: +NORMALIZE_WHITESPACE
+    [('agent.encoder=stacked', 0), ('agent.encoder=stacked', 1),
+     ('agent.encoder=single', 0), ('agent.encoder=single', 1)]
+"""
+
+from __future__ import annotations
+
+import difflib
+import itertools
+import json
+import re
+import typing
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.presets import SetupError, config_fields, dmc_task, parse_value, resolve
+
+SWEEP_FILE = "sweep.json"
+"""The sweep's grid and base config, written once in the sweep directory."""
+
+BASE_VARIANT = "base"
+"""Variant name of a sweep without ``--grid`` (seeds and envs only)."""
+
+DEDICATED = {
+    "seed": "--seeds",
+    "env": "--envs",
+    "run_dir": "--sweep-dir (each trial's run directory is <variant>/<env>/s<seed> under it)",
+    "torch_threads": "--cpus-per-trial (each trial gets one torch thread per CPU)",
+}
+"""Config keys a sweep sets itself, and the flag to use instead."""
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``"0-4"`` -> [0, 1, 2, 3, 4]; ``"0,2,5"`` and mixes like ``"0-2,7"`` work too."""
+    seeds: list[int] = []
+    for part in text.split(","):
+        match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+        if match is None:
+            raise SetupError(
+                f"--seeds {text!r}: cannot read {part!r}; give non-negative integers and ranges, "
+                "e.g. --seeds 0-4 or --seeds 0,2,5"
+            )
+        first, last = int(match[1]), int(match[2] or match[1])
+        if last < first:
+            raise SetupError(
+                f"--seeds {text!r}: the range {part.strip()!r} runs backwards; write it low-high, "
+                f"e.g. --seeds {last}-{first}"
+            )
+        seeds += range(first, last + 1)
+    duplicates = sorted({seed for seed in seeds if seeds.count(seed) > 1})
+    if duplicates:
+        raise SetupError(f"--seeds {text!r} names seed {duplicates[0]} twice; list each seed once")
+    return seeds
+
+
+def split_values(text: str) -> list[str]:
+    """Split on the commas outside brackets and quotes, so JSON values keep theirs."""
+    values, depth, quoted, start = [], 0, False, 0
+    for i, char in enumerate(text):
+        if char == '"' and text[i - 1 : i] != "\\":
+            quoted = not quoted
+        elif not quoted and char in "[{":
+            depth += 1
+        elif not quoted and char in "]}":
+            depth -= 1
+        elif not quoted and depth == 0 and char == ",":
+            values.append(text[start:i])
+            start = i + 1
+    values.append(text[start:])
+    return [value.strip() for value in values]
+
+
+def check_key(key: str, flag: str) -> None:
+    """Raise SetupError for a key that is no config key (with the closest ones) or that the sweep
+    sets itself."""
+    if key in DEDICATED:
+        raise SetupError(f"{flag} cannot set {key}: the sweep sets it; use {DEDICATED[key]}")
+    known = config_fields()
+    if key not in known:
+        hint = difflib.get_close_matches(key, known, n=1)
+        raise SetupError(
+            f"{flag}: unknown config key {key!r}"
+            + (f" (did you mean {hint[0]}?)" if hint else "")
+            + "; `simoun-train --help` lists every key"
+        )
+
+
+def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
+    """``["agent.recipe=drq,sac"]`` -> ``{"agent.recipe": ["drq", "sac"]}``, values typed."""
+    grid: dict[str, list[Any]] = {}
+    fields = config_fields()
+    for pair in pairs:
+        key, sep, text = pair.partition("=")
+        key = key.strip()
+        if not sep:
+            raise SetupError(
+                f"--grid takes KEY=V1,V2,..., got {pair!r}; e.g. --grid agent.recipe=simoun,drq"
+            )
+        check_key(key, f"--grid {pair}")
+        if key in grid:
+            raise SetupError(f"--grid names {key} twice; give all its values in one --grid")
+        texts = split_values(text)
+        if not text.strip() or any(not value for value in texts):
+            raise SetupError(
+                f"--grid {pair!r} has an empty value; give at least one, comma-separated, e.g. "
+                f"--grid {key}=V1,V2"
+            )
+        values = [parse_value(key, value, fields[key][0]) for value in texts]
+        if len(set(map(show, values))) < len(values):
+            raise SetupError(f"--grid {pair!r} repeats a value; list each value once")
+        grid[key] = values
+    return grid
+
+
+def show(value: Any) -> str:
+    """A value as written on the command line: true/false, none, compact JSON, numbers as is."""
+    if isinstance(value, bool) or value is None:
+        return json.dumps(value).replace("null", "none")
+    if isinstance(value, (dict, list, tuple)):
+        return json.dumps(value, separators=(",", ":"))
+    return str(value)
+
+
+def path_part(text: str) -> str:
+    """A safe directory name: env ids and values keep letters, digits and ``.=,+-_``."""
+    return re.sub(r"[^A-Za-z0-9.=,+_-]", "-", text)
+
+
+def env_label(env_id: str) -> str:
+    """``dm_control/cartpole-swingup-v0`` -> ``cartpole-swingup``; others with ``/`` as ``-``."""
+    return dmc_task(env_id) or env_id.replace("/", "-")
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One training run of the sweep."""
+
+    variant: str
+    """the grid values of this run, e.g. ``agent.recipe=drq`` (``base`` without a grid)"""
+    env: str
+    """Gymnasium id"""
+    seed: int
+    """the run's seed"""
+    run_dir: str
+    """its run directory, ``<sweep>/<variant>/<env>/s<seed>``"""
+    preset: str | None
+    """the base preset"""
+    overrides: dict
+    """flat config overrides (base, grid values, env, seed, run_dir, torch_threads)"""
+
+    @property
+    def name(self) -> str:
+        return f"{self.variant}/{env_label(self.env)}/s{self.seed}"
+
+
+@dataclass
+class SweepSpec:
+    """What a sweep runs; saved as ``sweep.json`` and compared when the sweep is resumed."""
+
+    preset: str | None
+    """the base preset (``--preset``)"""
+    base: dict
+    """the base config overrides, flat (``{"agent.lr": 3e-4}``), as ``simoun-train`` takes them"""
+    grid: dict
+    """config key -> the values to try (their product makes the variants)"""
+    seeds: list
+    """seeds of every variant x env"""
+    envs: list
+    """Gymnasium ids of every variant"""
+    cpus_per_trial: int = 1
+    """CPUs Ray reserves per trial; the trial runs with as many torch threads"""
+
+    @classmethod
+    def create(
+        cls,
+        preset: str | None,
+        base: dict[str, Any],
+        grid_pairs: list[str],
+        seeds: str | None,
+        envs: str | None,
+        cpus_per_trial: int = 1,
+    ) -> SweepSpec:
+        """Parse and check the sweep's flags (raises SetupError naming the flag and the fix)."""
+        for key in ("run_dir", "torch_threads"):
+            if key in base:
+                raise SetupError(f"a sweep sets {key} itself; drop it and use {DEDICATED[key]}")
+        if "seed" in base and seeds is not None:
+            raise SetupError("give the seeds once: --seeds (e.g. --seeds 0-4), not --seed too")
+        if "env" in base and envs is not None:
+            raise SetupError("give the envs once: --envs A,B, not --env too")
+        if cpus_per_trial < 1:
+            raise SetupError(f"--cpus-per-trial must be at least 1, got {cpus_per_trial}")
+        grid = parse_grid(grid_pairs)
+        both = sorted(set(grid) & set(base))
+        if both:
+            raise SetupError(
+                f"{both[0]} is given both as a base flag and in --grid; keep it in one place"
+            )
+        base_config = resolve(preset, base)
+        seed_list = parse_seeds(seeds) if seeds is not None else [base_config.seed]
+        env_list = split_values(envs) if envs is not None else [base_config.env]
+        if not all(env_list):
+            raise SetupError(f"--envs {envs!r} has an empty id; e.g. --envs simoun/PointReach-v0")
+        spec = cls(preset, _plain(base), _plain(grid), seed_list, env_list, cpus_per_trial)
+        spec.check_trials()
+        return spec
+
+    def variants(self) -> list[dict[str, Any]]:
+        """Each combination of grid values, in the order given (one ``{}`` without a grid)."""
+        combos = itertools.product(*self.grid.values())
+        return [dict(zip(self.grid, combo, strict=True)) for combo in combos]
+
+    def trials(self, sweep_dir: Path | str) -> list[Trial]:
+        """Every trial: variants x envs x seeds, each with its own run directory."""
+        trials = []
+        for values in self.variants():
+            variant = ",".join(f"{key}={show(value)}" for key, value in values.items())
+            variant = variant or BASE_VARIANT
+            for env, seed in itertools.product(self.envs, self.seeds):
+                run_dir = Path(sweep_dir, path_part(variant), path_part(env_label(env)), f"s{seed}")
+                overrides = {
+                    "progress": False,
+                    **self.base,
+                    **values,
+                    "env": env,
+                    "seed": seed,
+                    "run_dir": str(run_dir),
+                    "torch_threads": self.cpus_per_trial,
+                }
+                trials.append(
+                    Trial(variant, env, seed, str(run_dir), self.preset, _typed(overrides))
+                )
+        return trials
+
+    def check_trials(self) -> None:
+        """Resolve every trial's config now (unknown recipe, a value its key refuses, a preset
+        meant for another env...), before anything runs; two trials may not share a directory."""
+        seen: dict[str, str] = {}
+        for trial in self.trials("."):
+            try:
+                resolve(trial.preset, trial.overrides)
+            except SetupError as err:
+                raise SetupError(f"trial {trial.name} (from --grid / --envs): {err}") from None
+            if trial.run_dir in seen:
+                raise SetupError(
+                    f"trials {seen[trial.run_dir]} and {trial.name} would share the run "
+                    f"directory {trial.run_dir}; make their --grid values differ in letters or "
+                    "digits"
+                )
+            seen[trial.run_dir] = trial.name
+
+    def describe_differences(self, other: SweepSpec) -> list[str]:
+        """What differs from ``other`` (the saved sweep), one line per flag."""
+        flags = {
+            "grid": "--grid",
+            "seeds": "--seeds",
+            "envs": "--envs",
+            "preset": "--preset",
+            "base": "the base config flags",
+            "cpus_per_trial": "--cpus-per-trial",
+        }
+        mine, saved = asdict(self), asdict(other)
+        return [
+            f"{flag}: saved {json.dumps(saved[name])}, given {json.dumps(mine[name])}"
+            for name, flag in flags.items()
+            if mine[name] != saved[name]
+        ]
+
+    def save(self, sweep_dir: Path) -> None:
+        text = json.dumps(asdict(self), indent=2) + "\n"
+        atomic_write(sweep_dir / SWEEP_FILE, lambda tmp: tmp.write_text(text))
+
+    @classmethod
+    def load(cls, sweep_dir: Path) -> SweepSpec:
+        path = sweep_dir / SWEEP_FILE
+        if not path.is_file():
+            raise SetupError(
+                f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing); pass the --sweep-dir of "
+                "a sweep that simoun-sweep started, or drop --resume to start one"
+            )
+        try:
+            return cls(**json.loads(path.read_text()))
+        except (json.JSONDecodeError, TypeError) as err:
+            raise SetupError(f"{path} is corrupt ({err}); start a new sweep") from None
+
+
+def _typed(overrides: dict[str, Any]) -> dict[str, Any]:
+    """Lists back to tuples for tuple-typed keys (JSON has no tuples)."""
+    fields = config_fields()
+    return {
+        key: tuple(value)
+        if isinstance(value, list) and typing.get_origin(fields[key][0]) is tuple
+        else value
+        for key, value in overrides.items()
+    }
+
+
+def _plain(value: Any) -> Any:
+    """The JSON form (tuples as lists), so a fresh spec compares equal to a loaded one."""
+    return json.loads(json.dumps(value))

@@ -1,0 +1,337 @@
+"""``simoun-report DIR``: compare the runs of a sweep, or of any directory of ``simoun-train``
+runs, per variant and env, over seeds (the paper's Table 1 and Fig. 6). Needs no Ray.
+
+    simoun-report sweeps/baselines
+    simoun-report runs/ --out runs/report
+
+Runs are found by their ``config.json``. A *variant* is the config values that tell runs of
+the same env apart, seeds aside: a sweep's ``--grid`` keys, or, for plain runs, every key that
+differs between two runs of one env (``seed``, ``run_dir`` and output-only keys excepted).
+Only finished runs (``summary.json`` present) are counted; unfinished and failed ones are
+listed. Writes:
+
+- ``report.md`` and ``report.csv``: per variant x env, the number of seeds n and mean ± std
+  over seeds (sample std, ddof=1) of the final evaluation return, of the area under the
+  learning curve, of the wall time and of the env steps per second;
+- ``curves_env_steps.png`` and ``curves_wall_time.png``: the evaluation return's mean ± std
+  band per variant against env steps and against wall-clock seconds, one panel per env.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.logger import EVAL_CSV, read_csv
+from simoun_agent.run.presets import SetupError
+from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
+from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
+
+REPORT_MD = "report.md"
+REPORT_CSV = "report.csv"
+CURVES_STEPS_PNG = "curves_env_steps.png"
+CURVES_TIME_PNG = "curves_wall_time.png"
+ERROR_FILE = "error.txt"
+"""Written by a failed sweep trial into its run directory (:mod:`simoun_agent.sweep.trainable`)."""
+
+NOT_VARIANT = {
+    "seed",
+    "run_dir",
+    "progress",
+    "video",
+    "checkpoint_every",
+    "device",
+    "torch_threads",
+}
+"""Keys that differ between runs without making them another method: the seed and where or how
+the run was executed."""
+
+CURVE_POINTS = 100
+"""Points of the common wall-time grid the runs of a variant are interpolated onto."""
+
+
+@dataclass
+class RunRecord:
+    """One run directory as the report sees it."""
+
+    run_dir: Path
+    config: dict[str, Any]
+    """flat config (``{"agent.lr": 0.001, ...}``)"""
+    curve: dict[str, np.ndarray]
+    """eval.csv columns env_step, return_mean, wall_time_s"""
+    summary: dict[str, Any] | None
+    """summary.json, present only when the run finished"""
+    error: str | None
+    """last line of error.txt when a sweep trial failed"""
+
+    @property
+    def env(self) -> str:
+        return self.config["env"]
+
+
+def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``{"agent": {"lr": 1}}`` -> ``{"agent.lr": 1}``, every nested dict walked."""
+    flat: dict[str, Any] = {}
+    for key, value in nested.items():
+        if isinstance(value, dict) and value:
+            flat.update(flatten(value, f"{prefix}{key}."))
+        else:
+            flat[prefix + key] = value
+    return flat
+
+
+def find_runs(root: Path) -> list[RunRecord]:
+    """Every run directory under ``root`` (Tune's own records under ``tune/`` skipped)."""
+    records = []
+    for config_path in sorted(root.rglob(CONFIG_NAME)):
+        relative = config_path.relative_to(root).parts
+        if relative[0] == "tune" or any(part.startswith(".") for part in relative):
+            continue
+        run_dir = config_path.parent
+        try:
+            config = flatten(json.loads(config_path.read_text()))
+        except json.JSONDecodeError:
+            continue
+        if "env" not in config or "seed" not in config:
+            continue
+        rows = read_csv(run_dir / EVAL_CSV) if (run_dir / EVAL_CSV).is_file() else []
+        curve = {
+            key: np.array([row.get(key, math.nan) for row in rows], dtype=float)
+            for key in ("env_step", "return_mean", "wall_time_s")
+        }
+        summary_path = run_dir / SUMMARY_NAME
+        summary = json.loads(summary_path.read_text()) if summary_path.is_file() else None
+        error_path = run_dir / ERROR_FILE
+        error = None
+        if error_path.is_file() and summary is None:
+            lines = error_path.read_text().strip().splitlines()
+            error = lines[-1] if lines else "failed"
+        records.append(RunRecord(run_dir, config, curve, summary, error))
+    return records
+
+
+def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
+    """The keys that name a variant: a sweep's grid keys, else those differing within an env."""
+    sweep_file = root / SWEEP_FILE
+    if sweep_file.is_file():
+        return list(json.loads(sweep_file.read_text())["grid"])
+    keys: list[str] = []
+    for env in dict.fromkeys(record.env for record in records):
+        same_env = [record.config for record in records if record.env == env]
+        for key in dict.fromkeys(key for config in same_env for key in config):
+            values = {json.dumps(config.get(key), sort_keys=True) for config in same_env}
+            if key not in NOT_VARIANT and len(values) > 1 and key not in keys:
+                keys.append(key)
+    return keys
+
+
+def variant_name(config: dict[str, Any], keys: list[str]) -> str:
+    return ",".join(f"{key}={show(config.get(key))}" for key in keys) or BASE_VARIANT
+
+
+def area_under_curve(steps: np.ndarray, returns: np.ndarray) -> float:
+    """Normalized area under the learning curve: the trapezoid integral of the evaluation return
+    over env steps divided by the env-step span, i.e. the run's average return (in return units,
+    comparable across run lengths). NaN with fewer than two evaluations."""
+    if len(steps) < 2 or steps[-1] <= steps[0]:
+        return math.nan
+    return float(np.trapezoid(returns, steps) / (steps[-1] - steps[0]))
+
+
+def mean_std(values: list[float]) -> tuple[float, float]:
+    """Mean and sample standard deviation (ddof=1; NaN for a single value)."""
+    array = np.asarray(values, dtype=float)
+    if array.size == 0:
+        return math.nan, math.nan
+    std = float(array.std(ddof=1)) if array.size > 1 else math.nan
+    return float(array.mean()), std
+
+
+@dataclass
+class Group:
+    """The runs of one variant on one env."""
+
+    variant: str
+    env: str
+    runs: list[RunRecord]
+
+    @property
+    def done(self) -> list[RunRecord]:
+        return [run for run in self.runs if run.summary is not None]
+
+    def row(self) -> dict[str, Any]:
+        done = self.done
+        finals = [run.summary["final_eval"]["return_mean"] for run in done]
+        aucs = [area_under_curve(run.curve["env_step"], run.curve["return_mean"]) for run in done]
+        walls = [run.summary["wall_time_s"] for run in done]
+        speeds = [run.summary["env_step"] / run.summary["wall_time_s"] for run in done]
+        row: dict[str, Any] = {"variant": self.variant, "env": self.env, "n": len(done)}
+        for name, values in (
+            ("final_return", finals),
+            ("auc", aucs),
+            ("wall_time_s", walls),
+            ("env_steps_per_s", speeds),
+        ):
+            row[f"{name}_mean"], row[f"{name}_std"] = mean_std(values)
+        row["env_steps"] = int(np.mean([run.summary["env_step"] for run in done])) if done else 0
+        row["unfinished"] = len(self.runs) - len(done)
+        return row
+
+
+def group_runs(records: list[RunRecord], keys: list[str]) -> list[Group]:
+    groups: dict[tuple[str, str], Group] = {}
+    for record in records:
+        variant = variant_name(record.config, keys)
+        label = env_label(record.env)
+        groups.setdefault((variant, label), Group(variant, label, [])).runs.append(record)
+    return list(groups.values())
+
+
+def _pm(mean: float, std: float) -> str:
+    if math.isnan(mean):
+        return "–"
+    return f"{mean:.4g}" if math.isnan(std) else f"{mean:.4g} ± {std:.2g}"
+
+
+def markdown(rows: list[dict[str, Any]], failures: list[str], unfinished: list[str]) -> str:
+    lines = [
+        "# Sweep report",
+        "",
+        "Mean ± std over seeds (sample std, ddof=1; none for n = 1), finished runs only. Final "
+        "return: the last evaluation's mean return. AUC: normalized area under the learning "
+        "curve (trapezoid of the evaluation return over env steps, divided by the env-step "
+        "span: the run's average evaluation return). Wall time: seconds in the training loop, "
+        "evaluations included.",
+        "",
+        "| variant | env | n | final return | AUC | wall time (s) | env steps/s | env steps |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for row in rows:
+        cells = [
+            row["variant"],
+            row["env"],
+            str(row["n"]),
+            _pm(row["final_return_mean"], row["final_return_std"]),
+            _pm(row["auc_mean"], row["auc_std"]),
+            _pm(row["wall_time_s_mean"], row["wall_time_s_std"]),
+            _pm(row["env_steps_per_s_mean"], row["env_steps_per_s_std"]),
+            str(row["env_steps"]),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    if unfinished:
+        lines += ["", "## Unfinished runs (not counted)", ""] + [f"- {u}" for u in unfinished]
+    if failures:
+        lines += ["", "## Failed runs", ""] + [f"- {f}" for f in failures]
+    lines += ["", f"![learning curves]({CURVES_STEPS_PNG})", f"![wall time]({CURVES_TIME_PNG})"]
+    return "\n".join(lines) + "\n"
+
+
+def band(
+    runs: list[RunRecord], x_key: str, points: int | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs' evaluation returns on a common x grid (the shared range of ``x_key``; the
+    union of their x values, or ``points`` evenly spaced ones): x, mean and sample std over
+    runs (zero for one run)."""
+    curves = [(run.curve[x_key], run.curve["return_mean"]) for run in runs if len(run.curve[x_key])]
+    if not curves:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    low = max(x[0] for x, _ in curves)
+    high = min(x[-1] for x, _ in curves)
+    if points is None:
+        grid = np.unique(np.concatenate([x for x, _ in curves]))
+        grid = grid[(grid >= low) & (grid <= high)]
+    else:
+        grid = np.linspace(low, high, points)
+    values = np.stack([np.interp(grid, x, y) for x, y in curves])
+    std = values.std(axis=0, ddof=1) if len(values) > 1 else np.zeros_like(grid)
+    return grid, values.mean(axis=0), std
+
+
+def plot_curves(groups: list[Group], x_key: str, xlabel: str, path: Path, points: int | None):
+    """One panel per env, one mean ± std band per variant (finished runs)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    envs = list(dict.fromkeys(group.env for group in groups))
+    fig, axes = plt.subplots(1, len(envs), figsize=(5.5 * len(envs), 4), dpi=110, squeeze=False)
+    for ax, env in zip(axes[0], envs, strict=True):
+        for group in (g for g in groups if g.env == env and g.done):
+            x, mean, std = band(group.done, x_key, points)
+            ax.plot(x, mean, label=f"{group.variant} (n={len(group.done)})")
+            ax.fill_between(x, mean - std, mean + std, alpha=0.2)
+        ax.set_title(env)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("evaluation return")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize="small")
+    fig.tight_layout()
+    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png"))
+    plt.close(fig)
+
+
+def write_report(root: Path, out: Path | None = None) -> list[Path]:
+    """Write the tables and curves of the runs under ``root`` into ``out`` (default: ``root``);
+    returns the files written. Raises SetupError when ``root`` holds no run."""
+    root, out = Path(root), Path(out or root)
+    records = find_runs(root)
+    if not records:
+        raise SetupError(
+            f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
+            "directory of simoun-train runs"
+        )
+    groups = group_runs(records, variant_keys(records, root))
+    rows = [group.row() for group in groups]
+    unfinished = [
+        str(run.run_dir.relative_to(root))
+        for run in records
+        if run.summary is None and run.error is None
+    ]
+    failures = [
+        f"{run.run_dir.relative_to(root)}: {run.error}" for run in records if run.error is not None
+    ]
+    out.mkdir(parents=True, exist_ok=True)
+    text = markdown(rows, failures, unfinished)
+    atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, list(rows[0]))
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write(out / REPORT_CSV, lambda tmp: tmp.write_text(buffer.getvalue()))
+    plot_curves(groups, "env_step", "environment steps", out / CURVES_STEPS_PNG, None)
+    plot_curves(groups, "wall_time_s", "wall-clock seconds", out / CURVES_TIME_PNG, CURVE_POINTS)
+    return [out / name for name in (REPORT_MD, REPORT_CSV, CURVES_STEPS_PNG, CURVES_TIME_PNG)]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-report``."""
+    parser = argparse.ArgumentParser(
+        prog="simoun-report",
+        description="Tables (Markdown, CSV) and learning curves (PNG) of a sweep or of a "
+        "directory of simoun-train runs, per variant and env, over seeds.",
+    )
+    parser.add_argument("root", metavar="DIR", help="a sweep directory or a directory of runs")
+    parser.add_argument("--out", metavar="DIR", help="where to write the report (default: DIR)")
+    args = parser.parse_args(argv)
+    try:
+        written = write_report(Path(args.root), Path(args.out) if args.out else None)
+    except SetupError as err:
+        parser.exit(2, f"simoun-report: error: {err}\n")
+    print((Path(written[0])).read_text(), end="")
+    print(f"written: {', '.join(map(str, written))}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
