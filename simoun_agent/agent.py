@@ -159,13 +159,15 @@ class SimounAgent:
         ``step`` is the global environment step (curiosity decay). Returns detached 0-d tensors
         (no host sync here); call ``float()`` on the ones you log.
         """
-        batch = replay.sample(self.config.batch_size)
+        cfg = self.config
+        batch = replay.sample(cfg.batch_size, cfg.n_step, cfg.discount)
 
         def put(name: str) -> torch.Tensor:
             return torch.from_numpy(batch[name]).to(self.device, non_blocking=True)
 
+        bootstrap = (put("bootstrap_obs"), put("return")) if cfg.n_step > 1 else None
         return self.update_window(
-            put("window"), put("action"), put("reward"), put("discount"), step
+            put("window"), put("action"), put("reward"), put("discount"), step, bootstrap
         )
 
     def intrinsic_reward(
@@ -193,12 +195,17 @@ class SimounAgent:
         reward: torch.Tensor,
         discount: torch.Tensor,
         step: int,
+        bootstrap: tuple[torch.Tensor, torch.Tensor] | None = None,
     ) -> dict[str, torch.Tensor]:
         """One gradient step on a batch already on the device (what :meth:`update` samples).
 
         ``window`` is uint8 ``(B, 4, C, H, W)``, frames t-2 .. t+1 (the triplet at t and, shifted
-        by one frame, the one at t+1); ``action`` float ``(B, A)``; ``reward`` and ``discount``
-        ``(B,)``; ``step`` the global environment step.
+        by one frame, the one at t+1); ``action`` float ``(B, A)``; ``reward`` (r_{t+1}) and
+        ``discount`` ``(B,)``; ``step`` the global environment step. ``bootstrap``: for n-step
+        targets, the uint8 triplet to bootstrap from ``(B, 3, C, H, W)`` and the n-step return
+        ``(B,)`` that replaces ``reward`` in the TD target (``FrameReplay.sample``'s
+        ``bootstrap_obs`` and ``return``; ``discount`` then carries gamma^(m-1)); L_re and L_tran
+        keep the one-step reward and frame t+1.
 
         With ``augmentation="shift"`` the critic and actor see the window shifted by one random
         offset per sample (all four frames alike); the contrastive key is a random convolution
@@ -219,14 +226,19 @@ class SimounAgent:
                         self.encoder.key_frames(seen[:, :-1]), cfg.random_conv_kernel
                     )
                 key = self.encoder_target.encode_key(view)
-            next_action, next_log_prob = self.actor(following.state)
-            next_q = self.critic_target(following.state, next_action)
+            target_state, td_reward = following.state, reward
+            if bootstrap is not None:
+                frames, td_reward = bootstrap
+                if cfg.augmentation == "shift":
+                    frames = random_shift(frames, self.shift_pad)
+                target_state = self.encoder(frames).state
+            next_action, next_log_prob = self.actor(target_state)
+            next_q = self.critic_target(target_state, next_action)
             value = soft_value(*next_q, next_log_prob, self.alpha)
             metrics = {}
-            td_reward = reward
             if cfg.curiosity:
                 r_i, _ = self.intrinsic_reward(enc, reward, step)
-                td_reward = reward + r_i
+                td_reward = td_reward + r_i
                 metrics["intrinsic_reward"] = r_i.mean()
             q_target = td_target(td_reward, discount, cfg.discount, value)
 

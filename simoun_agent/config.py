@@ -45,6 +45,9 @@ class AgentConfig:
     """Adam beta1 of the temperature optimiser (CURL / SAC-AE value)"""
     discount: float = 0.99
     """gamma of the TD target (Eq. 9)"""
+    n_step: int = 1
+    """steps of reward summed before bootstrapping in the TD target (DrQ-v2 uses 3); cut at
+    episode ends, bootstrapped across truncation, never across an episode boundary"""
     critic_tau: float = 0.01
     """EMA rate of the target Q heads"""
     encoder_tau: float = 0.05
@@ -122,6 +125,12 @@ class AgentConfig:
                 f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
                 f"{self.encoder!r} does not have; set curiosity=False or use a dual encoder"
             )
-        for name in ("batch_size", "actor_update_every", "target_update_every", "num_frames"):
+        for name in (
+            "batch_size",
+            "actor_update_every",
+            "target_update_every",
+            "num_frames",
+            "n_step",
+        ):
             if getattr(self, name) < 1:
                 raise ValueError(f"AgentConfig.{name} must be >= 1, got {getattr(self, name)}")

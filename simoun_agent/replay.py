@@ -147,14 +147,25 @@ class FrameReplay:
         broken = np.count_nonzero((self.steps[head % self.slots] >= 1) & ~self._valid(head))
         return self.transitions - int(broken)
 
-    def sample(self, batch_size: int) -> dict[str, np.ndarray]:
+    def sample(
+        self, batch_size: int, n_step: int = 1, discount: float = 1.0
+    ) -> dict[str, np.ndarray]:
         """Sample ``batch_size`` transitions uniformly (with replacement).
 
         Returns uint8 ``obs`` and ``next_obs`` ``(B, k, C, H, W)`` (views of ``window``
         ``(B, k+1, C, H, W)`` = frames t-k+1 .. t+1), float32 ``action`` ``(B, A)``, ``reward``
-        ``(B,)``, ``discount`` ``(B,)`` (0 where the episode terminated, 1 otherwise; truncated
-        transitions bootstrap) and bool ``truncated``.
+        ``(B,)`` (the one-step reward r_{t+1}), bool ``truncated``, and the bootstrap of the TD
+        target: with ``n_step`` = n, the return ``R = sum_{j<m} discount^j r_{t+1+j}`` over the
+        ``m <= n`` steps that stay in the episode, ``bootstrap_obs`` (the triplet ending at frame
+        t+m, = ``next_obs`` when m = 1) and ``discount`` = ``discount^(m-1)`` where the last of
+        those steps did not terminate, else 0, so that ``R + discount * gamma * V(bootstrap_obs)``
+        is the n-step target. The sum stops at a terminated step (no bootstrap), at a truncated
+        one (bootstrapped from the frame it reached) and at the newest frame stored; it never
+        crosses an episode boundary. With ``n_step=1`` ``return`` equals ``reward`` and
+        ``discount`` is 1 - terminated.
         """
+        if n_step < 1:
+            raise ValueError(f"n_step must be >= 1, got {n_step}")
         available = len(self)
         if batch_size > available:
             raise ValueError(
@@ -168,18 +179,42 @@ class FrameReplay:
             chosen = np.concatenate([chosen, candidates[self._valid(candidates)]])
         chosen = chosen[:batch_size]
         slot = chosen % self.slots
-        back = np.arange(self.num_frames, -1, -1)
-        clamp = np.minimum(back[None, :], self.steps[slot][:, None].astype(np.int64))
-        window = self.frames[(chosen[:, None] - clamp) % self.slots]
+        window = self._frames_ending_at(chosen, self.num_frames + 1)
+        end, n_return = chosen.copy(), self.rewards[slot].astype(np.float64)
+        going = np.ones(batch_size, bool)
+        for j in range(1, n_step):
+            following = chosen + j
+            previous = (following - 1) % self.slots
+            going &= (
+                (following < self.written)
+                & ~self.terminated[previous]
+                & ~self.truncated[previous]
+                & (self.steps[following % self.slots] != 0)
+            )
+            n_return += np.where(going, discount**j * self.rewards[following % self.slots], 0.0)
+            end = np.where(going, following, end)
+        steps_taken = end - chosen + 1
+        alive = 1.0 - self.terminated[end % self.slots].astype(np.float64)
         return {
             "obs": window[:, :-1],
             "next_obs": window[:, 1:],
             "window": window,
             "action": self.actions[slot],
             "reward": self.rewards[slot],
-            "discount": 1.0 - self.terminated[slot].astype(np.float32),
+            "return": n_return.astype(np.float32),
+            "bootstrap_obs": window[:, 1:]
+            if n_step == 1
+            else self._frames_ending_at(end, self.num_frames),
+            "discount": (alive * discount ** (steps_taken - 1)).astype(np.float32),
             "truncated": self.truncated[slot],
         }
+
+    def _frames_ending_at(self, index: np.ndarray, count: int) -> np.ndarray:
+        """uint8 ``(B, count, C, H, W)``: the ``count`` frames up to absolute ``index``, the
+        episode's first frame repeated before its start (FrameTriplet's reset padding)."""
+        back = np.arange(count - 1, -1, -1)
+        steps = self.steps[index % self.slots][:, None].astype(np.int64)
+        return self.frames[(index[:, None] - np.minimum(back[None, :], steps)) % self.slots]
 
     # -- size and persistence ------------------------------------------------------------------
 

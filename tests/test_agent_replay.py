@@ -107,3 +107,58 @@ def test_bad_inputs_are_refused_with_a_fix():
     assert len(replay) == 1
     with pytest.raises(ValueError, match="holds 1; collect more"):
         replay.sample(2)
+
+
+def episodes_replay(lengths_and_ends, n_frames=3):
+    """Episodes of the given (length, "terminated" | "truncated" | "open") whose frame j of
+    episode e holds the value 10 e + j and whose step j has reward j + e / 10."""
+    replay = FrameReplay(200, (1, 2, 2), 1, num_frames=n_frames, seed=0)
+    for e, (length, end) in enumerate(lengths_and_ends):
+        replay.start_episode(np.full((1, 2, 2), 10 * e, np.uint8))
+        for j in range(1, length + 1):
+            last = j == length
+            replay.add(
+                np.zeros(1),
+                j + e / 10,
+                np.full((1, 2, 2), 10 * e + j, np.uint8),
+                last and end == "terminated",
+                last and end == "truncated",
+            )
+    return replay
+
+
+@pytest.mark.parametrize("n_step", [1, 2, 3, 5])
+def test_n_step_targets_sum_discounted_rewards_and_stop_at_episode_ends(n_step):
+    gamma = 0.9
+    ends = [(4, "terminated"), (6, "truncated"), (2, "terminated"), (5, "open")]
+    replay = episodes_replay(ends)
+    draws = [replay.sample(len(replay), n_step=n_step, discount=gamma) for _ in range(25)]
+    batch = {key: np.concatenate([draw[key] for draw in draws]) for key in draws[0]}
+    seen = set()
+    for i in range(len(batch["reward"])):
+        value = int(batch["window"][i, -2, 0, 0, 0])  # frame t: 10 e + j
+        e, t = divmod(value, 10)
+        length, end = ends[e]
+        m = min(n_step, length - t)  # steps left in the episode from t
+        expected = sum(gamma**k * (t + 1 + k + e / 10) for k in range(m))
+        assert batch["reward"][i] == pytest.approx(t + 1 + e / 10)
+        assert batch["return"][i] == pytest.approx(expected, rel=1e-5)
+        cut_by_termination = end == "terminated" and t + m == length
+        assert batch["discount"][i] == pytest.approx(
+            0.0 if cut_by_termination else gamma ** (m - 1)
+        )
+        # bootstrapped from the frame reached (never one of another episode), reset-padded
+        triplet = batch["bootstrap_obs"][i, :, 0, 0, 0].tolist()
+        reached = t + m
+        assert triplet == [10 * e + max(reached - 2 + k, 0) for k in range(3)]
+        seen.add((e, t))
+    assert len(seen) == sum(length for length, _ in ends)  # every transition was drawn
+
+
+def test_one_step_sample_keeps_its_meaning():
+    replay = episodes_replay([(3, "terminated"), (3, "truncated")])
+    batch = replay.sample(6)
+    assert np.array_equal(batch["return"], batch["reward"])
+    assert np.array_equal(batch["bootstrap_obs"], batch["next_obs"])
+    terminal = batch["next_obs"][:, -1, 0, 0, 0] == 3  # the terminated episode's last frame
+    assert np.array_equal(batch["discount"], np.where(terminal, 0.0, 1.0))
