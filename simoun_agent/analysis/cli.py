@@ -1,0 +1,236 @@
+"""``simoun-analyze``: the paper's analyses for any trained run.
+
+    simoun-analyze masks RUN_DIR [--steps 2,20,40] [--query 40,42] [--video]
+    simoun-analyze bias RUN_A [RUN_B ...] --out DIR
+
+``masks`` draws the structure masks X^m and X^a (Eq. 5, Fig. 7) over the frames of deterministic
+evaluation episodes; ``bias`` counts static, dynamic, joint and residual units per layer
+(Sec. 4, Fig. 5) with the estimator of Kowal et al. (CVPR 2022).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from simoun_agent.analysis import masks as mask_pictures
+from simoun_agent.analysis.bias import information_bias
+from simoun_agent.analysis.layers import layer_activations
+from simoun_agent.analysis.pairs import make_pairs, sample_observations
+from simoun_agent.analysis.report import RunBias, write_report
+from simoun_agent.analysis.runs import LoadedRun, load_run, play_episode, prepare_output
+from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.make_env import video_fps
+from simoun_agent.run.presets import SetupError
+from simoun_agent.run.video import write_video
+
+MAX_BIAS_EPISODES = 200
+"""Episodes the bias analysis plays at most to gather its observations."""
+
+
+def parse_pair(text: str) -> tuple[int, int]:
+    """``"40,42"`` -> ``(40, 42)``."""
+    try:
+        row, col = (int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected ROW,COL (two integers), got {text!r}") from None
+    return row, col
+
+
+def parse_steps(text: str) -> list[int]:
+    """``"2,20,40"`` -> ``[2, 20, 40]`` (non-negative)."""
+    try:
+        steps = sorted({int(part) for part in text.split(",")})
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated step numbers, e.g. 2,20,40, got {text!r}"
+        ) from None
+    if steps[0] < 0:
+        raise argparse.ArgumentTypeError(f"steps count agent decisions from 0, got {steps[0]}")
+    return steps
+
+
+def masks_command(args: argparse.Namespace) -> list[Path]:
+    """Play the episodes, then write one PNG (+ its heat maps as .npz) per chosen step."""
+    run = load_run(Path(args.run), args.device)
+    mask_pictures.require_masks(run.agent.encoder, run.config.agent.encoder)
+    episodes = [play_episode(run.agent, run.env, run.first_seed + e) for e in range(args.episodes)]
+    lengths = [len(episode) - 1 for episode in episodes]
+    if args.steps is not None and args.steps[-1] > min(lengths):
+        raise SetupError(
+            f"--steps {args.steps[-1]} is beyond the episode: the episodes played last "
+            f"{', '.join(map(str, lengths))} agent decisions (steps 0..length); pick steps up to "
+            f"{min(lengths)}"
+        )
+    size = tuple(episodes[0].shape[-2:])
+    if args.query is not None:
+        mask_pictures.query_index(args.query, size, (1, 1))
+    out = Path(args.out) if args.out else run.run_dir / "analysis" / f"masks-{run.env_step}"
+    prepare_output(out, ["ep*-step*.png", "ep*-step*.npz", "masks-ep0.*"], args.overwrite)
+    written = []
+    for e, episode in enumerate(episodes):
+        steps = args.steps if args.steps is not None else mask_pictures.default_steps(lengths[e])
+        every = list(range(len(episode))) if args.video and e == 0 else steps
+        heats = mask_pictures.heat_maps(
+            mask_pictures.structure_masks(run.agent.encoder, episode[every]), size, args.query
+        )
+        position = {step: i for i, step in enumerate(every)}
+        for step in steps:
+            one = {name: heat[position[step]] for name, heat in heats.items()}
+            frame = episode[step, -1]
+            stem = out / f"ep{e}-step{step:04d}"
+            title = (
+                f"{run.config.env}, {run.config.agent.encoder}, env step {run.env_step}: "
+                f"episode {e}, decision {step}"
+            )
+            written.append(
+                mask_pictures.draw_figure(stem.with_suffix(".png"), frame, one, title, args.query)
+            )
+            npz = stem.with_suffix(".npz")
+            atomic_write(npz, lambda tmp, one=one, frame=frame: np.savez(tmp, frame=frame, **one))
+            written.append(npz)
+        if args.video and e == 0:
+            frames = [
+                mask_pictures.composite(
+                    episode[i, -1], {name: heat[i] for name, heat in heats.items()}
+                )
+                for i in range(len(episode))
+            ]
+            fps = video_fps(run.env, run.config.resolved_action_repeat())
+            written.append(write_video(out / f"masks-ep0.{args.video}", frames, fps))
+    run.env.close()
+    return written
+
+
+def bias_of_run(run: LoadedRun, count: int, seed: int) -> RunBias:
+    """Play evaluation episodes until ``count`` observations at t >= 2, make the pairs, and
+    estimate each layer."""
+    episodes, available = [], 0
+    while available < count:
+        if len(episodes) == MAX_BIAS_EPISODES:
+            raise SetupError(
+                f"{MAX_BIAS_EPISODES} episodes of {run.config.env} gave only {available} "
+                f"observations at t >= 2; pass a smaller --pairs (at most {available})"
+            )
+        episodes.append(play_episode(run.agent, run.env, run.first_seed + len(episodes)))
+        available += max(0, len(episodes[-1]) - 2)
+    observations = sample_observations(episodes, count, seed)
+    activations = {}
+    for factor, (first, second) in make_pairs(observations, seed).items():
+        both = layer_activations(
+            run.agent.encoder, torch.as_tensor(np.concatenate([first, second]))
+        )
+        activations[factor] = {
+            name: (v[:count].numpy(), v[count:].numpy()) for name, v in both.items()
+        }
+    layers = {
+        name: information_bias({factor: activations[factor][name] for factor in activations})
+        for name in activations["dynamic"]
+    }
+    run.env.close()
+    return RunBias(
+        str(run.run_dir), run.config.agent.encoder, run.config.env, run.env_step, count, layers
+    )
+
+
+def bias_command(args: argparse.Namespace) -> list[Path]:
+    """The estimates of every run, then one chart, JSON and Markdown for all of them."""
+    if args.out is None and len(args.runs) > 1:
+        raise SetupError("several runs need one output directory: pass --out DIR")
+    runs = [load_run(Path(path), args.device) for path in args.runs]
+    out = Path(args.out) if args.out else runs[0].run_dir / "analysis" / "bias"
+    prepare_output(out, ["bias.json", "bias.md", "bias.png"], args.overwrite)
+    results = [bias_of_run(run, args.pairs, args.seed) for run in runs]
+    return write_report(out, results, args.seed)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-analyze",
+        description="The paper's analyses for a trained run: structure masks (Fig. 7) and the "
+        "information-bias analysis (Fig. 5).",
+    )
+    commands = parser.add_subparsers(dest="command", required=True)
+    masks = commands.add_parser(
+        "masks",
+        help="draw X^m and X^a (Eq. 5) over the frames of deterministic episodes",
+        description="Play deterministic evaluation episodes of a dual_interactive run and write, "
+        "for each chosen step, a PNG of frame o_t beside the heat maps of X^m and X^a (and the "
+        "attention row of --query), plus the heat maps as .npz.",
+        epilog="example: simoun-analyze masks runs/highway-highway-s1-... --steps 2,40 "
+        "--query 42,126 --video",
+    )
+    masks.add_argument("run", help="a run directory or its checkpoint.pt")
+    masks.add_argument("--episodes", type=int, default=1, help="episodes to play (default 1)")
+    masks.add_argument(
+        "--steps",
+        type=parse_steps,
+        default=None,
+        help="agent decisions after which to draw, comma-separated, e.g. 2,20,40 (step 0 is the "
+        "reset observation; default: 4 steps spread over each episode from step 2)",
+    )
+    masks.add_argument(
+        "--query",
+        type=parse_pair,
+        default=None,
+        metavar="ROW,COL",
+        help="also draw the attention row X[q, :] of this pixel of the frame (Eq. 4)",
+    )
+    masks.add_argument(
+        "--video",
+        nargs="?",
+        const="gif",
+        choices=("gif", "mp4"),
+        default=None,
+        help="also write the overlays of the first episode as an animation (default format gif)",
+    )
+    bias = commands.add_parser(
+        "bias",
+        help="count static / dynamic / joint / residual units per layer (Kowal et al.)",
+        description="For each run: play deterministic evaluation episodes, build dynamic pairs "
+        "(same frames under a random convolution) and static pairs (same frames in shuffled "
+        "order), and estimate each layer with the estimator of Kowal et al. (CVPR 2022). Writes "
+        "bias.png (one grouped bar chart), bias.json and bias.md.",
+        epilog="example: simoun-analyze bias runs/stacked-... runs/flare-... runs/simoun-... "
+        "--out docs/bias",
+    )
+    bias.add_argument("runs", nargs="+", help="run directories (or checkpoint.pt files)")
+    bias.add_argument("--pairs", type=int, default=256, help="pairs per factor (default 256)")
+    bias.add_argument("--seed", type=int, default=0, help="seed of the pairs (default 0)")
+    for sub in (masks, bias):
+        sub.add_argument(
+            "--out",
+            default=None,
+            help="output directory (default: <run dir>/analysis/masks-<step> or "
+            "<run dir>/analysis/bias)",
+        )
+        sub.add_argument(
+            "--overwrite", action="store_true", help="replace results already in --out"
+        )
+        sub.add_argument("--device", default=None, help="torch device (default: the run's)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-analyze``."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if getattr(args, "episodes", 1) < 1:
+        parser.error("--episodes must be at least 1")
+    if getattr(args, "pairs", 2) < 2:
+        parser.error("--pairs must be at least 2")
+    try:
+        written = masks_command(args) if args.command == "masks" else bias_command(args)
+    except SetupError as err:
+        parser.exit(2, f"simoun-analyze {args.command}: error: {err}\n")
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

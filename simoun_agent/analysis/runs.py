@@ -1,0 +1,91 @@
+"""Reload a trained run (config, environment, agent) and play it deterministically."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import torch
+
+from simoun_agent.agent import SimounAgent
+from simoun_agent.run.checkpoint import atomic_write, load_checkpoint
+from simoun_agent.run.evaluate import EVAL_SEED_OFFSET
+from simoun_agent.run.make_env import make_env
+from simoun_agent.run.presets import SetupError, TrainConfig, from_dict
+
+
+@dataclass
+class LoadedRun:
+    """A run rebuilt from its checkpoint, ready to be looked at."""
+
+    run_dir: Path
+    """the run directory (where checkpoint.pt lives)"""
+    config: TrainConfig
+    """the run's config, as saved in the checkpoint"""
+    env: gym.Env
+    """the run's own environment stack (make_env)"""
+    agent: SimounAgent
+    """the agent with the checkpoint's weights"""
+    env_step: int
+    """environment steps the run had taken at this checkpoint"""
+
+    @property
+    def first_seed(self) -> int:
+        """Seed of episode 0: the run's evaluation episodes, never its training ones."""
+        return self.config.seed + EVAL_SEED_OFFSET
+
+
+def load_run(path: Path, device: str | None = None) -> LoadedRun:
+    """Rebuild a run from its directory (or checkpoint.pt); SetupError when it cannot."""
+    payload = load_checkpoint(Path(path))
+    config = from_dict(payload["config"])
+    if config.torch_threads:
+        torch.set_num_threads(config.torch_threads)
+    env = make_env(config)
+    agent = SimounAgent(
+        env.observation_space["frames"].shape[1:],
+        env.action_space.shape[0],
+        config.agent,
+        device=device or config.device,
+    )
+    agent.load_state_dict(payload["agent"])
+    run_dir = payload["replay_path"].parent
+    return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
+
+
+def play_episode(agent: SimounAgent, env: gym.Env, seed: int) -> np.ndarray:
+    """Observations ``(T + 1, k, C, H, W)`` uint8 of one episode with deterministic actions:
+    entry s is the triplet after s agent decisions (entry 0 the reset observation)."""
+    obs, _ = env.reset(seed=seed)
+    observations = [obs["frames"]]
+    done = False
+    with torch.random.fork_rng():
+        while not done:
+            obs, _, terminated, truncated, _ = env.step(agent.act(obs["frames"], True))
+            observations.append(obs["frames"])
+            done = terminated or truncated
+    return np.stack(observations)
+
+
+def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--out") -> None:
+    """Create ``out``; refuse when it cannot be written, or when it already holds one of
+    ``names`` (glob patterns) and ``overwrite`` is off."""
+    existing = (
+        sorted(p.name for pattern in names for p in out.glob(pattern)) if out.is_dir() else []
+    )
+    if existing and not overwrite:
+        shown = ", ".join(existing[:3]) + (" ..." if len(existing) > 3 else "")
+        raise SetupError(
+            f"{out} already holds results ({shown}); pass --overwrite to replace them, or "
+            f"another {flag}"
+        )
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write(out / ".write-test", lambda tmp: tmp.write_text(""))
+        (out / ".write-test").unlink()
+    except OSError as err:
+        raise SetupError(
+            f"cannot write to the output directory {out} ({err.strerror}); pass a writable {flag}"
+        ) from None

@@ -1,0 +1,234 @@
+"""simoun-analyze: the estimator of Kowal et al., the pairs, the structure-mask pictures and the
+bias report, on tiny runs trained in the test."""
+
+import json
+
+import gymnasium as gym
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+import torch
+
+from simoun_agent.analysis import masks as mask_pictures
+from simoun_agent.analysis.bias import information_bias
+from simoun_agent.analysis.cli import main
+from simoun_agent.analysis.layers import layer_activations
+from simoun_agent.analysis.pairs import make_pairs
+from simoun_agent.config import AgentConfig
+from simoun_agent.models.encoder import ENCODERS, DualPathEncoder, make_encoder
+from simoun_agent.run import train
+from simoun_agent.run.presets import resolve
+from simoun_wrappers import SimounObservation
+
+TINY = {
+    "env": "simoun/PointReach-v0",
+    "image_size": 32,
+    "total_env_steps": 60,
+    "warmup_agent_steps": 20,
+    "replay_capacity": 1000,
+    "eval_every": 60,
+    "eval_episodes": 1,
+    "checkpoint_every": 60,
+    "video": False,
+    "progress": False,
+    "device": "cpu",
+    "torch_threads": 1,
+    "seed": 3,
+    "agent.batch_size": 8,
+    "agent.num_filters": 8,
+    "agent.feature_dim": 16,
+    "agent.hidden_dim": 32,
+    "agent.aux_hidden_dim": 32,
+}
+
+
+def tiny_run(run_dir, encoder):
+    curiosity = ENCODERS[encoder].motion_path
+    overrides = {"run_dir": str(run_dir), "agent.encoder": encoder, "agent.curiosity": curiosity}
+    run = train.create_run(resolve(None, {**TINY, **overrides}))
+    train.train(run)
+    return run_dir
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    root = tmp_path_factory.mktemp("runs")
+    return {name: tiny_run(root / name, name) for name in ("dual_interactive", "stacked")}
+
+
+def synthetic_pairs(n=600, seed=0):
+    """Inputs with three latent signals: s (kept by static pairs, redrawn by dynamic ones), d
+    (kept by dynamic pairs, redrawn by static ones) and j (kept by both, like where a moving
+    object is). Units 0-9 copy s, 10-19 copy d, 20-29 copy j, 30-39 are noise, 40 is dead."""
+    rng = np.random.default_rng(seed)
+
+    def units(s, d, j):
+        copies = [np.repeat(v[:, None], 10, axis=1) for v in (s, d, j)]
+        noise = rng.normal(size=(len(s), 10))
+        signal = np.concatenate([*copies, noise, np.zeros((len(s), 1))], axis=1)
+        return signal + 0.2 * rng.normal(size=signal.shape) * (np.arange(41) < 40)
+
+    def draw():
+        return rng.normal(size=n)
+
+    s, d, j = draw(), draw(), draw()
+    static = (units(s, d, j), units(s, draw(), j))
+    dynamic = (units(s, d, j), units(draw(), d, j))
+    return {"static": static, "dynamic": dynamic}
+
+
+def test_estimator_finds_the_known_structure():
+    estimate = information_bias(synthetic_pairs())
+    static, dynamic = estimate.unit_scores["static"], estimate.unit_scores["dynamic"]
+    assert np.all(static[:10] > 0.8) and np.all(dynamic[:10] < 0.2)
+    assert np.all(dynamic[10:20] > 0.8) and np.all(static[10:20] < 0.2)
+    assert np.all(static[20:30] > 0.8) and np.all(dynamic[20:30] > 0.8)
+    assert np.all(np.abs(static[30:]) < 0.2) and np.all(np.abs(dynamic[30:]) < 0.2)
+    assert estimate.categories == {"static": 10, "dynamic": 10, "joint": 10, "residual": 11}
+    assert sum(estimate.factor_units.values()) == estimate.units == 41
+    assert estimate.layer_scores["static"] == pytest.approx(estimate.layer_scores["dynamic"], 0.2)
+
+
+def test_estimator_layer_share_follows_the_units():
+    pairs = synthetic_pairs()
+    static_only = {k: (a[:, :10], b[:, :10]) for k, (a, b) in pairs.items()}
+    estimate = information_bias(static_only)
+    assert estimate.factor_units["static"] > estimate.factor_units["dynamic"]
+    assert estimate.category_percent()["static"] == 100.0
+    with pytest.raises(ValueError, match="same shape"):
+        information_bias({"static": static_only["static"], "dynamic": pairs["dynamic"]})
+
+
+def pointreach_observations(count=24):
+    env = SimounObservation(gym.make("simoun/PointReach-v0"), size=32, motion=False)
+    obs, _ = env.reset(seed=0)
+    observations = []
+    rng = np.random.default_rng(0)
+    while len(observations) < count:
+        obs, _, terminated, truncated, _ = env.step(rng.uniform(-1, 1, 2).astype(np.float32))
+        observations.append(obs["frames"])
+        if terminated or truncated:
+            obs, _ = env.reset()
+    return np.stack(observations)
+
+
+def test_dynamic_pairs_change_pixels_and_keep_motion():
+    x = pointreach_observations()
+    first, recoloured = make_pairs(x, seed=1)["dynamic"]
+    assert first is x and recoloured.shape == x.shape and recoloured.dtype == np.uint8
+    # a convolution without bias leaves PointReach's black background black: look at the rest
+    lit = x != 0
+    assert np.mean(recoloured[lit] != x[lit]) > 0.5
+    # one kernel for the three frames: where a pixel's 3x3 neighbourhood did not change between
+    # two frames, the recoloured pixel does not change either, so the motion is kept
+    still = (x[:, 1:] == x[:, :-1]).all(axis=2)
+    padded = np.pad(~still, ((0, 0), (0, 0), (1, 1), (1, 1)))
+    moved = np.zeros_like(still)
+    for dr in range(3):
+        for dc in range(3):
+            moved |= padded[:, :, dr : dr + still.shape[2], dc : dc + still.shape[3]]
+    same = (recoloured[:, 1:] == recoloured[:, :-1]).all(axis=2)
+    assert np.all(same[~moved])
+    assert (~moved).any() and moved.any()
+
+
+def test_static_pairs_shuffle_the_same_frames():
+    x = pointreach_observations()
+    first, shuffled = make_pairs(x, seed=1)["static"]
+    assert first is x
+    for original, other in zip(x, shuffled, strict=True):
+        rows = sorted(f.tobytes() for f in original)
+        assert rows == sorted(f.tobytes() for f in other)
+    distinct = np.array([len({f.tobytes() for f in o}) == 3 for o in x])
+    assert distinct.any()
+    assert np.all((shuffled[distinct] != x[distinct]).any(axis=(1, 2, 3, 4)))
+
+
+@pytest.mark.parametrize("name", sorted(ENCODERS))
+def test_every_encoder_has_path_and_state_layers(name):
+    motion = ENCODERS[name].motion_path
+    config = AgentConfig(encoder=name, num_filters=8, feature_dim=16, curiosity=motion)
+    encoder = make_encoder(config, (3, 32, 32))
+    layers = layer_activations(encoder, torch.as_tensor(pointreach_observations(5)))
+    expected = {"motion path", "appearance path"} if motion else {"path"}
+    assert set(layers) == expected | {"fused state"}
+    assert all(v.shape[0] == 5 and torch.isfinite(v).all() for v in layers.values())
+
+
+def test_masks_of_multi_camera_frames_cover_the_whole_image(tmp_path):
+    encoder = DualPathEncoder((3, 32, 96), num_filters=8, feature_dim=16)
+    obs = np.random.default_rng(0).integers(0, 256, (2, 3, 3, 32, 96), dtype=np.uint8)
+    heats = mask_pictures.heat_maps(
+        mask_pictures.structure_masks(encoder, obs), (32, 96), query=(10, 80)
+    )
+    assert {name: h.shape for name, h in heats.items()} == dict.fromkeys(heats, (2, 32, 96))
+    path = mask_pictures.draw_figure(
+        tmp_path / "wide.png", obs[0, -1], {k: v[0] for k, v in heats.items()}, "wide", (10, 80)
+    )
+    height, width = imageio.imread(path).shape[:2]
+    assert height > width  # one panel per row for wide frames
+
+
+def test_masks_command_writes_pictures_and_heat_maps(runs, tmp_path, capsys):
+    out = tmp_path / "masks"
+    args = ["masks", str(runs["dual_interactive"]), "--steps", "2,10", "--query", "16,5"]
+    assert main([*args, "--video", "--out", str(out)]) == 0
+    for step in (2, 10):
+        picture = imageio.imread(out / f"ep0-step{step:04d}.png")
+        assert picture.ndim == 3 and picture.shape[1] > 3 * picture.shape[0] > 3 * 32
+        heats = np.load(out / f"ep0-step{step:04d}.npz")
+        assert heats["frame"].shape == (3, 32, 32)
+        for name in ("motion", "appearance", "attention"):
+            assert heats[name].shape == (32, 32)
+            assert np.ptp(heats[name]) > 0, name  # not constant
+    gif = imageio.mimread(out / "masks-ep0.gif")
+    assert len(gif) == 21  # reset + 20 decisions of PointReach
+    before = (out / "ep0-step0002.png").stat().st_mtime_ns
+    with pytest.raises(SystemExit) as exit_info:
+        main([*args, "--out", str(out)])
+    assert exit_info.value.code == 2
+    assert "--overwrite" in capsys.readouterr().err
+    assert (out / "ep0-step0002.png").stat().st_mtime_ns == before
+
+
+def test_masks_command_refuses_bad_input(runs, tmp_path, capsys):
+    run = str(runs["dual_interactive"])
+    (tmp_path / "file").write_text("")
+    cases = {
+        "stacked": (["masks", str(runs["stacked"])], "encoder=dual_interactive", "analyze bias"),
+        "beyond": (["masks", run, "--steps", "5,21"], "--steps 21", "up to 20"),
+        "no checkpoint": (["masks", str(tmp_path)], "no checkpoint", "run directory"),
+        "query": (["masks", run, "--query", "40,1"], "outside", "0 <= ROW < 32"),
+        "unwritable": (
+            ["masks", run, "--out", str(tmp_path / "file" / "out")],
+            "writable",
+            "--out",
+        ),
+    }
+    for name, (argv, *expected) in cases.items():
+        with pytest.raises(SystemExit) as exit_info:
+            main(argv)
+        err = capsys.readouterr().err
+        assert exit_info.value.code == 2, name
+        assert all(text in err for text in expected), (name, err)
+        assert "Traceback" not in err
+    assert not (runs["dual_interactive"] / "analysis").exists()
+
+
+def test_bias_command_compares_runs(runs, tmp_path):
+    out = tmp_path / "bias"
+    argv = ["bias", str(runs["dual_interactive"]), str(runs["stacked"]), "--pairs", "24"]
+    assert main([*argv, "--out", str(out)]) == 0
+    report = json.loads((out / "bias.json").read_text())
+    encoders = [run["encoder"] for run in report["runs"]]
+    assert encoders == ["dual_interactive", "stacked"]
+    layers = report["runs"][0]["layers"]
+    assert set(layers) == {"motion path", "appearance path", "fused state"}
+    for layer in [*layers.values(), *report["runs"][1]["layers"].values()]:
+        assert sum(layer["categories_percent"].values()) == pytest.approx(100.0)
+        assert sum(layer["factor_percent"].values()) == pytest.approx(100.0)
+    table = (out / "bias.md").read_text()
+    assert "| stacked | path |" in table and "| dual_interactive | motion path |" in table
+    assert imageio.imread(out / "bias.png").shape[0] > 100
+    with pytest.raises(SystemExit):
+        main(argv)  # several runs need --out
