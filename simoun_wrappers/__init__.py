@@ -9,16 +9,19 @@ from simoun_wrappers.curiosity_reward import (
     ConsistencyCuriosityReward,
     ConsistencyCuriosityVectorReward,
 )
+from simoun_wrappers.distractors import ColorShift, MovingBackground
 from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
 
 __all__ = [
     "ActionRepeat",
+    "ColorShift",
     "ConsistencyCuriosityReward",
     "ConsistencyCuriosityVectorReward",
     "FeatureSource",
     "FrameTriplet",
+    "MovingBackground",
     "MultiCamera",
     "RandomConvolution",
     "ResidualMotion",

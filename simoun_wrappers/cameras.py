@@ -39,7 +39,12 @@ def _dm_control_view(env: gym.Env, camera: int | str, hw: tuple[int, int] | None
             f"use an id in -1..{model.ncam - 1} (-1 is the free camera) or a name."
         )
     kwargs = {} if hw is None else {"height": hw[0], "width": hw[1]}
-    return lambda: physics.render(camera_id=camera, **kwargs)
+    # A distractor below (MovingBackground) may composite what the cameras see.
+    try:
+        render = env.get_wrapper_attr("render_camera")
+    except AttributeError:
+        render = physics.render
+    return lambda: render(camera_id=camera, **kwargs)
 
 
 def _highway_view(env: gym.Env, viewport: Mapping[str, Any], hw: tuple[int, int] | None):

@@ -1,0 +1,51 @@
+"""What the distractors share: finding the dm_control physics, checking the level, seeding."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+LEVELS = ("easy", "hard")
+
+
+def dm_control_physics(env: gym.Env, owner: str) -> Any:
+    """The ``dm_control.mujoco.Physics`` of a dm_control task made through shimmy.
+
+    Raises a TypeError that names what works instead for any other env.
+    """
+    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
+    if physics is None or not hasattr(physics, "model"):
+        raise TypeError(
+            f"{owner} needs a dm_control task made through shimmy (it changes the MuJoCo model "
+            f"or reads its segmentation), got {env.unwrapped}; make one with "
+            f"gym.make('dm_control/cartpole-swingup-v0', render_mode='rgb_array'). For other "
+            f"envs, RandomConvolution(env) randomises the appearance of any pixel env."
+        )
+    return physics
+
+
+def check_level(level: str, owner: str) -> None:
+    if level not in LEVELS:
+        raise ValueError(f"{owner} level must be one of {LEVELS}, got {level!r}.")
+
+
+def check_seed(seed: int | None, owner: str) -> None:
+    if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise ValueError(f"{owner} seed must be a non-negative int or None, got {seed!r}.")
+
+
+def episode_rng(
+    seed: int | None, reset_seed: int | None, current: np.random.Generator
+) -> np.random.Generator:
+    """The generator of an episode's distraction.
+
+    ``reset(seed=s)`` makes it a function of ``(seed, s)`` alone, so evaluation episode ``s``
+    sees the same distraction whatever ran before; an unseeded reset keeps drawing from the
+    wrapper's own stream (seeded by ``seed`` at construction). The env's RNG is never used, so
+    the dynamics cannot change.
+    """
+    if reset_seed is None:
+        return current
+    return np.random.default_rng([reset_seed] if seed is None else [reset_seed, seed])
