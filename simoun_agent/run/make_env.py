@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import importlib
+from collections.abc import Callable
 
 import gymnasium as gym
 import numpy as np
@@ -101,10 +102,19 @@ def _check_env(env: gym.Env, env_id: str) -> None:
         )
 
 
-def make_env(config: TrainConfig) -> gym.Env:
-    """The wrapped environment for ``config``; raises SetupError for an unusable env."""
+def make_env(
+    config: TrainConfig, distractor: Callable[[gym.Env], gym.Env] | None = None
+) -> gym.Env:
+    """The wrapped environment for ``config``; raises SetupError for an unusable env.
+
+    ``distractor`` wraps the bare env before anything else (e.g. a ``ColorShift`` or
+    ``MovingBackground``, see :mod:`simoun_agent.generalization`), so that every rendered view
+    above it shows the distraction.
+    """
     env = _make_base(config)
     _check_env(env, config.env)
+    if distractor is not None:
+        env = distractor(env)
     bound = np.ones(env.action_space.shape, dtype=env.action_space.dtype)
     env = RescaleAction(env, -bound, bound)
     env = ActionRepeat(env, config.resolved_action_repeat())
