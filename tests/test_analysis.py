@@ -14,9 +14,11 @@ from simoun_agent.analysis.bias import information_bias
 from simoun_agent.analysis.cli import main
 from simoun_agent.analysis.layers import layer_activations
 from simoun_agent.analysis.pairs import make_pairs
+from simoun_agent.analysis.recolour import dm_control_physics, replay_recoloured
 from simoun_agent.config import AgentConfig
 from simoun_agent.models.encoder import ENCODERS, DualPathEncoder, make_encoder
 from simoun_agent.run import train
+from simoun_agent.run.make_env import make_env
 from simoun_agent.run.presets import resolve
 from simoun_wrappers import SimounObservation
 
@@ -232,3 +234,37 @@ def test_bias_command_compares_runs(runs, tmp_path):
     assert imageio.imread(out / "bias.png").shape[0] > 100
     with pytest.raises(SystemExit):
         main(argv)  # several runs need --out
+
+
+def test_recoloured_replay_keeps_physics_and_rewards():
+    config = resolve(None, {"env": "dm_control/cartpole-swingup-v0", "image_size": 32})
+    env = make_env(config)
+    obs, _ = env.reset(seed=5)
+    actions = np.random.default_rng(0).uniform(-1, 1, (9, 1)).astype(np.float32)
+    observations, rewards = [obs["frames"]], []
+    for action in actions:
+        obs, reward, _, _, _ = env.step(action)
+        observations.append(obs["frames"])
+        rewards.append(reward)
+    state = dm_control_physics(env, config.env).get_state().copy()
+    env.close()
+    rng = np.random.default_rng(1)
+    recoloured, replayed_rewards, replayed_state = replay_recoloured(config, 5, actions, rng)
+    np.testing.assert_array_equal(replayed_rewards, rewards)
+    np.testing.assert_array_equal(replayed_state, state)
+    changed = (recoloured != np.stack(observations)).any(axis=(1, 2)).mean(axis=(1, 2))
+    assert np.all(changed > 0.3), changed  # sky, floor and bodies all change colour
+    # one colour set per block of three decisions: the triplet at t = 2 repeats the frames
+    # at 0, 1, 2 exactly, the one at t = 3 starts a new set
+    np.testing.assert_array_equal(recoloured[2], recoloured[0:3, -1])
+    assert (recoloured[3, -1] != recoloured[2, -1]).mean() > 0.3
+
+
+def test_model_recolouring_of_a_non_mujoco_run_says_what_still_works(runs, tmp_path, capsys):
+    out = tmp_path / "bias"
+    with pytest.raises(SystemExit):
+        main(["bias", str(runs["stacked"]), "--recolour", "model", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert "not a dm_control task" in err and "--recolour conv" in err
+    assert "simoun-analyze masks" in err
+    assert not out.exists()

@@ -20,7 +20,8 @@ import torch
 from simoun_agent.analysis import masks as mask_pictures
 from simoun_agent.analysis.bias import information_bias
 from simoun_agent.analysis.layers import layer_activations
-from simoun_agent.analysis.pairs import make_pairs, sample_observations
+from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
+from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
 from simoun_agent.analysis.report import RunBias, write_report
 from simoun_agent.analysis.runs import LoadedRun, load_run, play_episode, prepare_output
 from simoun_agent.run.checkpoint import atomic_write
@@ -58,7 +59,10 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
     """Play the episodes, then write one PNG (+ its heat maps as .npz) per chosen step."""
     run = load_run(Path(args.run), args.device)
     mask_pictures.require_masks(run.agent.encoder, run.config.agent.encoder)
-    episodes = [play_episode(run.agent, run.env, run.first_seed + e) for e in range(args.episodes)]
+    episodes = [
+        play_episode(run.agent, run.env, run.first_seed + e).observations
+        for e in range(args.episodes)
+    ]
     lengths = [len(episode) - 1 for episode in episodes]
     if args.steps is not None and args.steps[-1] > min(lengths):
         raise SetupError(
@@ -84,7 +88,7 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
             frame = episode[step, -1]
             stem = out / f"ep{e}-step{step:04d}"
             title = (
-                f"{run.config.env}, {run.config.agent.encoder}, env step {run.env_step}: "
+                f"{run.config.env}, {run.config.agent.encoder}, env step {run.env_step}\n"
                 f"episode {e}, decision {step}"
             )
             written.append(
@@ -106,21 +110,33 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
     return written
 
 
-def bias_of_run(run: LoadedRun, count: int, seed: int) -> RunBias:
-    """Play evaluation episodes until ``count`` observations at t >= 2, make the pairs, and
-    estimate each layer."""
-    episodes, available = [], 0
+def bias_of_run(run: LoadedRun, count: int, seed: int, recolour: str = "conv") -> RunBias:
+    """Play evaluation episodes until ``count`` usable observations, make the pairs (dynamic
+    ones by ``recolour``: ``"conv"`` or ``"model"``), and estimate each layer."""
+    block = None
+    if recolour == "model":
+        dm_control_physics(run.env, run.config.env)
+        block = BLOCK
+    rng = np.random.default_rng(seed)
+    firsts, seconds, available = [], [], 0
     while available < count:
-        if len(episodes) == MAX_BIAS_EPISODES:
+        if len(firsts) == MAX_BIAS_EPISODES:
             raise SetupError(
-                f"{MAX_BIAS_EPISODES} episodes of {run.config.env} gave only {available} "
-                f"observations at t >= 2; pass a smaller --pairs (at most {available})"
+                f"{MAX_BIAS_EPISODES} episodes of {run.config.env} gave only {available} usable "
+                f"observations; pass a smaller --pairs (at most {available})"
             )
-        episodes.append(play_episode(run.agent, run.env, run.first_seed + len(episodes)))
-        available += max(0, len(episodes[-1]) - 2)
-    observations = sample_observations(episodes, count, seed)
+        episode = play_episode(run.agent, run.env, run.first_seed + len(firsts))
+        steps = usable_steps(episode.length, block)
+        firsts.append(episode.observations[steps])
+        if block is not None:
+            replayed = replay_recoloured(run.config, episode.seed, episode.actions, rng)[0]
+            seconds.append(replayed[steps])
+        available += len(steps)
+    rows = sample_rows(available, count, seed)
+    observations = np.concatenate(firsts)[rows]
+    recoloured = np.concatenate(seconds)[rows] if seconds else None
     activations = {}
-    for factor, (first, second) in make_pairs(observations, seed).items():
+    for factor, (first, second) in make_pairs(observations, seed, recoloured).items():
         both = layer_activations(
             run.agent.encoder, torch.as_tensor(np.concatenate([first, second]))
         )
@@ -133,7 +149,13 @@ def bias_of_run(run: LoadedRun, count: int, seed: int) -> RunBias:
     }
     run.env.close()
     return RunBias(
-        str(run.run_dir), run.config.agent.encoder, run.config.env, run.env_step, count, layers
+        str(run.run_dir),
+        run.config.agent.encoder,
+        run.config.env,
+        run.env_step,
+        count,
+        recolour,
+        layers,
     )
 
 
@@ -142,9 +164,12 @@ def bias_command(args: argparse.Namespace) -> list[Path]:
     if args.out is None and len(args.runs) > 1:
         raise SetupError("several runs need one output directory: pass --out DIR")
     runs = [load_run(Path(path), args.device) for path in args.runs]
+    if args.recolour == "model":
+        for run in runs:
+            dm_control_physics(run.env, run.config.env)
     out = Path(args.out) if args.out else runs[0].run_dir / "analysis" / "bias"
     prepare_output(out, ["bias.json", "bias.md", "bias.png"], args.overwrite)
-    results = [bias_of_run(run, args.pairs, args.seed) for run in runs]
+    results = [bias_of_run(run, args.pairs, args.seed, args.recolour) for run in runs]
     return write_report(out, results, args.seed)
 
 
@@ -201,6 +226,14 @@ def build_parser() -> argparse.ArgumentParser:
     bias.add_argument("runs", nargs="+", help="run directories (or checkpoint.pt files)")
     bias.add_argument("--pairs", type=int, default=256, help="pairs per factor (default 256)")
     bias.add_argument("--seed", type=int, default=0, help="seed of the pairs (default 0)")
+    bias.add_argument(
+        "--recolour",
+        choices=("conv", "model"),
+        default="conv",
+        help="how dynamic pairs change appearance: conv, a random convolution of the frames "
+        "(any env, default); model, the episode replayed in a twin env under new colours of the "
+        "skybox, materials and bodies (dm_control tasks)",
+    )
     for sub in (masks, bias):
         sub.add_argument(
             "--out",

@@ -11,6 +11,9 @@ frames are real, not the reset padding). No data is downloaded.
   same kernel on every frame keeps where and how things move (before clipping, the residuals
   are the convolution of the original residuals) while colours, contrast and textures change,
   as Kowal et al.'s stylised copies of a video do.
+  With ``--recolour model`` (dm_control tasks) ``recolour(x)`` is instead the same observation
+  re-rendered by a twin of the environment that replays the episode's seed and actions under
+  new colours of the skybox, the materials and the geoms (:mod:`simoun_agent.analysis.recolour`).
 - *static pair* ``(x, shuffle(x))``: shares the appearance, differs in motion. ``shuffle`` puts the
   same frames in another order, a permutation drawn uniformly among those that are not the
   identity (one per pair): the same pixels, so the same objects and colours, but the residual
@@ -48,22 +51,32 @@ def shuffle_frames(observations: np.ndarray, rng: np.random.Generator) -> np.nda
     return np.take_along_axis(observations, chosen[:, :, None, None, None], axis=1)
 
 
-def make_pairs(observations: np.ndarray, seed: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def make_pairs(
+    observations: np.ndarray, seed: int, recoloured: np.ndarray | None = None
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """``{"dynamic": (x, recolour(x)), "static": (x, shuffle(x))}`` for observations
-    ``(N, k, C, H, W)`` uint8, reproducible from ``seed``."""
+    ``(N, k, C, H, W)`` uint8, reproducible from ``seed``. ``recoloured`` gives the second
+    member of the dynamic pairs instead (e.g. re-rendered by :mod:`simoun_agent.analysis.recolour`).
+    """
     generator = torch.Generator().manual_seed(seed)
     rng = np.random.default_rng(seed)
+    if recoloured is None:
+        recoloured = recolour(observations, generator)
     return {
-        "dynamic": (observations, recolour(observations, generator)),
+        "dynamic": (observations, recoloured),
         "static": (observations, shuffle_frames(observations, rng)),
     }
 
 
-def sample_observations(episodes: list[np.ndarray], count: int, seed: int) -> np.ndarray:
-    """``count`` observations drawn without replacement from steps t >= 2 of ``episodes``
-    (each ``(T + 1, k, C, H, W)``), in a reproducible order."""
-    pool = np.concatenate([episode[2:] for episode in episodes])
-    if len(pool) < count:
-        raise ValueError(f"only {len(pool)} observations at t >= 2 to draw {count} from")
-    chosen = np.random.default_rng(seed).choice(len(pool), size=count, replace=False)
-    return pool[np.sort(chosen)]
+def usable_steps(length: int, block: int | None = None) -> np.ndarray:
+    """Steps t >= 2 of an episode of ``length`` decisions (observations 0..length), and with a
+    ``block``, only the last step of each block (t = block - 1 mod block)."""
+    steps = np.arange(2, length + 1)
+    return steps if block is None else steps[steps % block == block - 1]
+
+
+def sample_rows(total: int, count: int, seed: int) -> np.ndarray:
+    """``count`` of ``range(total)`` drawn without replacement, sorted, reproducible."""
+    if total < count:
+        raise ValueError(f"only {total} observations to draw {count} from")
+    return np.sort(np.random.default_rng(seed).choice(total, size=count, replace=False))

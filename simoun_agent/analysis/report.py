@@ -34,6 +34,8 @@ class RunBias:
     """environment steps of the checkpoint"""
     pairs: int
     """pairs per factor"""
+    recolour: str
+    """how the dynamic pairs were recoloured: ``conv`` or ``model``"""
     layers: dict[str, BiasEstimate]
     """layer name -> estimate"""
 
@@ -52,6 +54,7 @@ def to_json(results: list[RunBias], seed: int) -> dict[str, Any]:
                 "env": result.env,
                 "env_step": result.env_step,
                 "pairs": result.pairs,
+                "recolour": result.recolour,
                 "layers": {
                     name: {
                         "units": estimate.units,
@@ -79,8 +82,8 @@ def to_markdown(results: list[RunBias]) -> str:
         "factor (softmax of the layer scores), Kowal et al. (CVPR 2022).",
         "",
         "| encoder | layer | units | static | dynamic | joint | residual | factors s / d / r "
-        "| env step | run |",
-        "|---|---|---:|---:|---:|---:|---:|---|---:|---|",
+        "| pairs | env step | run |",
+        "|---|---|---:|---:|---:|---:|---:|---|---|---:|---|",
     ]
     for result in results:
         for name, estimate in result.layers.items():
@@ -90,7 +93,8 @@ def to_markdown(results: list[RunBias]) -> str:
             lines.append(
                 f"| {result.encoder} | {name} | {estimate.units} | "
                 + " | ".join(f"{cats[c]:.1f}" for c in CATEGORIES)
-                + f" | {shares} | {result.env_step} | {Path(result.run_dir).name} |"
+                + f" | {shares} | {result.pairs} ({result.recolour}) | {result.env_step} | "
+                f"{Path(result.run_dir).name} |"
             )
     return "\n".join(lines) + "\n"
 

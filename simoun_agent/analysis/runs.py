@@ -55,18 +55,39 @@ def load_run(path: Path, device: str | None = None) -> LoadedRun:
     return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
 
 
-def play_episode(agent: SimounAgent, env: gym.Env, seed: int) -> np.ndarray:
-    """Observations ``(T + 1, k, C, H, W)`` uint8 of one episode with deterministic actions:
-    entry s is the triplet after s agent decisions (entry 0 the reset observation)."""
+@dataclass
+class Episode:
+    """One deterministic episode of the agent."""
+
+    seed: int
+    """the reset seed"""
+    observations: np.ndarray
+    """(T + 1, k, C, H, W) uint8: entry s is the triplet after s decisions (0: the reset one)"""
+    actions: np.ndarray
+    """(T, action_dim) the actions taken"""
+    rewards: np.ndarray
+    """(T,) the rewards received"""
+
+    @property
+    def length(self) -> int:
+        """Decisions taken (T)."""
+        return len(self.actions)
+
+
+def play_episode(agent: SimounAgent, env: gym.Env, seed: int) -> Episode:
+    """One episode from ``reset(seed=seed)`` with deterministic actions."""
     obs, _ = env.reset(seed=seed)
-    observations = [obs["frames"]]
+    observations, actions, rewards = [obs["frames"]], [], []
     done = False
     with torch.random.fork_rng():
         while not done:
-            obs, _, terminated, truncated, _ = env.step(agent.act(obs["frames"], True))
+            action = agent.act(obs["frames"], True)
+            obs, reward, terminated, truncated, _ = env.step(action)
             observations.append(obs["frames"])
+            actions.append(action)
+            rewards.append(reward)
             done = terminated or truncated
-    return np.stack(observations)
+    return Episode(seed, np.stack(observations), np.stack(actions), np.asarray(rewards, np.float64))
 
 
 def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--out") -> None:
