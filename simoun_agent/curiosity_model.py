@@ -12,18 +12,24 @@ Both follow :class:`simoun_wrappers.curiosity.FeatureSource`.
 from __future__ import annotations
 
 import copy
+import queue
+import threading
 import time
+import weakref
+from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import torch
+import torch.nn.functional as F
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.losses import contrastive_loss, transition_loss
-from simoun_agent.models.encoder import make_encoder
+from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
 from simoun_wrappers.augment import random_conv
 from simoun_wrappers.curiosity_reward import triplet_shape
@@ -33,24 +39,38 @@ __all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions
 
 @dataclass
 class CuriosityConfig:
-    """Hyperparameters of :class:`CuriosityModel` (encoder sizes as in ``AgentConfig``)."""
+    """Hyperparameters of :class:`CuriosityModel` (encoder sizes as in ``AgentConfig``).
+
+    The defaults size the encoder for a reward signal at a small share of an env step (16
+    filters on frames pooled to about 42x42, updates in a background thread);
+    ``CuriosityConfig(num_filters=32, encoder_size=None)`` is the agent's own encoder size.
+    """
 
     feature_dim: int = 50
     """size of f_m and of each f_a"""
-    num_filters: int = 32
-    """filters of every conv layer of both paths"""
+    num_filters: int = 16
+    """filters of every conv layer of both paths (the agent uses 32: about 2.6x the update time
+    at 42x42, measured with ``benchmarks/curiosity.py``)"""
+    encoder_size: int | None = 42
+    """frames are average-pooled by the integer factor ``min(H, W) // encoder_size`` before the
+    encoder and the buffer (84x84 -> 42x42, 4x fewer pixels); no pooling when that factor is
+    below 2. None encodes frames at their full size, as the agent does"""
     interactive: bool = True
     """use the structural interactive module (Eq. 4-6) between the paths"""
     aux_hidden_dim: int = 256
     """hidden units of the transition model G (Eq. 2)"""
     capacity: int = 1000
-    """transitions kept in the internal buffer (4 uint8 frames each: 85 MB at 84x84 RGB)"""
+    """transitions kept in the internal buffer (4 uint8 frames each: 21 MB at 42x42 RGB)"""
     batch_size: int = 32
-    """transitions per gradient step; one step blocks the env step that triggers it"""
+    """transitions per gradient step"""
     update_every: int = 8
     """one gradient step every this many ``watch`` calls (env steps, or vector steps)"""
     learning_starts: int = 256
     """transitions stored before the first gradient step"""
+    background: bool = True
+    """take the gradient steps in a background thread while the env steps on (torch releases
+    the GIL in its kernels). The rewards are the same either way: False runs each step inside
+    the ``watch`` call that is due, on the caller's thread (slower, no thread)"""
     lr: float = 1e-3
     """Adam learning rate"""
     encoder_tau: float = 0.05
@@ -77,6 +97,11 @@ class CuriosityConfig:
         for name in ("feature_dim", "num_filters", "capacity", "batch_size", "update_every"):
             if getattr(self, name) < 1:
                 raise ValueError(f"CuriosityConfig.{name} must be >= 1, got {getattr(self, name)}")
+        if self.encoder_size is not None and self.encoder_size < 1:
+            raise ValueError(
+                f"CuriosityConfig.encoder_size must be None (full-size frames) or a side >= 1 in "
+                f"pixels, got {self.encoder_size}; the default 42 pools 84x84 frames to 42x42."
+            )
         if self.batch_size < 2:
             raise ValueError(
                 f"CuriosityConfig.batch_size must be >= 2: the contrastive loss needs negatives "
@@ -127,6 +152,64 @@ def default_device(device: str | torch.device | None) -> torch.device:
     return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
 
 
+class UpdateThread:
+    """One daemon thread that runs the gradient steps handed to it, one at a time, in order.
+
+    Its queue holds at most one job (``CuriosityModel`` waits for an update before handing over
+    the next), so updates can never pile up behind a slow trainer. A job's exception is kept in
+    its ``Future`` for the caller to raise.
+    """
+
+    def __init__(self) -> None:
+        self.jobs: queue.Queue[tuple[Callable[[], Any], Future] | None] = queue.Queue(maxsize=1)
+        self.thread = threading.Thread(
+            target=self._run, args=(self.jobs,), name="simoun-curiosity-update", daemon=True
+        )
+        self.thread.start()
+
+    @staticmethod
+    def _run(jobs: queue.Queue) -> None:
+        # A static method: the thread holds the queue, not the model, so an unused model is freed.
+        while (job := jobs.get()) is not None:
+            work, future = job
+            if future.set_running_or_notify_cancel():
+                try:
+                    future.set_result(work())
+                except BaseException as exc:  # handed to the caller's thread, raised there
+                    future.set_exception(exc)
+
+    def submit(self, work: Callable[[], Any]) -> Future:
+        future: Future = Future()
+        self.jobs.put((work, future))
+        return future
+
+    def close(self) -> None:
+        """Let the job in progress finish, then stop the thread."""
+        if self.thread.is_alive():
+            self.jobs.put(None)
+            self.thread.join()
+
+
+def run_now(work: Callable[[], Any]) -> Future:
+    """``work()`` on the caller's thread, its result or exception in a done ``Future``."""
+    future: Future = Future()
+    future.set_running_or_notify_cancel()
+    try:
+        future.set_result(work())
+    except Exception as exc:  # raised where a background failure would be
+        future.set_exception(exc)
+    return future
+
+
+def frozen_copy(encoder: PixelEncoder) -> PixelEncoder:
+    """A copy of ``encoder`` that no optimizer holds: the published weights features come from."""
+    snapshot = copy.deepcopy(encoder)
+    for parameter in snapshot.parameters():
+        parameter.grad = None
+        parameter.requires_grad_(False)
+    return snapshot
+
+
 class CuriosityModel:
     """A dual-path encoder trained online with L_tran + L_con, as a curiosity ``FeatureSource``.
 
@@ -142,17 +225,28 @@ class CuriosityModel:
       random-convolution view of the same frame.
 
     The encoder is the agent's ``DualPathEncoder`` and its ``encode_transition`` (each of the
-    four frames through each path once); the losses are ``simoun_agent.losses``'.
+    four frames through each path once); the losses are ``simoun_agent.losses``'. Frames are
+    average-pooled to about ``encoder_size`` first (84x84 -> 42x42 by default).
 
-    The step runs inside ``watch``, so it blocks the env step that triggers it, once every
-    ``update_every`` steps. Measured with the default config (batch 32), one torch thread, on a
-    shared 2-core CPU under load (torch 2.13): one update takes about 130 ms at 32x32 RGB,
-    0.5 s at 64x64 and 0.9-1.1 s at 84x84; the features of one triplet 2 ms, 13 ms and 22 ms.
-    On CPU, lower ``batch_size`` or raise ``update_every`` to trade feature quality for speed;
-    on a GPU pass ``device="cuda"``. ``benchmarks/curiosity.py`` gives the per-step overhead.
-    ``last_metrics`` holds the last step's losses, its duration (``update_ms``) and the batch
-    standard deviation of f_m and f_a (``motion_std``, ``appearance_std``: near 0 means the
-    features collapsed to a constant).
+    **Schedule and reproducibility.** The batch of the step due at watch call ``k`` is sampled
+    at that call; the step runs in a background thread (``background=True``) or at once
+    (``background=False``), and its weights are published at the next due call, ``k +
+    update_every``, where ``watch`` waits for it if it has not finished. Features always come
+    from published weights, never from a model half-way through a step, and ``updates`` counts
+    the published steps (``feature_version`` is the count the last feature call used). So with a
+    ``seed`` the features, the rewards and the training are the same with and without the
+    thread, and from run to run, whatever the thread's timing; only ``update_ms`` and
+    ``wait_ms`` (time ``watch`` spent waiting for the thread) vary. The step only waits when an
+    update takes longer than ``update_every`` env steps. A failed update (e.g. a non-finite
+    loss) is raised by the next call to the model, and the model refuses to go on until
+    :meth:`load_state_dict`. Call :meth:`close` (the wrappers' ``close()`` does) to stop the
+    thread; a later ``watch`` starts a new one.
+
+    Measured with ``benchmarks/curiosity.py`` (see the README): on dm_control cartpole at 84x84,
+    one torch thread, the defaults add about XX to the env's step time. On a GPU pass
+    ``device="cuda"``. ``last_metrics`` holds the last published step's losses, its duration
+    (``update_ms``), the wait for it (``wait_ms``) and the batch standard deviation of f_m and
+    f_a (``motion_std``, ``appearance_std``: near 0 means the features collapsed to a constant).
 
     Example:
         >>> import gymnasium as gym
@@ -168,8 +262,9 @@ class CuriosityModel:
         ...     *_, terminated, truncated, info = env.step(env.action_space.sample())
         ...     if terminated or truncated:
         ...         _ = env.reset()
-        >>> model.updates, sorted(model.last_metrics)[:2]
-        (2, ['appearance_std', 'contrastive_loss'])
+        >>> model.updates, sorted(model.last_metrics)[:2]  # steps due at calls 8, 12; one published
+        (1, ['appearance_std', 'contrastive_loss'])
+        >>> env.close()  # stops the update thread
     """
 
     def __init__(
@@ -182,20 +277,27 @@ class CuriosityModel:
         """Build the model.
 
         Args:
-            frame_shape: ``(C, H, W)`` of one frame (H, W >= 23; >= 15 without the interactive
-                module).
+            frame_shape: ``(C, H, W)`` of one frame as the env gives it (after the pooling of
+                ``config.encoder_size``, H, W >= 23; >= 15 without the interactive module).
             action_space: the env's action space (Discrete, MultiDiscrete, MultiBinary or Box).
             config: hyperparameters; ``CuriosityConfig()`` when None.
             device: torch device; None picks cuda when available, else cpu.
         """
         self.config = config = config or CuriosityConfig()
         self.frame_shape = tuple(int(v) for v in frame_shape)
+        if len(self.frame_shape) != 3:
+            raise ValueError(f"frame_shape must be one frame's (C, H, W), got {frame_shape}.")
+        c, h, w = self.frame_shape
+        self.pool = max(1, min(h, w) // config.encoder_size) if config.encoder_size else 1
+        self.encoded_shape = (c, h // self.pool, w // self.pool)
         smallest = 23 if config.interactive else 15
-        if len(self.frame_shape) != 3 or min(self.frame_shape[1:]) < smallest:
+        if min(self.encoded_shape[1:]) < smallest:
             raise ValueError(
-                f"frame_shape must be one frame's (C, H, W) with H, W >= {smallest} (the conv "
-                f"paths{' and the interactive module' if config.interactive else ''} need it), "
-                f"got {frame_shape}; resize with SimounObservation(env, size=32) or larger."
+                f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
+                f"{self.pool}, CuriosityConfig.encoder_size={config.encoder_size}); the conv paths"
+                f"{' and the interactive module' if config.interactive else ''} need H, W >= "
+                f"{smallest}. Render larger frames (SimounObservation(env, size=32) or more) or "
+                "raise encoder_size."
             )
         self.action_space = action_space
         self.device = default_device(device)
@@ -208,7 +310,7 @@ class CuriosityModel:
                 num_filters=config.num_filters,
                 channels_last=config.channels_last,
             )
-            self.encoder = make_encoder(encoder_config, self.frame_shape)
+            self.encoder = make_encoder(encoder_config, self.encoded_shape)
             self.transition = TransitionModel(
                 config.feature_dim, action_dim(action_space), config.aux_hidden_dim
             )
@@ -227,13 +329,19 @@ class CuriosityModel:
         self.generator = torch.Generator(self.device)
         self.rng = np.random.default_rng(config.seed)
         self.generator.manual_seed(int(self.rng.integers(2**62)))
-        self._windows = np.zeros((config.capacity, 4, *self.frame_shape), dtype=np.uint8)
+        self._windows = np.zeros((config.capacity, 4, *self.encoded_shape), dtype=np.uint8)
         self._actions = np.zeros((config.capacity, action_dim(action_space)), dtype=np.float32)
         self.size = 0
         self._head = 0
         self.watch_calls = 0
+        self.published = frozen_copy(self.encoder)
+        """the encoder whose weights the features come from; replaced, never modified"""
         self.updates = 0
+        self.feature_version = 0
         self.last_metrics: dict[str, float] = {}
+        self._pending: Future | None = None
+        self._failure: BaseException | None = None
+        self._thread: UpdateThread | None = None
 
     @classmethod
     def for_env(
@@ -259,11 +367,22 @@ class CuriosityModel:
             )
         return triplets
 
+    def _pooled(self, frames: np.ndarray) -> np.ndarray:
+        """uint8 ``(..., C, H, W)`` average-pooled by ``self.pool`` (rounded back to uint8)."""
+        if self.pool == 1:
+            return frames
+        x = torch.from_numpy(np.ascontiguousarray(frames))
+        flat = x.reshape(-1, *x.shape[-3:]).float()
+        pooled = F.avg_pool2d(flat, self.pool).round_().to(torch.uint8)
+        return pooled.reshape(*x.shape[:-3], *self.encoded_shape).numpy()
+
     @torch.no_grad()
     def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``f_m (B, D)`` and ``f_a (B, 3, D)`` (frames t-2, t-1, t) of uint8 triplets."""
-        obs = torch.as_tensor(self._check(triplets, "triplets"), device=self.device)
-        encoding = self.encoder(obs, frame_features=True)
+        self._raise_failure()
+        frames = self._pooled(self._check(triplets, "triplets"))
+        encoding = self.published(torch.as_tensor(frames, device=self.device), frame_features=True)
+        self.feature_version = self.updates
         return (
             encoding.motion.float().cpu().numpy(),
             encoding.appearance.float().cpu().numpy(),
@@ -277,38 +396,112 @@ class CuriosityModel:
         terminated: np.ndarray,
         truncated: np.ndarray,
     ) -> None:
-        """Store a batch of transitions; take a gradient step when one is due.
+        """Store a batch of transitions; publish the last gradient step and start the next when
+        one is due.
 
         ``next_triplets`` must continue ``triplets`` (same episode), as the curiosity wrappers
         guarantee; only its newest frame is stored. ``terminated``/``truncated`` are accepted
         for the FeatureSource hook and not needed: G is trained on every stored transition.
         """
+        self._raise_failure()
         triplets = self._check(triplets, "triplets")
         next_triplets = self._check(next_triplets, "next_triplets")
         n = len(triplets)
         slots = (self._head + np.arange(n)) % self.config.capacity
-        self._windows[slots, :3] = triplets
-        self._windows[slots, 3] = next_triplets[:, -1]
+        self._windows[slots, :3] = self._pooled(triplets)
+        self._windows[slots, 3] = self._pooled(next_triplets[:, -1])
         self._actions[slots] = encode_actions(self.action_space, actions)
         self._head = int((self._head + n) % self.config.capacity)
         self.size = min(self.size + n, self.config.capacity)
         self.watch_calls += 1
-        due = self.watch_calls % self.config.update_every == 0
-        if due and self.size >= self.config.learning_starts:
-            self.last_metrics = self.update()
+        if self.watch_calls % self.config.update_every == 0:
+            self._publish()
+            if self.size >= self.config.learning_starts:
+                self._start(self._sample())
 
-    def update(self) -> dict[str, float]:
-        """One Adam step of L_tran + L_con on a batch from the buffer; returns python floats."""
+    @property
+    def pending(self) -> bool:
+        """True while a gradient step has been started and its weights are not yet published."""
+        return self._pending is not None
+
+    def _sample(self) -> tuple[torch.Tensor, torch.Tensor]:
+        """A batch copied out of the buffer, on the caller's thread (the buffer keeps filling)."""
         if self.size < self.config.batch_size:
             raise RuntimeError(
                 f"CuriosityModel.update needs {self.config.batch_size} stored transitions, has "
                 f"{self.size}; call watch() more first."
             )
+        idx = self.rng.integers(0, self.size, size=self.config.batch_size)
+        window = torch.as_tensor(self._windows[idx], device=self.device)
+        return window, torch.as_tensor(self._actions[idx], device=self.device)
+
+    def _start(self, batch: tuple[torch.Tensor, torch.Tensor]) -> None:
+        def work() -> tuple[dict[str, float], PixelEncoder]:
+            return self._train_step(*batch)
+
+        if not self.config.background:
+            self._pending = run_now(work)
+            return
+        if self._thread is None:
+            self._thread = UpdateThread()
+            weakref.finalize(self, self._thread.close)
+        self._pending = self._thread.submit(work)
+
+    def _publish(self) -> None:
+        """Wait for the step in flight, if any, and make its weights the features' weights."""
+        if self._pending is None:
+            return
+        start = time.perf_counter()
+        try:
+            metrics, encoder = self._pending.result()
+        except Exception as exc:  # kept, then raised with the fix
+            self._failure, self._pending = exc, None
+            self._raise_failure()
+        self._pending = None
+        self.published = encoder
+        self.updates += 1
+        self.last_metrics = {**metrics, "wait_ms": 1000.0 * (time.perf_counter() - start)}
+
+    def _raise_failure(self) -> None:
+        pending = self._pending
+        if pending is not None and pending.done() and pending.exception() is not None:
+            self._failure, self._pending = pending.exception(), None
+        if self._failure is not None:
+            raise RuntimeError(
+                f"CuriosityModel's gradient step failed ({type(self._failure).__name__}: "
+                f"{self._failure}). Its weights may be half-updated, so it stops here: build a "
+                "new model or load_state_dict() a saved one (for a non-finite loss, lower "
+                "CuriosityConfig.lr)."
+            ) from self._failure
+
+    def wait(self) -> None:
+        """Block until the gradient step in flight (if any) has run; it is still published at its
+        due ``watch`` call, so waiting changes no result."""
+        if self._pending is not None:
+            self._pending.exception()
+
+    def close(self) -> None:
+        """Stop the update thread after the step in progress (its result is kept)."""
+        if self._thread is not None:
+            self._thread.close()
+            self._thread = None
+
+    def update(self) -> dict[str, float]:
+        """One Adam step of L_tran + L_con on a batch from the buffer, now, on this thread, its
+        weights published at once (a step in flight is published first); returns its metrics."""
+        self._raise_failure()
+        self._publish()
+        batch = self._sample()
+        self._pending = run_now(lambda: self._train_step(*batch))
+        self._publish()
+        return self.last_metrics
+
+    def _train_step(
+        self, window: torch.Tensor, action: torch.Tensor
+    ) -> tuple[dict[str, float], PixelEncoder]:
+        """The gradient step (on the update thread when ``background``): metrics, new weights."""
         start = time.perf_counter()
         cfg = self.config
-        idx = self.rng.integers(0, self.size, size=cfg.batch_size)
-        window = torch.as_tensor(self._windows[idx], device=self.device)
-        action = torch.as_tensor(self._actions[idx], device=self.device)
         enc, following = self.encoder.encode_transition(window)
         with torch.no_grad():
             view = random_conv(
@@ -325,6 +518,8 @@ class CuriosityModel:
             + cfg.contrastive_weight * l_con
             + cfg.motion_contrastive_weight * l_motion
         )
+        if not torch.isfinite(loss):
+            raise FloatingPointError(f"the curiosity loss is {float(loss)} before this step")
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
         self.optimizer.step()
@@ -333,7 +528,6 @@ class CuriosityModel:
                 self.momentum.parameters(), self.encoder.parameters(), strict=True
             ):
                 ema.lerp_(online_param, cfg.encoder_tau)
-        self.updates += 1
         metrics = {
             "transition_loss": float(l_tran.detach()),
             "contrastive_loss": float(l_con.detach()),
@@ -342,12 +536,18 @@ class CuriosityModel:
             "appearance_std": float(enc.anchor.detach().std(0).mean()),
         }
         metrics["update_ms"] = 1000.0 * (time.perf_counter() - start)
-        return metrics
+        return metrics, frozen_copy(self.encoder)
 
     def state_dict(self) -> dict[str, Any]:
-        """Weights, optimizer, counters and RNG states (not the frame buffer)."""
+        """Weights (trained and published), optimizer, counters and RNG states (not the frame
+        buffer); waits for the step in flight, which stays unpublished."""
+        self.wait()
+        self._raise_failure()
+        pending = None if self._pending is None else self._pending.result()[0]
         return {
             "encoder": self.encoder.state_dict(),
+            "published": self.published.state_dict(),
+            "pending_metrics": pending,
             "momentum": self.momentum.state_dict(),
             "transition": self.transition.state_dict(),
             "similarity": self.similarity.state_dict(),
@@ -359,8 +559,16 @@ class CuriosityModel:
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned (the buffer refills from new transitions)."""
+        """Restore what :meth:`state_dict` returned (the buffer refills from new transitions);
+        clears a failure."""
+        self.wait()
         self.encoder.load_state_dict(state["encoder"])
+        self.published = frozen_copy(self.encoder)
+        self.published.load_state_dict(state.get("published", state["encoder"]))
+        self._failure = None
+        self._pending = None
+        if state.get("pending_metrics") is not None:
+            self._pending = run_now(lambda: (state["pending_metrics"], frozen_copy(self.encoder)))
         self.momentum.load_state_dict(state["momentum"])
         self.transition.load_state_dict(state["transition"])
         self.similarity.load_state_dict(state["similarity"])

@@ -198,7 +198,8 @@ class FeatureSource(Protocol):
     Sources that learn online may also define, as rllte's intrinsic-reward modules do,
     ``watch(triplets, actions, next_triplets, terminated, truncated)`` (called by the wrappers
     after every env step, with batch axis first) and ``update()`` (called by the source itself or
-    by the user); the wrappers call ``watch`` when it exists.
+    by the user); the wrappers call ``watch`` when it exists, and ``close()`` (e.g. to stop a
+    training thread) from their own ``close()``.
     """
 
     def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...

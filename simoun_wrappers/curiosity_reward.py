@@ -160,6 +160,12 @@ class IntrinsicReward:
         if watch is not None and len(triplets):
             watch(triplets, actions, next_triplets, terminated, truncated)
 
+    def close(self) -> None:
+        """Close the feature source when it has a ``close`` (a model's update thread)."""
+        close = getattr(self.features, "close", None)
+        if close is not None:
+            close()
+
     def state_dict(self) -> dict[str, Any]:
         return {"step": self.step, **self.maxima.state_dict()}
 
@@ -180,6 +186,14 @@ class CuriosityState:
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what :meth:`state_dict` returned."""
         self.curiosity.load_state_dict(state)
+
+    def close(self) -> None:
+        """Close the env, then the feature source (stops a ``CuriosityModel``'s update thread;
+        a model shared with other envs starts a new one when they step again)."""
+        try:
+            super().close()
+        finally:
+            self.curiosity.close()
 
 
 class ConsistencyCuriosityReward(
@@ -253,7 +267,6 @@ class ConsistencyCuriosityReward(
         self._read = triplet_reader(env.observation_space)
         self.curiosity = IntrinsicReward(features, scale, decay, r_e_max_init, r_i_max_init)
         self._last_triplet: np.ndarray | None = None
-        self._action_buffer: np.ndarray | None = None
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None

@@ -43,7 +43,8 @@ def test_losses_fall_over_a_short_run_on_a_real_env():
             history.append(model.last_metrics)
         if terminated or truncated:
             env.reset()
-    assert model.updates == len(history) == 161
+    # 161 steps started (calls 100..260), the last one's weights published at the next call
+    assert model.updates == len(history) == 160 and model.pending
     first, last = history[:15], history[-15:]
     for name in ("transition_loss", "contrastive_loss", "motion_contrastive_loss"):
         before = np.mean([m[name] for m in first])
@@ -63,7 +64,8 @@ def test_one_watch_call_triggers_at_most_one_update_of_one_batch():
         before = model.updates
         model.watch(triplets, rng.uniform(-2, 2, (40, 1)), triplets, *np.zeros((2, 40), bool))
         updates.append(model.updates - before)
-    assert updates == [0, 0, 1] * 4
+    # the step started at call 3 is published at call 6, and so on
+    assert updates == [0, 0, 0] + [0, 0, 1] * 3 and model.pending
     assert model.size == 64
 
 
@@ -93,7 +95,7 @@ def test_state_dict_restores_the_features_and_counters():
     fresh = CuriosityModel.for_env(env, CuriosityConfig(**{**TINY, "seed": 5}), device="cpu")
     fresh.load_state_dict(model.state_dict())
     np.testing.assert_array_equal(fresh(obs["frames"][None])[1], model(obs["frames"][None])[1])
-    assert (fresh.updates, fresh.watch_calls) == (model.updates, model.watch_calls) == (5, 12)
+    assert (fresh.updates, fresh.watch_calls) == (model.updates, model.watch_calls) == (4, 12)
 
 
 def test_actions_are_encoded_for_the_transition_model():
@@ -122,7 +124,7 @@ def test_vector_wrapper_feeds_one_model_with_every_sub_env():
     envs.reset(seed=0)
     for _ in range(10):
         _, _, _, _, info = envs.step(envs.action_space.sample())
-    assert model.size == 40 and model.updates == 4
+    assert model.size == 40 and model.updates == 3 and model.pending
     assert np.all(info["reward_intrinsic"] > 0)
     envs.close()
 

@@ -1,0 +1,200 @@
+"""CuriosityModel's update thread and frame pooling, on dm_control cartpole through shimmy."""
+
+import copy
+import dataclasses
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import shimmy
+import torch
+
+from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
+from simoun_wrappers import SimounObservation
+from simoun_wrappers.curiosity_reward import (
+    ConsistencyCuriosityReward,
+    ConsistencyCuriosityVectorReward,
+)
+
+gym.register_envs(shimmy)
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+SIZE = 32
+TINY = CuriosityConfig(
+    num_filters=8,
+    feature_dim=16,
+    aux_hidden_dim=32,
+    batch_size=8,
+    capacity=64,
+    learning_starts=16,
+    update_every=2,
+    seed=0,
+)
+
+
+def cartpole(size: int = SIZE) -> gym.Env:
+    render = {"height": size, "width": size, "camera_id": 0}
+    env = gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array", render_kwargs=render)
+    return SimounObservation(env, size=size)
+
+
+class Recorded:
+    """A CuriosityModel seen through the wrapper: each feature call's output and the number of
+    published gradient steps it used."""
+
+    def __init__(self, model: CuriosityModel) -> None:
+        self.model = model
+        self.calls: list[tuple[np.ndarray, np.ndarray, np.ndarray, int]] = []
+
+    def __call__(self, triplets):
+        f_m, f_a = self.model(triplets)
+        self.calls.append((triplets.copy(), f_m, f_a, self.model.feature_version))
+        return f_m, f_a
+
+    def watch(self, *transition):
+        self.model.watch(*transition)
+
+    def close(self):
+        self.model.close()
+
+
+def rollout(config: CuriosityConfig, steps: int = 24, vector: bool = False):
+    """Intrinsic rewards of a seeded rollout with fixed actions, and the recorded source."""
+    if vector:
+        env = gym.vector.SyncVectorEnv([cartpole, cartpole])
+        model = CuriosityModel.for_env(env, config, device="cpu")
+        source = Recorded(model)
+        env = ConsistencyCuriosityVectorReward(env, source)
+    else:
+        env = cartpole()
+        model = CuriosityModel.for_env(env, config, device="cpu")
+        source = Recorded(model)
+        env = ConsistencyCuriosityReward(env, source)
+    env.reset(seed=0)
+    actions = np.sin(np.arange(steps * 2) * 0.7).astype(np.float32).reshape(steps, 2, 1)
+    rewards = []
+    for t in range(steps):
+        action = actions[t] if vector else actions[t, 0]
+        rewards.append(np.atleast_1d(env.step(action)[4]["reward_intrinsic"]).copy())
+    env.close()
+    return np.array(rewards), source
+
+
+@pytest.mark.parametrize("vector", [False, True])
+def test_the_thread_changes_no_reward_and_a_seed_fixes_them(vector):
+    thread, recorded = rollout(TINY, vector=vector)
+    inline, recorded_inline = rollout(dataclasses.replace(TINY, background=False), vector=vector)
+    again, _ = rollout(TINY, vector=vector)
+    np.testing.assert_array_equal(thread, inline)
+    np.testing.assert_array_equal(thread, again)
+    versions = [call[3] for call in recorded.calls]
+    assert versions == [call[3] for call in recorded_inline.calls]
+    assert max(versions) >= 3  # the rewards span several published updates
+    other, _ = rollout(dataclasses.replace(TINY, seed=1), vector=vector)
+    assert not np.array_equal(thread, other)
+
+
+def test_features_come_only_from_weights_published_whole():
+    # One update per step, so the thread trains while most feature calls run.
+    config = dataclasses.replace(TINY, update_every=1, batch_size=16)
+    weights, calls = {}, None
+    for background in (False, True):
+        env = cartpole()
+        model = CuriosityModel.for_env(env, dataclasses.replace(config, background=background))
+        source = Recorded(model)
+        env = ConsistencyCuriosityReward(env, source)
+        env.reset(seed=0)
+        env.action_space.seed(0)
+        for _ in range(30):
+            if not background:  # the weights after exactly `updates` whole steps
+                weights[model.updates] = copy.deepcopy(model.published.state_dict())
+            env.step(env.action_space.sample())
+        env.close()
+        calls = source.calls
+    assert len(weights) > 10
+    # Each feature call of the threaded run equals a re-encoding with the weights of exactly the
+    # version it used: never a model half-way through a step.
+    reference = CuriosityModel.for_env(cartpole(), config, device="cpu")
+    for triplets, f_m, f_a, version in calls:
+        reference.published.load_state_dict(weights[version])
+        expected_m, expected_a = reference(triplets)
+        np.testing.assert_array_equal(f_m, expected_m)
+        np.testing.assert_array_equal(f_a, expected_a)
+
+
+def test_at_most_one_update_is_in_flight_and_none_is_dropped():
+    config = dataclasses.replace(TINY, update_every=1, batch_size=32, learning_starts=32)
+    env = cartpole()
+    model = CuriosityModel.for_env(env, config, device="cpu")
+    env = ConsistencyCuriosityReward(env, model)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    for t in range(1, 51):
+        env.step(env.action_space.sample())
+        started = max(0, t - config.learning_starts + 1)
+        # every due step was started; all but the newest are published, in order
+        assert model.updates + model.pending == started
+        assert model.updates == max(0, started - 1)
+        assert model._thread is None or model._thread.jobs.qsize() <= 1
+    assert model._thread.jobs.maxsize == 1
+    env.close()
+
+
+def test_a_failed_update_raises_on_the_next_step_until_a_state_is_loaded():
+    config = dataclasses.replace(TINY, update_every=1)
+    env = cartpole()
+    model = CuriosityModel.for_env(env, config, device="cpu")
+    env = ConsistencyCuriosityReward(env, model)
+    env.reset(seed=0)
+    for _ in range(20):
+        env.step(np.zeros(1, np.float32))
+    saved = model.state_dict()  # waits for the step in flight
+    with torch.no_grad():  # a diverged encoder: the next gradient step meets a NaN loss
+        next(model.encoder.parameters()).fill_(float("nan"))
+    env.step(np.zeros(1, np.float32))  # publishes the good step, starts the bad one
+    with pytest.raises(RuntimeError, match=r"gradient step failed \(FloatingPointError.*lr") as err:
+        env.step(np.zeros(1, np.float32))
+    assert isinstance(err.value.__cause__, FloatingPointError)
+    with pytest.raises(RuntimeError, match="load_state_dict"):
+        env.step(np.zeros(1, np.float32))
+    model.load_state_dict(saved)
+    env.step(np.zeros(1, np.float32))
+    env.close()
+
+
+def test_close_stops_the_update_thread_and_a_later_step_starts_a_new_one():
+    model = CuriosityModel.for_env(cartpole(), TINY, device="cpu")
+    envs = [ConsistencyCuriosityReward(cartpole(), model) for _ in range(2)]
+    for env in envs:
+        env.reset(seed=0)
+    for _ in range(20):
+        envs[0].step(np.zeros(1, np.float32))
+    thread = model._thread.thread
+    assert thread.is_alive()
+    envs[0].close()
+    assert not thread.is_alive() and model._thread is None
+    for _ in range(4):  # the model is shared: the other env keeps training it
+        envs[1].step(np.zeros(1, np.float32))
+    assert model._thread.thread.is_alive()
+    envs[1].close()
+    assert model._thread is None
+
+
+def test_frames_are_average_pooled_to_about_encoder_size():
+    pooled_config = dataclasses.replace(TINY, encoder_size=24)
+    model = CuriosityModel.for_env(cartpole(48), pooled_config, device="cpu")
+    full = CuriosityModel((3, 24, 24), model.action_space, dataclasses.replace(TINY), "cpu")
+    assert model.pool == 2 and model.encoded_shape == (3, 24, 24)
+    env = cartpole(48)
+    obs, _ = env.reset(seed=0)
+    obs, *_ = env.step(np.ones(1, np.float32))
+    triplet = obs["frames"][None]
+    by_hand = triplet.reshape(1, 3, 3, 24, 2, 24, 2).mean((4, 6)).round().astype(np.uint8)
+    for a, b in zip(model(triplet), full(by_hand), strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert CuriosityModel.for_env(cartpole(), pooled_config, device="cpu").pool == 1
+    with pytest.raises(ValueError, match=r"encoded at \(3, 16, 16\).*encoder_size=16"):
+        CuriosityModel.for_env(cartpole(), dataclasses.replace(TINY, encoder_size=16))
+    with pytest.raises(ValueError, match="encoder_size must be None"):
+        dataclasses.replace(TINY, encoder_size=0)
