@@ -66,7 +66,7 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
     lengths = [len(episode) - 1 for episode in episodes]
     if args.steps is not None and args.steps[-1] > min(lengths):
         raise SetupError(
-            f"--steps {args.steps[-1]} is beyond the episode: the episodes played last "
+            f"--steps {args.steps[-1]} is beyond the episode: the episodes played lasted "
             f"{', '.join(map(str, lengths))} agent decisions (steps 0..length); pick steps up to "
             f"{min(lengths)}"
         )
@@ -203,7 +203,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=parse_pair,
         default=None,
         metavar="ROW,COL",
-        help="also draw the attention row X[q, :] of this pixel of the frame (Eq. 4)",
+        help="also draw the attention row X[q, :] (Eq. 4) of the reduced-map position q under "
+        "this pixel; the queries of Eq. 4 come from frame t-1",
     )
     masks.add_argument(
         "--video",
@@ -211,7 +212,8 @@ def build_parser() -> argparse.ArgumentParser:
         const="gif",
         choices=("gif", "mp4"),
         default=None,
-        help="also write the overlays of the first episode as an animation (default format gif)",
+        help="also write the overlays of the first episode as an animation, each heat map "
+        "scaled to its own range (default format gif)",
     )
     bias = commands.add_parser(
         "bias",
@@ -234,13 +236,12 @@ def build_parser() -> argparse.ArgumentParser:
         "(any env, default); model, the episode replayed in a twin env under new colours of the "
         "skybox, materials and bodies (dm_control tasks)",
     )
-    for sub in (masks, bias):
-        sub.add_argument(
-            "--out",
-            default=None,
-            help="output directory (default: <run dir>/analysis/masks-<step> or "
-            "<run dir>/analysis/bias)",
-        )
+    defaults = {
+        masks: "<run dir>/analysis/masks-<env step>",
+        bias: "<run dir>/analysis/bias, required with several runs",
+    }
+    for sub, default in defaults.items():
+        sub.add_argument("--out", default=None, help=f"output directory (default: {default})")
         sub.add_argument(
             "--overwrite", action="store_true", help="replace results already in --out"
         )
