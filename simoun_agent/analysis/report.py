@@ -122,7 +122,8 @@ def draw_chart(path: Path, results: list[RunBias]) -> Path:
         )
     ax.set_xticks(x, [label for label, _ in groups], fontsize=8)
     ax.set_ylabel("units (%)")
-    ax.set_ylim(0, 100)
+    ax.set_ylim(0, 115)  # headroom for the legend above bars of 100 %
+    ax.set_yticks(range(0, 101, 20))
     ax.set_title(
         f"Static / dynamic units per encoder and layer (Kowal et al., threshold {THRESHOLD})"
     )
