@@ -113,7 +113,11 @@ def build_parser() -> argparse.ArgumentParser:
         "video.",
         epilog="example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10",
     )
-    parser.add_argument("checkpoint", help="a run directory or its checkpoint.pt")
+    parser.add_argument(
+        "checkpoint",
+        nargs="+",
+        help="a run directory or its checkpoint.pt (several with --distraction)",
+    )
     parser.add_argument("--episodes", type=int, default=10, help="episodes to play (default 10)")
     parser.add_argument(
         "--seed", type=int, default=None, help="first episode seed (default: the run's eval seeds)"
@@ -129,6 +133,21 @@ def build_parser() -> argparse.ArgumentParser:
         "(the baseline; writes to <run dir>/eval-<step>-random)",
     )
     parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
+    parser.add_argument(
+        "--distraction",
+        metavar="MODES",
+        default=None,
+        help="evaluate under distraction modes instead, comma-separated from train, color_easy, "
+        "color_hard, video_easy, video_hard (dm_control runs); writes a mean ± std table and a "
+        "bar chart to <run dir>/generalization, or <common folder>/generalization for several runs",
+    )
+    parser.add_argument(
+        "--videos",
+        metavar="DIR",
+        default=None,
+        help="with --distraction: a folder of video files for the video_* modes (default: a "
+        "procedural moving background)",
+    )
     return parser
 
 
@@ -144,8 +163,17 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error("--episodes must be at least 1")
+    if args.distraction is not None:
+        from simoun_agent.generalization.cli import evaluate_distractions
+
+        return evaluate_distractions(parser, args)
+    if len(args.checkpoint) > 1 or args.videos is not None:
+        parser.error(
+            "several runs and --videos go with --distraction (e.g. --distraction "
+            "train,video_hard); otherwise evaluate one run at a time"
+        )
     try:
-        payload = load_checkpoint(Path(args.checkpoint))
+        payload = load_checkpoint(Path(args.checkpoint[0]))
         config = from_dict(payload["config"])
         env = make_env(config)
         step = payload["state"]["env_step"]

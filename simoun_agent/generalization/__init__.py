@@ -1,0 +1,22 @@
+"""Generalization under distraction (the paper's Fig. 8): suite, evaluation, table and chart.
+
+``simoun-eval RUN_DIR [RUN_DIR ...] --distraction color_easy,color_hard,video_easy,video_hard``
+evaluates runs on DMC-GB's four modes built procedurally (:mod:`simoun_wrappers.distractors`);
+``simoun-train --eval-distraction video_hard`` adds them to every evaluation of a run.
+"""
+
+from simoun_agent.generalization.suite import (
+    DISTRACTIONS,
+    check_supported,
+    distractor,
+    make_distracted_env,
+    parse_distractions,
+)
+
+__all__ = [
+    "DISTRACTIONS",
+    "check_supported",
+    "distractor",
+    "make_distracted_env",
+    "parse_distractions",
+]

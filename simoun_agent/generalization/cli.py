@@ -1,0 +1,65 @@
+"""``simoun-eval RUN_DIR [RUN_DIR ...] --distraction MODES``: the generalization report."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from tqdm import tqdm
+
+from simoun_agent.generalization.evaluation import evaluate_runs
+from simoun_agent.generalization.report import write_report
+from simoun_agent.generalization.suite import parse_distractions
+from simoun_agent.run.presets import SetupError
+
+
+def default_out(run_dirs: list[Path]) -> Path:
+    """``<run dir>/generalization`` for one run, ``<their common folder>/generalization`` for
+    several (a run given by its checkpoint.pt counts as its folder)."""
+    folders = [path if path.is_dir() else path.parent for path in run_dirs]
+    return Path(os.path.commonpath([folder.resolve() for folder in folders])) / "generalization"
+
+
+def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """Evaluate ``args.checkpoint`` (one or several runs) on ``args.distraction``'s modes and
+    write the table, CSV and bar chart; bad input exits through ``parser`` without traceback."""
+    if args.random_policy:
+        parser.error("--random-policy does not combine with --distraction")
+    run_dirs = [Path(path) for path in args.checkpoint]
+    try:
+        modes = parse_distractions(args.distraction)
+        missing = [str(path) for path in run_dirs if not path.exists()]
+        if missing:
+            raise SetupError(
+                f"no such run directory or checkpoint: {', '.join(missing)}; pass directories "
+                "that simoun-train created"
+            )
+        out = Path(args.out) if args.out else default_out(run_dirs)
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise SetupError(
+                f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
+            ) from None
+        results = evaluate_runs(
+            run_dirs,
+            modes,
+            args.episodes,
+            seed=args.seed,
+            device=args.device,
+            videos=args.videos,
+            progress=tqdm.write,
+        )
+    except SetupError as err:
+        parser.exit(2, f"{parser.prog}: error: {err}\n")
+    envs = sorted({result.env.removeprefix("dm_control/") for result in results})
+    steps = sorted({result.env_step for result in results})
+    title = (
+        f"{', '.join(envs)}: return under distraction after "
+        f"{', '.join(str(step) for step in steps)} env steps"
+    )
+    paths = write_report(results, out, title)
+    print(paths["table"].read_text(), end="")
+    print(f"wrote {paths['table']}, {paths['csv']} and {paths['chart']}")
+    return 0

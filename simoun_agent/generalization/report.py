@@ -1,0 +1,90 @@
+"""The generalization table (Markdown and CSV, mean ± std) and grouped bar chart (Fig. 8)."""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Sequence
+from dataclasses import asdict, fields
+from pathlib import Path
+
+from simoun_agent.generalization.evaluation import ModeResult
+from simoun_agent.run.checkpoint import atomic_write
+
+TABLE_MD = "generalization.md"
+TABLE_CSV = "generalization.csv"
+CHART_PNG = "generalization.png"
+
+
+def _order(results: Sequence[ModeResult]) -> tuple[list[str], list[str]]:
+    runs = list(dict.fromkeys(result.run for result in results))
+    modes = list(dict.fromkeys(result.mode for result in results))
+    return runs, modes
+
+
+def markdown_table(results: Sequence[ModeResult]) -> str:
+    """One row per run, one column per mode, cells ``mean ± std`` of the episode return."""
+    runs, modes = _order(results)
+    cell = {(r.run, r.mode): f"{r.return_mean:.1f} ± {r.return_std:.1f}" for r in results}
+    lines = [
+        "| run | " + " | ".join(modes) + " |",
+        "|---|" + "---:|" * len(modes),
+    ]
+    lines += [
+        f"| {run} | " + " | ".join(cell.get((run, m), "") for m in modes) + " |" for run in runs
+    ]
+    first = results[0]
+    note = (
+        f"\nEpisode return, mean ± std over {first.episodes} deterministic episodes per mode "
+        f"(reset seeds from {first.first_seed} for the first run; every mode plays the same ones)."
+    )
+    return "\n".join(lines) + "\n" + note + "\n"
+
+
+def write_csv(results: Sequence[ModeResult], path: Path) -> None:
+    """One row per run and mode, with every ``ModeResult`` field."""
+
+    def write(tmp: Path) -> None:
+        with tmp.open("w", newline="") as f:
+            writer = csv.DictWriter(f, [field.name for field in fields(ModeResult)])
+            writer.writeheader()
+            writer.writerows(asdict(result) for result in results)
+
+    atomic_write(path, write)
+
+
+def plot_bars(results: Sequence[ModeResult], path: Path, title: str) -> None:
+    """Grouped bars as in the paper's Fig. 8: one group per mode, one bar per run, ± std."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    runs, modes = _order(results)
+    by_key = {(r.run, r.mode): r for r in results}
+    width = 0.8 / len(runs)
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(modes) * max(1, len(runs) / 2)), 4), dpi=110)
+    x = np.arange(len(modes))
+    for index, run in enumerate(runs):
+        means = [by_key[run, m].return_mean if (run, m) in by_key else np.nan for m in modes]
+        stds = [by_key[run, m].return_std if (run, m) in by_key else np.nan for m in modes]
+        offset = (index - (len(runs) - 1) / 2) * width
+        ax.bar(x + offset, means, width, yerr=stds, capsize=3, label=run)
+    ax.set_xticks(x, [mode.replace("_", " ") for mode in modes])
+    ax.set_ylabel("episode return (mean ± std)")
+    ax.set_title(title)
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    fig.tight_layout()
+    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png"))
+    plt.close(fig)
+
+
+def write_report(results: Sequence[ModeResult], out: Path, title: str) -> dict[str, Path]:
+    """Write the Markdown table, the CSV and the bar chart into ``out``; returns their paths."""
+    paths = {"table": out / TABLE_MD, "csv": out / TABLE_CSV, "chart": out / CHART_PNG}
+    text = f"# {title}\n\n" + markdown_table(results)
+    atomic_write(paths["table"], lambda tmp: tmp.write_text(text))
+    write_csv(results, paths["csv"])
+    plot_bars(results, paths["chart"], title)
+    return paths

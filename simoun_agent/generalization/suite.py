@@ -1,0 +1,106 @@
+"""The distraction suite: DMC-GB's four test modes (and ``train``) as env wrappers.
+
+Each mode names how to wrap the bare env that :func:`simoun_agent.run.make_env.make_env` builds
+for a run (its ``distractor`` hook), so a distracted env is the run's own stack, action repeat,
+cameras and image size included, with only the appearance changed.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Callable, Sequence
+from functools import partial
+from pathlib import Path
+
+import gymnasium as gym
+
+from simoun_agent.run.presets import SetupError, TrainConfig
+from simoun_wrappers import ColorShift, MovingBackground
+
+DISTRACTIONS: dict[str, tuple[type[gym.Wrapper], str] | None] = {
+    "train": None,
+    "color_easy": (ColorShift, "easy"),
+    "color_hard": (ColorShift, "hard"),
+    "video_easy": (MovingBackground, "easy"),
+    "video_hard": (MovingBackground, "hard"),
+}
+"""Mode name -> (wrapper, level); ``train`` is the run's own env. As in DMC-GB, ``color_*``
+recolour the sky, floor and body at each episode and ``video_*`` play a moving background
+behind the sky (easy) or the sky and the floor (hard)."""
+
+DISTRACTION_SEED = 0
+"""Seed of every distractor: with the evaluation's reset seeds it fixes the colours and
+backgrounds of each episode, so two runs evaluated on the same seeds see the same ones."""
+
+
+def parse_distractions(text: str | Sequence[str], flag: str = "--distraction") -> list[str]:
+    """Mode names from ``"color_easy,video_hard"`` (or a list), checked, duplicates dropped.
+
+    Raises SetupError for an unknown name, suggesting the closest one.
+    """
+    parts = text.split(",") if isinstance(text, str) else list(text)
+    names = [part.strip() for part in parts if part.strip()]
+    if not names:
+        raise SetupError(f"{flag} is empty; pass modes from {', '.join(DISTRACTIONS)}")
+    for name in names:
+        if name not in DISTRACTIONS:
+            close = difflib.get_close_matches(name, list(DISTRACTIONS), n=1, cutoff=0.5)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise SetupError(
+                f"unknown distraction {name!r} in {flag}; {hint}choose from "
+                f"{', '.join(DISTRACTIONS)} (comma-separated, e.g. {flag} color_easy,video_hard)"
+            )
+    return list(dict.fromkeys(names))
+
+
+def distractor(name: str, videos: str | Path | None = None) -> Callable[[gym.Env], gym.Env] | None:
+    """The wrapper of mode ``name`` for ``make_env(config, distractor)``; None for ``train``.
+
+    ``videos`` is a folder of video files played by the ``video_*`` modes instead of the
+    procedural background (DMC-GB's video folders, or DAVIS clips as mp4).
+    """
+    (name,) = parse_distractions([name])
+    entry = DISTRACTIONS[name]
+    if entry is None:
+        return None
+    wrapper, level = entry
+    if wrapper is MovingBackground:
+        return partial(MovingBackground, level=level, videos=videos, seed=DISTRACTION_SEED)
+    return partial(wrapper, level=level, seed=DISTRACTION_SEED)
+
+
+def check_supported(
+    config: TrainConfig, names: Sequence[str], videos: str | Path | None = None
+) -> None:
+    """Raise SetupError unless every mode in ``names`` can wrap the env of ``config``.
+
+    The distractors change a MuJoCo scene, so any mode but ``train`` needs a dm_control task;
+    a ``videos`` folder must hold a readable video. Checked before any episode is played.
+    """
+    distracted = [name for name in parse_distractions(names) if DISTRACTIONS[name] is not None]
+    if distracted and not config.env.startswith("dm_control/"):
+        raise SetupError(
+            f"distraction {distracted[0]!r} needs a dm_control task (it recolours or re-renders a "
+            f"MuJoCo scene), but this run trained on {config.env}; evaluate it with --distraction "
+            f"train, or randomise its appearance with simoun_wrappers.RandomConvolution."
+        )
+    if videos is not None and any(name.startswith("video_") for name in distracted):
+        from simoun_wrappers.distractors.backgrounds import VideoBackground
+
+        try:
+            VideoBackground(videos)
+        except ValueError as err:
+            raise SetupError(f"--videos {videos}: {err}") from None
+
+
+def make_distracted_env(
+    config: TrainConfig, name: str, videos: str | Path | None = None
+) -> gym.Env:
+    """The run's env stack for ``config`` under distraction mode ``name``.
+
+    Raises SetupError when the mode does not fit the run (see :func:`check_supported`).
+    """
+    from simoun_agent.run.make_env import make_env
+
+    check_supported(config, [name], videos)
+    return make_env(config, distractor(name, videos))

@@ -1,0 +1,116 @@
+"""The distraction suite end to end: a tiny ball_in_cup run, simoun-eval --distraction."""
+
+import csv
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from simoun_agent.generalization import DISTRACTIONS, check_supported, make_distracted_env
+from simoun_agent.run import evaluate, train
+from simoun_agent.run.presets import SetupError, resolve
+
+pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
+
+# A 1 s episode limit keeps ball_in_cup episodes at 50 env steps (13 decisions at repeat 4).
+TINY = {
+    "env": "dm_control/ball_in_cup-catch-v0",
+    "env_kwargs": {"task_kwargs": {"time_limit": 1}},
+    "image_size": 32,
+    "seed": 2,
+}
+TINY_FLAGS = [
+    "--env", TINY["env"],
+    "--env-kwargs", json.dumps(TINY["env_kwargs"]),
+    "--image-size", "32",
+    "--seed", "2",
+    "--total-env-steps", "60",
+    "--warmup-agent-steps", "10",
+    "--eval-every", "1000",
+    "--eval-episodes", "1",
+    "--checkpoint-every", "1000",
+    "--video", "false",
+    "--progress", "false",
+    "--device", "cpu",
+    "--torch-threads", "1",
+    "--agent.batch-size", "8",
+    "--agent.num-filters", "8",
+    "--agent.feature-dim", "16",
+    "--agent.hidden-dim", "32",
+    "--agent.aux-hidden-dim", "32",
+]  # fmt: skip
+MODES = list(DISTRACTIONS)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """One tiny trained run and an exact copy of it, as two runs of one report."""
+    root = tmp_path_factory.mktemp("runs")
+    assert train.main([*TINY_FLAGS, "--run-dir", str(root / "a")]) == 0
+    shutil.copytree(root / "a", root / "b")
+    return root
+
+
+def test_simoun_eval_distraction_writes_table_csv_and_chart(runs, capsys):
+    argv = [str(runs / "a"), str(runs / "b"), "--distraction", ",".join(MODES), "--episodes", "1"]
+    assert evaluate.main(argv) == 0
+    out = runs / "generalization"
+    with (out / "generalization.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [(row["run"], row["mode"]) for row in rows] == [(r, m) for r in "ab" for m in MODES]
+    by_run = {run: [row["return_mean"] for row in rows if row["run"] == run] for run in "ab"}
+    assert by_run["a"] == by_run["b"]  # same weights, same seeds, same distractions
+    table = (out / "generalization.md").read_text()
+    assert "| run | train | color_easy | color_hard | video_easy | video_hard |" in table
+    assert table.count("±") >= 10 and "ball_in_cup-catch" in table
+    assert (out / "generalization.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "wrote" in capsys.readouterr().out
+
+    # The train mode is the plain evaluation on the same episodes.
+    plain = runs / "plain"
+    assert (
+        evaluate.main([str(runs / "a"), "--episodes", "1", "--no-video", "--out", str(plain)]) == 0
+    )
+    metrics = json.loads((plain / "metrics.json").read_text())
+    assert float(rows[0]["return_mean"]) == pytest.approx(metrics["return_mean"])
+
+
+def test_each_mode_changes_only_the_pixels_of_the_runs_stack():
+    config = resolve(None, TINY)
+    action = np.full(1, 0.7, np.float32)
+    frames = {}
+    for mode in MODES:
+        env = make_distracted_env(config, mode)
+        obs, _ = env.reset(seed=9)
+        obs, reward, *_ = env.step(action)
+        frames[mode] = (obs["frames"], reward, env.unwrapped._env.physics.get_state().copy())
+        env.close()
+    plain_frames, plain_reward, plain_state = frames["train"]
+    for mode in MODES[1:]:
+        pixels, reward, state = frames[mode]
+        assert reward == plain_reward
+        np.testing.assert_array_equal(state, plain_state)
+        assert np.abs(pixels.astype(int) - plain_frames).mean() > 5, mode
+
+
+def test_bad_distraction_input_is_a_clear_error(runs, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.main([str(runs / "a"), "--distraction", "train,colr_hard"])
+    assert exit_info.value.code == 2
+    assert "did you mean 'color_hard'?" in capsys.readouterr().err
+
+    (tmp_path / "clip.mp4").write_bytes(b"not a video")
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.main([str(runs / "a"), "--distraction", "video_hard", "--videos", str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert "no readable video" in capsys.readouterr().err
+
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.main([str(runs / "a"), str(runs / "b")])
+    assert "go with --distraction" in capsys.readouterr().err
+
+    point_reach = resolve(None, {"env": "simoun/PointReach-v0"})
+    with pytest.raises(SetupError, match="needs a dm_control task"):
+        check_supported(point_reach, ["train", "video_easy"])
+    check_supported(point_reach, ["train"])
