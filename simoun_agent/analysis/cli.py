@@ -212,8 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
         const="gif",
         choices=("gif", "mp4"),
         default=None,
-        help="also write the overlays of the first episode as an animation, each heat map "
-        "scaled to its own range (default format gif)",
+        help="also write the first episode as an animation (default format gif): o_t, X^m, X^a "
+        "and the query's row, left to right (top to bottom for wide frames), each heat map "
+        "scaled to its own range",
     )
     bias = commands.add_parser(
         "bias",
