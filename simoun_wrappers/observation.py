@@ -48,8 +48,15 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     return int(pair[0]), int(pair[1])
 
 
-def check_stack_options(num_frames: int, motion: bool, fold_frames: bool, source: str) -> None:
+def check_stack_options(
+    num_frames: int, motion: bool, fold_frames: bool, source: str, grayscale: bool = False
+) -> None:
     """Reject bad ``SimounObservation`` options (shared with ``SimounParallelObservation``)."""
+    switches = {"grayscale": grayscale, "motion": motion, "fold_frames": fold_frames}
+    for name, value in switches.items():
+        if not isinstance(value, (bool, np.bool_)):
+            # A truthy string such as "false" would otherwise switch the option on.
+            raise TypeError(f"{name} must be True or False, got {value!r}.")
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
     if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
@@ -219,7 +226,7 @@ class SimounObservation(ChainWrapper):
             fold_frames=fold_frames,
             source=source,
         )
-        check_stack_options(num_frames, motion, fold_frames, source)
+        check_stack_options(num_frames, motion, fold_frames, source, grayscale)
         hw = parse_size(size)
         chain, from_render = pixel_env(env, source)
         height, width, channels = image_layout(chain.observation_space)

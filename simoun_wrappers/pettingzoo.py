@@ -70,7 +70,7 @@ class SimounParallelObservation(BaseParallelWrapper):
                 f"pettingzoo.utils.conversions.aec_to_parallel(env)."
             )
         super().__init__(env)
-        check_stack_options(num_frames, motion, fold_frames, source)
+        check_stack_options(num_frames, motion, fold_frames, source, grayscale)
         self._size = parse_size(size)
         self._grayscale = grayscale
         self._num_frames = int(num_frames)

@@ -107,3 +107,9 @@ def test_sdl_leaves_sigterm_to_python_after_highway_env_renders():
     finally:
         proc.kill()
         proc.wait()
+
+
+@pytest.mark.parametrize("option", ["grayscale", "motion", "fold_frames"])
+def test_switches_given_as_strings_are_refused(option):
+    with pytest.raises(TypeError, match=f"{option} must be True or False, got 'false'"):
+        SimounObservation(cartpole_pixels(), size=32, **{option: "false"})
