@@ -19,27 +19,26 @@ TINY = {
     "env_kwargs": {"task_kwargs": {"time_limit": 1}},
     "image_size": 32,
     "seed": 2,
+    "total_env_steps": 60,
+    "warmup_agent_steps": 10,
+    "eval_every": 1000,
+    "eval_episodes": 1,
+    "checkpoint_every": 1000,
+    "video": False,
+    "progress": False,
+    "device": "cpu",
+    "torch_threads": 1,
+    "agent.batch_size": 8,
+    "agent.num_filters": 8,
+    "agent.feature_dim": 16,
+    "agent.hidden_dim": 32,
+    "agent.aux_hidden_dim": 32,
 }
 TINY_FLAGS = [
-    "--env", TINY["env"],
-    "--env-kwargs", json.dumps(TINY["env_kwargs"]),
-    "--image-size", "32",
-    "--seed", "2",
-    "--total-env-steps", "60",
-    "--warmup-agent-steps", "10",
-    "--eval-every", "1000",
-    "--eval-episodes", "1",
-    "--checkpoint-every", "1000",
-    "--video", "false",
-    "--progress", "false",
-    "--device", "cpu",
-    "--torch-threads", "1",
-    "--agent.batch-size", "8",
-    "--agent.num-filters", "8",
-    "--agent.feature-dim", "16",
-    "--agent.hidden-dim", "32",
-    "--agent.aux-hidden-dim", "32",
-]  # fmt: skip
+    item
+    for key, value in TINY.items()
+    for item in ("--" + key.replace("_", "-"), json.dumps(value).strip('"'))
+]
 MODES = list(DISTRACTIONS)
 
 
@@ -77,7 +76,7 @@ def test_simoun_eval_distraction_writes_table_csv_and_chart(runs, capsys):
 
 
 def test_each_mode_changes_only_the_pixels_of_the_runs_stack():
-    config = resolve(None, TINY)
+    config = resolve(None, {key: TINY[key] for key in ("env", "env_kwargs", "image_size")})
     action = np.full(1, 0.7, np.float32)
     frames = {}
     for mode in MODES:
@@ -114,3 +113,20 @@ def test_bad_distraction_input_is_a_clear_error(runs, tmp_path, capsys):
     with pytest.raises(SetupError, match="needs a dm_control task"):
         check_supported(point_reach, ["train", "video_easy"])
     check_supported(point_reach, ["train"])
+
+
+def test_training_with_distraction_curves_leaves_training_unchanged(runs):
+    from simoun_agent.generalization.callback import DistractionEvaluation
+    from simoun_agent.run.checkpoint import load_checkpoint
+    from simoun_agent.run.logger import read_csv
+
+    run = train.create_run(resolve(None, {**TINY, "run_dir": str(runs / "curves")}))
+    train.train(run, [DistractionEvaluation(["video_hard", "color_easy"])])
+    rows = read_csv(runs / "curves" / "eval.csv")
+    plain_rows = read_csv(runs / "a" / "eval.csv")
+    assert [row["return_mean"] for row in rows] == [row["return_mean"] for row in plain_rows]
+    for mode in ("video_hard", "color_easy"):
+        assert all(np.isfinite(row[f"{mode}/return_mean"]) for row in rows)
+    ours, theirs = load_checkpoint(runs / "curves"), load_checkpoint(runs / "a")
+    for key, value in theirs["agent"]["actor"].items():
+        np.testing.assert_array_equal(ours["agent"]["actor"][key].numpy(), value.numpy())

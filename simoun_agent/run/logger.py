@@ -87,6 +87,11 @@ def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:
         label="min-max over episodes",
     )
     ax.plot(steps, mean, marker="o", label="mean evaluation return")
+    # Test curves beside the training env's (simoun-train --eval-distraction), as in DMC-GB.
+    for key in rows[0] if rows else ():
+        if key.endswith("/return_mean"):
+            mode = key.removesuffix("/return_mean")
+            ax.plot(steps, [row[key] for row in rows], marker=".", label=f"{mode} (mean)")
     ax.set_xlabel("environment steps")
     ax.set_ylabel("episode return")
     ax.set_title(title)

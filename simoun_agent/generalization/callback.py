@@ -1,0 +1,75 @@
+"""Test curves during training: evaluate on distraction modes at every evaluation (DMC-GB)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import gymnasium as gym
+
+from simoun_agent.generalization.suite import (
+    check_supported,
+    make_distracted_env,
+    parse_distractions,
+)
+from simoun_agent.run.presets import SetupError, TrainConfig
+from simoun_agent.run.train import TrainCallback
+
+if TYPE_CHECKING:
+    from simoun_agent.run.train import Run
+
+FLAG = "--eval-distraction"
+
+
+def check_eval_distractions(config: TrainConfig, modes: Sequence[str]) -> list[str]:
+    """``modes`` checked for ``config`` (names, a dm_control task); SetupError otherwise."""
+    names = parse_distractions(modes, flag=FLAG) if modes else []
+    if "train" in names:
+        raise SetupError(
+            f"{FLAG} train is the run's own evaluation, which always runs; name distraction "
+            f"modes only, e.g. {FLAG} video_hard"
+        )
+    check_supported(config, names)
+    return names
+
+
+class DistractionEvaluation(TrainCallback):
+    """At each evaluation, also play the evaluation episodes under each distraction mode.
+
+    Adds ``<mode>/return_mean`` and ``<mode>/return_std`` to the evaluation's metrics, which go
+    to eval.csv, TensorBoard and the learning curve beside the training env's return. The
+    episodes use the run's evaluation seeds, so every mode sees the same starts as the training
+    env; the distracted envs are built once, on the first evaluation.
+
+    Args:
+        modes: distraction modes (``simoun_agent.generalization.DISTRACTIONS``, not ``train``).
+        videos: a folder of video files for the ``video_*`` modes; None for procedural ones.
+    """
+
+    def __init__(self, modes: Sequence[str], videos: str | Path | None = None) -> None:
+        self.modes = list(modes)
+        self.videos = videos
+        self._envs: dict[str, gym.Env] = {}
+
+    def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
+        from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate
+
+        config = run.config
+        for mode in self.modes:
+            if mode not in self._envs:
+                self._envs[mode] = make_distracted_env(config, mode, self.videos)
+            result, _ = evaluate(
+                run.agent, self._envs[mode], config.eval_episodes, config.seed + EVAL_SEED_OFFSET
+            )
+            metrics[f"{mode}/return_mean"] = result["return_mean"]
+            metrics[f"{mode}/return_std"] = result["return_std"]
+
+    def on_end(self, run: Run, metrics: dict[str, float]) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the distracted envs (training may also end by Ctrl-C, without ``on_end``)."""
+        for env in self._envs.values():
+            env.close()
+        self._envs.clear()
