@@ -200,5 +200,7 @@ def test_bad_input_errors(tmp_path):
         MovingBackground(_cartpole(), videos=tmp_path)
     with pytest.raises(ValueError, match="is not a folder"):
         MovingBackground(_cartpole(), videos=tmp_path / "missing")
+    with pytest.raises(TypeError, match="goes under the pixel wrappers"):
+        MovingBackground(SimounObservation(_cartpole(), size=SIZE))
     with pytest.raises(ValueError, match="render_mode='rgb_array'"):
         MovingBackground(gym.make("dm_control/cartpole-swingup-v0"))

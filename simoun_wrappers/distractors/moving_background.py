@@ -82,6 +82,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
             )
         import mujoco
 
+        _check_under_pixel_wrappers(env)
         self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}
         self.level, self.seed = level, seed
         self._geom_type = int(mujoco.mjtObj.mjOBJ_GEOM)
@@ -129,3 +130,24 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
         ids, types = segmentation[..., 0], segmentation[..., 1]
         floor = (types == self._geom_type) & np.isin(ids, self._replaced_geoms)
         return (ids == -1) | floor
+
+
+def _check_under_pixel_wrappers(env: gym.Env) -> None:
+    """Refuse to sit over wrappers that already turned renders into observations.
+
+    Their observations were rendered below this wrapper, so the agent would never see the
+    background; only ``render()`` would change.
+    """
+    from gymnasium.wrappers import AddRenderObservation
+
+    from simoun_wrappers.cameras import MultiCamera
+
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if isinstance(inner, (AddRenderObservation, MultiCamera)):
+            raise TypeError(
+                f"MovingBackground goes under the pixel wrappers, but {env} already renders its "
+                f"observations ({type(inner).__name__}), which would keep the plain background. "
+                f"Swap the order, e.g. SimounObservation(MultiCamera(MovingBackground(env), ...))."
+            )
+        inner = inner.env
