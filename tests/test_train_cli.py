@@ -84,7 +84,7 @@ def test_simoun_eval_random_policy_is_a_seeded_baseline_on_the_same_episodes(tmp
     assert train.main(flags) == 0
     returns = []
     for _ in range(2):
-        argv = [str(run_dir), "--episodes", "2", "--random-policy", "--no-video"]
+        argv = [str(run_dir), "--episodes", "2", "--random-policy", "--no-video", "--overwrite"]
         assert evaluate.main(argv) == 0
         metrics = json.loads((run_dir / "eval-40-random" / "metrics.json").read_text())
         assert metrics["random_policy"] is True and metrics["episodes"] == 2

@@ -2,7 +2,9 @@
 
 ``simoun-eval RUN_DIR_OR_CHECKPOINT`` rebuilds the run's environment and agent from the
 checkpoint, plays evaluation episodes and writes ``eval-<step>/metrics.json`` and
-``eval-<step>/video.mp4`` next to the checkpoint (or under ``--out``).
+``eval-<step>/video.mp4`` next to the checkpoint (or under ``--out``); an earlier evaluation
+there is kept unless ``--overwrite``. Ctrl-C or SIGTERM stops it at once (exit 130 or 143)
+without leaving a half-written directory.
 """
 
 from __future__ import annotations
@@ -10,16 +12,22 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shutil
+import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from simoun_agent.run import driving_metrics
+from simoun_agent.run.flags import add_version, bool_argv
 from simoun_agent.run.presets import SetupError
+from simoun_agent.run.signals import Stopped, stop_at_once
 
 EVAL_SEED_OFFSET = 1_000_000
 """Evaluation episode i resets with seed ``config.seed + EVAL_SEED_OFFSET + i``: the same
@@ -32,12 +40,15 @@ def evaluate(
     episodes: int,
     seed: int,
     record: bool = False,
+    on_episode: Callable[[int, float], None] | None = None,
 ) -> tuple[dict[str, float], list[np.ndarray]]:
     """Play ``episodes`` episodes with deterministic actions.
 
     Leaves every global RNG as it found it, so evaluating does not change what training does
     next (a resumed run stays bit-exact). highway-env runs add the driving measures of
     :mod:`simoun_agent.run.driving_metrics`.
+
+    ``on_episode(index, return)`` is called after each episode (progress reports).
 
     Returns:
         metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
@@ -66,6 +77,8 @@ def evaluate(
                     frames.append(obs["frames"][-1])
             returns.append(total)
             lengths.append(length)
+            if on_episode is not None:
+                on_episode(episode, total)
             if drive:
                 drives.append(drive)
     metrics = {
@@ -93,6 +106,34 @@ class RandomPolicy:
 
     def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:
         return self._rng.uniform(-1.0, 1.0, self.action_dim).astype(np.float32)
+
+
+class EpisodeProgress:
+    """Progress of ``simoun-eval``: a bar on a terminal, else one plain line per episode on
+    stderr (logs of nohup or cluster jobs do not fill with bar redraws); nothing when off."""
+
+    def __init__(self, episodes: int, enabled: bool) -> None:
+        self.episodes = episodes
+        self.enabled = enabled
+        self.bar = tqdm(total=episodes, unit="episode") if enabled and sys.stderr.isatty() else None
+
+    def episode(self, index: int, episode_return: float) -> None:
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.set_postfix(episode_return=f"{episode_return:.1f}")
+        elif self.enabled:
+            print(
+                f"episode {index + 1}/{self.episodes}: return {episode_return:.1f}",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    def __enter__(self) -> EpisodeProgress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def metrics_json(data: dict[str, Any]) -> str:
@@ -125,7 +166,23 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--out", default=None, help="output directory (default: <run dir>/eval-<step>)"
     )
-    parser.add_argument("--no-video", action="store_true", help="skip the video")
+    parser.add_argument(
+        "--video",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="record the first episode to video.mp4 (default: on)",
+    )
+    parser.add_argument(
+        "--progress",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="show a progress bar, or one line per episode when stderr is not a terminal",
+    )
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an earlier evaluation in the output directory",
+    )
     parser.add_argument(
         "--random-policy",
         action="store_true",
@@ -148,6 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --distraction: a folder of video files for the video_* modes (default: a "
         "procedural moving background)",
     )
+    add_version(parser)
     return parser
 
 
@@ -160,7 +218,8 @@ def main(argv: list[str] | None = None) -> int:
     from simoun_agent.run.video import write_video
 
     parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(bool_argv(argv, ("--video", "--progress")))
     if args.episodes < 1:
         parser.error("--episodes must be at least 1")
     if args.distraction is not None:
@@ -174,12 +233,20 @@ def main(argv: list[str] | None = None) -> int:
         )
     try:
         payload = load_checkpoint(Path(args.checkpoint[0]))
-        config = from_dict(payload["config"])
+        saved = payload["config"]
+        # The machine may differ from the training one: --device applies before the checks.
+        config = from_dict({**saved, "device": args.device} if args.device else saved)
         env = make_env(config)
         step = payload["state"]["env_step"]
         suffix = "-random" if args.random_policy else ""
         default_out = payload["replay_path"].parent / f"eval-{step}{suffix}"
         out = Path(args.out) if args.out else default_out
+        if out.is_dir() and any(out.iterdir()) and not args.overwrite:
+            raise SetupError(
+                f"{out} holds an earlier evaluation; pass --overwrite to replace it, or --out DIR "
+                "to write this one elsewhere"
+            )
+        created = not out.exists()
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as err:
@@ -194,12 +261,22 @@ def main(argv: list[str] | None = None) -> int:
                 env.observation_space["frames"].shape[1:],
                 env.action_space.shape[0],
                 config.agent,
-                device=args.device or config.device,
+                device=config.device,
             )
             agent.load_state_dict(payload["agent"])
     except SetupError as err:
         parser.exit(2, f"simoun-eval: error: {err}\n")
-    metrics, frames = evaluate(agent, env, args.episodes, seed, record=not args.no_video)
+    try:
+        with stop_at_once(), EpisodeProgress(args.episodes, args.progress) as progress:
+            metrics, frames = evaluate(
+                agent, env, args.episodes, seed, record=args.video, on_episode=progress.episode
+            )
+    except Stopped as stop:
+        env.close()
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        print(f"simoun-eval: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
+        return stop.exit_code
     metrics.update(
         env_step=step, episodes=args.episodes, first_seed=seed, random_policy=args.random_policy
     )
@@ -209,7 +286,7 @@ def main(argv: list[str] | None = None) -> int:
         write_video(out / "video.mp4", frames, video_fps(env, config.resolved_action_repeat()))
     env.close()
     print(text, end="")
-    print(f"wrote {out}/metrics.json" + ("" if args.no_video else f" and {out}/video.mp4"))
+    print(f"wrote {out}/metrics.json" + (f" and {out}/video.mp4" if args.video else ""))
     return 0
 
 
