@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import itertools
 import json
 import math
 import sys
@@ -188,13 +189,19 @@ class Group:
         return row
 
 
-def group_runs(records: list[RunRecord], keys: list[str]) -> list[Group]:
+def group_runs(records: list[RunRecord], keys: list[str], root: Path) -> list[Group]:
+    """Runs by variant and env; a sweep's variants in its grid's order, others as found."""
     groups: dict[tuple[str, str], Group] = {}
     for record in records:
         variant = variant_name(record.config, keys)
         label = env_label(record.env)
         groups.setdefault((variant, label), Group(variant, label, [])).runs.append(record)
-    return list(groups.values())
+    order = list(dict.fromkeys(group.variant for group in groups.values()))
+    if (root / SWEEP_FILE).is_file():
+        grid = json.loads((root / SWEEP_FILE).read_text())["grid"]
+        combos = itertools.product(*grid.values())
+        order = [variant_name(dict(zip(grid, c, strict=True)), list(grid)) for c in combos]
+    return sorted(groups.values(), key=lambda group: order.index(group.variant))
 
 
 def _pm(mean: float, std: float) -> str:
@@ -291,7 +298,7 @@ def write_report(root: Path, out: Path | None = None) -> list[Path]:
             f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
             "directory of simoun-train runs"
         )
-    groups = group_runs(records, variant_keys(records, root))
+    groups = group_runs(records, variant_keys(records, root), root)
     rows = [group.row() for group in groups]
     unfinished = [
         str(run.run_dir.relative_to(root))

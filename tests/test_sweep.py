@@ -1,0 +1,272 @@
+"""simoun-sweep on a local Ray instance: a grid of tiny PointReach runs, a failing trial, Ctrl-C
+and --resume, and the bad inputs it refuses."""
+
+import csv
+import json
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("ray.tune", reason="the sweep extra: pip install 'simoun[sweep]'")
+
+import ray
+
+from simoun_agent.run.logger import read_csv
+from simoun_agent.sweep import cli
+from simoun_agent.sweep.grid import SWEEP_FILE, parse_seeds, split_values
+
+TINY = [
+    "--env", "simoun/PointReach-v0",
+    "--image-size", "32",
+    "--total-env-steps", "120",
+    "--warmup-agent-steps", "20",
+    "--replay-capacity", "1000",
+    "--eval-every", "60",
+    "--eval-episodes", "1",
+    "--checkpoint-every", "60",
+    "--video", "false",
+    "--device", "cpu",
+    "--set", "agent.batch_size=8",
+    "--set", "agent.num_filters=8",
+    "--set", "agent.feature_dim=16",
+    "--set", "agent.hidden_dim=32",
+    "--set", "agent.aux_hidden_dim=32",
+]  # fmt: skip
+"""The tiny run of tests/test_train_resume.py as simoun-train flags (a few seconds per run)."""
+
+
+def tiny_without(flag: str) -> list[str]:
+    """TINY less one flag and its value (for a key the grid gives instead)."""
+    at = TINY.index(flag)
+    return TINY[:at] + TINY[at + 2 :]
+
+
+@pytest.fixture(scope="module")
+def ray_address():
+    """One local Ray instance for the module (each sweep would otherwise start its own)."""
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield ray.get_runtime_context().gcs_address
+    ray.shutdown()
+
+
+def run_dirs(sweep_dir: Path) -> list[Path]:
+    return sorted(p.parent for p in sweep_dir.glob("*/*/s*/config.json"))
+
+
+def tune_results(sweep_dir: Path, experiment: int = -1) -> dict[str, list[dict]]:
+    """What each trial reported to Tune (its result.json lines), by trial name."""
+    experiments = sorted(p for p in (sweep_dir / "tune").iterdir() if p.is_dir())
+    results = {}
+    for trial_dir in experiments[experiment].iterdir():
+        if (trial_dir / "result.json").is_file():
+            lines = (trial_dir / "result.json").read_text().splitlines()
+            rows = [json.loads(line) for line in lines]
+            results[json.loads((trial_dir / "params.json").read_text())["trial"]] = rows
+    return results
+
+
+def report_rows(sweep_dir: Path) -> list[dict]:
+    with (sweep_dir / "report.csv").open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+@pytest.fixture(scope="module")
+def sweep_dir(ray_address, tmp_path_factory):
+    """2 recipes x 2 seeds, run once for the tests that read it."""
+    sweep_dir = tmp_path_factory.mktemp("sweeps") / "recipes"
+    argv = [*TINY, "--grid", "agent.recipe=drq,sac", "--seeds", "0-1", "--verbose", "0"]
+    assert cli.main([*argv, "--sweep-dir", str(sweep_dir)]) == 0
+    return sweep_dir
+
+
+def test_grid_of_two_recipes_and_two_seeds_makes_four_runs_and_a_report(sweep_dir):
+    dirs = run_dirs(sweep_dir)
+    assert [d.relative_to(sweep_dir).as_posix() for d in dirs] == [
+        "agent.recipe=drq/simoun-PointReach-v0/s0",
+        "agent.recipe=drq/simoun-PointReach-v0/s1",
+        "agent.recipe=sac/simoun-PointReach-v0/s0",
+        "agent.recipe=sac/simoun-PointReach-v0/s1",
+    ]
+    for run_dir in dirs:
+        config = json.loads((run_dir / "config.json").read_text())
+        assert config["agent"]["recipe"] == run_dir.parts[-3].split("=")[1]
+        assert config["seed"] == int(run_dir.name[1:])
+        assert config["torch_threads"] == 1  # one torch thread per CPU of the trial
+        assert (run_dir / "summary.json").is_file()
+    rows = report_rows(sweep_dir)
+    assert [(row["variant"], row["n"]) for row in rows] == [
+        ("agent.recipe=drq", "2"),
+        ("agent.recipe=sac", "2"),
+    ]
+    table = (sweep_dir / "report.md").read_text()
+    assert "| agent.recipe=drq | simoun-PointReach-v0 | 2 |" in table
+    for png in ("curves_env_steps.png", "curves_wall_time.png"):
+        assert (sweep_dir / png).stat().st_size > 1000
+
+
+def test_trials_report_each_evaluation_to_tune(sweep_dir):
+    reported = tune_results(sweep_dir)
+    assert len(reported) == 4
+    for name, rows in reported.items():
+        run_dir = sweep_dir / name
+        logged = read_csv(run_dir / "eval.csv")
+        assert [row["env_step"] for row in rows] == [0, 60, 120]
+        assert [row["return_mean"] for row in rows] == [row["return_mean"] for row in logged]
+
+
+def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path, capsys):
+    # 8x8 frames are too small for the encoder's convolutions: that trial raises at its first
+    # evaluation, inside Ray, after its config was accepted.
+    sweep_dir = tmp_path / "failing"
+    argv = [*tiny_without("--image-size"), "--grid", "image_size=8,32", "--seeds", "0"]
+    argv += ["--sweep-dir", str(sweep_dir)]
+    assert cli.main([*argv, "--verbose", "0"]) == 1
+    bad, good = sweep_dir / "image_size=8", sweep_dir / "image_size=32"
+    assert (good / "simoun-PointReach-v0/s0/summary.json").is_file()
+    assert not (bad / "simoun-PointReach-v0/s0/summary.json").exists()
+    error = (bad / "simoun-PointReach-v0/s0/error.txt").read_text()
+    assert "Kernel size can't be greater than actual input size" in error
+    err = capsys.readouterr().err
+    assert "FAILED image_size=8/simoun-PointReach-v0/s0" in err
+    assert "--resume" in err
+    assert [(row["variant"], row["n"]) for row in report_rows(sweep_dir)] == [
+        ("image_size=8", "0"),
+        ("image_size=32", "1"),
+    ]
+    assert "## Failed runs" in (sweep_dir / "report.md").read_text()
+
+
+def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_path):
+    sweep_dir = tmp_path / "interrupted"
+    # The two short trials are scheduled first (2 CPUs, 1 per trial) and finish; Ctrl-C comes
+    # once a long one has written a checkpoint, well before it can finish.
+    argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=120,360"]
+    argv += ["--seeds", "0-1", "--sweep-dir"]
+    argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
+    command = [sys.executable, "-m", "simoun_agent.sweep.cli", *argv]
+    log = tmp_path / "sweep.log"  # a file, not a pipe nobody reads until the end
+    with log.open("w") as out:
+        proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
+    long_runs = [sweep_dir / f"total_env_steps=360/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    deadline = time.monotonic() + 120
+    while not any((d / "checkpoint.pt").exists() for d in long_runs):
+        assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
+        time.sleep(0.1)
+    proc.send_signal(signal.SIGINT)
+    proc.wait(timeout=60)
+    output = log.read_text()
+    assert proc.returncode == 130, output
+    assert "simoun-sweep --resume --sweep-dir" in output
+
+    short_runs = [sweep_dir / f"total_env_steps=120/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    summaries = {d: (d / "summary.json").read_bytes() for d in short_runs}
+    unfinished = [d for d in long_runs if not (d / "summary.json").exists()]
+    assert unfinished
+    checkpointed = [d for d in unfinished if (d / "checkpoint.pt").exists()]
+    assert checkpointed
+
+    resumed = [*argv, "--resume"]
+    result = subprocess.run(
+        [sys.executable, "-m", "simoun_agent.sweep.cli", *resumed],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert f"{len(unfinished)} trials to run, {4 - len(unfinished)} already finished" in (
+        result.stdout
+    )
+    reported = tune_results(sweep_dir)  # the resumed part's Tune experiment
+    assert sorted(reported) == sorted(d.relative_to(sweep_dir).as_posix() for d in unfinished)
+    for run_dir in checkpointed:  # went on from its checkpoint: no evaluation at step 0 again
+        assert reported[run_dir.relative_to(sweep_dir).as_posix()][0]["env_step"] > 0
+    assert {d: (d / "summary.json").read_bytes() for d in short_runs} == summaries
+    assert all((d / "summary.json").is_file() for d in long_runs)
+    assert [row["n"] for row in report_rows(sweep_dir)] == ["2", "2"]
+
+
+def error_of(argv: list[str], capsys) -> str:
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == 2
+    return capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--grid", "agent.lrr=1e-3"], "unknown config key 'agent.lrr' (did you mean agent.lr?)"),
+        (["--grid", "image_size=32,48"], "image_size is given both as a base flag and in --grid"),
+        (["--grid", "agent.recipe=drqq,sac"], "--agent.recipe 'drqq' (did you mean 'drq'?)"),
+        (["--grid", "agent.lr="], "has an empty value"),
+        (["--grid", "agent.lr"], "--grid takes KEY=V1,V2"),
+        (["--grid", "agent.lr=1e-3,,3e-4"], "has an empty value"),
+        (["--grid", "seed=1,2"], "use --seeds"),
+        (["--seeds", "5-2"], "the range '5-2' runs backwards; write it low-high, e.g. --seeds 2-5"),
+        (["--seeds", "a"], "cannot read 'a'"),
+        (["--seed", "3", "--seeds", "0-1"], "give the seeds once"),
+        (["--torch-threads", "2"], "use --cpus-per-trial"),
+    ],
+)  # fmt: skip
+def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, capsys):
+    sweep_dir = tmp_path / "bad"
+    err = error_of([*TINY, *flags, "--sweep-dir", str(sweep_dir)], capsys)
+    assert message in err
+    assert not sweep_dir.exists()
+
+
+def test_resume_with_another_grid_is_refused_and_changes_nothing(sweep_dir, capsys):
+    saved = (sweep_dir / SWEEP_FILE).read_bytes()
+    experiments = sorted((sweep_dir / "tune").iterdir())
+    argv = [*TINY, "--grid", "agent.recipe=drq,curl", "--seeds", "0-1", "--resume"]
+    err = error_of([*argv, "--sweep-dir", str(sweep_dir)], capsys)
+    assert "was started with another grid" in err
+    assert '--grid: saved {"agent.recipe": ["drq", "sac"]}' in err
+    # starting a new sweep over it is refused too
+    err = error_of([*TINY, "--seeds", "0", "--sweep-dir", str(sweep_dir)], capsys)
+    assert "already holds a sweep; continue it with --resume" in err
+    assert (sweep_dir / SWEEP_FILE).read_bytes() == saved
+    assert sorted((sweep_dir / "tune").iterdir()) == experiments
+
+
+def test_resume_of_a_finished_sweep_runs_nothing(sweep_dir, capsys):
+    summaries = {d: (d / "summary.json").read_bytes() for d in run_dirs(sweep_dir)}
+    assert cli.main(["--resume", "--sweep-dir", str(sweep_dir)]) == 0
+    assert "0 trials to run, 4 already finished" in capsys.readouterr().out
+    assert {d: (d / "summary.json").read_bytes() for d in run_dirs(sweep_dir)} == summaries
+
+
+def test_unreachable_address_fails_within_seconds(tmp_path):
+    with socket.socket() as sock:  # a port nothing listens on
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    argv = [*TINY, "--seeds", "0", "--sweep-dir", str(tmp_path / "s")]
+    start = time.monotonic()
+    result = subprocess.run(
+        [sys.executable, "-m", "simoun_agent.sweep.cli", *argv, "--address", f"127.0.0.1:{port}"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert time.monotonic() - start < 20  # the interpreter and imports take most of it
+    assert result.returncode == 2
+    assert f"--address 127.0.0.1:{port}: no Ray cluster answers" in result.stderr
+    assert "ray start --head" in result.stderr
+    assert not (tmp_path / "s").exists()
+
+
+def test_without_ray_the_sweep_says_how_to_install_it(monkeypatch, tmp_path, capsys):
+    monkeypatch.setitem(sys.modules, "ray", None)  # what `import ray` meets when not installed
+    err = error_of([*TINY, "--seeds", "0", "--sweep-dir", str(tmp_path / "s")], capsys)
+    assert "pip install 'simoun[sweep]'" in err
+
+
+def test_seeds_and_grid_values_parse():
+    assert parse_seeds("0-2,5") == [0, 1, 2, 5]
+    assert parse_seeds("3") == [3]
+    assert split_values('1e-3, {"a": [1, 2]},"x,y"') == ["1e-3", '{"a": [1, 2]}', '"x,y"']
