@@ -1,0 +1,126 @@
+"""simoun-report on a directory of ordinary simoun-train runs (no Ray): variants found from the
+configs, mean ± std over seeds of the final return and the normalized AUC, the curves."""
+
+import csv
+import itertools
+import json
+import math
+
+import matplotlib.image
+import numpy as np
+import pytest
+
+from simoun_agent.run import train
+from simoun_agent.run.logger import read_csv
+from simoun_agent.run.presets import resolve
+from simoun_agent.sweep import report
+
+TINY = {
+    "env": "simoun/PointReach-v0",
+    "image_size": 32,
+    "total_env_steps": 120,
+    "warmup_agent_steps": 20,
+    "replay_capacity": 1000,
+    "eval_every": 60,
+    "eval_episodes": 1,
+    "checkpoint_every": 60,
+    "video": False,
+    "progress": False,
+    "device": "cpu",
+    "torch_threads": 1,
+    "agent.batch_size": 8,
+    "agent.num_filters": 8,
+    "agent.feature_dim": 16,
+    "agent.hidden_dim": 32,
+    "agent.aux_hidden_dim": 32,
+}
+"""The tiny run of tests/test_train_resume.py."""
+
+
+@pytest.fixture(scope="module")
+def runs_dir(tmp_path_factory):
+    """Three finished runs (lr 1e-3 with seeds 0 and 1, lr 3e-4 with seed 0) and one that was
+    set up but never trained (lr 3e-4, seed 1), as simoun-train leaves them."""
+    root = tmp_path_factory.mktemp("runs")
+    for name, lr, seed, trained in (
+        ("a-s0", 1e-3, 0, True),
+        ("a-s1", 1e-3, 1, True),
+        ("b-s0", 3e-4, 0, True),
+        ("b-s1", 3e-4, 1, False),
+    ):
+        config = resolve(None, {**TINY, "agent.lr": lr, "seed": seed, "run_dir": str(root / name)})
+        run = train.create_run(config)
+        if trained:
+            train.train(run)
+        run.env.close()
+        run.eval_env.close()
+    report.write_report(root)
+    return root
+
+
+def rows_of(root):
+    with (root / report.REPORT_CSV).open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def trapezoid_by_hand(rows):
+    area = 0.0
+    for before, after in itertools.pairwise(rows):
+        width = after["env_step"] - before["env_step"]
+        area += width * (before["return_mean"] + after["return_mean"]) / 2
+    return area / (rows[-1]["env_step"] - rows[0]["env_step"])
+
+
+def sample_std(values):
+    mean = sum(values) / len(values)
+    return math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+
+
+def test_plain_runs_group_by_the_key_that_differs(runs_dir):
+    rows = rows_of(runs_dir)
+    assert [(r["variant"], r["env"], r["n"], r["unfinished"]) for r in rows] == [
+        ("agent.lr=0.001", "simoun-PointReach-v0", "2", "0"),
+        ("agent.lr=0.0003", "simoun-PointReach-v0", "1", "1"),
+    ]
+    table = (runs_dir / report.REPORT_MD).read_text()
+    assert "## Unfinished runs (not counted)\n\n- b-s1" in table
+    assert "normalized area under the learning curve" in table
+
+
+def test_final_return_and_auc_are_mean_and_sample_std_over_seeds(runs_dir):
+    row = rows_of(runs_dir)[0]
+    summaries = [json.loads((runs_dir / n / "summary.json").read_text()) for n in ("a-s0", "a-s1")]
+    finals = [s["final_eval"]["return_mean"] for s in summaries]
+    aucs = [trapezoid_by_hand(read_csv(runs_dir / n / "eval.csv")) for n in ("a-s0", "a-s1")]
+    speeds = [s["env_step"] / s["wall_time_s"] for s in summaries]
+    assert float(row["final_return_mean"]) == pytest.approx(sum(finals) / 2)
+    assert float(row["final_return_std"]) == pytest.approx(sample_std(finals))
+    assert float(row["auc_mean"]) == pytest.approx(sum(aucs) / 2)
+    assert float(row["auc_std"]) == pytest.approx(sample_std(aucs))
+    assert float(row["env_steps_per_s_mean"]) == pytest.approx(sum(speeds) / 2)
+    assert int(row["env_steps"]) == 120
+    single = rows_of(runs_dir)[1]
+    assert single["final_return_std"] == "nan"  # one seed: no spread to report
+
+
+def test_curves_are_drawn_against_env_steps_and_wall_time(runs_dir):
+    for name in (report.CURVES_STEPS_PNG, report.CURVES_TIME_PNG):
+        image = matplotlib.image.imread(runs_dir / name)
+        assert image.ndim == 3 and image.shape[0] > 100
+
+
+def test_auc_is_the_normalized_trapezoid():
+    steps, returns = np.array([0.0, 10.0, 20.0]), np.array([0.0, 10.0, 10.0])
+    assert report.area_under_curve(steps, returns) == pytest.approx((50 + 100) / 20)
+    assert math.isnan(report.area_under_curve(steps[:1], returns[:1]))
+
+
+def test_cli_prints_the_table_and_refuses_a_directory_without_runs(runs_dir, tmp_path, capsys):
+    assert report.main([str(runs_dir), "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "| agent.lr=0.001 | simoun-PointReach-v0 | 2 |" in out
+    assert (tmp_path / "out" / report.REPORT_CSV).is_file()
+    with pytest.raises(SystemExit) as exit_info:
+        report.main([str(tmp_path / "out")])
+    assert exit_info.value.code == 2
+    assert "no runs under" in capsys.readouterr().err
