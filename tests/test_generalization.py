@@ -109,6 +109,11 @@ def test_bad_distraction_input_is_a_clear_error(runs, tmp_path, capsys):
         evaluate.main([str(runs / "a"), str(runs / "b")])
     assert "go with --distraction" in capsys.readouterr().err
 
+    (tmp_path / "generalization.csv").write_text("run,mode\n")
+    with pytest.raises(SystemExit) as exit_info:
+        evaluate.main([str(runs / "a"), "--distraction", "train", "--out", str(tmp_path)])
+    assert "--overwrite" in capsys.readouterr().err
+
     point_reach = resolve(None, {"env": "simoun/PointReach-v0"})
     with pytest.raises(SetupError, match="needs a dm_control task"):
         check_supported(point_reach, ["train", "video_easy"])

@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
+import signal
+import sys
 from pathlib import Path
 
-from tqdm import tqdm
-
 from simoun_agent.generalization.evaluation import evaluate_runs
-from simoun_agent.generalization.report import write_report
+from simoun_agent.generalization.report import TABLE_CSV, write_report
 from simoun_agent.generalization.suite import parse_distractions
 from simoun_agent.run.presets import SetupError
+from simoun_agent.run.signals import Stopped, stop_at_once
 
 
 def default_out(run_dirs: list[Path]) -> Path:
@@ -36,23 +38,35 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
                 "that simoun-train created"
             )
         out = Path(args.out) if args.out else default_out(run_dirs)
+        if (out / TABLE_CSV).exists() and not args.overwrite:
+            raise SetupError(
+                f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
+                "or --out DIR to write this one elsewhere"
+            )
+        created = not out.exists()
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as err:
             raise SetupError(
                 f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
             ) from None
-        results = evaluate_runs(
-            run_dirs,
-            modes,
-            args.episodes,
-            seed=args.seed,
-            device=args.device,
-            videos=args.videos,
-            progress=tqdm.write,
-        )
+        with stop_at_once():
+            results = evaluate_runs(
+                run_dirs,
+                modes,
+                args.episodes,
+                seed=args.seed,
+                device=args.device,
+                videos=args.videos,
+                progress=_status if args.progress else None,
+            )
     except SetupError as err:
         parser.exit(2, f"{parser.prog}: error: {err}\n")
+    except Stopped as stop:
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        print(f"{parser.prog}: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
+        return stop.exit_code
     envs = sorted({result.env.removeprefix("dm_control/") for result in results})
     steps = sorted({result.env_step for result in results})
     title = (
@@ -63,3 +77,7 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
     print(paths["table"].read_text(), end="")
     print(f"wrote {paths['table']}, {paths['csv']} and {paths['chart']}")
     return 0
+
+
+def _status(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
