@@ -1,7 +1,13 @@
-"""A short Stable-Baselines3 PPO run from pixels through ConsistencyCuriosityReward."""
+"""Stable-Baselines3 through ConsistencyCuriosityReward: a short PPO run, and the two examples."""
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
+import pytest
 import stable_baselines3 as sb3
 from stable_baselines3.common import callbacks
 
@@ -9,6 +15,8 @@ import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
 from simoun_wrappers import SimounObservation
 from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 class RewardsSeen(callbacks.BaseCallback):
@@ -54,3 +62,24 @@ def test_ppo_learns_for_a_few_hundred_steps_through_the_wrapper():
     # PPO was trained on r_e + r_i (Eq. 12), r_i from Eq. 13 at every step
     np.testing.assert_allclose(rewards, extrinsic + intrinsic, rtol=1e-6)
     assert np.all(intrinsic > 0) and np.all(intrinsic <= 0.2 * env.state_dict()["r_e_max"] + 1e-6)
+
+
+@pytest.mark.parametrize(
+    ("script", "curiosity"), [("sb3_ppo_curiosity.py", True), ("sb3_sac_curiosity.py", False)]
+)
+def test_examples_write_a_csv_of_episode_returns(tmp_path, script, curiosity):
+    out = tmp_path / "returns.csv"
+    command = [sys.executable, str(EXAMPLES / script), "--env", "simoun/PointReach-v0"]
+    command += ["--size", "36", "--action-repeat", "1", "--steps", "64", "--csv", str(out)]
+    command += [] if curiosity else ["--no-curiosity"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    with out.open() as file:
+        rows = list(csv.DictReader(file))
+    assert len(rows) >= 3  # PointReach episodes last 20 steps
+    assert {row["curiosity"] for row in rows} == {str(curiosity)}
+    assert all(int(row["length"]) == 20 for row in rows)
+    # the CSV scores the task's own reward; curiosity only adds the intrinsic column
+    assert all(float(row["return_extrinsic"]) < 0 for row in rows)
+    intrinsic = [float(row["return_intrinsic"]) for row in rows]
+    assert all(r > 0 for r in intrinsic) if curiosity else all(r == 0 for r in intrinsic)
