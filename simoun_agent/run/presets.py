@@ -96,6 +96,9 @@ class TrainConfig:
     """torch device; None: cuda when available, else cpu"""
     torch_threads: int | None = None
     """torch intra-op threads; None: torch's default"""
+    env_process: bool = False
+    """step the training environment in a background process while the agent updates (a
+    second core works on physics and rendering; results are identical either way)"""
     run_dir: str | None = None
     """output directory; None: runs/<env>-<preset>-s<seed>-<date>"""
     progress: bool = True
@@ -110,7 +113,14 @@ class TrainConfig:
         return PAPER_ACTION_REPEAT.get(dmc_task(self.env), 1)
 
 
-RESUMABLE_FIELDS = ("total_env_steps", "eval_every", "checkpoint_every", "progress", "video")
+RESUMABLE_FIELDS = (
+    "total_env_steps",
+    "eval_every",
+    "checkpoint_every",
+    "progress",
+    "video",
+    "env_process",
+)
 """Fields a resumed run may change; every other field must match the saved config."""
 
 

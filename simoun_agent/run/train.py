@@ -43,6 +43,7 @@ from simoun_agent.run.checkpoint import (
     restore_rng,
     save_checkpoint,
 )
+from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
 from simoun_agent.run.logger import CURVE_PNG, RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
@@ -86,7 +87,8 @@ class Run:
 
     config: TrainConfig
     run_dir: Path
-    env: gym.Env
+    env: EnvRunner
+    """the training environment, stepped in this process or a background one"""
     eval_env: gym.Env
     agent: SimounAgent
     replay: FrameReplay
@@ -120,14 +122,15 @@ def default_run_dir(config: TrainConfig) -> Path:
     return Path("runs") / f"{task}-{config.preset or 'default'}-s{config.seed}-{stamp}"
 
 
-def build(config: TrainConfig) -> tuple[gym.Env, gym.Env, SimounAgent, FrameReplay]:
-    """Environments, agent and an empty replay; seeds python, numpy and torch first."""
+def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
+    """The training env's runner (in this process or a background one), the evaluation env,
+    the agent and an empty replay; seeds python, numpy and torch first."""
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
     random.seed(config.seed)
     np.random.seed(config.seed)  # noqa: NPY002  (for libraries that draw from it)
     torch.manual_seed(config.seed)
-    env, eval_env = make_env(config), make_env(config)
+    env, eval_env = make_runner(config), make_env(config)
     frame_shape = env.observation_space["frames"].shape[1:]
     action_dim = env.action_space.shape[0]
     agent = SimounAgent(frame_shape, action_dim, config.agent, device=config.device)
@@ -316,26 +319,28 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     with deferred_interrupt() as interrupt:
         while counters.env_step < config.total_env_steps and not interrupt.is_set():
             if obs is None:
-                obs, _ = env.reset(seed=config.seed + counters.episode)
+                obs = env.reset(seed=config.seed + counters.episode)
                 replay.start_episode(obs["frames"][-1])
                 episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
             if counters.agent_step < config.warmup_agent_steps:
                 action = run.rng.uniform(-1.0, 1.0, action_dim).astype(np.float32)
             else:
                 action = agent.act(obs["frames"])
-            obs, reward, terminated, truncated, _ = env.step(action)
+            # the environment steps (in a background process with env_process) while the agent
+            # updates on the transitions before this one; both runners give the same results
+            env.step_async(action)
+            if counters.agent_step >= learning_starts:
+                for _ in range(config.updates_per_step):
+                    # Actor metrics come every actor_update_every updates: keep the latest of each.
+                    update_metrics.update(agent.update(replay, counters.env_step + repeat))
+                    counters.updates += 1
+            obs, reward, terminated, truncated = env.step_wait()
             replay.add(action, reward, obs["frames"][-1], terminated, truncated)
             counters.agent_step += 1
             counters.env_step += repeat
             episode_return += float(reward)
             episode_length += 1
             bar.update(repeat)
-
-            if counters.agent_step > learning_starts:
-                for _ in range(config.updates_per_step):
-                    # Actor metrics come every actor_update_every updates: keep the latest of each.
-                    update_metrics.update(agent.update(replay, counters.env_step))
-                    counters.updates += 1
 
             if not (terminated or truncated):
                 continue
