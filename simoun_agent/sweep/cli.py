@@ -178,7 +178,9 @@ def run_sweep(
             {"cpu": spec.cpus_per_trial, "gpu": gpus},
         ),
         param_space={"trial": tune.grid_search([trial.name for trial in trials])},
-        tune_config=tune.TuneConfig(trial_name_creator=lambda t: t.config["trial"]),
+        tune_config=tune.TuneConfig(
+            trial_name_creator=lambda t: t.config["trial"], reuse_actors=True
+        ),
         run_config=tune.RunConfig(
             name=stamp,
             storage_path=str((sweep_dir / "tune").resolve()),
