@@ -12,7 +12,7 @@ import pytest
 
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
-from simoun_agent.run.presets import resolve
+from simoun_agent.run.presets import resolve, to_dict
 from simoun_agent.sweep import report
 
 TINY = {
@@ -124,3 +124,20 @@ def test_cli_prints_the_table_and_refuses_a_directory_without_runs(runs_dir, tmp
         report.main([str(tmp_path / "out")])
     assert exit_info.value.code == 2
     assert "no runs under" in capsys.readouterr().err
+
+
+def test_a_recipe_names_the_variant_without_the_values_it_implies(tmp_path):
+    """drq and sac differ in encoder-free ways too (augmentation, temperature...): the recipe
+    alone names them; a key that splits further (the lr) is kept."""
+    records = []
+    for recipe, lr, seed in (
+        ("drq", 1e-3, 0),
+        ("drq", 1e-3, 1),
+        ("sac", 1e-3, 0),
+        ("sac", 3e-4, 0),
+    ):
+        config = to_dict(
+            resolve(None, {**TINY, "agent.recipe": recipe, "agent.lr": lr, "seed": seed})
+        )
+        records.append(report.RunRecord(tmp_path, report.flatten(config), {}, None, None))
+    assert report.variant_keys(records, tmp_path) == ["agent.recipe", "agent.lr"]

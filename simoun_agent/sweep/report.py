@@ -122,18 +122,29 @@ def find_runs(root: Path) -> list[RunRecord]:
 
 
 def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
-    """The keys that name a variant: a sweep's grid keys, else those differing within an env."""
+    """The keys that name a variant: a sweep's grid keys; else the keys that differ within an
+    env, recipe and preset first, each kept only if it tells apart runs the kept ones do not
+    (``agent.recipe`` differing implies its encoder, losses... which then add nothing)."""
     sweep_file = root / SWEEP_FILE
     if sweep_file.is_file():
         return list(json.loads(sweep_file.read_text())["grid"])
+    candidates = list(dict.fromkeys(key for record in records for key in record.config))
+    candidates.sort(key=lambda key: not key.endswith(("recipe", "preset")))
     keys: list[str] = []
-    for env in dict.fromkeys(record.env for record in records):
-        same_env = [record.config for record in records if record.env == env]
-        for key in dict.fromkeys(key for config in same_env for key in config):
-            values = {json.dumps(config.get(key), sort_keys=True) for config in same_env}
-            if key not in NOT_VARIANT and len(values) > 1 and key not in keys:
-                keys.append(key)
+    for key in candidates:
+        if key not in NOT_VARIANT and _splits(records, [*keys, key]) > _splits(records, keys):
+            keys.append(key)
     return keys
+
+
+def _splits(records: list[RunRecord], keys: list[str]) -> int:
+    """How many groups ``keys`` (with the env) make of the runs."""
+    return len(
+        {
+            json.dumps([record.env, *(record.config.get(key) for key in keys)], sort_keys=True)
+            for record in records
+        }
+    )
 
 
 def variant_name(config: dict[str, Any], keys: list[str]) -> str:
