@@ -26,7 +26,7 @@ from stable_baselines3 import PPO
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    add_arguments(parser, steps=4096)
+    add_arguments(parser, steps=2048)
     parser.add_argument("--n-envs", type=int, default=1, help="sub-envs sharing one model")
     parser.add_argument("--tensorboard", default=None, help="TensorBoard log directory")
     args = parser.parse_args()

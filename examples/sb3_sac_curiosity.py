@@ -21,7 +21,7 @@ from stable_baselines3 import SAC
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    add_arguments(parser, steps=2000)
+    add_arguments(parser, steps=1500)
     parser.add_argument("--buffer-size", type=int, default=10_000, help="replay transitions")
     args = parser.parse_args()
 

@@ -235,18 +235,21 @@ class CuriosityModel:
     from published weights, never from a model half-way through a step, and ``updates`` counts
     the published steps (``feature_version`` is the count the last feature call used). So with a
     ``seed`` the features, the rewards and the training are the same with and without the
-    thread, and from run to run, whatever the thread's timing; only ``update_ms`` and
-    ``wait_ms`` (time ``watch`` spent waiting for the thread) vary. The step only waits when an
+    thread, and from run to run, whatever the thread's timing (on the same hardware and torch
+    thread count; on CUDA only with ``torch.use_deterministic_algorithms``); only ``update_ms``
+    and ``wait_ms`` (time ``watch`` spent waiting for the thread) vary. The step only waits when an
     update takes longer than ``update_every`` env steps. A failed update (e.g. a non-finite
     loss) is raised by the next call to the model, and the model refuses to go on until
     :meth:`load_state_dict`. Call :meth:`close` (the wrappers' ``close()`` does) to stop the
     thread; a later ``watch`` starts a new one.
 
-    Measured with ``benchmarks/curiosity.py`` (see the README): on dm_control cartpole at 84x84,
-    one torch thread, the defaults add about XX to the env's step time. On a GPU pass
-    ``device="cuda"``. ``last_metrics`` holds the last published step's losses, its duration
-    (``update_ms``), the wait for it (``wait_ms``) and the batch standard deviation of f_m and
-    f_a (``motion_std``, ``appearance_std``: near 0 means the features collapsed to a constant).
+    Measured with ``benchmarks/curiosity.py`` (dm_control cartpole-swingup at 84x84, one torch
+    thread, a shared 2-core CPU under load; the README has the tables): the defaults added
+    11-21 % to the env's step time for the features and 5-23 % with training in the thread, in
+    two runs. On a GPU pass ``device="cuda"``. ``last_metrics`` holds the last published step's
+    losses, its duration (``update_ms``), the wait for it (``wait_ms``) and the batch standard
+    deviation of f_m and f_a (``motion_std``, ``appearance_std``: near 0 means the features
+    collapsed to a constant).
 
     Example:
         >>> import gymnasium as gym
