@@ -285,7 +285,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.resume and not args.sweep_dir:
         parser.exit(2, "simoun-sweep: error: --resume needs the --sweep-dir of the sweep\n")
     stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
-    sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp)
+    # absolute: Tune runs each trial in a working directory of its own
+    sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
     try:
         ray = load_ray()
         spec = sweep_spec(args, sweep_dir)
