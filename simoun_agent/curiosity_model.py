@@ -169,14 +169,17 @@ class UpdateThread:
 
     @staticmethod
     def _run(jobs: queue.Queue) -> None:
-        # A static method: the thread holds the queue, not the model, so an unused model is freed.
+        # A static method that drops each job once done: between jobs the thread holds the queue
+        # but not the model, so a model nobody closed is still freed (and its finalizer stops us).
         while (job := jobs.get()) is not None:
             work, future = job
+            del job
             if future.set_running_or_notify_cancel():
                 try:
                     future.set_result(work())
                 except BaseException as exc:  # handed to the caller's thread, raised there
                     future.set_exception(exc)
+            del work, future
 
     def submit(self, work: Callable[[], Any]) -> Future:
         future: Future = Future()

@@ -2,6 +2,7 @@
 
 import copy
 import dataclasses
+import gc
 
 import gymnasium as gym
 import numpy as np
@@ -179,6 +180,19 @@ def test_close_stops_the_update_thread_and_a_later_step_starts_a_new_one():
     assert model._thread.thread.is_alive()
     envs[1].close()
     assert model._thread is None
+
+
+def test_a_model_nobody_closed_stops_its_thread_when_freed():
+    env = ConsistencyCuriosityReward(cartpole(), CuriosityModel.for_env(cartpole(), TINY))
+    env.reset(seed=0)
+    for _ in range(20):
+        env.step(np.zeros(1, np.float32))
+    thread = env.curiosity.features._thread.thread
+    assert thread.is_alive()
+    del env
+    gc.collect()
+    thread.join(timeout=10)
+    assert not thread.is_alive()
 
 
 def test_frames_are_average_pooled_to_about_encoder_size():
