@@ -55,7 +55,8 @@ def _rollout(env: gym.Env, seed: int = 3) -> tuple[list, list, list, list]:
     return rewards, dones, states, frames
 
 
-@pytest.mark.parametrize("name", list(DISTRACTORS))
+# Each wrapper and each level appears at least once across these two parametrizations.
+@pytest.mark.parametrize("name", ["color_easy", "video_hard"])
 def test_same_dynamics_different_pixels(name):
     plain = _rollout(_cartpole())
     distracted = _rollout(DISTRACTORS[name](_cartpole()))
@@ -92,7 +93,7 @@ def test_moving_background_keeps_body_pixels_and_moves(level):
     assert mask.any() and (~mask).any()
 
 
-@pytest.mark.parametrize("name", ["color_hard", "video_hard"])
+@pytest.mark.parametrize("name", ["color_hard", "video_easy"])
 def test_same_seed_same_frames(name):
     first = _rollout(DISTRACTORS[name](_cartpole()), seed=5)[3]
     again = _rollout(DISTRACTORS[name](_cartpole()), seed=5)[3]
@@ -137,9 +138,6 @@ def _with_distractor(distractor):
 STACKS = {
     "color": _with_distractor(lambda env: ColorShift(env, "hard", seed=1)),
     "video": _with_distractor(lambda env: MovingBackground(env, "hard", seed=1)),
-    "video_under_observation": lambda: SimounObservation(
-        ActionRepeat(MovingBackground(_cartpole(), "easy", seed=1), 2), size=SIZE
-    ),
 }
 
 
@@ -156,9 +154,8 @@ def test_stack_passes_check_env_and_rebuilds_from_spec(name):
     pairs += [(env.step(np.ones(1))[0], rebuilt.step(np.ones(1))[0]) for _ in range(2)]
     for a, b in pairs:
         np.testing.assert_array_equal(a["frames"], b["frames"])
-    if name != "video_under_observation":
-        # The distractor reaches MultiCamera's views, not only render().
-        assert not np.array_equal(plain.reset(seed=4)[0]["frames"], pairs[0][0]["frames"])
+    # The distractor reaches MultiCamera's views, not only render().
+    assert not np.array_equal(plain.reset(seed=4)[0]["frames"], pairs[0][0]["frames"])
 
 
 def test_bare_wrappers_pass_check_env():
