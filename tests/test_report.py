@@ -127,8 +127,8 @@ def test_cli_prints_the_table_and_refuses_a_directory_without_runs(runs_dir, tmp
 
 
 def test_a_recipe_names_the_variant_without_the_values_it_implies(tmp_path):
-    """drq and sac differ in encoder-free ways too (augmentation, temperature...): the recipe
-    alone names them; a key that splits further (the lr) is kept."""
+    """drq and sac differ in augmentation and temperature settings too: the recipe alone names
+    them; a key that splits the runs further (the lr) is kept."""
     records = []
     for recipe, lr, seed in (
         ("drq", 1e-3, 0),

@@ -11,14 +11,13 @@ import time
 from pathlib import Path
 
 import pytest
-
-pytest.importorskip("ray.tune", reason="the sweep extra: pip install 'simoun[sweep]'")
-
-import ray
+import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
 from simoun_agent.run.logger import read_csv
 from simoun_agent.sweep import cli
 from simoun_agent.sweep.grid import SWEEP_FILE, parse_seeds, split_values
+
+pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
 
 TINY = [
     "--env", "simoun/PointReach-v0",

@@ -293,7 +293,10 @@ def plot_curves(groups: list[Group], x_key: str, xlabel: str, path: Path, points
         ax.set_xlabel(xlabel)
         ax.set_ylabel("evaluation return")
         ax.grid(alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
+        if ax.lines:
+            ax.legend(loc="best", fontsize="small")
+        else:
+            ax.text(0.5, 0.5, "no finished run", ha="center", transform=ax.transAxes)
     fig.tight_layout()
     atomic_write(path, lambda tmp: fig.savefig(tmp, format="png"))
     plt.close(fig)
