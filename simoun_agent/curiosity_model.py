@@ -190,7 +190,9 @@ class UpdateThread:
         """Let the job in progress finish, then stop the thread."""
         if self.thread.is_alive():
             self.jobs.put(None)
-            self.thread.join()
+            # The model's finalizer may run on this thread (the last reference dropped there).
+            if threading.current_thread() is not self.thread:
+                self.thread.join()
 
 
 def run_now(work: Callable[[], Any]) -> Future:
