@@ -210,11 +210,15 @@ def error_of(argv: list[str], capsys) -> str:
         (["--seeds", "a"], "cannot read 'a'"),
         (["--seed", "3", "--seeds", "0-1"], "give the seeds once"),
         (["--torch-threads", "2"], "use --cpus-per-trial"),
+        (["--cpus-per-trial", "0"], "--cpus-per-trial must be at least 1, got 0"),
+        (["--envs", "simoun/PointReach-v0,"], "--envs 'simoun/PointReach-v0,' has an empty id"),
+        (["--envs", "simoun/PointReach-v0", "--env", "simoun/PointReach-v0"], "give the envs once"),
     ],
 )  # fmt: skip
 def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, capsys):
     sweep_dir = tmp_path / "bad"
-    err = error_of([*TINY, *flags, "--sweep-dir", str(sweep_dir)], capsys)
+    base = tiny_without("--env") if "--envs" in flags else TINY  # --envs replaces --env
+    err = error_of([*base, *flags, "--sweep-dir", str(sweep_dir)], capsys)
     assert message in err
     assert not sweep_dir.exists()
 

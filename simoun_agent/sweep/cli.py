@@ -19,7 +19,7 @@ from pathlib import Path
 from types import ModuleType
 
 from simoun_agent.run import train
-from simoun_agent.run.presets import SetupError
+from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, Trial
 from simoun_agent.sweep.trainable import ERROR_FILE, run_trial, trial_table
@@ -99,10 +99,12 @@ def probe_gcs(address: str) -> str | None:
     return None
 
 
-def gpus_per_trial(ray: ModuleType, wanted: str) -> float:
-    """``auto``: one GPU per trial when the cluster has GPUs, else none; or the number given."""
+def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
+    """``auto``: one GPU per trial when the cluster has GPUs and the config's ``device`` is not
+    ``cpu``, else none; or the number given."""
     if wanted == "auto":
-        return 1.0 if ray.cluster_resources().get("GPU", 0) > 0 else 0.0
+        has_gpus = ray.cluster_resources().get("GPU", 0) > 0
+        return 1.0 if has_gpus and device != "cpu" else 0.0
     try:
         gpus = float(wanted)
     except ValueError:
@@ -136,9 +138,8 @@ def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
             )
         if sweep_dir.exists() and any(sweep_dir.iterdir()):
             raise SetupError(f"{sweep_dir} is not empty; pass a new --sweep-dir")
-        return SweepSpec.create(
-            args.preset, base, args.grid, args.seeds, args.envs, args.cpus_per_trial or 1
-        )
+        cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
+        return SweepSpec.create(args.preset, base, args.grid, args.seeds, args.envs, cpus)
     saved = SweepSpec.load(sweep_dir)
     if not given and args.cpus_per_trial in (None, saved.cpus_per_trial):
         return saved
@@ -148,7 +149,7 @@ def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
         args.grid,
         args.seeds,
         args.envs,
-        args.cpus_per_trial or saved.cpus_per_trial,
+        saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
     )
     differences = spec.describe_differences(saved)
     if differences:
@@ -299,7 +300,8 @@ def main(argv: list[str] | None = None) -> int:
         started = False
         try:
             started = connect(ray, args.address, args.num_cpus)
-            gpus = gpus_per_trial(ray, args.gpus_per_trial)
+            device = spec.base.get("device", resolve(spec.preset, {}).device)
+            gpus = gpus_per_trial(ray, args.gpus_per_trial, device)
             check_fits(ray, spec.cpus_per_trial, gpus)
             sweep_dir.mkdir(parents=True, exist_ok=True)
             if not (sweep_dir / SWEEP_FILE).exists():
