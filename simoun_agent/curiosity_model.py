@@ -494,6 +494,23 @@ class CuriosityModel:
             self._thread.close()
             self._thread = None
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle without the thread: the step in flight is waited for and kept unpublished."""
+        self.wait()
+        state = {**self.__dict__, "_thread": None, "_pending": None}
+        pending = self._pending
+        if pending is not None and pending.exception() is not None:
+            state["_failure"] = pending.exception()
+        elif pending is not None:
+            state["_pending_result"] = pending.result()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        result = state.pop("_pending_result", None)
+        self.__dict__.update(state)
+        if result is not None:
+            self._pending = run_now(lambda: result)
+
     def update(self) -> dict[str, float]:
         """One Adam step of L_tran + L_con on a batch from the buffer, now, on this thread, its
         weights published at once (a step in flight is published first); returns its metrics."""

@@ -3,6 +3,7 @@
 import copy
 import dataclasses
 import gc
+import pickle
 
 import gymnasium as gym
 import numpy as np
@@ -180,6 +181,27 @@ def test_close_stops_the_update_thread_and_a_later_step_starts_a_new_one():
     assert model._thread.thread.is_alive()
     envs[1].close()
     assert model._thread is None
+
+
+def test_a_pickled_model_keeps_its_unpublished_step_and_not_the_thread():
+    env = ConsistencyCuriosityReward(cartpole(), CuriosityModel.for_env(cartpole(), TINY))
+    env.reset(seed=0)
+    for _ in range(20):
+        env.step(np.zeros(1, np.float32))
+    model = env.curiosity.features
+    clone = pickle.loads(pickle.dumps(model))
+    assert clone.pending and clone._thread is None and clone.updates == model.updates
+    env.step(np.zeros(1, np.float32))
+    triplets = np.stack([env.step(np.zeros(1, np.float32))[0]["frames"]] * 2)  # a due step
+    for a, b in zip(model(triplets), clone(triplets), strict=True):
+        assert not np.array_equal(a, b)  # the clone has not published the step yet
+    transition = (triplets, np.zeros((2, 1), np.float32), triplets, *np.zeros((2, 2), bool))
+    clone.watch(*transition)
+    clone.watch(*transition)  # a due call: publishes the step made before pickling
+    for a, b in zip(model(triplets), clone(triplets), strict=True):
+        np.testing.assert_array_equal(a, b)
+    env.close()
+    clone.close()
 
 
 def test_a_model_nobody_closed_stops_its_thread_when_freed():
