@@ -316,7 +316,10 @@ def main(argv: list[str] | None = None) -> int:
                 ray.shutdown()
     else:
         outcome = {}
-    written = report.write_report(sweep_dir)
+    try:
+        written = report.write_report(sweep_dir)
+    except SetupError:  # no trial got as far as writing its config.json
+        written = []
     return summarize(outcome, sweep_dir, written)
 
 
@@ -326,7 +329,8 @@ def summarize(outcome: dict[str, list[Trial]], sweep_dir: Path, written: list[Pa
         error = Path(trial.run_dir) / ERROR_FILE
         last = error.read_text().strip().splitlines()[-1] if error.is_file() else "see Tune's log"
         print(f"FAILED {trial.name}: {last} (traceback: {error})", file=sys.stderr)
-    print(f"report: {', '.join(map(str, written))}")
+    if written:
+        print(f"report: {', '.join(map(str, written))}")
     if outcome.get("stopped"):
         print(
             f"stopped with {len(outcome['stopped'])} trials unfinished; continue with: "
