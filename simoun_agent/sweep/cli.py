@@ -18,6 +18,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from types import ModuleType
 
+from simoun_agent.recipes import RECIPES
 from simoun_agent.run import train
 from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.sweep import report
@@ -217,6 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
         "  simoun-sweep --resume --sweep-dir sweeps/baselines\n"
         "  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq "
         "--seeds 0-4 --sweep-dir /shared/sweeps/walker\n\n"
+        f"agent recipes (--grid agent.recipe=A,B): {', '.join(RECIPES)}\n"
         "Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.",
     )
     sweep = parser.add_argument_group("sweep")
@@ -252,7 +254,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--gpus-per-trial",
         default="auto",
         metavar="N|auto",
-        help="GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs, else 0",
+        help="GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device "
+        "is not cpu, else 0",
     )
     sweep.add_argument(
         "--address",
