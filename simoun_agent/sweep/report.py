@@ -293,12 +293,21 @@ def plot_curves(groups: list[Group], x_key: str, xlabel: str, path: Path, points
         ax.set_xlabel(xlabel)
         ax.set_ylabel("evaluation return")
         ax.grid(alpha=0.3)
-        if ax.lines:
-            ax.legend(loc="best", fontsize="small")
-        else:
+        if not ax.lines:
             ax.text(0.5, 0.5, "no finished run", ha="center", transform=ax.transAxes)
     fig.tight_layout()
-    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png"))
+    # one legend under the panels: ten recipes' labels inside a panel would hide its curves
+    labelled = {line.get_label(): line for ax in axes[0] for line in ax.lines}
+    if labelled:
+        fig.legend(
+            labelled.values(),
+            labelled.keys(),
+            loc="upper center",
+            bbox_to_anchor=(0.5, 0.0),
+            ncol=min(3, len(labelled)),
+            fontsize="small",
+        )
+    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", bbox_inches="tight"))
     plt.close(fig)
 
 
