@@ -70,8 +70,9 @@ class SharedSource:
     """A feature source as recorded in ``env.spec``: kept by reference, never deep-copied.
 
     Every wrapper stacked above ours deep-copies the spec (SB3's ``Monitor`` reads ``env.spec``),
-    which would copy a ``CuriosityModel``'s weights and frame buffer (about 1 s and 85 MB at
-    84x84). ``gym.make(env.spec)`` hands this holder back to the constructor, which unwraps it,
+    which would copy a ``CuriosityModel``'s weights and frame buffer (measured: about 1 s and
+    85 MB with an unpooled 84x84 buffer) and wait for its update thread.
+    ``gym.make(env.spec)`` hands this holder back to the constructor, which unwraps it,
     so a rebuilt env shares the original source, as it does when nothing is stacked above.
     """
 
