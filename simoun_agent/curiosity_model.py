@@ -244,7 +244,8 @@ class CuriosityModel:
     thread count; on CUDA only with ``torch.use_deterministic_algorithms``); only ``update_ms``
     and ``wait_ms`` (time ``watch`` spent waiting for the thread) vary. The step only waits when an
     update takes longer than ``update_every`` env steps. A failed update (e.g. a non-finite
-    loss) is raised by the next call to the model, and the model refuses to go on until
+    loss) is raised by the first call to the model after it failed (at the latest by the next
+    due ``watch``, which waits for it), and the model refuses to go on until
     :meth:`load_state_dict`. Call :meth:`close` (the wrappers' ``close()`` does) to stop the
     thread; a later ``watch`` starts a new one.
 
