@@ -141,3 +141,30 @@ def test_a_recipe_names_the_variant_without_the_values_it_implies(tmp_path):
         )
         records.append(report.RunRecord(tmp_path, report.flatten(config), {}, None, None))
     assert report.variant_keys(records, tmp_path) == ["agent.recipe", "agent.lr"]
+
+
+def test_equal_budget_cuts_every_run_at_it_and_counts_unfinished_runs_that_reached_it(
+    runs_dir, tmp_path
+):
+    out = tmp_path / "at-60"
+    (runs_dir / "a-s1" / "summary.json").rename(tmp_path / "summary.json")  # a-s1 "unfinished"
+    try:
+        report.write_report(runs_dir, out, budget=("env_step", 60))
+    finally:
+        (tmp_path / "summary.json").rename(runs_dir / "a-s1" / "summary.json")
+    rows = {row["variant"]: row for row in rows_of(out)}
+    at_60 = {
+        name: next(r for r in read_csv(runs_dir / name / "eval.csv") if r["env_step"] == 60)
+        for name in ("a-s0", "a-s1", "b-s0")
+    }
+    a = rows["agent.lr=0.001"]
+    assert int(a["n"]) == 2  # the unfinished run reached 60 steps: it counts
+    expected = [at_60[name]["return_mean"] for name in ("a-s0", "a-s1")]
+    assert float(a["final_return_mean"]) == pytest.approx(np.mean(expected))
+    assert float(a["wall_time_s_mean"]) == pytest.approx(
+        np.mean([at_60[name]["wall_time_s"] for name in ("a-s0", "a-s1")])
+    )
+    assert int(rows["agent.lr=0.0003"]["n"]) == 1  # b-s1 never trained: short of the budget
+    assert "b-s1" in (out / report.REPORT_MD).read_text().split("short of the budget")[1]
+    with pytest.raises(SystemExit):
+        report.main([str(runs_dir), "--at-step", "0"])

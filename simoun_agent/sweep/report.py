@@ -8,7 +8,8 @@ Runs are found by their ``config.json``. A *variant* is the config values that t
 the same env apart, seeds aside: a sweep's ``--grid`` keys, or, for plain runs, every key that
 differs between two runs of one env (``seed``, ``run_dir`` and output-only keys excepted).
 Only finished runs (``summary.json`` present) are counted; unfinished and failed ones are
-listed. Writes:
+listed. ``--at-step N`` / ``--at-wall-time SECONDS`` compare at an equal budget instead: every
+run that reached it, finished or not, counts with its last evaluation within it. Writes:
 
 - ``report.md`` and ``report.csv``: per variant x env, the number of seeds n and mean ± std
   over seeds (sample std, ddof=1) of the final evaluation return, of the area under the
@@ -221,11 +222,22 @@ def _pm(mean: float, std: float) -> str:
     return f"{mean:.4g}" if math.isnan(std) else f"{mean:.4g} ± {std:.2g}"
 
 
-def markdown(rows: list[dict[str, Any]], failures: list[str], unfinished: list[str]) -> str:
+def markdown(
+    rows: list[dict[str, Any]],
+    failures: list[str],
+    unfinished: list[str],
+    budget: tuple[str, float] | None = None,
+) -> str:
+    counted = "finished runs only"
+    if budget is not None:
+        counted = (
+            f"every run cut at an equal budget of {budget[1]:g} {BUDGETS[budget[0]]} (its last "
+            "evaluation within it; runs that had not reached it are not counted)"
+        )
     lines = [
         "# Sweep report",
         "",
-        "Mean ± std over seeds (sample std, ddof=1; none for n = 1), finished runs only. Final "
+        f"Mean ± std over seeds (sample std, ddof=1; none for n = 1), {counted}. Final "
         "return: the last evaluation's mean return. AUC: normalized area under the learning "
         "curve (trapezoid of the evaluation return over env steps, divided by the env-step "
         "span: the run's average evaluation return). Wall time: seconds in the training loop, "
@@ -247,7 +259,8 @@ def markdown(rows: list[dict[str, Any]], failures: list[str], unfinished: list[s
         ]
         lines.append("| " + " | ".join(cells) + " |")
     if unfinished:
-        lines += ["", "## Unfinished runs (not counted)", ""] + [f"- {u}" for u in unfinished]
+        title = "Unfinished runs" if budget is None else "Runs short of the budget"
+        lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in unfinished]
     if failures:
         lines += ["", "## Failed runs", ""] + [f"- {f}" for f in failures]
     lines += ["", f"![learning curves]({CURVES_STEPS_PNG})", f"![wall time]({CURVES_TIME_PNG})"]
@@ -311,9 +324,37 @@ def plot_curves(groups: list[Group], x_key: str, xlabel: str, path: Path, points
     plt.close(fig)
 
 
-def write_report(root: Path, out: Path | None = None) -> list[Path]:
+BUDGETS = {"env_step": "env steps", "wall_time_s": "seconds of wall time"}
+"""What ``--at-step`` and ``--at-wall-time`` cut the runs at (an eval.csv column)."""
+
+
+def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None:
+    """``record`` as if it had ended at its last evaluation within ``budget`` of ``column``
+    (``env_step`` or ``wall_time_s``); None if the run has not reached the budget yet (so every
+    run counted had the same budget)."""
+    x = record.curve[column]
+    if not len(x) or x[-1] < budget:
+        return None
+    keep = x <= budget
+    curve = {key: values[keep] for key, values in record.curve.items()}
+    summary = {
+        "env_step": float(curve["env_step"][-1]),
+        "wall_time_s": float(curve["wall_time_s"][-1]),
+        "final_eval": {"return_mean": float(curve["return_mean"][-1])},
+    }
+    return RunRecord(record.run_dir, record.config, curve, summary, None)
+
+
+def write_report(
+    root: Path, out: Path | None = None, budget: tuple[str, float] | None = None
+) -> list[Path]:
     """Write the tables and curves of the runs under ``root`` into ``out`` (default: ``root``);
-    returns the files written. Raises SetupError when ``root`` holds no run."""
+    returns the files written. Raises SetupError when ``root`` holds no run.
+
+    ``budget`` = (``"env_step"`` or ``"wall_time_s"``, value) compares the runs at an equal
+    budget instead of at their ends: each run that reached it, finished or not, counts with its
+    last evaluation within it; the others are listed as not having reached it.
+    """
     root, out = Path(root), Path(out or root)
     records = find_runs(root)
     if not records:
@@ -321,6 +362,13 @@ def write_report(root: Path, out: Path | None = None) -> list[Path]:
             f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
             "directory of simoun-train runs"
         )
+    if budget is not None:
+        column, value = budget
+        cut = {id(record): at_budget(record, column, value) for record in records}
+        short = [r for r in records if cut[id(r)] is None and r.error is None]
+        records = [cut[id(r)] or r for r in records]
+        for record in short:
+            record.summary = None
     groups = group_runs(records, variant_keys(records, root), root)
     rows = [group.row() for group in groups]
     unfinished = [
@@ -332,7 +380,7 @@ def write_report(root: Path, out: Path | None = None) -> list[Path]:
         f"{run.run_dir.relative_to(root)}: {run.error}" for run in records if run.error is not None
     ]
     out.mkdir(parents=True, exist_ok=True)
-    text = markdown(rows, failures, unfinished)
+    text = markdown(rows, failures, unfinished, budget)
     atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, list(rows[0]))
@@ -353,9 +401,31 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("root", metavar="DIR", help="a sweep directory or a directory of runs")
     parser.add_argument("--out", metavar="DIR", help="where to write the report (default: DIR)")
+    equal = parser.add_mutually_exclusive_group()
+    equal.add_argument(
+        "--at-step",
+        type=int,
+        metavar="N",
+        help="compare at an equal budget of N env steps: every run that reached N, finished or "
+        "not, counts with its last evaluation at or before N",
+    )
+    equal.add_argument(
+        "--at-wall-time",
+        type=float,
+        metavar="SECONDS",
+        help="compare at an equal wall-time budget: every run that trained that long counts "
+        "with its last evaluation within it",
+    )
     args = parser.parse_args(argv)
+    budget = None
+    if args.at_step is not None:
+        budget = ("env_step", args.at_step)
+    elif args.at_wall_time is not None:
+        budget = ("wall_time_s", args.at_wall_time)
+    if budget is not None and budget[1] <= 0:
+        parser.exit(2, "simoun-report: error: --at-step / --at-wall-time must be positive\n")
     try:
-        written = write_report(Path(args.root), Path(args.out) if args.out else None)
+        written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
     except SetupError as err:
         parser.exit(2, f"simoun-report: error: {err}\n")
     print((Path(written[0])).read_text(), end="")
