@@ -121,12 +121,13 @@ def test_bad_distraction_input_is_a_clear_error(runs, tmp_path, capsys):
 
 
 def test_training_with_distraction_curves_leaves_training_unchanged(runs):
-    from simoun_agent.generalization.callback import DistractionEvaluation
     from simoun_agent.run.checkpoint import load_checkpoint
     from simoun_agent.run.logger import read_csv
 
-    run = train.create_run(resolve(None, {**TINY, "run_dir": str(runs / "curves")}))
-    train.train(run, [DistractionEvaluation(["video_hard", "color_easy"])])
+    flags = ["--eval-distraction", "video_hard", "--eval-distraction", "color_easy"]
+    assert train.main([*TINY_FLAGS, *flags, "--run-dir", str(runs / "curves")]) == 0
+    saved = json.loads((runs / "curves" / "config.json").read_text())
+    assert saved["eval_distraction"] == ["video_hard", "color_easy"]
     rows = read_csv(runs / "curves" / "eval.csv")
     plain_rows = read_csv(runs / "a" / "eval.csv")
     assert [row["return_mean"] for row in rows] == [row["return_mean"] for row in plain_rows]
@@ -135,3 +136,19 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
     ours, theirs = load_checkpoint(runs / "curves"), load_checkpoint(runs / "a")
     for key, value in theirs["agent"]["actor"].items():
         np.testing.assert_array_equal(ours["agent"]["actor"][key].numpy(), value.numpy())
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--eval-distraction", "video_hrd"], "did you mean 'video_hard'?"),
+        (["--eval-distraction", "train"], "is the run's own evaluation"),
+        (["--env", "simoun/PointReach-v0", "--eval-distraction", "video_hard"], "dm_control"),
+    ],
+)
+def test_bad_eval_distraction_is_refused_before_training(tmp_path, capsys, flags, message):
+    with pytest.raises(SystemExit) as exit_info:
+        train.main([*TINY_FLAGS, *flags, "--run-dir", str(tmp_path / "run")])
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "run" / "config.json").exists()

@@ -7,6 +7,7 @@ evaluates runs on DMC-GB's four modes built procedurally (:mod:`simoun_wrappers.
 
 from simoun_agent.generalization.suite import (
     DISTRACTIONS,
+    check_eval_distractions,
     check_supported,
     distractor,
     make_distracted_env,
@@ -15,6 +16,7 @@ from simoun_agent.generalization.suite import (
 
 __all__ = [
     "DISTRACTIONS",
+    "check_eval_distractions",
     "check_supported",
     "distractor",
     "make_distracted_env",

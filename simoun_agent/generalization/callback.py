@@ -8,30 +8,11 @@ from typing import TYPE_CHECKING
 
 import gymnasium as gym
 
-from simoun_agent.generalization.suite import (
-    check_supported,
-    make_distracted_env,
-    parse_distractions,
-)
-from simoun_agent.run.presets import SetupError, TrainConfig
+from simoun_agent.generalization.suite import make_distracted_env
 from simoun_agent.run.train import TrainCallback
 
 if TYPE_CHECKING:
     from simoun_agent.run.train import Run
-
-FLAG = "--eval-distraction"
-
-
-def check_eval_distractions(config: TrainConfig, modes: Sequence[str]) -> list[str]:
-    """``modes`` checked for ``config`` (names, a dm_control task); SetupError otherwise."""
-    names = parse_distractions(modes, flag=FLAG) if modes else []
-    if "train" in names:
-        raise SetupError(
-            f"{FLAG} train is the run's own evaluation, which always runs; name distraction "
-            f"modes only, e.g. {FLAG} video_hard"
-        )
-    check_supported(config, names)
-    return names
 
 
 class DistractionEvaluation(TrainCallback):

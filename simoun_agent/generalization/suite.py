@@ -77,6 +77,8 @@ def check_supported(
     The distractors change a MuJoCo scene, so any mode but ``train`` needs a dm_control task;
     a ``videos`` folder must hold a readable video. Checked before any episode is played.
     """
+    if not names:
+        return
     distracted = [name for name in parse_distractions(names) if DISTRACTIONS[name] is not None]
     if distracted and not config.env.startswith("dm_control/"):
         raise SetupError(
@@ -104,3 +106,19 @@ def make_distracted_env(
 
     check_supported(config, [name], videos)
     return make_env(config, distractor(name, videos))
+
+
+def check_eval_distractions(config: TrainConfig) -> list[str]:
+    """``config.eval_distraction`` checked (names, a dm_control task); SetupError otherwise.
+
+    ``train`` is refused: it is the run's own evaluation, which always runs.
+    """
+    flag = "--eval-distraction"
+    names = parse_distractions(config.eval_distraction, flag) if config.eval_distraction else []
+    if "train" in names:
+        raise SetupError(
+            f"{flag} train is the run's own evaluation, which always runs; name distraction "
+            f"modes only, e.g. {flag} video_hard"
+        )
+    check_supported(config, names)
+    return names

@@ -88,6 +88,10 @@ class TrainConfig:
     """environment steps between evaluations"""
     eval_episodes: int = 10
     """episodes per evaluation (deterministic actions)"""
+    eval_distraction: tuple[str, ...] = ()
+    """distraction modes also evaluated at every evaluation, as test curves beside the training
+    env's (dm_control tasks; repeat the flag, e.g. --eval-distraction video_hard; modes in
+    simoun_agent.generalization.DISTRACTIONS)"""
     checkpoint_every: int = 50_000
     """environment steps between checkpoints (written at the next episode end)"""
     video: bool = True
@@ -120,6 +124,7 @@ RESUMABLE_FIELDS = (
     "progress",
     "video",
     "env_process",
+    "eval_distraction",
 )
 """Fields a resumed run may change; every other field must match the saved config."""
 
@@ -299,6 +304,11 @@ def _parse_one(text: str, kind: Any) -> Any:
             return origin(text)
         except ValueError:
             raise ValueError(f"expected {origin.__name__}") from None
+    words = origin in (list, tuple) and set(typing.get_args(kind)) in ({str}, {str, Ellipsis})
+    if words and not text.lstrip().startswith("["):
+        # A list of words may be given plainly: --set eval_distraction=video_hard,color_hard
+        value = [item.strip() for item in text.split(",") if item.strip()]
+        return tuple(value) if origin is tuple else value
     if origin in (dict, list, tuple):
         try:
             value = json.loads(text)

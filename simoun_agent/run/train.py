@@ -34,6 +34,7 @@ import torch
 from tqdm import tqdm
 
 from simoun_agent import SimounAgent
+from simoun_agent.generalization.suite import check_eval_distractions
 from simoun_agent.recipes import RECIPES
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.checkpoint import (
@@ -130,6 +131,7 @@ def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameRe
     random.seed(config.seed)
     np.random.seed(config.seed)  # noqa: NPY002  (for libraries that draw from it)
     torch.manual_seed(config.seed)
+    check_eval_distractions(config)
     env, eval_env = make_runner(config), make_env(config)
     frame_shape = env.observation_space["frames"].shape[1:]
     action_dim = env.action_space.shape[0]
@@ -294,6 +296,11 @@ class WallClock:
 def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     """The training loop; returns the final evaluation metrics (None if interrupted first)."""
     config, counters, agent, replay, env = run.config, run.counters, run.agent, run.replay, run.env
+    if config.eval_distraction:
+        # Imported here: the callback's module builds on this one's TrainCallback.
+        from simoun_agent.generalization.callback import DistractionEvaluation
+
+        callbacks = [DistractionEvaluation(config.eval_distraction), *callbacks]
     clock = WallClock(counters.wall_time_s)
     repeat = config.resolved_action_repeat()
     action_dim = env.action_space.shape[0]
@@ -471,6 +478,8 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
         group.add_argument(
             "--" + key.replace("_", "-"),
             dest=key,
+            # A tuple key's flag is repeatable: --eval-distraction video_hard --eval-distraction ...
+            action="append" if (typing.get_origin(kind) or kind) is tuple else "store",
             default=argparse.SUPPRESS,
             metavar=_metavar(kind),
             help=f"{doc} (default: {shown})".replace("%", "%%"),
@@ -494,6 +503,7 @@ def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
         if key not in fields:
             resolve(None, {key: value})  # raises the unknown-key error with suggestions
         given[key] = value
+    given = {key: ",".join(v) if isinstance(v, list) else v for key, v in given.items()}
     return {key: parse_value(key, value, fields[key][0]) for key, value in given.items()}
 
 
