@@ -10,6 +10,7 @@ import numpy as np
 import torch
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config_checks import check_agent_inputs
 from simoun_agent.losses import (
     actor_loss,
     contrastive_loss,
@@ -54,6 +55,7 @@ class SimounAgent:
         device: str | torch.device | None = None,
     ) -> None:
         self.config = config = config or AgentConfig()
+        check_agent_inputs(frame_shape, action_dim, config)
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
         self.device = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from simoun_agent.config_checks import check_agent_config
+
 AUGMENTATIONS = ("none", "shift")
 CONTRASTIVE_VIEWS = ("random_conv", "shift")
 
@@ -98,39 +100,4 @@ class AgentConfig:
     on our AVX-512 CPU; benchmarks/update.py --no-channels-last compares)"""
 
     def __post_init__(self) -> None:
-        from simoun_agent.models.encoder import ENCODERS  # the registry needs torch: load late
-
-        if self.encoder not in ENCODERS:
-            raise ValueError(
-                f"AgentConfig.encoder={self.encoder!r} is not known; choose one of "
-                f"{', '.join(ENCODERS)}"
-            )
-        for name, options in (
-            ("augmentation", AUGMENTATIONS),
-            ("contrastive_view", CONTRASTIVE_VIEWS),
-        ):
-            if getattr(self, name) not in options:
-                raise ValueError(
-                    f"AgentConfig.{name}={getattr(self, name)!r} is not known; choose one of "
-                    f"{', '.join(options)}"
-                )
-        motion_path = ENCODERS[self.encoder].motion_path
-        if self.num_frames != 3 and motion_path:
-            raise ValueError(
-                f"the dual-path encoders need num_frames=3 (o_t-2, o_t-1, o_t), got "
-                f"{self.num_frames}; set num_frames=3"
-            )
-        if self.curiosity and not motion_path:
-            raise ValueError(
-                f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
-                f"{self.encoder!r} does not have; set curiosity=False or use a dual encoder"
-            )
-        for name in (
-            "batch_size",
-            "actor_update_every",
-            "target_update_every",
-            "num_frames",
-            "n_step",
-        ):
-            if getattr(self, name) < 1:
-                raise ValueError(f"AgentConfig.{name} must be >= 1, got {getattr(self, name)}")
+        check_agent_config(self)  # every field, then cross-field

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import multiprocessing
+import signal
 from typing import Any
 
 import numpy as np
@@ -60,7 +61,7 @@ class BackgroundEnv:
     def __init__(self, config: TrainConfig, timeout_s: float = 600.0) -> None:
         self.timeout_s = timeout_s
         self.vector = AsyncVectorEnv(
-            [functools.partial(make_env, config)],
+            [functools.partial(_worker_env, config)],
             context="spawn",
             autoreset_mode=AutoresetMode.DISABLED,
         )
@@ -92,6 +93,15 @@ class BackgroundEnv:
 
     def close(self) -> None:
         self.vector.close(terminate=True)
+
+
+def _worker_env(config: TrainConfig) -> Any:
+    """``make_env`` in the worker, which leaves SIGINT and SIGTERM to the trainer: Ctrl-C and
+    many schedulers signal the whole process group, and the trainer needs its worker alive to
+    finish the step and write its checkpoint (it closes the worker itself)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    return make_env(config)
 
 
 class EnvProcessError(SetupError):

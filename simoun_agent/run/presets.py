@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config_checks import check_train_config
 
 
 class SetupError(ValueError):
@@ -39,7 +40,7 @@ PAPER_ACTION_REPEAT = {
     "walker-walk": 2,
     "finger-spin": 2,
 }
-"""Action repeat of the paper's six DeepMind Control tasks (DESIGN.md, from DrQ)."""
+"""Action repeat of the paper's six DeepMind Control tasks (DrQ's values)."""
 
 HIGHWAY_CONFIG = {
     "action": {"type": "ContinuousAction"},
@@ -109,6 +110,9 @@ class TrainConfig:
     """show a progress bar"""
     agent: AgentConfig = field(default_factory=AgentConfig)
     """the agent's hyperparameters (simoun_agent.config.AgentConfig)"""
+
+    def __post_init__(self) -> None:
+        check_train_config(self)
 
     def resolved_action_repeat(self) -> int:
         """The action repeat to use: the explicit value, the paper's for a DMC task, or 1."""

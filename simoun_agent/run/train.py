@@ -8,7 +8,13 @@ A run directory holds ``config.json`` (the resolved config, written once set-up 
 succeeded), ``eval.csv`` / ``train.csv`` / ``tb/`` (logs), ``learning_curve.png`` (redrawn at
 each evaluation), ``checkpoint.pt`` + ``replay-<step>.npz`` (the latest checkpoint),
 ``video.mp4`` (an evaluation episode) and ``summary.json`` (written only when the run ends).
-Ctrl-C finishes the current step, writes a checkpoint and exits; ``--resume`` continues.
+
+Ctrl-C or SIGTERM (a scheduler's preemption, ``kill``) finishes the current step, writes a
+checkpoint atomically, prints how to resume and exits with status **130** after Ctrl-C or
+**143** after SIGTERM (128 + the signal number); a second signal stops at once
+(:mod:`simoun_agent.run.signals`). ``--resume`` continues. One trainer at a time holds a run
+directory (:mod:`simoun_agent.run.rundir`); ``--overwrite`` starts over a run that stopped before
+its first checkpoint.
 """
 
 from __future__ import annotations
@@ -18,15 +24,13 @@ import json
 import random
 import signal
 import sys
-import threading
 import time
 import typing
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import gymnasium as gym
 import numpy as np
@@ -46,6 +50,7 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
+from simoun_agent.run.flags import add_version
 from simoun_agent.run.logger import CURVE_PNG, RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.presets import (
@@ -60,6 +65,8 @@ from simoun_agent.run.presets import (
     resolve,
     to_dict,
 )
+from simoun_agent.run.rundir import take_run_dir
+from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.video import write_video
 
 CONFIG_NAME = "config.json"
@@ -96,6 +103,9 @@ class Run:
     rng: np.random.Generator
     """the trainer's own generator (random warm-up actions)"""
     counters: Counters
+    lock: IO[str] | None = None
+    """the run directory's lock (:func:`~simoun_agent.run.rundir.lock_run_dir`), held while
+    this process uses it"""
 
 
 class TrainCallback:
@@ -146,14 +156,14 @@ def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameRe
     return env, eval_env, agent, replay
 
 
-def create_run(config: TrainConfig) -> Run:
-    """Set up a new run; the run directory gets ``config.json`` only once all of it worked."""
+def create_run(config: TrainConfig, overwrite: bool = False) -> Run:
+    """Set up a new run; the run directory gets ``config.json`` only once all of it worked.
+
+    ``overwrite`` starts over in a directory whose run stopped before its first checkpoint.
+    """
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
-    if (run_dir / CONFIG_NAME).exists():
-        raise SetupError(
-            f"{run_dir} already holds a run; continue it with --resume {run_dir}, or pass "
-            "another --run-dir"
-        )
+    if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
+        take_run_dir(run_dir, overwrite=overwrite).close()
     env, eval_env, agent, replay = build(config)
     created = not run_dir.exists()
     try:
@@ -168,10 +178,11 @@ def create_run(config: TrainConfig) -> Run:
             f"cannot write to the output directory {run_dir} ({err.strerror}); pass a "
             "writable --run-dir"
         ) from None
+    lock = take_run_dir(run_dir, overwrite=overwrite)
     config.run_dir = str(run_dir)
     write_config(run_dir, config)
     rng = np.random.default_rng(config.seed)
-    return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters())
+    return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters(), lock)
 
 
 def write_config(run_dir: Path, config: TrainConfig) -> None:
@@ -201,8 +212,17 @@ def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
     for key, value in overrides.items():
         setattr(config, key, value)
     config.run_dir = str(run_dir)
+    take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
     check_config(payload, to_dict(config), run_dir)
+    done = payload["state"]["env_step"]
+    if config.total_env_steps <= done:
+        finished = " and is finished" if (run_dir / SUMMARY_NAME).exists() else ""
+        raise SetupError(
+            f"--total-env-steps {config.total_env_steps}: this run is at env step {done}"
+            f"{finished}, so there is nothing to continue; pass a larger --total-env-steps "
+            f"(e.g. --total-env-steps {done + config.eval_every}) to train it further"
+        )
     if not payload["replay_path"].is_file():
         raise SetupError(
             f"{payload['replay_path']} (the replay of the checkpoint) is missing; the run cannot "
@@ -221,8 +241,9 @@ def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
     rng = np.random.default_rng()
     rng.bit_generator.state = payload["state"]["trainer_rng"]
     counters = Counters(**payload["state"]["counters"])
+    lock = take_run_dir(run_dir, resume=True)
     write_config(run_dir, config)
-    return Run(config, run_dir, env, eval_env, agent, replay, rng, counters)
+    return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
 
 
 def checkpoint(run: Run) -> None:
@@ -240,28 +261,31 @@ def checkpoint(run: Run) -> None:
     )
 
 
-@contextmanager
-def deferred_interrupt() -> Iterator[threading.Event]:
-    """Turn the first Ctrl-C into a request the loop answers at a clean point (between steps).
+class StatusLines(TrainCallback):
+    """One plain line per evaluation on stderr, instead of the progress bar when stderr is not a
+    terminal (nohup, cluster jobs, CI): logs get a line per evaluation, not bar redraws."""
 
-    A second Ctrl-C interrupts at once. Outside the main thread signals cannot be caught, so
-    the returned event is simply never set there.
-    """
-    requested = threading.Event()
-    if threading.current_thread() is not threading.main_thread():
-        yield requested
-        return
+    def __init__(self, run: Run) -> None:
+        self.start_step = run.counters.env_step
+        self.start = time.perf_counter()
 
-    def handler(signum: int, frame: Any) -> None:
-        if requested.is_set():
-            raise KeyboardInterrupt
-        requested.set()
+    def on_logged(self, run: Run, metrics: dict[str, float]) -> None:
+        step, total = run.counters.env_step, run.config.total_env_steps
+        elapsed = time.perf_counter() - self.start
+        rate = (step - self.start_step) / elapsed if elapsed > 0 else 0.0
+        eta = f", ETA {_duration((total - step) / rate)}" if rate > 0 and step < total else ""
+        print(
+            f"env step {step}/{total}: eval return {metrics['return_mean']:.1f} +- "
+            f"{metrics['return_std']:.1f}, {rate:.1f} env steps/s, {_duration(elapsed)} "
+            f"elapsed{eta}",
+            file=sys.stderr,
+            flush=True,
+        )
 
-    previous = signal.signal(signal.SIGINT, handler)
-    try:
-        yield requested
-    finally:
-        signal.signal(signal.SIGINT, previous)
+
+def _duration(seconds: float) -> str:
+    minutes, secs = divmod(int(seconds), 60)
+    return f"{minutes // 60}:{minutes % 60:02d}:{secs:02d}"
 
 
 def evaluate_and_log(
@@ -310,6 +334,9 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     next_eval = _next(counters, config.eval_every)
     next_checkpoint = _next(counters, config.checkpoint_every)
     last_eval: dict[str, float] | None = None
+    show_bar = config.progress and sys.stderr.isatty()
+    if config.progress and not show_bar:
+        callbacks = [*callbacks, StatusLines(run)]
     if counters.env_step == 0:
         last_eval = evaluate_and_log(run, logger, callbacks, clock)
     update_metrics: dict[str, Any] = {}
@@ -321,9 +348,10 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
         unit="step",
         desc=title.split(" ")[0],
         dynamic_ncols=True,
-        disable=not config.progress,
+        disable=not show_bar,
     )
-    with deferred_interrupt() as interrupt:
+    # Entered after the envs were built, so a library that took the signals then (SDL) is found
+    with deferred_stop() as interrupt:
         while counters.env_step < config.total_env_steps and not interrupt.is_set():
             if obs is None:
                 obs = env.reset(seed=config.seed + counters.episode)
@@ -378,11 +406,13 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
             counters.wall_time_s = clock.total()
             checkpoint(run)
             logger.close()
+            release(run)
             tqdm.write(
-                f"interrupted at env step {counters.env_step}: checkpoint written; continue "
-                f"with: simoun-train --resume {run.run_dir}"
+                f"stopped by {signal.Signals(interrupt.signum).name} at env step "
+                f"{counters.env_step}: checkpoint written; continue with: simoun-train --resume "
+                f"{run.run_dir}"
             )
-            raise KeyboardInterrupt
+            raise Stopped(interrupt.signum)
         return finish(run, logger, last_eval, callbacks, clock)
 
 
@@ -416,9 +446,17 @@ def finish(
     }
     text = metrics_json(summary)
     atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
+    release(run)
     for callback in callbacks:
         callback.on_end(run, last_eval)
     return last_eval
+
+
+def release(run: Run) -> None:
+    """Let go of the run directory (the lock), once the run has written what it writes."""
+    if run.lock is not None:
+        run.lock.close()
+        run.lock = None
 
 
 def _next(counters: Counters, every: int) -> int:
@@ -453,6 +491,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="continue a run from its last checkpoint (only "
         f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
     )
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="start over in a --run-dir whose run stopped before its first checkpoint (a run "
+        "with a checkpoint is never deleted: --resume it)",
+    )
+    add_version(parser)
     add_config_arguments(parser)
     return parser
 
@@ -475,15 +520,29 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
         if key == "preset":
             continue
         shown = json.dumps(default) if isinstance(default, dict) else repr(default)
+        flag = "--" + key.replace("_", "-")
+        switch = kind is bool
+        hint = f"; --no-{flag[2:]} for false" if switch else ""
         group.add_argument(
-            "--" + key.replace("_", "-"),
+            flag,
             dest=key,
             # A tuple key's flag is repeatable: --eval-distraction video_hard --eval-distraction ...
             action="append" if (typing.get_origin(kind) or kind) is tuple else "store",
             default=argparse.SUPPRESS,
             metavar=_metavar(kind),
-            help=f"{doc} (default: {shown})".replace("%", "%%"),
+            # a switch: --progress alone means true, and --progress false still works
+            **({"nargs": "?", "const": "true"} if switch else {}),
+            help=f"{doc} (default: {shown}{hint})".replace("%", "%%"),
         )
+        if switch:
+            group.add_argument(
+                f"--no-{flag[2:]}",
+                dest=key,
+                action="store_const",
+                const="false",
+                default=argparse.SUPPRESS,
+                help=argparse.SUPPRESS,
+            )
 
 
 def _metavar(kind: Any) -> str:
@@ -516,20 +575,23 @@ def main(argv: list[str] | None = None) -> int:
         if args.resume:
             if args.preset:
                 raise SetupError("--preset does not combine with --resume: a run keeps its config")
+            if args.overwrite:
+                raise SetupError("--overwrite starts a run over; it does not combine with --resume")
             run = resume_run(Path(args.resume), overrides)
         else:
             config = resolve(args.preset, overrides)
-            run = create_run(config)
+            run = create_run(config, overwrite=args.overwrite)
     except SetupError as err:
         parser.exit(2, f"simoun-train: error: {err}\n")
     tqdm.write(f"run directory: {run.run_dir}")
     try:
         final = train(run)
-    except KeyboardInterrupt:
-        return 130
+    except KeyboardInterrupt as stop:  # Stopped after a checkpoint, or a second Ctrl-C
+        return getattr(stop, "exit_code", 130)
     finally:
         run.env.close()
         run.eval_env.close()
+        release(run)
     tqdm.write(
         f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
         f"{run.counters.env_step} env steps; learning curve, logs, checkpoint"

@@ -1,0 +1,115 @@
+"""A run directory's ownership: one trainer at a time, and starting over after a crash.
+
+Two trainers writing one directory would overwrite each other's checkpoints and logs, so a
+trainer holds an exclusive ``flock`` on ``<run dir>/.lock`` for the life of its process (the
+kernel releases it when the process ends, crash or not); the file names the PID of its holder,
+so the second trainer can say whom to wait for.
+
+A run that crashed after set-up and before its first checkpoint leaves ``config.json`` and logs
+but nothing to resume from; ``--overwrite`` starts it over in the same directory. A directory
+with a checkpoint is never overwritten: it is resumed, or the user deletes it.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import shutil
+from pathlib import Path
+from typing import IO
+
+from simoun_agent.run.presets import SetupError
+
+LOCK_NAME = ".lock"
+CHECKPOINT_NAME = "checkpoint.pt"
+TRAINER_FILES = ("config.json", "eval.csv", "train.csv", "learning_curve.png", "video.mp4")
+"""What a run writes before its first checkpoint (with ``tb/``): removed by ``--overwrite``."""
+
+_held: dict[Path, IO[str]] = {}
+"""The run-directory locks this process holds, by lock file"""
+
+
+def lock_run_dir(run_dir: Path) -> IO[str]:
+    """Take the run directory's lock, or raise SetupError naming the PID that holds it.
+
+    Keep the returned file open as long as the run uses the directory; closing it releases the
+    lock.
+    """
+    path = (run_dir / LOCK_NAME).resolve()
+    earlier = _held.pop(path, None)
+    if earlier is not None:
+        # This process held it already (a run that raised, in a notebook or a Ray worker): flock
+        # would refuse a second handle of our own, so the old one goes.
+        earlier.close()
+    handle = path.open("a+")
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        handle.seek(0)
+        holder = handle.read().strip() or "unknown"
+        handle.close()
+        raise SetupError(
+            f"{run_dir} is in use by another simoun-train (PID {holder}); two trainers in one "
+            f"directory would overwrite each other's checkpoints. Wait for it to end, stop it "
+            f"with `kill -TERM {holder}` (it checkpoints first), or pass another --run-dir"
+        ) from None
+    handle.seek(0)
+    handle.truncate()
+    handle.write(f"{os.getpid()}\n")
+    handle.flush()
+    _held[path] = handle
+    return handle
+
+
+def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
+    """Make ``run_dir`` ready for a new run, or raise SetupError saying what to do instead.
+
+    A directory that already holds a run (``config.json``) is refused, with ``--resume`` as the
+    way on when it has a checkpoint and ``--overwrite`` when it has none; with ``overwrite`` the
+    files of the crashed attempt are removed. Call it while holding the lock.
+    """
+    if not (run_dir / TRAINER_FILES[0]).exists():
+        return
+    if (run_dir / CHECKPOINT_NAME).exists():
+        raise SetupError(
+            f"{run_dir} already holds a run with a checkpoint; continue it with --resume "
+            f"{run_dir}, or pass another --run-dir (--overwrite never deletes a checkpoint)"
+        )
+    if not overwrite:
+        raise SetupError(
+            f"{run_dir} holds a run that stopped before its first checkpoint, so there is "
+            "nothing to resume; pass --overwrite to start over in it, or another --run-dir"
+        )
+    for name in TRAINER_FILES:
+        (run_dir / name).unlink(missing_ok=True)
+    shutil.rmtree(run_dir / "tb", ignore_errors=True)
+
+
+def require_checkpoint(run_dir: Path) -> None:
+    """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint."""
+    if (run_dir / TRAINER_FILES[0]).exists() and not (run_dir / CHECKPOINT_NAME).exists():
+        raise SetupError(
+            f"{run_dir} has no checkpoint: the run stopped before its first one, so there is "
+            f"nothing to resume. Start it over with its flags plus --run-dir {run_dir} "
+            "--overwrite"
+        )
+
+
+def take_run_dir(run_dir: Path, *, resume: bool = False, overwrite: bool = False) -> IO[str]:
+    """Lock ``run_dir`` and check that it suits the run: a new one (:func:`claim_new_run_dir`,
+    ``overwrite`` clearing a run that crashed before its first checkpoint) or a resumed one
+    (it must have a checkpoint). On a refusal the lock is released and SetupError raised.
+
+    Trainers call it once to fail fast, before building anything (closing what it returns),
+    and again right before they write, keeping the lock until they are done.
+    """
+    handle = lock_run_dir(run_dir)
+    try:
+        if resume:
+            require_checkpoint(run_dir)
+        else:
+            claim_new_run_dir(run_dir, overwrite)
+    except BaseException:
+        handle.close()
+        raise
+    return handle

@@ -1,0 +1,140 @@
+"""Every config value is checked when the config is built: the error names the flag, the value
+and the fix (issue 10). One bad value per field, and every field has a row."""
+
+import math
+
+import pytest
+import torch
+
+from simoun_agent.config import AgentConfig
+from simoun_agent.config_checks import min_image_size
+from simoun_agent.models.encoder import make_encoder
+from simoun_agent.recipes import RECIPES
+from simoun_agent.run.presets import PRESETS, SetupError, config_fields, resolve
+
+BAD = {
+    "env": "",
+    "env_kwargs": [1, 2],
+    "preset": "fast",
+    "seed": -1,
+    "action_repeat": 0,
+    "image_size": 7,
+    "grayscale": "yes",
+    "cameras": 0,
+    "total_env_steps": -5,
+    "warmup_agent_steps": -1,
+    "updates_per_step": 0,
+    "replay_capacity": 0,
+    "eval_every": 0,
+    "eval_episodes": 0,
+    "eval_distraction": [1],
+    "checkpoint_every": 0,
+    "video": "no",
+    "device": "cuda:64",  # no such device, with or without a GPU
+    "torch_threads": 0,
+    "env_process": "yes",
+    "run_dir": "",
+    "progress": 3,
+    "agent.recipe": "curly",
+    "agent.encoder": "triple",
+    "agent.augmentation": "flip",
+    "agent.shift_pad": -1,
+    "agent.contrastive_view": "crop",
+    "agent.feature_dim": 0,
+    "agent.num_filters": 0,
+    "agent.hidden_dim": 0,
+    "agent.aux_hidden_dim": 0,
+    "agent.batch_size": 0,
+    "agent.lr": 0.0,
+    "agent.alpha_lr": -1e-4,
+    "agent.alpha_beta": 1.0,
+    "agent.discount": 1.5,
+    "agent.n_step": 0,
+    "agent.critic_tau": 0.0,
+    "agent.encoder_tau": 2.0,
+    "agent.actor_update_every": 0,
+    "agent.target_update_every": 0,
+    "agent.init_temperature": 0.0,
+    "agent.log_std_min": 5.0,  # above log_std_max
+    "agent.log_std_max": math.inf,
+    "agent.curiosity": "sometimes",
+    "agent.curiosity_scale": -0.2,
+    "agent.curiosity_decay": -1.0,
+    "agent.r_e_max_init": 0.0,
+    "agent.r_i_max_init": -1.0,
+    "agent.transition_weight": -1.0,
+    "agent.contrastive_weight": math.nan,
+    "agent.reward_weight": -1.0,
+    "agent.num_frames": 0,
+    "agent.reduce_kernel": 0,
+    "agent.reduce_stride": 0,
+    "agent.random_conv_kernel": 2,
+    "agent.detach_past_frames": "true",
+    "agent.channels_last": 1,
+}
+
+
+def test_every_config_field_has_a_bad_value_row():
+    assert set(config_fields()) - set(BAD) == set(), "add a row for each new config field"
+
+
+@pytest.mark.parametrize("key", [key for key in BAD if key in config_fields()])
+def test_bad_value_names_the_flag(key):
+    flag = "--" + key.replace("_", "-")
+    with pytest.raises(SetupError) as error:
+        resolve(None, {key: BAD[key]})
+    assert flag in str(error.value), str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "words"),
+    [
+        ({"total_env_steps": -5}, ["--total-env-steps -5", "int >= 1", "500000"]),
+        ({"eval_every": 0}, ["--eval-every 0", "int >= 1"]),
+        ({"checkpoint_every": 0}, ["--checkpoint-every 0", "int >= 1"]),
+        ({"action_repeat": 0}, ["--action-repeat 0", "int >= 1"]),
+        ({"image_size": 7}, ["--image-size 7", "too small", "--image-size 19 or more"]),
+        ({"replay_capacity": 100, "agent.batch_size": 512}, ["--replay-capacity 100", "512"]),
+        ({"agent.log_std_min": 3.0}, ["--agent.log-std-min 3", "--agent.log-std-max 2"]),
+    ],
+)
+def test_messages_give_the_value_and_the_fix(overrides, words):
+    with pytest.raises(SetupError) as error:
+        resolve(None, overrides)
+    for word in words:
+        assert word in str(error.value), str(error.value)
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="needs a torch that sees no CUDA GPU")
+def test_device_cuda_without_a_gpu_names_the_flag_and_cpu():
+    with pytest.raises(SetupError, match=r"--device cuda: .*no CUDA GPU.*--device cpu"):
+        resolve(None, {"device": "cuda"})
+
+
+@pytest.mark.filterwarnings("ignore:Initializing zero-element tensors")
+@pytest.mark.parametrize("encoder", ["dual_interactive", "dual", "stacked"])
+def test_min_image_size_is_the_smallest_the_real_encoder_runs_on(encoder):
+    config = AgentConfig(encoder=encoder, curiosity=encoder.startswith("dual"), num_filters=4)
+    size = min_image_size(config, channels=3, cameras=1)
+    frames = torch.zeros(1, 3, 3, size, size, dtype=torch.uint8)
+    make_encoder(config, (3, size, size))(frames)
+    with pytest.raises(RuntimeError):
+        smaller = torch.zeros(1, 3, 3, size - 1, size - 1, dtype=torch.uint8)
+        make_encoder(config, (3, size - 1, size - 1))(smaller)
+    checked = {"image_size": size, "agent.encoder": encoder, "agent.curiosity": config.curiosity}
+    assert resolve(None, checked).image_size == size
+
+
+def test_agent_config_in_python_names_the_field_too():
+    with pytest.raises(ValueError, match=r"--agent\.batch-size 0 \(AgentConfig\.batch_size\)"):
+        AgentConfig(batch_size=0)
+
+
+@pytest.mark.parametrize("preset", list(PRESETS))
+def test_every_preset_passes_the_checks(preset):
+    resolve(preset, {})
+
+
+@pytest.mark.parametrize("recipe", list(RECIPES))
+def test_every_recipe_passes_the_checks(recipe):
+    resolve("cpu", {"agent.recipe": recipe})
