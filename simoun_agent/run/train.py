@@ -547,7 +547,8 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _metavar(kind: Any) -> str:
     names = {int: "INT", float: "FLOAT", str: "STR", bool: "BOOL", dict: "JSON"}
-    options = [option for option in typing.get_args(kind) or (kind,) if option is not type(None)]
+    skipped = (type(None), Ellipsis)  # Ellipsis: tuple[str, ...] shows as STR
+    options = [option for option in typing.get_args(kind) or (kind,) if option not in skipped]
     return "|".join(names.get(typing.get_origin(o) or o, "VALUE") for o in options)
 
 
