@@ -165,10 +165,16 @@ def test_bare_wrappers_pass_check_env():
     check_env(MovingBackground(_cartpole(), seed=0))
 
 
-def test_videos_are_played_behind_the_task(tmp_path):
+@pytest.mark.parametrize("layout", ["mp4", "image_folder"])
+def test_videos_are_played_behind_the_task(tmp_path, layout):
     colors = [(250, 0, 0), (0, 250, 0), (0, 0, 250), (250, 250, 0)]
     frames = [np.full((32, 32, 3), color, np.uint8) for color in colors]
-    imageio.mimsave(tmp_path / "clip.mp4", frames, fps=10, macro_block_size=1)
+    if layout == "mp4":
+        imageio.mimsave(tmp_path / "clip.mp4", frames, fps=10, macro_block_size=1)
+    else:  # DAVIS: JPEGImages/480p/<sequence>/00000.jpg, ...
+        (tmp_path / "sequence").mkdir()
+        for index, frame in enumerate(frames):
+            imageio.imwrite(tmp_path / "sequence" / f"{index:05d}.jpg", frame)
     (tmp_path / "notes.txt").write_text("not a video")
     env = MovingBackground(_cartpole(), "easy", videos=tmp_path, seed=0)
     env.reset(seed=0)

@@ -202,8 +202,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--videos",
         metavar="DIR",
         default=None,
-        help="with --distraction: a folder of video files for the video_* modes (default: a "
-        "procedural moving background)",
+        help="with --distraction: a folder of video files (or of DAVIS-style folders of frames) "
+        "for the video_* modes (default: a procedural moving background)",
     )
     add_version(parser)
     return parser

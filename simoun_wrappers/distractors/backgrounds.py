@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import cv2
 import numpy as np
 
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".webm", ".gif")
-"""File endings read as videos from a ``videos`` folder (DMC-GB ships mp4, DAVIS jpg folders
-can be turned into mp4 with ffmpeg)."""
+"""File endings read as videos from a ``videos`` folder (DMC-GB ships mp4 files)."""
+
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
+"""File endings of the frames of a clip given as a sub-folder of images, in name order (DAVIS's
+``JPEGImages/480p/<sequence>/00000.jpg`` layout)."""
 
 MAX_VIDEO_SIDE = 256
 """Video frames are shrunk on loading so that their longer side is at most this many pixels:
@@ -69,7 +73,8 @@ class VideoBackground:
 
     Args:
         folder: a folder of video files (``VIDEO_SUFFIXES``), e.g. DMC-GB's
-            ``src/env/data/video_hard`` or DAVIS clips made into mp4 files.
+            ``src/env/data/video_hard``, and/or of sub-folders of frames (``IMAGE_SUFFIXES``),
+            e.g. DAVIS's ``JPEGImages/480p``.
 
     Raises a ValueError when the folder holds no readable video, naming what was tried.
     """
@@ -82,15 +87,18 @@ class VideoBackground:
                 f"({', '.join(VIDEO_SUFFIXES)}), or videos=None for the procedural background."
             )
         candidates = sorted(
-            path for path in self.folder.iterdir() if path.suffix.lower() in VIDEO_SUFFIXES
+            path
+            for path in self.folder.iterdir()
+            if path.suffix.lower() in VIDEO_SUFFIXES or (path.is_dir() and _images(path))
         )
         self.paths = [path for path in candidates if _readable(path)]
         if not self.paths:
             tried = ", ".join(path.name for path in candidates) or "none"
             raise ValueError(
-                f"no readable video in {self.folder} (files with a video ending tried: "
-                f"{tried}); put {', '.join(VIDEO_SUFFIXES)} files there that imageio can read "
-                f"(imageio-ffmpeg installed), or pass videos=None for the procedural background."
+                f"no readable video in {self.folder} (video files and image folders tried: "
+                f"{tried}); put {', '.join(VIDEO_SUFFIXES)} files that imageio can read "
+                f"(imageio-ffmpeg installed) or folders of {', '.join(IMAGE_SUFFIXES)} frames "
+                f"there, or pass videos=None for the procedural background."
             )
         self._loaded: tuple[Path, list[np.ndarray]] | None = None
 
@@ -106,21 +114,30 @@ class VideoBackground:
         return cv2.resize(image, (width, height), interpolation=cv2.INTER_AREA)
 
 
-def _readable(path: Path) -> bool:
+def _images(folder: Path) -> list[Path]:
+    return sorted(path for path in folder.iterdir() if path.suffix.lower() in IMAGE_SUFFIXES)
+
+
+def _frames(path: Path) -> Iterator[np.ndarray]:
+    """The frames of a video file or of a folder of images, decoded one at a time."""
     import imageio.v3 as iio
 
+    if path.is_dir():
+        return (iio.imread(image) for image in _images(path))
+    return iio.imiter(path)
+
+
+def _readable(path: Path) -> bool:
     try:
-        frame = next(iter(iio.imiter(path)))
+        frame = next(iter(_frames(path)))
     except Exception:  # any decoder failure means "not a video we can play"
         return False
     return isinstance(frame, np.ndarray) and frame.ndim == 3 and frame.shape[2] in (3, 4)
 
 
 def _read_frames(path: Path) -> list[np.ndarray]:
-    import imageio.v3 as iio
-
     frames = []
-    for frame in iio.imiter(path):
+    for frame in _frames(path):
         image = np.ascontiguousarray(frame[..., :3], dtype=np.uint8)
         scale = MAX_VIDEO_SIDE / max(image.shape[:2])
         if scale < 1:

@@ -65,7 +65,8 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
         Args:
             env: a dm_control task made through shimmy with ``render_mode="rgb_array"``.
             level: ``"easy"`` replaces the sky, ``"hard"`` the sky and the floor.
-            videos: a folder of video files to play; None for the procedural background.
+            videos: a folder of video files, or of sub-folders of frames (DAVIS's layout), to
+                play; None for the procedural background.
             seed: seed of the background stream; None draws fresh entropy.
         """
         gym.utils.RecordConstructorArgs.__init__(
