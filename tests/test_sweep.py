@@ -119,23 +119,23 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
 
 
 def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path, capsys):
-    # 8x8 frames are too small for the encoder's convolutions: that trial raises at its first
-    # evaluation, inside Ray, after its config was accepted.
+    # A replay of 8 slots passes the config checks (it is one batch) but holds 7 whole windows
+    # when the updates start: that trial raises at its first update, inside Ray.
     sweep_dir = tmp_path / "failing"
-    argv = [*tiny_without("--image-size"), "--grid", "image_size=8,32", "--seeds", "0"]
-    argv += ["--sweep-dir", str(sweep_dir)]
+    argv = [*tiny_without("--replay-capacity"), "--grid", "replay_capacity=8,1000"]
+    argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir)]
     assert cli.main([*argv, "--verbose", "0"]) == 1
-    bad, good = sweep_dir / "image_size=8", sweep_dir / "image_size=32"
+    bad, good = sweep_dir / "replay_capacity=8", sweep_dir / "replay_capacity=1000"
     assert (good / "simoun-PointReach-v0/s0/summary.json").is_file()
     assert not (bad / "simoun-PointReach-v0/s0/summary.json").exists()
     error = (bad / "simoun-PointReach-v0/s0/error.txt").read_text()
-    assert "Kernel size can't be greater than actual input size" in error
+    assert "cannot sample 8 transitions" in error
     err = capsys.readouterr().err
-    assert "FAILED image_size=8/simoun-PointReach-v0/s0" in err
+    assert "FAILED replay_capacity=8/simoun-PointReach-v0/s0" in err
     assert "--resume" in err
     assert [(row["variant"], row["n"]) for row in report_rows(sweep_dir)] == [
-        ("image_size=8", "0"),
-        ("image_size=32", "1"),
+        ("replay_capacity=8", "0"),
+        ("replay_capacity=1000", "1"),
     ]
     assert "## Failed runs" in (sweep_dir / "report.md").read_text()
 
