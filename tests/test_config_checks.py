@@ -138,3 +138,18 @@ def test_every_preset_passes_the_checks(preset):
 @pytest.mark.parametrize("recipe", list(RECIPES))
 def test_every_recipe_passes_the_checks(recipe):
     resolve("cpu", {"agent.recipe": recipe})
+
+
+@pytest.mark.parametrize(
+    ("frame_shape", "action_dim", "words"),
+    [
+        ((84, 84, 3), 1, "looks channel-last"),
+        ((3, 7, 7), 1, "too small for the conv trunk of encoder 'dual_interactive'"),
+        ((3, 48, 48), 0, "action_dim must be an int >= 1"),
+    ],
+)
+def test_agent_constructor_names_the_problem(frame_shape, action_dim, words):
+    from simoun_agent import SimounAgent
+
+    with pytest.raises(ValueError, match=words):
+        SimounAgent(frame_shape, action_dim, AgentConfig(batch_size=8, num_filters=4))

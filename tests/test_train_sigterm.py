@@ -177,3 +177,25 @@ def test_background_env_worker_leaves_sigterm_to_the_trainer():
         assert obs["frames"].shape[0] == 3
     finally:
         env.close()
+
+
+SECOND_SIGTERM = """
+import os, signal, time
+from simoun_agent.run.signals import deferred_stop
+
+with deferred_stop() as stop:
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(0.2)
+    print("first", stop.signum == signal.SIGTERM, flush=True)
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(10)
+print("survived", flush=True)
+"""
+
+
+def test_a_second_sigterm_stops_at_once():
+    done = subprocess.run(
+        [sys.executable, "-c", SECOND_SIGTERM], capture_output=True, text=True, timeout=60
+    )
+    assert done.stdout.split() == ["first", "True"], done.stdout + done.stderr
+    assert done.returncode == -signal.SIGTERM
