@@ -200,3 +200,8 @@ def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
         process.kill()
         process.wait()
     assert not (run_dir / "eval-12").exists()  # nothing half-written is left behind
+
+
+def test_simoun_eval_refuses_a_negative_seed(finished, capsys):
+    err = exit_message(capsys, evaluate.main, [str(finished), "--seed", "-1", "--no-video"])
+    assert "--seed -1" in err

@@ -222,6 +222,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(bool_argv(argv, ("--video", "--progress")))
     if args.episodes < 1:
         parser.error("--episodes must be at least 1")
+    if args.seed is not None and not 0 <= args.seed < 2**32:
+        parser.error(f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
     if args.distraction is not None:
         from simoun_agent.generalization.cli import evaluate_distractions
 
