@@ -168,3 +168,8 @@ def test_equal_budget_cuts_every_run_at_it_and_counts_unfinished_runs_that_reach
     assert "b-s1" in (out / report.REPORT_MD).read_text().split("short of the budget")[1]
     with pytest.raises(SystemExit):
         report.main([str(runs_dir), "--at-step", "0"])
+
+
+def test_a_dict_valued_key_stays_one_value_so_it_can_name_a_variant():
+    flat = report.flatten({"env_kwargs": {"config": {"lanes": 4}}, "agent": {"lr": 1e-3}})
+    assert flat == {"env_kwargs": {"config": {"lanes": 4}}, "agent.lr": 1e-3}

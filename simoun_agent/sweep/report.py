@@ -35,7 +35,7 @@ import numpy as np
 
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.run.presets import SetupError
+from simoun_agent.run.presets import SetupError, config_sections
 from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
 
@@ -82,10 +82,12 @@ class RunRecord:
 
 
 def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """``{"agent": {"lr": 1}}`` -> ``{"agent.lr": 1}``, every nested dict walked."""
+    """``{"agent": {"lr": 1}}`` -> ``{"agent.lr": 1}``: config sections are walked, any other
+    dict (``env_kwargs``) stays one value, as on the command line."""
+    sections = config_sections()
     flat: dict[str, Any] = {}
     for key, value in nested.items():
-        if isinstance(value, dict) and value:
+        if isinstance(value, dict) and f"{prefix}{key}." in sections:
             flat.update(flatten(value, f"{prefix}{key}."))
         else:
             flat[prefix + key] = value
