@@ -35,7 +35,7 @@ import numpy as np
 
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.run.presets import SetupError, config_sections
+from simoun_agent.run.presets import SetupError, config_sections, from_dict, to_dict
 from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
 
@@ -94,6 +94,16 @@ def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return flat
 
 
+def with_defaults(saved: dict[str, Any]) -> dict[str, Any]:
+    """A saved config with this version's defaults for the keys it predates, so a run saved
+    before a key existed groups with runs that have its default; as saved when it no longer
+    loads (a key since removed, a value now refused)."""
+    try:
+        return to_dict(from_dict(saved))
+    except (SetupError, TypeError, ValueError):
+        return saved
+
+
 def find_runs(root: Path) -> list[RunRecord]:
     """Every run directory under ``root`` (Tune's own records under ``tune/`` skipped)."""
     records = []
@@ -103,7 +113,7 @@ def find_runs(root: Path) -> list[RunRecord]:
             continue
         run_dir = config_path.parent
         try:
-            config = flatten(json.loads(config_path.read_text()))
+            config = flatten(with_defaults(json.loads(config_path.read_text())))
         except json.JSONDecodeError:
             continue
         if "env" not in config or "seed" not in config:
