@@ -8,6 +8,7 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 import torch
+from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent.analysis import masks as mask_pictures
 from simoun_agent.analysis.bias import information_bias
@@ -22,26 +23,8 @@ from simoun_agent.run.make_env import make_env
 from simoun_agent.run.presets import resolve
 from simoun_wrappers import SimounObservation
 
-TINY = {
-    "env": "simoun/PointReach-v0",
-    "image_size": 32,
-    "total_env_steps": 60,
-    "warmup_agent_steps": 20,
-    "replay_capacity": 1000,
-    "eval_every": 60,
-    "eval_episodes": 1,
-    "checkpoint_every": 60,
-    "video": False,
-    "progress": False,
-    "device": "cpu",
-    "torch_threads": 1,
-    "seed": 3,
-    "agent.batch_size": 8,
-    "agent.num_filters": 8,
-    "agent.feature_dim": 16,
-    "agent.hidden_dim": 32,
-    "agent.aux_hidden_dim": 32,
-}
+TINY = {**RESUME_TINY, "total_env_steps": 60}
+"""tests/test_train_resume.py's tiny run, cut to one evaluation interval."""
 
 
 def tiny_run(run_dir, encoder):

@@ -9,32 +9,15 @@ import math
 import matplotlib.image
 import numpy as np
 import pytest
+from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.presets import resolve, to_dict
 from simoun_agent.sweep import report
 
-TINY = {
-    "env": "simoun/PointReach-v0",
-    "image_size": 32,
-    "total_env_steps": 120,
-    "warmup_agent_steps": 20,
-    "replay_capacity": 1000,
-    "eval_every": 60,
-    "eval_episodes": 1,
-    "checkpoint_every": 60,
-    "video": False,
-    "progress": False,
-    "device": "cpu",
-    "torch_threads": 1,
-    "agent.batch_size": 8,
-    "agent.num_filters": 8,
-    "agent.feature_dim": 16,
-    "agent.hidden_dim": 32,
-    "agent.aux_hidden_dim": 32,
-}
-"""The tiny run of tests/test_train_resume.py."""
+TINY = {key: value for key, value in RESUME_TINY.items() if key != "seed"}
+"""The tiny run of tests/test_train_resume.py, each run choosing its own seed."""
 
 
 @pytest.fixture(scope="module")
