@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
+from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
 from simoun_agent.sweep import cli
 from simoun_agent.sweep.grid import SWEEP_FILE, parse_seeds, split_values
@@ -187,6 +188,53 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     assert {d: (d / "summary.json").read_bytes() for d in short_runs} == summaries
     assert all((d / "summary.json").is_file() for d in long_runs)
     assert [row["n"] for row in report_rows(sweep_dir)] == ["2", "2"]
+
+
+def test_sigterm_stops_every_trial_with_a_checkpoint_and_resume_finishes(ray_address, tmp_path):
+    sweep_dir = tmp_path / "terminated"
+    # one long trial, no periodic checkpoint: the only checkpoint is the one SIGTERM asks for
+    argv = [*tiny_without("--total-env-steps"), "--total-env-steps", "100000"]
+    at = argv.index("--checkpoint-every")
+    argv[at + 1] = "1000000000"
+    argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir), "--address", ray_address]
+    argv += ["--verbose", "0"]
+    command = [sys.executable, "-m", "simoun_agent.sweep.cli", *argv]
+    log = tmp_path / "sweep.log"
+    with log.open("w") as out:
+        proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
+    run_dir = sweep_dir / "base/simoun-PointReach-v0/s0"
+    deadline = time.monotonic() + 120
+    while not (run_dir / "train.csv").exists():
+        assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
+        time.sleep(0.1)
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    proc.wait(timeout=60)
+    output = log.read_text()
+    assert proc.returncode == 143, output
+    assert time.monotonic() - sent < 30, output
+    assert "simoun-sweep --resume --sweep-dir" in output
+    assert not (run_dir / "summary.json").exists() and not (sweep_dir / "STOP").exists()
+    stopped_at = load_checkpoint(run_dir)["state"]["env_step"]
+    assert stopped_at > 0
+
+    # the trial's run directory is an ordinary run: simoun-train continues it from the checkpoint
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "simoun_agent.run.train",
+            "--resume",
+            str(run_dir),
+            "--total-env-steps",
+            str(stopped_at + 20),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=180,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] >= stopped_at + 20
 
 
 def error_of(argv: list[str], capsys) -> str:

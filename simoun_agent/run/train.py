@@ -125,6 +125,12 @@ class TrainCallback:
     def on_end(self, run: Run, metrics: dict[str, float]) -> None:
         """Once, after the final evaluation, checkpoint, video and summary.json."""
 
+    def stop_requested(self, run: Run) -> int | None:
+        """Polled after every step: a signal number stops the run as if that signal had
+        arrived (checkpoint, then :class:`Stopped`); None goes on. For supervisors that cannot
+        signal the loop's thread, such as a Ray Tune trial."""
+        return None
+
 
 def default_run_dir(config: TrainConfig) -> Path:
     """``runs/<task>-<preset>-s<seed>-<UTC time>``, e.g. ``runs/cartpole-swingup-cpu-s1-...``."""
@@ -376,6 +382,10 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
             episode_return += float(reward)
             episode_length += 1
             bar.update(repeat)
+            for callback in callbacks:
+                asked = callback.stop_requested(run)
+                if asked is not None and not interrupt.is_set():
+                    interrupt.signum = asked
 
             if not (terminated or truncated):
                 continue

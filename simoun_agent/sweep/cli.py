@@ -12,18 +12,23 @@ the report (:mod:`simoun_agent.sweep.report`) is written when the sweep ends.
 from __future__ import annotations
 
 import argparse
+import signal
 import socket
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 from simoun_agent.recipes import RECIPES
 from simoun_agent.run import train
+from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, Trial
-from simoun_agent.sweep.trainable import ERROR_FILE, run_trial, trial_table
+from simoun_agent.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table
 
 CONNECT_TIMEOUT_S = 5.0
 """How long ``--address HOST:PORT`` may take to answer before the sweep gives up."""
@@ -176,7 +181,9 @@ def run_sweep(
     stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
     tuner = tune.Tuner(
         tune.with_resources(
-            tune.with_parameters(run_trial, trials=trial_table(trials)),
+            tune.with_parameters(
+                run_trial, trials=trial_table(trials), stop_file=str(sweep_dir / STOP_FILE)
+            ),
             {"cpu": spec.cpus_per_trial, "gpu": gpus},
         ),
         param_space={"trial": tune.grid_search([trial.name for trial in trials])},
@@ -299,6 +306,7 @@ def main(argv: list[str] | None = None) -> int:
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
     print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
+    terminated: list[bool] = []
     if todo:
         started = False
         try:
@@ -309,7 +317,10 @@ def main(argv: list[str] | None = None) -> int:
             sweep_dir.mkdir(parents=True, exist_ok=True)
             if not (sweep_dir / SWEEP_FILE).exists():
                 spec.save(sweep_dir)
-            outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
+            (sweep_dir / STOP_FILE).unlink(missing_ok=True)
+            with stop_trials_on_sigterm(sweep_dir) as came:
+                terminated = came
+                outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
         except SetupError as err:
             parser.exit(2, f"simoun-sweep: error: {err}\n")
         except KeyboardInterrupt:
@@ -323,10 +334,36 @@ def main(argv: list[str] | None = None) -> int:
         written = report.write_report(sweep_dir)
     except SetupError:  # no trial got as far as writing its config.json
         written = []
-    return summarize(outcome, sweep_dir, written)
+    return summarize(outcome, sweep_dir, written, bool(terminated))
 
 
-def summarize(outcome: dict[str, list[Trial]], sweep_dir: Path, written: list[Path]) -> int:
+@contextmanager
+def stop_trials_on_sigterm(sweep_dir: Path) -> Iterator[list[bool]]:
+    """On the first SIGTERM, write the sweep's STOP file: every trial checkpoints at its next
+    step and ends unfinished, and Tune returns; a second SIGTERM stops at once. The yielded list
+    gets an entry once SIGTERM came."""
+    came: list[bool] = []
+
+    def handler(signum: int, frame: Any) -> None:
+        if came:
+            raise KeyboardInterrupt
+        came.append(True)
+        atomic_write(sweep_dir / STOP_FILE, lambda tmp: tmp.write_text("SIGTERM\n"))
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield came
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        (sweep_dir / STOP_FILE).unlink(missing_ok=True)
+
+
+def summarize(
+    outcome: dict[str, list[Trial]],
+    sweep_dir: Path,
+    written: list[Path],
+    terminated: bool = False,
+) -> int:
     """Say what happened to each trial and how to go on; the exit status."""
     for trial in outcome.get("failed", []):
         error = Path(trial.run_dir) / ERROR_FILE
@@ -340,7 +377,7 @@ def summarize(outcome: dict[str, list[Trial]], sweep_dir: Path, written: list[Pa
             f"simoun-sweep --resume --sweep-dir {sweep_dir}",
             file=sys.stderr,
         )
-        return 130
+        return 143 if terminated else 130
     if outcome.get("failed"):
         print(
             f"{len(outcome['failed'])} trials failed, the others finished; fix the cause and "

@@ -9,6 +9,7 @@ visible beside the run, to ``simoun-report`` too, without Ray.
 from __future__ import annotations
 
 import shutil
+import signal
 import traceback
 from dataclasses import asdict
 from pathlib import Path
@@ -17,8 +18,24 @@ from typing import Any
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import CHECKPOINT_NAME, atomic_write
 from simoun_agent.run.presets import resolve
+from simoun_agent.run.signals import Stopped
 from simoun_agent.sweep.grid import Trial
 from simoun_agent.sweep.report import ERROR_FILE
+
+STOP_FILE = "STOP"
+"""Written into the sweep directory by ``simoun-sweep`` on SIGTERM: every trial then stops at
+its next step with a checkpoint (a Ray trial runs in a worker thread, where no signal reaches
+it), and ``simoun-sweep --resume`` goes on from there."""
+
+
+class StopFile(train.TrainCallback):
+    """Ask the trial's training loop to stop, as on SIGTERM, once ``path`` exists."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def stop_requested(self, run: train.Run) -> int | None:
+        return signal.SIGTERM if self.path.exists() else None
 
 
 class TuneReporter(train.TrainCallback):
@@ -45,14 +62,22 @@ def open_run(trial: Trial) -> train.Run:
     return train.create_run(resolve(trial.preset, trial.overrides))
 
 
-def run_trial(config: dict[str, Any], trials: dict[str, dict[str, Any]]) -> None:
-    """Tune's function trainable: train the trial named ``config["trial"]`` to the end."""
+def run_trial(
+    config: dict[str, Any], trials: dict[str, dict[str, Any]], stop_file: str | None = None
+) -> None:
+    """Tune's function trainable: train the trial named ``config["trial"]`` to the end, or until
+    ``stop_file`` appears (then it ends unfinished, with a checkpoint to resume from)."""
     trial = Trial(**trials[config["trial"]])
     run_dir = Path(trial.run_dir)
+    callbacks: list[train.TrainCallback] = [TuneReporter()]
+    if stop_file is not None:
+        callbacks.append(StopFile(Path(stop_file)))
     try:
         run = open_run(trial)
         try:
-            train.train(run, callbacks=[TuneReporter()])
+            train.train(run, callbacks=callbacks)
+        except Stopped:
+            return
         finally:
             run.env.close()
             run.eval_env.close()
