@@ -10,10 +10,11 @@ import numpy as np
 import torch
 
 from simoun_agent.agent import SimounAgent
-from simoun_agent.run.checkpoint import atomic_write, load_checkpoint
+from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.evaluate import EVAL_SEED_OFFSET
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.presets import SetupError, TrainConfig, from_dict
+from simoun_agent.run.rundir import make_output_dir
 
 
 @dataclass
@@ -102,11 +103,4 @@ def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--
             f"{out} already holds results ({shown}); pass --overwrite to replace them, or "
             f"another {flag}"
         )
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        atomic_write(out / ".write-test", lambda tmp: tmp.write_text(""))
-        (out / ".write-test").unlink()
-    except OSError as err:
-        raise SetupError(
-            f"cannot write to the output directory {out} ({err.strerror}); pass a writable {flag}"
-        ) from None
+    make_output_dir(out, flag)

@@ -13,6 +13,7 @@ from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.generalization.report import TABLE_CSV, write_report
 from simoun_agent.generalization.suite import parse_distractions
 from simoun_agent.run.presets import SetupError
+from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
 
 
@@ -43,13 +44,7 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
                 f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
                 "or --out DIR to write this one elsewhere"
             )
-        created = not out.exists()
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as err:
-            raise SetupError(
-                f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
-            ) from None
+        created = make_output_dir(out)
         with stop_at_once():
             results = evaluate_runs(
                 run_dirs,

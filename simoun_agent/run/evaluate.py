@@ -27,6 +27,7 @@ from tqdm import tqdm
 from simoun_agent.run import driving_metrics
 from simoun_agent.run.flags import add_version, bool_argv
 from simoun_agent.run.presets import SetupError
+from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
 
 EVAL_SEED_OFFSET = 1_000_000
@@ -248,13 +249,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"{out} holds an earlier evaluation; pass --overwrite to replace it, or --out DIR "
                 "to write this one elsewhere"
             )
-        created = not out.exists()
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as err:
-            raise SetupError(
-                f"cannot create output directory {out}: {err.strerror}; pass a writable --out"
-            ) from None
+        created = make_output_dir(out)
         seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
         if args.random_policy:
             agent = RandomPolicy(env.action_space.shape[0], seed)

@@ -29,6 +29,25 @@ _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""
 
 
+def make_output_dir(path: Path, flag: str = "--out") -> bool:
+    """Create ``path`` (with its parents) and check that it can be written. Returns True when
+    it did not exist before, so a caller that stops later can remove what it made; raises
+    SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
+    created = not path.exists()
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".write-test"
+        probe.write_text("")
+        probe.unlink()
+    except OSError as err:
+        if created and path.is_dir() and not any(path.iterdir()):
+            path.rmdir()
+        raise SetupError(
+            f"cannot write to the output directory {path} ({err.strerror}); pass a writable {flag}"
+        ) from None
+    return created
+
+
 def lock_run_dir(run_dir: Path) -> IO[str]:
     """Take the run directory's lock, or raise SetupError naming the PID that holds it.
 

@@ -65,7 +65,7 @@ from simoun_agent.run.presets import (
     resolve,
     to_dict,
 )
-from simoun_agent.run.rundir import take_run_dir
+from simoun_agent.run.rundir import make_output_dir, take_run_dir
 from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.video import write_video
 
@@ -171,19 +171,7 @@ def create_run(config: TrainConfig, overwrite: bool = False) -> Run:
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
         take_run_dir(run_dir, overwrite=overwrite).close()
     env, eval_env, agent, replay = build(config)
-    created = not run_dir.exists()
-    try:
-        run_dir.mkdir(parents=True, exist_ok=True)
-        probe = run_dir / ".write-test"
-        probe.write_text("")
-        probe.unlink()
-    except OSError as err:
-        if created and run_dir.is_dir() and not any(run_dir.iterdir()):
-            run_dir.rmdir()
-        raise SetupError(
-            f"cannot write to the output directory {run_dir} ({err.strerror}); pass a "
-            "writable --run-dir"
-        ) from None
+    make_output_dir(run_dir, "--run-dir")
     lock = take_run_dir(run_dir, overwrite=overwrite)
     config.run_dir = str(run_dir)
     write_config(run_dir, config)
