@@ -1,0 +1,133 @@
+"""simoun_agent.stats against hand-worked examples and against the rliable package itself
+(Agarwal et al. 2021) on the same scores: the same point estimates and, since the resampling
+draws rliable's indices from the same seeded stream, the same bootstrap intervals."""
+
+import numpy as np
+import pytest
+from rliable import library as rly
+from rliable import metrics
+
+from simoun_agent import stats
+
+
+def as_tasks(matrix):
+    """rliable's runs x tasks matrix as simoun's task -> runs mapping."""
+    return {f"task{j}": matrix[:, j] for j in range(matrix.shape[1])}
+
+
+def seed_rliable(seed):
+    """rliable's bootstrap draws its indices from numpy's global generator: seeding that is how
+    an rliable result is made reproducible."""
+    np.random.seed(seed)  # noqa: NPY002
+
+
+def rliable_ci(scores, func, seed, reps=2000):
+    """rliable's point estimate and 95 % percentile interval."""
+    seed_rliable(seed)
+    point, interval = rly.get_interval_estimates({"x": scores}, func, reps=reps)
+    return float(np.ravel(point["x"])[0]), *np.ravel(interval["x"])
+
+
+def test_iqm_by_hand():
+    assert stats.iqm(np.arange(1.0, 9.0)) == 4.5  # (3 + 4 + 5 + 6) / 4
+    assert stats.iqm(np.array([1.0, 2.0, 3.0, 100.0])) == 2.5  # 1 and 100 cut
+    assert stats.iqm(np.array([1.0, 2.0, 9.0])) == 4.0  # int(0.75) = 0 cut: the mean
+    five = np.array([0.0, 10.0, 20.0, 30.0, 1000.0])
+    assert stats.iqm(five) == 20.0  # one cut at each end
+    tasks = {"a": np.array([1.0, 2.0, 3.0, 4.0]), "b": np.array([5.0, 6.0, 7.0, 8.0])}
+    assert stats.aggregate_iqm(tasks) == 4.5  # over all 8 runs of both tasks
+    with pytest.raises(ValueError, match="at least one run"):
+        stats.iqm(np.zeros(0))
+
+
+@pytest.mark.parametrize("shape", [(3, 1), (5, 2), (8, 3), (10, 5)])
+def test_iqm_equals_rliable(shape):
+    matrix = np.random.default_rng(sum(shape)).normal(size=shape)
+    assert stats.aggregate_iqm(as_tasks(matrix)) == pytest.approx(metrics.aggregate_iqm(matrix))
+    assert stats.aggregate_mean(as_tasks(matrix)) == pytest.approx(metrics.aggregate_mean(matrix))
+
+
+@pytest.mark.parametrize(("runs", "tasks", "seed"), [(3, 1, 0), (5, 3, 11), (10, 2, 4)])
+def test_bootstrap_intervals_equal_rliable(runs, tasks, seed):
+    matrix = np.random.default_rng(seed).uniform(size=(runs, tasks))
+    ours = stats.stratified_bootstrap_ci(as_tasks(matrix), stats.aggregate_iqm, seed=seed)
+    theirs = rliable_ci(matrix, lambda s: np.array([metrics.aggregate_iqm(s)]), seed)
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
+    ours = stats.stratified_bootstrap_ci(as_tasks(matrix), stats.aggregate_mean, seed=seed)
+    theirs = rliable_ci(matrix, lambda s: np.array([metrics.aggregate_mean(s)]), seed)
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
+    assert ours[1] < ours[0] < ours[2]
+
+
+def test_bootstrap_is_stratified_and_seeded():
+    """Resamples draw each task's runs from that task only, keeping its number of runs; the
+    same seed gives the same interval, another seed another one."""
+    scores = {"low": np.array([0.0, 0.5, 1.0]), "high": np.array([10.0, 10.5, 11.0, 11.5, 12.0])}
+    replicates = stats.bootstrap_replicates(
+        scores, lambda s: [s["low"].max(), s["high"].min(), len(s["low"]), len(s["high"])], 500
+    )
+    assert replicates[:, 0].max() <= 1.0 and replicates[:, 1].min() >= 10.0
+    assert set(replicates[:, 2]) == {3} and set(replicates[:, 3]) == {5}
+    first = stats.stratified_bootstrap_ci(scores, stats.aggregate_iqm, seed=1)
+    assert stats.stratified_bootstrap_ci(scores, stats.aggregate_iqm, seed=1) == first
+    other = stats.bootstrap_replicates(scores, stats.aggregate_iqm, 500, seed=2)
+    assert not np.array_equal(other, stats.bootstrap_replicates(scores, stats.aggregate_iqm, 500))
+    constant = stats.stratified_bootstrap_ci({"t": np.full(4, 0.3)}, stats.aggregate_iqm)
+    assert constant == pytest.approx((0.3, 0.3, 0.3))
+
+
+def test_probability_of_improvement_by_hand():
+    x = {"a": np.array([2.0, 3.0]), "b": np.array([5.0, 6.0])}
+    y = {"a": np.array([1.0, 3.0]), "b": np.array([7.0])}
+    # task a: 2>1, 2<3, 3>1, 3=3 (a half) -> 2.5 / 4; task b: both below 7 -> 0
+    assert stats.probability_of_improvement(x, y) == pytest.approx((2.5 / 4 + 0.0) / 2)
+    assert stats.probability_of_improvement(y, x) == pytest.approx((1.5 / 4 + 1.0) / 2)
+    assert stats.probability_of_improvement(x, x) == 0.5
+    with pytest.raises(ValueError, match=r"same tasks.*\['b'\]"):
+        stats.probability_of_improvement(x, {"a": y["a"]})
+
+
+def test_probability_of_improvement_and_its_interval_equal_rliable():
+    rng = np.random.default_rng(3)
+    # rounded so that ties occur, as they do between equal evaluation returns
+    x, y = rng.uniform(size=(5, 3)).round(1), rng.uniform(size=(4, 3)).round(1)
+    assert stats.probability_of_improvement(as_tasks(x), as_tasks(y)) == pytest.approx(
+        metrics.probability_of_improvement(x, y)
+    )
+    seed_rliable(9)
+    point, interval = rly.get_interval_estimates(
+        {"x,y": [x, y]},
+        lambda a, b: np.array([metrics.probability_of_improvement(a, b)]),
+        reps=500,  # scipy's Mann-Whitney test in rliable takes 2 ms a resample
+    )
+    ours = stats.probability_of_improvement_ci(as_tasks(x), as_tasks(y), reps=500, seed=9)
+    theirs = (float(np.ravel(point["x,y"])[0]), *np.ravel(interval["x,y"]))
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
+
+
+def test_performance_profile_and_its_band_equal_rliable():
+    matrix = np.random.default_rng(5).uniform(size=(6, 2))
+    taus = np.linspace(0.0, 1.0, 21)
+    seed_rliable(2)
+    profile, band = rly.create_performance_profile({"x": matrix}, taus, reps=2000)
+    point, low, high = stats.stratified_bootstrap_band(
+        as_tasks(matrix), lambda s: stats.performance_profile(s, taus), seed=2
+    )
+    np.testing.assert_allclose(point, profile["x"], atol=1e-12)
+    np.testing.assert_allclose(np.stack([low, high]), band["x"], atol=1e-12)
+    by_hand = stats.performance_profile({"t": np.array([0.1, 0.5, 0.9])}, np.array([0.0, 0.5]))
+    np.testing.assert_array_equal(by_hand, [1.0, 1 / 3])  # strictly above tau
+
+
+def test_iqm_over_steps_is_the_iqm_at_each_step():
+    curves = {"t": np.array([[0.0, 1.0], [1.0, 2.0], [2.0, 3.0], [9.0, 30.0]])}
+    np.testing.assert_array_equal(stats.iqm_over_steps(curves), [1.5, 2.5])
+
+
+def test_normalize_divides_dm_control_returns_by_1000_and_leaves_others():
+    returns = np.array([250.0, 1000.0])
+    np.testing.assert_array_equal(
+        stats.normalize("dm_control/cartpole-swingup-v0", returns), [0.25, 1.0]
+    )
+    np.testing.assert_array_equal(stats.normalize("simoun/PointReach-v0", returns), returns)
+    assert stats.max_return("simoun/PointReach-v0") is None
