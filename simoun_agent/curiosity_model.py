@@ -12,12 +12,7 @@ Both follow :class:`simoun_wrappers.curiosity.FeatureSource`.
 from __future__ import annotations
 
 import copy
-import queue
-import threading
 import time
-import weakref
-from collections.abc import Callable
-from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,8 +26,9 @@ from simoun_agent.config import AgentConfig
 from simoun_agent.losses import contrastive_loss, transition_loss
 from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
+from simoun_agent.online_model import OnlineModel, default_device, frozen_copy
 from simoun_wrappers.augment import random_conv
-from simoun_wrappers.curiosity_reward import triplet_shape
+from simoun_wrappers.intrinsic_reward import triplet_shape
 
 __all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions"]
 
@@ -148,74 +144,7 @@ def encode_actions(space: spaces.Space, actions: np.ndarray) -> np.ndarray:
     return flat
 
 
-def default_device(device: str | torch.device | None) -> torch.device:
-    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
-
-
-class UpdateThread:
-    """One daemon thread that runs the gradient steps handed to it, one at a time, in order.
-
-    Its queue holds at most one job (``CuriosityModel`` waits for an update before handing over
-    the next), so updates can never pile up behind a slow trainer. A job's exception is kept in
-    its ``Future`` for the caller to raise.
-    """
-
-    def __init__(self) -> None:
-        self.jobs: queue.Queue[tuple[Callable[[], Any], Future] | None] = queue.Queue(maxsize=1)
-        self.thread = threading.Thread(
-            target=self._run, args=(self.jobs,), name="simoun-curiosity-update", daemon=True
-        )
-        self.thread.start()
-
-    @staticmethod
-    def _run(jobs: queue.Queue) -> None:
-        # A static method that drops each job once done: between jobs the thread holds the queue
-        # but not the model, so a model nobody closed is still freed (and its finalizer stops us).
-        while (job := jobs.get()) is not None:
-            work, future = job
-            del job
-            if future.set_running_or_notify_cancel():
-                try:
-                    future.set_result(work())
-                except BaseException as exc:  # handed to the caller's thread, raised there
-                    future.set_exception(exc)
-            del work, future
-
-    def submit(self, work: Callable[[], Any]) -> Future:
-        future: Future = Future()
-        self.jobs.put((work, future))
-        return future
-
-    def close(self) -> None:
-        """Let the job in progress finish, then stop the thread."""
-        if self.thread.is_alive():
-            self.jobs.put(None)
-            # The model's finalizer may run on this thread (the last reference dropped there).
-            if threading.current_thread() is not self.thread:
-                self.thread.join()
-
-
-def run_now(work: Callable[[], Any]) -> Future:
-    """``work()`` on the caller's thread, its result or exception in a done ``Future``."""
-    future: Future = Future()
-    future.set_running_or_notify_cancel()
-    try:
-        future.set_result(work())
-    except Exception as exc:  # raised where a background failure would be
-        future.set_exception(exc)
-    return future
-
-
-def frozen_copy(encoder: PixelEncoder) -> PixelEncoder:
-    """A copy of ``encoder`` that no optimizer holds: the published weights features come from."""
-    snapshot = copy.deepcopy(encoder)
-    for parameter in snapshot.parameters():
-        parameter.grad = None
-        parameter.requires_grad_(False)
-    return snapshot
-
-
-class CuriosityModel:
+class CuriosityModel(OnlineModel):
     """A dual-path encoder trained online with L_tran + L_con, as a curiosity ``FeatureSource``.
 
     Calling it encodes a batch of triplets (one batched, gradient-free forward pass) and returns
@@ -335,22 +264,12 @@ class CuriosityModel:
             ],
             lr=config.lr,
         )
-        self.generator = torch.Generator(self.device)
-        self.rng = np.random.default_rng(config.seed)
-        self.generator.manual_seed(int(self.rng.integers(2**62)))
         self._windows = np.zeros((config.capacity, 4, *self.encoded_shape), dtype=np.uint8)
         self._actions = np.zeros((config.capacity, action_dim(action_space)), dtype=np.float32)
         self.size = 0
         self._head = 0
-        self.watch_calls = 0
-        self.published = frozen_copy(self.encoder)
-        """the encoder whose weights the features come from; replaced, never modified"""
-        self.updates = 0
         self.feature_version = 0
-        self.last_metrics: dict[str, float] = {}
-        self._pending: Future | None = None
-        self._failure: BaseException | None = None
-        self._thread: UpdateThread | None = None
+        self._init_schedule(self.encoder)
 
     @classmethod
     def for_env(
@@ -397,24 +316,8 @@ class CuriosityModel:
             encoding.appearance.float().cpu().numpy(),
         )
 
-    def watch(
-        self,
-        triplets: np.ndarray,
-        actions: np.ndarray,
-        next_triplets: np.ndarray,
-        terminated: np.ndarray,
-        truncated: np.ndarray,
-    ) -> None:
-        """Store a batch of transitions; publish the last gradient step and start the next when
-        one is due.
-
-        ``next_triplets`` must continue ``triplets`` (same episode), as the curiosity wrappers
-        guarantee; only its newest frame is stored. ``terminated``/``truncated`` are accepted
-        for the FeatureSource hook and not needed: G is trained on every stored transition.
-        """
-        self._raise_failure()
-        triplets = self._check(triplets, "triplets")
-        next_triplets = self._check(next_triplets, "next_triplets")
+    def _store(self, triplets: np.ndarray, actions: np.ndarray, next_triplets: np.ndarray) -> None:
+        """Keep frames t-2 .. t+1 of each transition (pooled) and its encoded action."""
         n = len(triplets)
         slots = (self._head + np.arange(n)) % self.config.capacity
         self._windows[slots, :3] = self._pooled(triplets)
@@ -422,105 +325,13 @@ class CuriosityModel:
         self._actions[slots] = encode_actions(self.action_space, actions)
         self._head = int((self._head + n) % self.config.capacity)
         self.size = min(self.size + n, self.config.capacity)
-        self.watch_calls += 1
-        if self.watch_calls % self.config.update_every == 0:
-            self._publish()
-            if self.size >= self.config.learning_starts:
-                self._start(self._sample())
-
-    @property
-    def pending(self) -> bool:
-        """True while a gradient step has been started and its weights are not yet published."""
-        return self._pending is not None
 
     def _sample(self) -> tuple[torch.Tensor, torch.Tensor]:
         """A batch copied out of the buffer, on the caller's thread (the buffer keeps filling)."""
-        if self.size < self.config.batch_size:
-            raise RuntimeError(
-                f"CuriosityModel.update needs {self.config.batch_size} stored transitions, has "
-                f"{self.size}; call watch() more first."
-            )
+        self._need_batch()
         idx = self.rng.integers(0, self.size, size=self.config.batch_size)
         window = torch.as_tensor(self._windows[idx], device=self.device)
         return window, torch.as_tensor(self._actions[idx], device=self.device)
-
-    def _start(self, batch: tuple[torch.Tensor, torch.Tensor]) -> None:
-        def work() -> tuple[dict[str, float], PixelEncoder]:
-            return self._train_step(*batch)
-
-        if not self.config.background:
-            self._pending = run_now(work)
-            return
-        if self._thread is None:
-            self._thread = UpdateThread()
-            weakref.finalize(self, self._thread.close)
-        self._pending = self._thread.submit(work)
-
-    def _publish(self) -> None:
-        """Wait for the step in flight, if any, and make its weights the features' weights."""
-        if self._pending is None:
-            return
-        start = time.perf_counter()
-        try:
-            metrics, encoder = self._pending.result()
-        except Exception as exc:  # kept, then raised with the fix
-            self._failure, self._pending = exc, None
-            self._raise_failure()
-        self._pending = None
-        self.published = encoder
-        self.updates += 1
-        self.last_metrics = {**metrics, "wait_ms": 1000.0 * (time.perf_counter() - start)}
-
-    def _raise_failure(self) -> None:
-        pending = self._pending
-        if pending is not None and pending.done() and pending.exception() is not None:
-            self._failure, self._pending = pending.exception(), None
-        if self._failure is not None:
-            raise RuntimeError(
-                f"CuriosityModel's gradient step failed ({type(self._failure).__name__}: "
-                f"{self._failure}). Its weights may be half-updated, so it stops here: build a "
-                "new model or load_state_dict() a saved one (for a non-finite loss, lower "
-                "CuriosityConfig.lr)."
-            ) from self._failure
-
-    def wait(self) -> None:
-        """Block until the gradient step in flight (if any) has run; it is still published at its
-        due ``watch`` call, so waiting changes no result."""
-        if self._pending is not None:
-            self._pending.exception()
-
-    def close(self) -> None:
-        """Stop the update thread after the step in progress (its result is kept)."""
-        if self._thread is not None:
-            self._thread.close()
-            self._thread = None
-
-    def __getstate__(self) -> dict[str, Any]:
-        """Pickle without the thread: the step in flight is waited for and kept unpublished."""
-        self.wait()
-        state = {**self.__dict__, "_thread": None, "_pending": None}
-        pending = self._pending
-        if pending is not None and pending.exception() is not None:
-            state["_failure"] = pending.exception()
-        elif pending is not None:
-            state["_pending_result"] = pending.result()
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        result = state.pop("_pending_result", None)
-        self.__dict__.update(state)
-        if result is not None:
-            self._pending = run_now(lambda: result)
-
-    def update(self) -> dict[str, float]:
-        """One Adam step of L_tran + L_con on a batch from the buffer, now, on this thread, its
-        weights published at once (a step in flight is published first); returns its metrics."""
-        self._raise_failure()
-        self._publish()
-        batch = self._sample()
-        self._pending = run_now(lambda: self._train_step(*batch))
-        self._publish()
-        return self.last_metrics
 
     def _train_step(
         self, window: torch.Tensor, action: torch.Tensor
@@ -564,45 +375,24 @@ class CuriosityModel:
         metrics["update_ms"] = 1000.0 * (time.perf_counter() - start)
         return metrics, frozen_copy(self.encoder)
 
-    def state_dict(self) -> dict[str, Any]:
-        """Weights (trained and published), optimizer, counters and RNG states (not the frame
-        buffer); waits for the step in flight, which stays unpublished."""
-        self.wait()
-        self._raise_failure()
-        pending = None if self._pending is None else self._pending.result()[0]
+    def _trained(self) -> PixelEncoder:
+        return self.encoder
+
+    def _modules_state(self) -> dict[str, Any]:
         return {
             "encoder": self.encoder.state_dict(),
-            "published": self.published.state_dict(),
-            "pending_metrics": pending,
             "momentum": self.momentum.state_dict(),
             "transition": self.transition.state_dict(),
             "similarity": self.similarity.state_dict(),
             "optimizer": self.optimizer.state_dict(),
-            "watch_calls": self.watch_calls,
-            "updates": self.updates,
-            "rng": self.rng.bit_generator.state,
-            "generator": self.generator.get_state(),
         }
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned (the buffer refills from new transitions);
-        clears a failure."""
-        self.wait()
+    def _load_modules_state(self, state: dict[str, Any]) -> None:
         self.encoder.load_state_dict(state["encoder"])
-        self.published = frozen_copy(self.encoder)
-        self.published.load_state_dict(state.get("published", state["encoder"]))
-        self._failure = None
-        self._pending = None
-        if state.get("pending_metrics") is not None:
-            self._pending = run_now(lambda: (state["pending_metrics"], frozen_copy(self.encoder)))
         self.momentum.load_state_dict(state["momentum"])
         self.transition.load_state_dict(state["transition"])
         self.similarity.load_state_dict(state["similarity"])
         self.optimizer.load_state_dict(state["optimizer"])
-        self.watch_calls = int(state["watch_calls"])
-        self.updates = int(state["updates"])
-        self.rng.bit_generator.state = state["rng"]
-        self.generator.set_state(state["generator"])
 
 
 class AgentFeatures:

@@ -131,9 +131,11 @@ def test_wrong_observations_are_refused_with_the_fix():
     with pytest.raises(TypeError, match="FeatureSource"):
         ConsistencyCuriosityReward(cartpole(), features="encoder")
     source = ProjectionFeatures(3 * SIZE * SIZE)
-    with pytest.raises(ValueError, match=r"scale and decay must be numbers >= 0.*scale=0.2"):
+    with pytest.raises(ValueError, match=r"scale must be a finite number >= 0.*scale=0.2"):
         ConsistencyCuriosityReward(cartpole(), source, scale=-0.2)
-    with pytest.raises(ValueError, match=r"scale and decay must be numbers >= 0"):
+    with pytest.raises(ValueError, match=r"scale must be a finite number >= 0"):
+        ConsistencyCuriosityVectorReward(make_vec(1), source, scale=float("inf"))
+    with pytest.raises(ValueError, match=r"decay must be a number >= 0.*decay=2e-5"):
         ConsistencyCuriosityVectorReward(make_vec(1), source, decay=float("nan"))
 
 
@@ -245,7 +247,7 @@ def test_passes_check_env_and_rebuilds_from_its_spec():
     env = ConsistencyCuriosityReward(cartpole(), source, scale=0.5)
     check_env(env, skip_render_check=True)
     rebuilt = gym.make(env.spec)
-    assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.curiosity.scale == 0.5
+    assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.scale == 0.5
     # a wrapper above deep-copies the spec, but not the feature source (a model's weights, buffer)
     above = gym.make(gym.wrappers.RecordEpisodeStatistics(env).spec)
     assert above.env.curiosity.features is source and rebuilt.curiosity.features is source

@@ -1,0 +1,308 @@
+"""Models that learn online beside an env, for the intrinsic-reward wrappers: a gradient step
+every few env steps, taken in one background thread, its weights published whole.
+
+:class:`OnlineModel` holds the schedule that ``CuriosityModel`` (Eq. 13's features) and
+``RNDModel`` (random network distillation) share; each subclass says only what it stores, how it
+samples a batch and what one gradient step does.
+"""
+
+from __future__ import annotations
+
+import copy
+import queue
+import threading
+import time
+import weakref
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+__all__ = ["OnlineModel", "UpdateThread", "default_device", "frozen_copy", "run_now"]
+
+
+def default_device(device: str | torch.device | None) -> torch.device:
+    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+
+
+class UpdateThread:
+    """One daemon thread that runs the gradient steps handed to it, one at a time, in order.
+
+    Its queue holds at most one job (``OnlineModel`` waits for an update before handing over
+    the next), so updates can never pile up behind a slow trainer. A job's exception is kept in
+    its ``Future`` for the caller to raise.
+    """
+
+    def __init__(self) -> None:
+        self.jobs: queue.Queue[tuple[Callable[[], Any], Future] | None] = queue.Queue(maxsize=1)
+        self.thread = threading.Thread(
+            target=self._run, args=(self.jobs,), name="simoun-online-update", daemon=True
+        )
+        self.thread.start()
+
+    @staticmethod
+    def _run(jobs: queue.Queue) -> None:
+        # A static method that drops each job once done: between jobs the thread holds the queue
+        # but not the model, so a model nobody closed is still freed (and its finalizer stops us).
+        while (job := jobs.get()) is not None:
+            work, future = job
+            del job
+            if future.set_running_or_notify_cancel():
+                try:
+                    future.set_result(work())
+                except BaseException as exc:  # handed to the caller's thread, raised there
+                    future.set_exception(exc)
+            del work, future
+
+    def submit(self, work: Callable[[], Any]) -> Future:
+        future: Future = Future()
+        self.jobs.put((work, future))
+        return future
+
+    def close(self) -> None:
+        """Let the job in progress finish, then stop the thread."""
+        if self.thread.is_alive():
+            self.jobs.put(None)
+            # The model's finalizer may run on this thread (the last reference dropped there).
+            if threading.current_thread() is not self.thread:
+                self.thread.join()
+
+
+def run_now(work: Callable[[], Any]) -> Future:
+    """``work()`` on the caller's thread, its result or exception in a done ``Future``."""
+    future: Future = Future()
+    future.set_running_or_notify_cancel()
+    try:
+        future.set_result(work())
+    except Exception as exc:  # raised where a background failure would be
+        future.set_exception(exc)
+    return future
+
+
+def frozen_copy(module: nn.Module) -> nn.Module:
+    """A copy of ``module`` that no optimizer holds: the published weights rewards come from."""
+    snapshot = copy.deepcopy(module)
+    for parameter in snapshot.parameters():
+        parameter.grad = None
+        parameter.requires_grad_(False)
+    return snapshot
+
+
+class OnlineModel(ABC):
+    """The online-training schedule of an intrinsic-reward model.
+
+    The wrappers hand every transition to :meth:`watch`; the model stores it (``_store``) and
+    every ``config.update_every`` calls, once ``config.learning_starts`` transitions are stored,
+    samples a batch (``_sample``, on the caller's thread) and takes one gradient step on it
+    (``_train_step``), in a background thread when ``config.background``. The step due at watch
+    call ``k`` is published at the next due call, ``k + update_every``, where ``watch`` waits for
+    it if it has not finished. Rewards always come from :attr:`published`, a frozen copy of the
+    trained module, never from a module half-way through a step, so with a seed the rewards are
+    the same with and without the thread, whatever its timing. A failed step is raised by the
+    first call after it failed, and the model refuses to go on until :meth:`load_state_dict`.
+
+    Subclasses set ``config`` (with ``update_every``, ``learning_starts``, ``background``,
+    ``batch_size``, ``lr``, ``seed``), ``device``, ``size`` (transitions stored), call
+    :meth:`_init_schedule` once their modules exist, and define ``_store``, ``_sample``,
+    ``_train_step``, ``_trained`` and ``_modules_state`` / ``_load_modules_state``.
+    """
+
+    config: Any
+    device: torch.device
+    size: int
+
+    def _init_schedule(self, published: nn.Module) -> None:
+        """Counters, RNGs, and the first published weights (a frozen copy of ``published``)."""
+        self.generator = torch.Generator(self.device)
+        self.rng = np.random.default_rng(self.config.seed)
+        self.generator.manual_seed(int(self.rng.integers(2**62)))
+        self.watch_calls = 0
+        self.published = frozen_copy(published)
+        """the module rewards come from; replaced, never modified"""
+        self.updates = 0
+        self.last_metrics: dict[str, float] = {}
+        self._pending: Future | None = None
+        self._failure: BaseException | None = None
+        self._thread: UpdateThread | None = None
+
+    @abstractmethod
+    def _store(self, triplets: np.ndarray, actions: np.ndarray, next_triplets: np.ndarray) -> None:
+        """Keep a batch of checked transitions in the buffer and raise ``size``."""
+
+    @abstractmethod
+    def _sample(self) -> tuple[torch.Tensor, ...]:
+        """A batch copied out of the buffer, on the caller's thread (the buffer keeps filling)."""
+
+    @abstractmethod
+    def _train_step(self, *batch: torch.Tensor) -> tuple[dict[str, float], nn.Module]:
+        """One gradient step: its metrics and a frozen copy of the new weights."""
+
+    @abstractmethod
+    def _trained(self) -> nn.Module:
+        """The module the optimizer trains (whose frozen copies are published)."""
+
+    @abstractmethod
+    def _modules_state(self) -> dict[str, Any]:
+        """The state of the modules and the optimizer, for :meth:`state_dict`."""
+
+    @abstractmethod
+    def _load_modules_state(self, state: dict[str, Any]) -> None:
+        """Load what :meth:`_modules_state` returned."""
+
+    @abstractmethod
+    def _check(self, triplets: np.ndarray, name: str) -> np.ndarray:
+        """``triplets`` as an array, or an error naming ``name`` and the expected shape."""
+
+    def watch(
+        self,
+        triplets: np.ndarray,
+        actions: np.ndarray,
+        next_triplets: np.ndarray,
+        terminated: np.ndarray,
+        truncated: np.ndarray,
+    ) -> None:
+        """Store a batch of transitions; publish the last gradient step and start the next when
+        one is due.
+
+        ``next_triplets`` must continue ``triplets`` (same episode), as the wrappers guarantee.
+        ``terminated``/``truncated`` are accepted for the wrappers' hook and not needed.
+        """
+        self._raise_failure()
+        triplets = self._check(triplets, "triplets")
+        next_triplets = self._check(next_triplets, "next_triplets")
+        self._store(triplets, actions, next_triplets)
+        self.watch_calls += 1
+        if self.watch_calls % self.config.update_every == 0:
+            self._publish()
+            if self.size >= self.config.learning_starts:
+                self._start(self._sample())
+
+    @property
+    def pending(self) -> bool:
+        """True while a gradient step has been started and its weights are not yet published."""
+        return self._pending is not None
+
+    def _need_batch(self) -> None:
+        if self.size < self.config.batch_size:
+            raise RuntimeError(
+                f"{type(self).__name__}.update needs {self.config.batch_size} stored "
+                f"transitions, has {self.size}; call watch() more first."
+            )
+
+    def _start(self, batch: tuple[torch.Tensor, ...]) -> None:
+        def work() -> tuple[dict[str, float], nn.Module]:
+            return self._train_step(*batch)
+
+        if not self.config.background:
+            self._pending = run_now(work)
+            return
+        if self._thread is None:
+            self._thread = UpdateThread()
+            weakref.finalize(self, self._thread.close)
+        self._pending = self._thread.submit(work)
+
+    def _publish(self) -> None:
+        """Wait for the step in flight, if any, and make its weights the published ones."""
+        if self._pending is None:
+            return
+        start = time.perf_counter()
+        try:
+            metrics, module = self._pending.result()
+        except Exception as exc:  # kept, then raised with the fix
+            self._failure, self._pending = exc, None
+            self._raise_failure()
+        self._pending = None
+        self.published = module
+        self.updates += 1
+        self.last_metrics = {**metrics, "wait_ms": 1000.0 * (time.perf_counter() - start)}
+
+    def _raise_failure(self) -> None:
+        pending = self._pending
+        if pending is not None and pending.done() and pending.exception() is not None:
+            self._failure, self._pending = pending.exception(), None
+        if self._failure is not None:
+            name = type(self).__name__
+            raise RuntimeError(
+                f"{name}'s gradient step failed ({type(self._failure).__name__}: "
+                f"{self._failure}). Its weights may be half-updated, so it stops here: build a "
+                f"new model or load_state_dict() a saved one (for a non-finite loss, lower "
+                f"{type(self.config).__name__}.lr)."
+            ) from self._failure
+
+    def wait(self) -> None:
+        """Block until the gradient step in flight (if any) has run; it is still published at its
+        due ``watch`` call, so waiting changes no result."""
+        if self._pending is not None:
+            self._pending.exception()
+
+    def close(self) -> None:
+        """Stop the update thread after the step in progress (its result is kept)."""
+        if self._thread is not None:
+            self._thread.close()
+            self._thread = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle without the thread: the step in flight is waited for and kept unpublished."""
+        self.wait()
+        state = {**self.__dict__, "_thread": None, "_pending": None}
+        pending = self._pending
+        if pending is not None and pending.exception() is not None:
+            state["_failure"] = pending.exception()
+        elif pending is not None:
+            state["_pending_result"] = pending.result()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        result = state.pop("_pending_result", None)
+        self.__dict__.update(state)
+        if result is not None:
+            self._pending = run_now(lambda: result)
+
+    def update(self) -> dict[str, float]:
+        """One gradient step on a batch from the buffer, now, on this thread, its weights
+        published at once (a step in flight is published first); returns its metrics."""
+        self._raise_failure()
+        self._publish()
+        batch = self._sample()
+        self._pending = run_now(lambda: self._train_step(*batch))
+        self._publish()
+        return self.last_metrics
+
+    def state_dict(self) -> dict[str, Any]:
+        """Weights (trained and published), optimizer, counters and RNG states (not the
+        buffer); waits for the step in flight, which stays unpublished."""
+        self.wait()
+        self._raise_failure()
+        pending = None if self._pending is None else self._pending.result()[0]
+        return {
+            **self._modules_state(),
+            "published": self.published.state_dict(),
+            "pending_metrics": pending,
+            "watch_calls": self.watch_calls,
+            "updates": self.updates,
+            "rng": self.rng.bit_generator.state,
+            "generator": self.generator.get_state(),
+        }
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore what :meth:`state_dict` returned (the buffer refills from new transitions);
+        clears a failure."""
+        self.wait()
+        self._load_modules_state(state)
+        self.published = frozen_copy(self._trained())
+        if "published" in state:  # states saved before the published weights were kept
+            self.published.load_state_dict(state["published"])
+        self._failure = None
+        self._pending = None
+        if state.get("pending_metrics") is not None:
+            self._pending = run_now(
+                lambda: (state["pending_metrics"], frozen_copy(self._trained()))
+            )
+        self.watch_calls = int(state["watch_calls"])
+        self.updates = int(state["updates"])
+        self.rng.bit_generator.state = state["rng"]
+        self.generator.set_state(state["generator"])
