@@ -292,6 +292,7 @@ def train_rules() -> dict[str, Rule]:
     positive = integer(1)
     return {
         "env": text(fix="e.g. --env dm_control/cartpole-swingup-v0"),
+        "env_module": text(optional=True, fix="e.g. --env-module minigrid, or none"),
         "env_kwargs": json_object(fix='e.g. --env-kwargs \'{"config": {"lanes_count": 3}}\''),
         "preset": Rule(f"none or one of {', '.join(PRESETS)}", lambda v: v is None or v in PRESETS),
         "seed": Rule(

@@ -14,6 +14,7 @@ from simoun_agent.run.presets import PRESETS, SetupError, config_fields, resolve
 
 BAD = {
     "env": "",
+    "env_module": "",
     "env_kwargs": [1, 2],
     "preset": "fast",
     "seed": -1,

@@ -4,12 +4,18 @@ import json
 
 import pytest
 
+from simoun_agent.recipes import RECIPES, Recipe
 from simoun_agent.run.presets import (
+    CPU_PRESET_TIME,
     PAPER_ACTION_REPEAT,
     PRESETS,
+    RESUMABLE_FIELDS,
+    Preset,
     SetupError,
+    TrainConfig,
     config_fields,
     from_dict,
+    from_flat,
     parse_value,
     resolve,
     to_dict,
@@ -86,8 +92,90 @@ def test_bad_value_names_the_key():
 
 
 def test_unknown_key_suggests_the_close_one():
-    with pytest.raises(SetupError, match=r"did you mean agent\.batch_size"):
+    with pytest.raises(SetupError, match=r"did you mean agent\.batch_size\?"):
         resolve(None, {"agent.bach_size": 64})
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        ("agent.learning_rate", "agent.lr"),  # letters alone pointed at agent.n_step
+        ("learning-rate", "agent.lr"),
+        ("agent.batch", "agent.batch_size"),
+        ("agent.batch-size", "agent.batch_size"),  # the flag's spelling
+        ("batch", "agent.batch_size"),
+        ("agent.gamma", "agent.discount"),  # only the field's docstring says gamma
+        ("agent.tau", "agent.critic_tau or agent.encoder_tau"),
+        ("seeds", "seed"),
+        ("agent.seed", "seed"),
+        ("agent.lr_alpha", "agent.alpha_lr"),
+        ("threads", "torch_threads"),
+        ("frame_skip", "action_repeat"),
+        ("total_steps", "total_env_steps"),
+    ],
+)
+def test_misspelled_keys_suggest_the_field_meant_by_words_and_docs(typed, meant):
+    with pytest.raises(SetupError) as error:
+        resolve(None, {typed: 1})
+    assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)
+
+
+def test_a_misspelled_key_in_a_preset_is_refused_with_the_close_match(monkeypatch):
+    cpu = PRESETS["cpu"]
+    broken = {**cpu.overrides, "agent": {**cpu.overrides["agent"], "bach_size": 32}}
+    monkeypatch.setitem(PRESETS, "cpu", Preset(cpu.description, broken, cpu.envs))
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {})
+    message = str(error.value)
+    assert message.startswith("preset 'cpu': unknown config key agent.bach_size")
+    assert "did you mean agent.batch_size?" in message and "PRESETS" in message
+
+
+def test_a_misspelled_key_in_a_recipe_is_refused_with_the_close_match(monkeypatch):
+    drq = RECIPES["drq"]
+    monkeypatch.setitem(RECIPES, "drq", Recipe(drq.description, {**drq.values, "gamma": 0.9}))
+    for preset, overrides in ((None, {"agent.recipe": "drq"}), ("cpu", {"agent.recipe": "drq"})):
+        with pytest.raises(SetupError) as error:
+            resolve(preset, overrides)
+        message = str(error.value)
+        assert message.startswith("recipe 'drq': unknown config key agent.gamma")
+        assert "did you mean agent.discount?" in message and "RECIPES" in message
+
+
+def test_every_shipped_preset_and_recipe_resolves():
+    env = {"highway": "highway-v0"}
+    for name in PRESETS:
+        assert resolve(name, {"env": env.get(name, resolve(name, {}).env)}).preset == name
+    for name in RECIPES:
+        assert resolve(None, {"agent.recipe": name}).agent.recipe == name
+
+
+def test_flat_values_with_an_unknown_key_are_refused_not_dropped():
+    with pytest.raises(SetupError, match=r"unknown config key agent\.learning_rate"):
+        from_flat({"agent.learning_rate": 1e-3})
+
+
+def test_module_colon_id_imports_the_module_and_is_saved_as_env_module():
+    config = resolve(None, {"env": "minigrid:MiniGrid-DoorKey-6x6-v0"})
+    assert (config.env, config.env_module) == ("MiniGrid-DoorKey-6x6-v0", "minigrid")
+    assert to_dict(config)["env_module"] == "minigrid"
+    assert from_dict(to_dict(config)) == config
+    same = resolve(None, {"env": "MiniGrid-DoorKey-6x6-v0", "env_module": "minigrid"})
+    assert same == config
+    with pytest.raises(SetupError, match="names the module 'minigrid' but --env-module is 'x'"):
+        resolve(None, {"env": "minigrid:MiniGrid-DoorKey-6x6-v0", "env_module": "x"})
+
+
+def test_torch_threads_is_resumable_and_what_the_agent_learns_is_not():
+    assert "torch_threads" in RESUMABLE_FIELDS
+    assert not {"seed", "env", "env_module", "env_kwargs", "image_size"} & set(RESUMABLE_FIELDS)
+    assert not any(key.startswith("agent.") for key in RESUMABLE_FIELDS)
+
+
+def test_the_cpu_preset_quotes_the_measured_wall_time():
+    assert CPU_PRESET_TIME in PRESETS["cpu"].description
+    assert "30 min" not in PRESETS["cpu"].description
+    assert TrainConfig().env_module is None
 
 
 def test_preset_for_another_task_is_refused_with_the_fitting_presets():

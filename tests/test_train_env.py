@@ -90,6 +90,51 @@ def test_discrete_actions_are_refused_with_the_fix():
         make_env(resolve(None, {"env": "highway-v0"}))
 
 
+def test_module_colon_id_imports_the_package_that_registers_it():
+    # MiniGrid registers its ids when minigrid is imported; its actions are discrete, so the
+    # env is made and then refused for that (and not for an unknown id), without a highway hint
+    config = resolve(None, {"env": "minigrid:MiniGrid-DoorKey-6x6-v0"})
+    with pytest.raises(SetupError) as error:
+        make_env(config)
+    assert "MiniGrid-DoorKey-6x6-v0 has action space Discrete(7)" in str(error.value)
+    assert "continuous actions" in str(error.value) and "highway" not in str(error.value)
+
+
+def test_a_missing_env_module_is_refused_with_the_pip_hint():
+    config = resolve(None, {"env": "simoun_no_such_package:Thing-v0"})
+    with pytest.raises(SetupError, match=r"'simoun_no_such_package' is not installed.*pip install"):
+        make_env(config)
+    with pytest.raises(SetupError, match=r"did not register it; did you mean MiniGrid-DoorKey-6x6"):
+        make_env(resolve(None, {"env": "MiniGrid-DoorKy-6x6-v0", "env_module": "minigrid"}))
+
+
+def test_unknown_env_kwargs_are_refused_naming_the_key_and_the_accepted_ones():
+    config = resolve(None, {"env": POINT_REACH_ID, "env_kwargs": {"sise": 40}, "image_size": 32})
+    with pytest.raises(SetupError) as error:
+        make_env(config)
+    assert str(error.value) == (
+        f"--env-kwargs: {POINT_REACH_ID} takes no keyword 'sise' (did you mean 'size'?); it "
+        "accepts: max_steps, size, step_size"
+    )
+    highway = resolve(None, {"env": "highway-fast-v0", "env_kwargs": {"foo": 1}})
+    with pytest.raises(SetupError, match=r"highway-fast-v0 takes no keyword 'foo'; it accepts: "):
+        make_env(highway)
+    with pytest.raises(SetupError, match=r"--env-kwargs sets render_mode='human'.*drop it"):
+        make_env(resolve(None, {"env": "Pendulum-v1", "env_kwargs": {"render_mode": "human"}}))
+    accepted = resolve(None, {"env": POINT_REACH_ID, "env_kwargs": {"size": 40}, "image_size": 32})
+    assert make_env(accepted).unwrapped.size == 40
+
+
+def test_env_kwargs_passed_on_to_the_env_are_refused_when_it_rejects_them():
+    # shimmy's dm_control creator takes **kwargs, so only making the env finds the bad key
+    config = resolve("cpu", {"env_kwargs": {"foo": 1}})
+    with pytest.raises(SetupError) as error:
+        make_env(config)
+    message = str(error.value)
+    assert message.startswith('--env-kwargs {"foo": 1} does not fit dm_control/cartpole-swingup')
+    assert "unexpected keyword argument 'foo'" in message and "task_kwargs" in message
+
+
 def _drive(env, action, steps):
     episode = DrivingEpisode()
     env.reset(seed=3)

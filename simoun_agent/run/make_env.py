@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import difflib
 import importlib
+import inspect
+import json
 from collections.abc import Callable
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.envs.registration import load_env_creator
 from gymnasium.wrappers import RescaleAction
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
@@ -35,56 +38,156 @@ of its size) and ``scaling`` is pixels per metre, scaled with the image size."""
 _SUITES = {"dm_control/": ("shimmy", "dmc"), "": ("highway_env", "highway")}
 
 
-def ensure_registered(env_id: str) -> None:
-    """Import the suite that registers ``env_id``; raise SetupError with close matches if none.
+def import_env_module(module: str) -> None:
+    """Import ``module`` (``--env-module`` or the MODULE of ``--env MODULE:ID``), whose import
+    registers ids; raise SetupError with the pip hint when it is not installed."""
+    try:
+        importlib.import_module(module)
+    except ModuleNotFoundError as err:
+        missing = err.name or module
+        if not (module == missing or module.startswith(missing + ".")):
+            raise SetupError(
+                f"importing --env-module {module!r} failed: it needs {missing!r}, which is not "
+                f"installed; pip install {missing.split('.')[0].replace('_', '-')}"
+            ) from None
+        raise SetupError(
+            f"--env-module {module!r} is not installed, so the ids it registers are unknown; "
+            f"pip install {missing.split('.')[0].replace('_', '-')} (or the package that "
+            f"provides {module}), or drop the module from --env"
+        ) from None
 
-    dm_control ids are registered by shimmy and highway-env ids by highway_env, on import.
+
+def ensure_registered(env_id: str, module: str | None = None) -> None:
+    """Import ``module`` and the suite that registers ``env_id``; raise SetupError with close
+    matches if the id is still unknown.
+
+    dm_control ids are registered by shimmy and highway-env ids by highway_env, on import; other
+    packages by the ``module`` named with ``--env-module`` (or ``--env MODULE:ID``).
     """
+    if module is not None:
+        import_env_module(module)
     if env_id in gym.registry:
         return
-    for prefix, (module, extra) in _SUITES.items():
+    for prefix, (suite, extra) in _SUITES.items():
         if not env_id.startswith(prefix):
             continue
         try:
-            importlib.import_module(module)
+            importlib.import_module(suite)
         except ImportError:
             if prefix:
                 raise SetupError(
-                    f"{env_id!r} needs {module}, which is not installed; "
+                    f"{env_id!r} needs {suite}, which is not installed; "
                     f'pip install "simoun[{extra}]"'
                 ) from None
         if env_id in gym.registry:
             return
     matches = difflib.get_close_matches(env_id, list(gym.registry), n=5, cutoff=0.6)
     hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
+    if module is not None:
+        raise SetupError(
+            f"unknown environment id {env_id!r}: importing {module!r} did not register it; "
+            f"{hint} Pass an id that {module} registers."
+        )
     raise SetupError(
         f"unknown environment id {env_id!r}; {hint} Pass a registered Gymnasium id "
-        "(e.g. dm_control/cartpole-swingup-v0, highway-v0, simoun/PointReach-v0)."
+        "(e.g. dm_control/cartpole-swingup-v0, highway-v0, simoun/PointReach-v0), or "
+        "MODULE:ID (--env minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
+        "on import."
+    )
+
+
+def env_keywords(env_id: str) -> tuple[list[str], bool]:
+    """The keyword arguments ``gym.make(env_id, ...)`` passes on to the env's creator (its
+    registered kwargs and the creator's named parameters), and whether it takes any others
+    (``**kwargs``). Raises SetupError when the creator cannot be loaded (a missing extra)."""
+    spec = gym.spec(env_id)
+    try:
+        creator = (
+            spec.entry_point if callable(spec.entry_point) else load_env_creator(spec.entry_point)
+        )
+    except gym.error.DependencyNotInstalled as err:
+        raise SetupError(f"{env_id} cannot be made: {err}") from None
+    try:
+        parameters = inspect.signature(creator).parameters.values()
+    except (TypeError, ValueError):  # a builtin or C extension: nothing to read
+        return sorted(spec.kwargs), True
+    named = [
+        p.name
+        for p in parameters
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name != "self"
+    ]
+    open_ended = any(p.kind is p.VAR_KEYWORD for p in parameters)
+    return sorted({*spec.kwargs, *named}), open_ended
+
+
+def check_env_kwargs(env_id: str, kwargs: dict) -> None:
+    """Refuse ``--env-kwargs`` keys that the env's creator does not take, before it is made,
+    naming the accepted ones; ``render_mode`` is refused too (simoun sets rgb_array)."""
+    if "render_mode" in kwargs:
+        raise SetupError(
+            f"--env-kwargs sets render_mode={kwargs['render_mode']!r}; simoun makes {env_id} "
+            "with render_mode='rgb_array' itself (it learns from the rendered frames): drop it"
+        )
+    accepted, open_ended = env_keywords(env_id)
+    unknown = [key for key in kwargs if key not in accepted]
+    if unknown and not open_ended:
+        close = {key: difflib.get_close_matches(key, accepted, n=1) for key in unknown}
+        named = ", ".join(
+            repr(key) + (f" (did you mean {close[key][0]!r}?)" if close[key] else "")
+            for key in unknown
+        )
+        listed = ", ".join(key for key in accepted if key != "render_mode") or "none"
+        raise SetupError(f"--env-kwargs: {env_id} takes no keyword {named}; it accepts: {listed}")
+
+
+def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
+    """The SetupError for a TypeError that gym.make raised over a keyword (an env whose creator
+    takes ``**kwargs`` and passes them on, e.g. shimmy's dm_control envs)."""
+    accepted, _ = env_keywords(env_id)
+    listed = ", ".join(key for key in accepted if key != "render_mode")
+    known = f"; its creator names {listed}" if listed else ""
+    message = str(err).split(" was raised from the environment creator")[0]
+    return SetupError(
+        f"--env-kwargs {json.dumps(kwargs)} does not fit {env_id} ({message}){known}. Fix or "
+        "drop --env-kwargs"
     )
 
 
 def _make_base(config: TrainConfig) -> gym.Env:
     """``gym.make`` the env with rgb_array rendering at the run's image size."""
-    ensure_registered(config.env)
+    ensure_registered(config.env, config.env_module)
+    check_env_kwargs(config.env, config.env_kwargs)
     kwargs = dict(config.env_kwargs)
     if config.env.startswith("dm_control/"):
         render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
         kwargs.setdefault("render_kwargs", render)
     try:
-        return gym.make(config.env, render_mode="rgb_array", **kwargs)
+        try:
+            return gym.make(config.env, render_mode="rgb_array", **kwargs)
+        except TypeError as err:
+            if "render_mode" not in str(err):
+                raise
+        # an env whose creator takes no render_mode: it may still return image observations
+        return gym.make(config.env, **kwargs)
     except TypeError as err:
-        if "render_mode" not in str(err):
-            raise SetupError(f"gymnasium.make({config.env!r}, ...) failed: {err}") from None
-    return gym.make(config.env, **kwargs)
+        if "keyword argument" in str(err):
+            raise _refused_kwargs(config.env, config.env_kwargs, err) from None
+        raise SetupError(f"gymnasium.make({config.env!r}, ...) failed: {err}") from None
+    except gym.error.DependencyNotInstalled as err:
+        raise SetupError(f"{config.env} cannot be made: {err}") from None
 
 
 def _check_env(env: gym.Env, env_id: str) -> None:
     if not isinstance(env.action_space, spaces.Box) or len(env.action_space.shape) != 1:
+        highway = (
+            "; for highway-env use --preset highway, or --env-kwargs "
+            '\'{"config": {"action": {"type": "ContinuousAction"}}}\''
+            if is_highway(env_id)
+            else ""
+        )
         raise SetupError(
             f"{env_id} has action space {env.action_space}; the Simoun agent is a SAC agent for "
-            "continuous actions and needs a 1-D Box. Pick a continuous-control env; for "
-            "highway-env use --preset highway, or --env-kwargs "
-            '\'{"config": {"action": {"type": "ContinuousAction"}}}\'.'
+            f"continuous actions and needs a 1-D Box. Pick a continuous-control env{highway}."
         )
     if not np.all(np.isfinite(env.action_space.low) & np.isfinite(env.action_space.high)):
         raise SetupError(

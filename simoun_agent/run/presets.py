@@ -22,6 +22,7 @@ from typing import Any
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.config_checks import check_train_config
+from simoun_agent.run.key_match import did_you_mean
 
 
 class SetupError(ValueError):
@@ -61,7 +62,12 @@ class TrainConfig:
     """Everything a training run needs; saved with the run as ``config.json``."""
 
     env: str = "dm_control/cartpole-swingup-v0"
-    """Gymnasium id: a dm_control task through shimmy, a highway-env id, any pixel/renderable env"""
+    """Gymnasium id: a dm_control task through shimmy, a highway-env id, any pixel/renderable env;
+    MODULE:ID (Gymnasium's form, e.g. minigrid:MiniGrid-DoorKey-6x6-v0) imports MODULE first and
+    is saved as env ID plus env_module MODULE"""
+    env_module: str | None = None
+    """module imported before the env is made, for ids that a package registers on import (e.g.
+    ale_py, minigrid); saved with the run, so --resume and simoun-eval import it too"""
     env_kwargs: dict = field(default_factory=dict)
     """extra keyword arguments for gymnasium.make (JSON on the command line)"""
     preset: str | None = None
@@ -69,7 +75,8 @@ class TrainConfig:
     seed: int = 1
     """seed of the environments, the replay, torch, numpy and python"""
     action_repeat: int | None = None
-    """env steps per agent decision; None: the paper's value for its six DMC tasks, else 1"""
+    """env steps per agent decision (frame skip); None: the paper's value for its six DMC tasks,
+    else 1"""
     image_size: int = 84
     """height and width of each camera view fed to the agent"""
     grayscale: bool = False
@@ -84,9 +91,9 @@ class TrainConfig:
     updates_per_step: int = 1
     """gradient updates per agent decision once learning has started"""
     replay_capacity: int = 100_000
-    """transitions kept in the replay"""
+    """transitions kept in the replay buffer"""
     eval_every: int = 10_000
-    """environment steps between evaluations"""
+    """environment steps between evaluations (run at the next episode end)"""
     eval_episodes: int = 10
     """episodes per evaluation (deterministic actions)"""
     eval_distraction: tuple[str, ...] = ()
@@ -112,6 +119,14 @@ class TrainConfig:
     """the agent's hyperparameters (simoun_agent.config.AgentConfig)"""
 
     def __post_init__(self) -> None:
+        module, env_id = split_env_id(self.env) if isinstance(self.env, str) else (None, self.env)
+        if module:
+            if self.env_module not in (None, module):
+                raise ValueError(
+                    f"--env {self.env} names the module {module!r} but --env-module is "
+                    f"{self.env_module!r}; give the module once"
+                )
+            self.env, self.env_module = env_id, module
         check_train_config(self)
 
     def resolved_action_repeat(self) -> int:
@@ -128,9 +143,19 @@ RESUMABLE_FIELDS = (
     "progress",
     "video",
     "env_process",
+    "torch_threads",
     "eval_distraction",
 )
-"""Fields a resumed run may change; every other field must match the saved config."""
+"""Fields a resumed run may change: how long and how it runs and reports, not what it learns
+(torch_threads changes speed only); every other field must match the saved config."""
+
+
+def split_env_id(env: str) -> tuple[str | None, str]:
+    """``"minigrid:MiniGrid-DoorKey-6x6-v0"`` -> ``("minigrid", "MiniGrid-DoorKey-6x6-v0")``,
+    Gymnasium's MODULE:ID form (``gym.make`` imports MODULE to register ID); ``(None, env)``
+    for a plain id."""
+    module, sep, env_id = env.rpartition(":")
+    return (module, env_id) if sep else (None, env)
 
 
 def dmc_task(env_id: str) -> str | None:
@@ -198,8 +223,12 @@ PRESETS["highway"] = Preset(
     },
     envs="highway",
 )
+CPU_PRESET_TIME = "about 40-55 min on 2 cores (measured 2026-11-29)"
+"""Wall time of one cpu-preset run (the README's three main-job runs took 39, 39 and 56 min, two
+side by side): the one figure the help text and the README quote; update both together."""
+
 PRESETS["cpu"] = Preset(
-    description="sized for 2 CPU cores (the main job, about 30 min): "
+    description=f"sized for 2 CPU cores (the main job, {CPU_PRESET_TIME}): "
     "dm_control/cartpole-swingup-v0 "
     "(action repeat 8) for 100k env steps, 48x48 frames, 16 filters, batch 64, random shift, "
     "3-step returns, one torch thread",
@@ -322,30 +351,36 @@ def _parse_one(text: str, kind: Any) -> Any:
     raise ValueError(f"unsupported type {kind}")
 
 
+HELP_FIX = "`simoun-train --help` lists every key"
+
+
+def check_keys(keys: Any, source: str = "", fix: str = HELP_FIX) -> None:
+    """Raise SetupError naming every key of ``keys`` that no config field has, each with its
+    close matches (:mod:`simoun_agent.run.key_match`); ``source`` says where the keys came from
+    (none: the user) and ``fix`` how to correct them. The user's overrides, presets and recipes
+    all pass here."""
+    known = config_fields()
+    unknown = [key for key in keys if key not in known]
+    if unknown:
+        docs = {key: doc for key, (_, _, doc) in known.items()}
+        named = ", ".join(key + did_you_mean(key, docs) for key in unknown)
+        where = f"{source}: " if source else ""
+        raise SetupError(f"{where}unknown config key {named}; {fix}")
+
+
 def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
     """Build a TrainConfig from the defaults, a preset and ``{"agent.lr": 3e-4, ...}`` overrides.
 
-    Raises SetupError for an unknown preset or key, or a preset meant for another environment.
+    Every layer (the preset, the recipe, the overrides) is checked for unknown keys the same
+    way. Raises SetupError for an unknown preset or key, or a preset meant for another
+    environment.
     """
-    known = config_fields()
-    unknown = [key for key in overrides if key not in known]
-    if unknown:
-        import difflib
-
-        hints = [difflib.get_close_matches(key, known, n=1) for key in unknown]
-        named = ", ".join(
-            key + (f" (did you mean {hint[0]}?)" if hint else "")
-            for key, hint in zip(unknown, hints, strict=True)
-        )
-        raise SetupError(f"unknown config key {named}; `simoun-train --help` lists every key")
+    check_keys(overrides)
     values: dict[str, Any] = {}
     if preset is not None:
-        if preset not in PRESETS:
-            raise SetupError(f"unknown preset {preset!r}; choose one of {', '.join(PRESETS)}")
+        values.update(preset_values(preset))
         chosen = PRESETS[preset]
-        values.update(_flatten(chosen.overrides))
-        values["preset"] = preset
-        env_id = overrides.get("env", values.get("env", TrainConfig.env))
+        env_id = split_env_id(overrides.get("env", values.get("env", TrainConfig.env)))[1]
         if not chosen.accepts(env_id):
             meant = "highway-env ids" if chosen.envs == "highway" else chosen.envs
             fitting = [name for name, other in PRESETS.items() if other.envs != "any"]
@@ -362,8 +397,19 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
     return from_flat(values)
 
 
+def preset_values(name: str) -> dict[str, Any]:
+    """The flat overrides of the preset ``name`` with ``"preset": name``; SetupError for an
+    unknown preset or a preset entry with an unknown key."""
+    if name not in PRESETS:
+        raise SetupError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
+    values = _flatten(PRESETS[name].overrides)
+    check_keys(values, f"preset {name!r}", "fix its entry in simoun_agent.run.presets.PRESETS")
+    return {**values, "preset": name}
+
+
 def recipe_values(name: str) -> dict[str, Any]:
-    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name``."""
+    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name``;
+    SetupError for an unknown recipe or a recipe entry with an unknown key."""
     from simoun_agent.recipes import RECIPES
 
     if name not in RECIPES:
@@ -375,7 +421,9 @@ def recipe_values(name: str) -> dict[str, Any]:
             + (f" (did you mean {hint[0]!r}?)" if hint else "")
             + f"; choose one of {', '.join(RECIPES)}"
         )
-    return {"agent." + key: value for key, value in RECIPES[name].values.items()}
+    values = {"agent." + key: value for key, value in RECIPES[name].values.items()}
+    check_keys(values, f"recipe {name!r}", "fix its entry in simoun_agent.recipes.RECIPES")
+    return values
 
 
 def _flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
@@ -392,7 +440,9 @@ def _flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
 
 
 def from_flat(values: dict[str, Any]) -> TrainConfig:
-    """TrainConfig from flat keys (``"agent.lr"``) over the dataclass defaults."""
+    """TrainConfig from flat keys (``"agent.lr"``) over the dataclass defaults; SetupError for a
+    key no field has (nothing is dropped silently)."""
+    check_keys(values)
     try:
         return _build(TrainConfig, "", values)
     except ValueError as err:

@@ -58,6 +58,7 @@ from simoun_agent.run.presets import (
     RESUMABLE_FIELDS,
     SetupError,
     TrainConfig,
+    check_keys,
     config_fields,
     dmc_task,
     from_dict,
@@ -556,10 +557,10 @@ def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
     given = {k: v for k, v in vars(args).items() if k in fields and k != "preset"}
     for pair in args.set:
         key, sep, value = pair.partition("=")
+        key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
         if not sep:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
-        if key not in fields:
-            resolve(None, {key: value})  # raises the unknown-key error with suggestions
+        check_keys([key])  # an unknown key fails here, with its close matches
         given[key] = value
     given = {key: ",".join(v) if isinstance(v, list) else v for key, v in given.items()}
     return {key: parse_value(key, value, fields[key][0]) for key, value in given.items()}
