@@ -191,10 +191,13 @@ def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
             assert lines[-1], "".join(lines)
             lines.append(process.stderr.readline())
         assert "SIGTERM handler" in "".join(lines)  # SDL's handler was found and replaced
-        sent = time.monotonic()
         process.send_signal(signal.SIGTERM)
-        assert process.wait(timeout=10) == 143
-        assert time.monotonic() - sent < 10
+        # 10,000 episodes take hours: exiting 143 at all means the signal stopped it, and at
+        # once means no further episode (one may have ended while the signal was on its way)
+        assert process.wait(timeout=120) == 143
+        after = process.stderr.read()
+        assert "stopped by SIGTERM" in after
+        assert after.count("episode ") <= 1, after
     finally:
         watchdog.cancel()
         process.kill()

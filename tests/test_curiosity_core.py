@@ -3,16 +3,15 @@
 import math
 import pickle
 
+import gymnasium as gym
 import numpy as np
 import pytest
 import torch
 
-from simoun_wrappers.curiosity import (
-    FeatureSource,
-    RunningMax,
-    consistency_distance,
-    consistency_reward,
-)
+import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+from simoun_wrappers import SimounObservation
+from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
+from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
 
 F_M = np.array([[1.0, -2.0, 0.5], [0.0, 0.0, 0.0]], dtype=np.float32)
 F_A = np.array(
@@ -117,12 +116,25 @@ def test_state_dict_round_trip_and_pickle():
         RunningMax().load_state_dict({"r_e_max": 1.0})
 
 
-def test_feature_source_protocol_is_runtime_checkable():
-    projection = np.random.default_rng(0).normal(size=(12, 4)).astype(np.float32)
+def test_the_wrapper_scores_a_plain_function_source_by_eq13_and_refuses_a_non_source():
+    """FeatureSource is the wrappers' contract: any callable giving (f_m, f_a) drives Eq. 13, an
+    object that is not one is refused with the protocol spelled out."""
+    projection = np.random.default_rng(0).normal(size=(16 * 16 * 3, 4)) / 500
 
     def project(triplets):
-        flat = triplets.reshape(*triplets.shape[:2], -1).astype(np.float32) @ projection
-        return flat[:, 2] - flat[:, 1], flat
+        f_a = triplets.reshape(*triplets.shape[:2], -1).astype(np.float64) @ projection
+        return (f_a[:, 2] - f_a[:, 1] + 0.3).astype(np.float32), f_a.astype(np.float32)
 
-    assert isinstance(project, FeatureSource)
-    assert not isinstance(object(), FeatureSource)
+    env = SimounObservation(gym.make("simoun/PointReach-v0"), size=16, motion=False)
+    env = ConsistencyCuriosityReward(env, project, scale=0.5, decay=1e-3, r_i_max_init=1e-3)
+    env.reset(seed=0)
+    next_obs, reward, *_, info = env.step(np.array([0.5, -0.5], np.float32))
+    f_m, f_a = (x.astype(np.float64) for x in project(next_obs["frames"][None]))
+    flow = np.abs(f_a[:, 1] - f_a[:, 0]) + np.abs(f_a[:, 2] - f_a[:, 1])
+    d = np.sqrt(((np.abs(f_m) - flow) ** 2).sum())
+    r_e = info["reward_extrinsic"]
+    expected = 0.5 * math.exp(-1e-3 * 0) * d * max(1.0, abs(r_e)) / max(1e-3, d)
+    assert info["reward_intrinsic"] == pytest.approx(expected, rel=1e-5)
+    assert reward == pytest.approx(r_e + expected, rel=1e-6)
+    with pytest.raises(TypeError, match=r"must be a FeatureSource \(callable"):
+        ConsistencyCuriosityReward(env, object())

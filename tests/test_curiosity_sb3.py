@@ -33,7 +33,7 @@ class RewardsSeen(callbacks.BaseCallback):
         return True
 
 
-def test_ppo_learns_for_a_few_hundred_steps_through_the_wrapper():
+def test_ppo_trains_on_extrinsic_plus_intrinsic_reward_through_the_wrapper():
     # SB3's NatureCNN needs frames of at least 36x36; the folded triplet is its (9, H, W) image.
     env = SimounObservation(gym.make("simoun/PointReach-v0"), size=36, fold_frames=True)
     config = CuriosityConfig(

@@ -6,6 +6,7 @@ import itertools
 import json
 import math
 
+import matplotlib.colors
 import matplotlib.image
 import numpy as np
 import pytest
@@ -86,10 +87,34 @@ def test_final_return_and_auc_are_mean_and_sample_std_over_seeds(runs_dir):
     assert single["final_return_std"] == "nan"  # one seed: no spread to report
 
 
-def test_curves_are_drawn_against_env_steps_and_wall_time(runs_dir):
+def line_pixels(image: np.ndarray, colour: str) -> int:
+    """Pixels of ``image`` drawn in matplotlib colour ``colour`` (a line's core, not its band)."""
+    rgb = np.array(matplotlib.colors.to_rgb(colour))
+    return int(np.all(np.abs(image[..., :3] - rgb) < 0.03, axis=-1).sum())
+
+
+def test_curves_are_drawn_against_env_steps_and_wall_time(runs_dir, tmp_path):
+    """The curves plot each variant's mean return over seeds at each evaluation, one line per
+    variant across the panel (far more pixels than a legend sample), and other data (the runs
+    cut at 60 env steps) draw another picture."""
+    groups = report.compare_runs(runs_dir).groups
+    bands = report.std_bands(groups, "env_step", None)["simoun-PointReach-v0"]
+    x, mean, low, high = bands["agent.lr=0.001 (n=2)"]
+    curves = [read_csv(runs_dir / name / "eval.csv") for name in ("a-s0", "a-s1")]
+    np.testing.assert_array_equal(x, [row["env_step"] for row in curves[0]])
+    by_hand = [(a["return_mean"] + b["return_mean"]) / 2 for a, b in zip(*curves, strict=True)]
+    np.testing.assert_allclose(mean, by_hand)
+    assert np.all(high - low >= 0) and np.any(high > low)
+    images = {}
     for name in (report.CURVES_STEPS_PNG, report.CURVES_TIME_PNG):
-        image = matplotlib.image.imread(runs_dir / name)
-        assert image.ndim == 3 and image.shape[0] > 100
+        images[name] = image = matplotlib.image.imread(runs_dir / name)
+        for colour in ("C0", "C1"):  # the two variants
+            assert line_pixels(image, colour) > 300, (name, colour)
+    cut = tmp_path / "cut"
+    report.write_report(runs_dir, cut, budget=("env_step", 60))
+    other = matplotlib.image.imread(cut / report.CURVES_STEPS_PNG)
+    steps = images[report.CURVES_STEPS_PNG]
+    assert other.shape != steps.shape or np.abs(other - steps).max() > 0.5
 
 
 def test_auc_is_the_normalized_trapezoid():
