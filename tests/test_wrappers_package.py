@@ -1,17 +1,48 @@
-"""The package's import-time promises: headless defaults set, torch not loaded."""
+"""The package's import-time promises: headless defaults set only without a display, SDL's
+signal handlers always off, torch not loaded."""
 
 import os
 import subprocess
 import sys
 
+import pytest
 
-def test_import_sets_headless_defaults_and_leaves_torch_unloaded():
-    code = (
-        "import os, sys, simoun_wrappers, simoun_wrappers.pettingzoo; "
-        "print(os.environ['MUJOCO_GL'], os.environ['SDL_VIDEODRIVER'], 'torch' in sys.modules)"
-    )
-    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "SDL_VIDEODRIVER")}
+RENDER_VARIABLES = ("MUJOCO_GL", "SDL_VIDEODRIVER", "SDL_NO_SIGNAL_HANDLERS")
+DISPLAYS = ("DISPLAY", "WAYLAND_DISPLAY")
+SHOW = (
+    "import os, sys, simoun_wrappers, simoun_wrappers.pettingzoo; "
+    f"print(*(os.environ.get(k, '-') for k in {RENDER_VARIABLES}), 'torch' in sys.modules)"
+)
+
+
+def import_with(**display: str) -> list[str]:
+    """What importing simoun_wrappers leaves in the environment, given only ``display``."""
+    env = {k: v for k, v in os.environ.items() if k not in RENDER_VARIABLES + DISPLAYS}
+    env.update(display)
     out = subprocess.run(
-        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        [sys.executable, "-c", SHOW], env=env, capture_output=True, text=True, timeout=300
     )
-    assert out.stdout.split() == ["egl", "offscreen", "False"]
+    assert out.returncode == 0, out.stderr
+    return out.stdout.split()
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="display rule for Linux")
+def test_import_without_a_display_sets_headless_defaults_and_leaves_torch_unloaded():
+    assert import_with() == ["egl", "offscreen", "1", "False"]
+    assert import_with(DISPLAY="") == ["egl", "offscreen", "1", "False"]  # empty is no display
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="display rule for Linux")
+@pytest.mark.parametrize("display", [{"DISPLAY": ":99"}, {"WAYLAND_DISPLAY": "wayland-9"}])
+def test_import_with_a_display_leaves_rendering_to_the_desktop(display):
+    """A fake display value: nothing connects to it, the import only reads the variable."""
+    assert import_with(**display) == ["-", "-", "1", "False"]
+
+
+def test_values_the_user_set_win():
+    env = {k: v for k, v in os.environ.items() if k not in DISPLAYS}
+    env.update(MUJOCO_GL="osmesa", SDL_VIDEODRIVER="x11", SDL_NO_SIGNAL_HANDLERS="0")
+    out = subprocess.run(
+        [sys.executable, "-c", SHOW], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert out.stdout.split() == ["osmesa", "x11", "0", "False"], out.stderr
