@@ -7,13 +7,17 @@ from typing import Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
+from simoun_wrappers.frames import refuse_over_frame_stack
+
 
 class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Apply each action ``repeat`` times, summing the rewards; stop early when an episode ends.
 
-    Returns the observation and info of the last inner step taken. Put it under the pixel
+    Returns the observation and info of the last inner step taken. It goes under the pixel
     wrappers (``SimounObservation(ActionRepeat(env, 8))``) so that the frame triplet holds
-    agent steps, as in DrQ: cartpole-swingup uses 8, walker-walk 2.
+    agent steps, as in DrQ: cartpole-swingup uses 8, walker-walk 2. Over an env that already
+    stacks frames (``SimounObservation``, ``FrameTriplet``, ``FrameStackObservation``) it
+    raises: the stack would hold consecutive env steps instead of decisions.
 
     Example:
         >>> import gymnasium as gym
@@ -38,6 +42,12 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 f"repeat must be a positive int, got {repeat!r}; e.g. ActionRepeat(env, 8) for "
                 f"cartpole-swingup, or leave the wrapper out for no repeat."
             )
+        refuse_over_frame_stack(
+            env,
+            "ActionRepeat",
+            "its frames would be consecutive env steps instead of the agent's decisions",
+            f"SimounObservation(ActionRepeat(env, {repeat}), ...) stacks one frame per decision",
+        )
         self.repeat = int(repeat)
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:

@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
-from simoun_wrappers.frames import FrameTriplet
+from simoun_wrappers.frames import refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
 if TYPE_CHECKING:
@@ -195,7 +195,13 @@ class RandomConvolution(ChainWrapper):
                 f"kernel_size must be a positive odd int, got {kernel_size!r}; use 3 as in "
                 f"Lee et al. 2020."
             )
-        check_not_stacked(env)
+        refuse_over_frame_stack(
+            env,
+            "RandomConvolution",
+            "convolving its render() would drop the triplet and its motion channels",
+            "SimounObservation(RandomConvolution(env), ...) convolves every frame of the triplet "
+            "with the episode's kernel, and motion is computed from the convolved frames",
+        )
         chain, from_render = pixel_env(env, source, owner="RandomConvolution")
         self._layout = image_layout(chain.observation_space)
         chain = TransformObservation(chain, self._convolve, chain.observation_space)
@@ -225,22 +231,3 @@ class RandomConvolution(ChainWrapper):
         self._generator.manual_seed(self._kernel_seed)
         out = random_conv(batch, self.kernel_size, self._generator, clamp=(0.0, 255.0))
         return out[0].round().to(torch.uint8).permute(1, 2, 0).reshape(image.shape).numpy()
-
-
-def check_not_stacked(env: gym.Env) -> None:
-    """Refuse an env whose observations are already frame stacks (``FrameTriplet`` inside).
-
-    ``RandomConvolution`` convolves one image: over ``SimounObservation`` it would fall back to
-    ``render()`` and silently drop the triplet and its motion channels.
-    """
-    inner = env
-    while isinstance(inner, gym.Wrapper):
-        if isinstance(inner, FrameTriplet):
-            raise TypeError(
-                f"RandomConvolution goes under the frame stack, not over it: {env} already stacks "
-                f"frames, and convolving its render() would drop the triplet and its motion "
-                f"channels. Swap the order: SimounObservation(RandomConvolution(env), ...) "
-                f"convolves every frame of the triplet with the episode's kernel, and motion is "
-                f"computed from the convolved frames."
-            )
-        inner = inner.env

@@ -10,6 +10,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from simoun_wrappers.augment import RandomConvolution
+from simoun_wrappers.frames import refuse_over_frame_stack
 from simoun_wrappers.observation import parse_size
 
 Camera = int | str | Mapping[str, Any] | Callable[[gym.Env], np.ndarray]
@@ -90,7 +92,11 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     The paper's CARLA setup, three 84x84 cameras, gives an 84 x 252 image. ``size=None`` keeps
     every view's own size, which must then agree. The wrapper's ``render()`` returns the same
     side-by-side image, so its only render mode is ``"rgb_array"``. Compose with
-    ``SimounObservation(MultiCamera(env, ...), size=None)`` to stack the wide frames.
+    ``SimounObservation(MultiCamera(env, ...), size=None)`` to stack the wide frames, and
+    ``RandomConvolution(MultiCamera(env, ...))`` to convolve them. The views are drawn from the
+    env's cameras, not from its observation, so over an env that already stacks frames or
+    applies ``RandomConvolution`` (which would be silently dropped) it raises, naming the order
+    to use.
     ``close()`` leaves the highway viewers alone: ``EnvViewer.close()`` quits pygame for all.
     The constructor resets ``env`` once (unseeded) to learn the views' sizes: highway-env has
     no road to draw before a reset.
@@ -121,6 +127,14 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         """
         gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
         gym.ObservationWrapper.__init__(self, env)
+        refuse_over_frame_stack(
+            env,
+            "MultiCamera",
+            "its views are rendered from the env's cameras, so the triplet and its motion "
+            "channels would be dropped",
+            "SimounObservation(MultiCamera(env, cameras), size=None) stacks the side-by-side views",
+        )
+        refuse_over_random_convolution(env)
         if isinstance(cameras, (str, bytes, Mapping)) or not isinstance(cameras, Sequence):
             raise TypeError(
                 f"cameras must be a list of views, got {cameras!r}; e.g. ['side', 'back'] or "
@@ -181,3 +195,18 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                 f"that every view is resized to the same size."
             )
         return np.concatenate(views, axis=1)
+
+
+def refuse_over_random_convolution(env: gym.Env) -> None:
+    """Raise TypeError when ``env`` holds a ``RandomConvolution``: views rendered from the
+    cameras never pass through it, so ``MultiCamera`` over it would silently drop it."""
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if isinstance(inner, RandomConvolution):
+            raise TypeError(
+                f"MultiCamera goes under RandomConvolution, not over it: its views are rendered "
+                f"from the env's cameras, so the convolution in {env} would never reach them. "
+                f"Swap the order: RandomConvolution(MultiCamera(env, cameras)) convolves the "
+                f"side-by-side image with the episode's kernel."
+            )
+        inner = inner.env

@@ -9,6 +9,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
+from gymnasium.wrappers import FrameStackObservation
 
 
 class FrameRing:
@@ -103,3 +104,39 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
             )
         obs, reward, terminated, truncated, info = self.env.step(action)
         return self._ring.push(obs), reward, terminated, truncated, info
+
+
+def frame_stack_in(env: gym.Env) -> gym.Wrapper | None:
+    """The outermost frame-stacking wrapper inside ``env`` (``FrameTriplet``, hence
+    ``SimounObservation``, or gymnasium's ``FrameStackObservation``), or None."""
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if isinstance(inner, (FrameTriplet, FrameStackObservation)):
+            return inner
+        inner = inner.env
+    return None
+
+
+def refuse_over_frame_stack(env: gym.Env, owner: str, why: str, right_order: str) -> None:
+    """Raise TypeError when ``env`` already stacks frames: ``owner`` belongs under the stack.
+
+    Args:
+        env: the env ``owner`` was given.
+        owner: the wrapper being built, as the user wrote it.
+        why: what would go wrong over the stack (a clause, lower case).
+        right_order: the composition to use instead, with a word on what it does.
+
+    Example:
+        >>> import gymnasium as gym
+        >>> env = FrameTriplet(gym.make("CartPole-v1"))
+        >>> refuse_over_frame_stack(env, "ActionRepeat", "it would repeat", "ActionRepeat(env)")
+        Traceback (most recent call last):
+        ...
+        TypeError: ActionRepeat goes under the frame stack, not over it: ...
+    """
+    stack = frame_stack_in(env)
+    if stack is not None:
+        raise TypeError(
+            f"{owner} goes under the frame stack, not over it: {env} already stacks frames "
+            f"({type(stack).__name__} inside), and {why}. Swap the order: {right_order}."
+        )

@@ -15,7 +15,7 @@ from gymnasium.wrappers import (
     TransformObservation,
 )
 
-from simoun_wrappers.frames import FrameTriplet
+from simoun_wrappers.frames import FrameTriplet, frame_stack_in
 from simoun_wrappers.motion import ResidualMotion
 
 _SOURCES = ("auto", "observation", "render")
@@ -70,21 +70,110 @@ def check_stack_options(
         )
 
 
+def minigrid_object_grid(env: gym.Env) -> bool:
+    """Whether ``env`` observes MiniGrid's encoded grid (object id, colour, state per cell) through
+    ``ImgObsWrapper``, with no ``RGBImgObsWrapper`` / ``RGBImgPartialObsWrapper`` under it to make
+    pixels (and no ``AddRenderObservation`` over it). Found by class, so minigrid need not be
+    installed."""
+
+    def is_minigrid(wrapper: gym.Env, *names: str) -> bool:
+        return any(
+            c.__name__ in names and c.__module__.split(".")[0] == "minigrid"
+            for c in type(wrapper).__mro__
+        )
+
+    grid = False
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if isinstance(inner, AddRenderObservation) and not grid:
+            return False
+        if is_minigrid(inner, "RGBImgObsWrapper", "RGBImgPartialObsWrapper"):
+            return False
+        grid = grid or is_minigrid(inner, "ImgObsWrapper")
+        inner = inner.env
+    return grid
+
+
+def layout_hint(space: gym.Space) -> str | None:
+    """What a uint8 ``(C, H, W)`` Box holds, and how to convert it to an ``(H, W, C)`` image; None
+    for anything else. Channel-first planes ``(C, H, W)`` may be one image or a stack of grayscale
+    frames (highway-env's ``GrayscaleObservation``): only the user knows which, so no guess."""
+    if not isinstance(space, spaces.Box) or space.dtype != np.uint8:
+        return None
+    shape = space.shape
+    if len(shape) == 3 and shape[-1] not in (1, 3, 4) and shape[0] < min(shape[1:]):
+        c, h, w = shape
+        stack = (
+            f"if they are {c} stacked grayscale frames, give the env one frame per observation "
+            f"(this wrapper stacks frames itself)"
+        )
+        if c not in (1, 3, 4):
+            return f"{c} channel-first planes {shape}, not an image of 1 or 3 channels: {stack}"
+        return (
+            f"{c} channel-first planes {shape}, but images must be channel-last (H, W, C). If "
+            f"they are one image, transpose it: TransformObservation(env, lambda o: "
+            f"o.transpose(1, 2, 0), Box(0, 255, ({h}, {w}, {c}), np.uint8)); {stack}"
+        )
+    return None
+
+
+def _rgba(space: gym.Space) -> bool:
+    return isinstance(space, spaces.Box) and len(space.shape) == 3 and space.shape[-1] == 4
+
+
+def _drop_alpha(env: gym.Env) -> gym.Env:
+    """``env`` with the alpha channel of its ``(H, W, 4)`` image observations dropped."""
+    height, width, _ = env.observation_space.shape
+    rgb = spaces.Box(0, 255, (height, width, 3), dtype=env.observation_space.dtype)
+    return TransformObservation(env, lambda o: o[..., :3], rgb)
+
+
 def pixel_env(
     env: gym.Env, source: str = "auto", owner: str = "SimounObservation"
 ) -> tuple[gym.Env, bool]:
-    """An env whose observation is the image to use, and whether it comes from ``render()``.
+    """An env whose observation is the ``(H, W, C)`` image to use, and whether it comes from
+    ``render()``.
 
     ``source`` is ``"auto"``, ``"observation"`` or ``"render"``; ``owner`` names the caller in
-    error messages. ``"auto"`` takes a uint8 image observation, else ``render()`` when the
-    render mode is ``"rgb_array"``; an image-shaped observation that is not uint8 (say a float
-    (H, W) state matrix such as highway-env's kinematics) then goes to ``render()`` too, and is
-    an error only when there is nothing to render.
+    error messages. ``"auto"`` takes a uint8 image observation, or the ``"pixels"`` entry of a
+    Dict observation (gymnasium's ``AddRenderObservation(render_only=False)``, dm_control's
+    pixel wrapper through shimmy), else ``render()`` when the render mode is ``"rgb_array"``; an
+    image-shaped observation that is not uint8 (say a float (H, W) state matrix such as
+    highway-env's kinematics) then goes to ``render()`` too, and is an error only when there is
+    nothing to render. RGBA images lose their alpha channel. Refused with a fix: MiniGrid's
+    object-id grid (``ImgObsWrapper`` without an ``RGBImg*`` wrapper) and channel-first planes,
+    unless ``source="render"`` asks for ``render()``.
     """
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
-    layout = image_layout(env.observation_space)
-    is_uint8 = layout is not None and env.observation_space.dtype == np.uint8
+    chain = env
+    if source != "render":
+        if minigrid_object_grid(env):
+            raise TypeError(
+                f"{owner} needs pixels, but MiniGrid's ImgObsWrapper gives the "
+                f"{env.observation_space.shape} grid of object ids, colours and states (one "
+                f"cell per value), which is not an image. Make pixels under it: "
+                f"ImgObsWrapper(RGBImgPartialObsWrapper(env)) for the agent's view, or "
+                f"ImgObsWrapper(RGBImgObsWrapper(env)) for the whole grid (minigrid.wrappers); "
+                f"or pass source='render' to use the env's rgb_array renders."
+            )
+        space = env.observation_space
+        if isinstance(space, spaces.Dict) and isinstance(space.spaces.get("pixels"), spaces.Box):
+            chain = TransformObservation(env, lambda o: o["pixels"], space["pixels"])
+        if _rgba(chain.observation_space):
+            chain = _drop_alpha(chain)
+    layout = image_layout(chain.observation_space)
+    is_uint8 = layout is not None and chain.observation_space.dtype == np.uint8
+    hint = layout_hint(chain.observation_space)
+    if source != "render" and hint is not None:
+        renders = (
+            " Or pass source='render' to use the env's rgb_array renders instead."
+            if env.render_mode == "rgb_array"
+            else ""
+        )
+        raise TypeError(
+            f"{owner} takes (H, W, C) uint8 images; this env's observations are {hint}.{renders}"
+        )
     use_observation = source == "observation" or (
         source == "auto" and layout is not None and (is_uint8 or env.render_mode != "rgb_array")
     )
@@ -98,12 +187,12 @@ def pixel_env(
         if not is_uint8:
             raise TypeError(
                 f"{owner} expects uint8 images in [0, 255], got "
-                f"{env.observation_space.dtype} observations of shape "
-                f"{env.observation_space.shape}; convert them first, e.g. TransformObservation("
+                f"{chain.observation_space.dtype} observations of shape "
+                f"{chain.observation_space.shape}; convert them first, e.g. TransformObservation("
                 f"env, lambda o: (o * 255).astype(np.uint8), Box(0, 255, shape, np.uint8)), or "
                 f"pass source='render' to use the env's rgb_array renders."
             )
-        return env, False
+        return chain, False
 
     if env.render_mode != "rgb_array":
         raise ValueError(
@@ -121,6 +210,8 @@ def pixel_env(
             f"{getattr(frame, 'dtype', type(frame))}; use an env whose rgb_array render is "
             f"an (H, W, 3) uint8 array."
         )
+    if _rgba(pixels.observation_space):
+        pixels = _drop_alpha(pixels)
     if image_layout(pixels.observation_space) is None:
         raise ValueError(
             f"{owner} expects env.render() to return an (H, W, 3) image, got shape "
@@ -160,9 +251,14 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
 class SimounObservation(ChainWrapper):
     """Turn a pixel or renderable env into Simoun's inputs: frame triplet and motion channels.
 
-    Pixels come from the observation when it is an image (``(H, W, C)`` or ``(H, W)`` uint8),
-    otherwise from ``render()`` when ``render_mode="rgb_array"`` (gymnasium's
-    ``AddRenderObservation``). Frames are resized (``ResizeObservation``, OpenCV area
+    Pixels come from the observation when it is an image (``(H, W, C)`` or ``(H, W)`` uint8,
+    or ``(H, W, 4)`` RGBA whose alpha is dropped) or a Dict with a ``"pixels"`` image entry
+    (which wins over ``render()``; ``source="render"`` picks the renders), otherwise from
+    ``render()`` when ``render_mode="rgb_array"`` (gymnasium's ``AddRenderObservation``).
+    Observations that hold pixels in another layout are refused with the conversion to make:
+    channel-first ``(C, H, W)`` planes (one image or stacked grayscale frames: only you know
+    which) and MiniGrid's ``ImgObsWrapper`` object-id grid (put
+    ``RGBImgPartialObsWrapper`` under it). Frames are resized (``ResizeObservation``, OpenCV area
     interpolation), optionally made grayscale (``GrayscaleObservation``), made channel-first
     ``(C, H, W)``, stacked by ``FrameTriplet`` with reset padding, and given residual motion
     channels by ``ResidualMotion``. The observation is
@@ -173,6 +269,12 @@ class SimounObservation(ChainWrapper):
       axis, which Stable-Baselines3's ``CnnPolicy`` treats as an image. Motion is then left
       out, whatever ``motion`` says: SB3 has no image form for int16 channels, and
       ``simoun_wrappers.motion.residual_motion(obs.reshape(k, C, H, W))`` recovers it exactly.
+
+    Wrapper order: ``ActionRepeat``, ``MultiCamera``, ``RandomConvolution`` and the distractors
+    go under this wrapper, the reward wrappers over it; over an env that already stacks frames
+    (a ``SimounObservation``, ``FrameTriplet`` or ``FrameStackObservation`` inside) it raises.
+    With Stable-Baselines3 use ``fold_frames=True`` and ``CnnPolicy``
+    (``check_sb3_policy(env, policy)`` says why the Dict form does not fit).
 
     ``env.spec`` records this wrapper alone (not its inner gymnasium wrappers), so
     ``gym.make(env.spec)`` rebuilds the same chain. When pixels come from ``render()``,
@@ -228,6 +330,14 @@ class SimounObservation(ChainWrapper):
         )
         check_stack_options(num_frames, motion, fold_frames, source, grayscale)
         hw = parse_size(size)
+        stack = frame_stack_in(env)
+        if stack is not None:
+            raise TypeError(
+                f"SimounObservation stacks frames itself, but {env} already does "
+                f"({type(stack).__name__} inside): over it, the triplet would be lost to a "
+                f"render() or taken as one image. Apply SimounObservation once, to the unstacked "
+                f"env (drop FrameStackObservation; set num_frames={num_frames} here instead)."
+            )
         chain, from_render = pixel_env(env, source)
         height, width, channels = image_layout(chain.observation_space)
         if hw is not None and hw != (height, width):
