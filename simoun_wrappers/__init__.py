@@ -1,4 +1,8 @@
-"""Gymnasium and PettingZoo wrappers for the Simoun method."""
+"""Gymnasium and PettingZoo wrappers for the Simoun method.
+
+Importing the package sets headless rendering defaults when there is no display (``MUJOCO_GL=egl``,
+``SDL_VIDEODRIVER=offscreen``) and ``SDL_NO_SIGNAL_HANDLERS=1`` always; see ``_headless``.
+"""
 
 from simoun_wrappers import _headless  # noqa: F401  (must run before dm_control/pygame load)
 from simoun_wrappers.action_repeat import ActionRepeat
@@ -13,6 +17,7 @@ from simoun_wrappers.distractors import ColorShift, MovingBackground
 from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
+from simoun_wrappers.sb3_check import check_sb3_policy
 
 __all__ = [
     "ActionRepeat",
@@ -26,6 +31,7 @@ __all__ = [
     "RandomConvolution",
     "ResidualMotion",
     "SimounObservation",
+    "check_sb3_policy",
     "random_conv",
     "residual_motion",
 ]

@@ -1,0 +1,71 @@
+"""The supported Stable-Baselines3 path (issue 22): ``fold_frames=True`` with ``CnnPolicy``; what
+SB3 does with the Dict form, and ``check_sb3_policy`` saying why and what to use."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import stable_baselines3 as sb3
+import torch
+
+import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+from simoun_wrappers import SimounObservation, check_sb3_policy
+
+FIX = r"SimounObservation\(env, fold_frames=True\) with 'CnnPolicy'"
+
+
+def point_reach(**options) -> gym.Env:
+    return SimounObservation(gym.make("simoun/PointReach-v0"), size=36, **options)
+
+
+def test_folded_triplet_with_cnn_policy_convolves_all_frames_and_learns():
+    env = point_reach(fold_frames=True)
+    assert check_sb3_policy(env, "CnnPolicy") == "CnnPolicy"
+    ppo = sb3.PPO(
+        "CnnPolicy",
+        env,
+        n_steps=32,
+        batch_size=16,
+        n_epochs=1,
+        policy_kwargs={"features_extractor_kwargs": {"features_dim": 16}},
+        device="cpu",
+        seed=0,
+    )
+    extractor = ppo.policy.features_extractor
+    assert type(extractor).__name__ == "NatureCNN"
+    assert extractor.cnn[0].in_channels == 9  # the three RGB frames of the triplet
+    before = [p.detach().clone() for p in extractor.parameters()]
+    ppo.learn(total_timesteps=32)
+    assert ppo.num_timesteps == 32
+    assert any(not torch.equal(a, b) for a, b in zip(before, extractor.parameters(), strict=True))
+    obs, _ = env.reset(seed=0)
+    action, _ = ppo.predict(obs, deterministic=True)
+    assert env.action_space.contains(action.astype(np.float32))
+
+
+def test_multi_input_policy_on_the_dict_flattens_pixels_and_the_check_says_so():
+    env = point_reach()
+    ppo = sb3.PPO("MultiInputPolicy", env, n_steps=32, batch_size=16, device="cpu")
+    frames_extractor = ppo.policy.features_extractor.extractors["frames"]
+    assert isinstance(frames_extractor, torch.nn.Flatten)  # an MLP on raw pixels, silently
+    with pytest.raises(ValueError, match=r"flatten the \(3, 3, 36, 36\) frame stack.*" + FIX):
+        check_sb3_policy(env, "MultiInputPolicy")
+    with pytest.raises(ValueError, match=FIX):  # SB3's own alias class
+        check_sb3_policy(env, sb3.PPO.policy_aliases["MultiInputPolicy"])
+
+
+def test_cnn_policy_on_the_dict_gets_sb3s_misleading_error_and_ours_points_to_folding():
+    env = point_reach()
+    with pytest.raises(ValueError, match="You must use `MultiInputPolicy`"):
+        sb3.PPO("CnnPolicy", env, device="cpu")
+    with pytest.raises(ValueError, match=r"CnnPolicy needs one \(C, H, W\) uint8 image.*" + FIX):
+        check_sb3_policy(env.observation_space, "CnnPolicy")
+
+
+def test_mlp_policy_on_the_folded_image_and_frames_too_small_for_nature_cnn():
+    with pytest.raises(ValueError, match=r"MlpPolicy does not convolve.*use 'CnnPolicy'"):
+        check_sb3_policy(point_reach(fold_frames=True), "MlpPolicy")
+    small = SimounObservation(gym.make("simoun/PointReach-v0"), size=32, fold_frames=True)
+    with pytest.raises(ValueError, match=r"at least 36x36, got 32x32.*size=36"):
+        check_sb3_policy(small, "CnnPolicy")
+    with pytest.raises(RuntimeError):  # what SB3 alone does with them
+        sb3.PPO("CnnPolicy", small, device="cpu")
