@@ -119,6 +119,11 @@ class SimounAgent:
     # -- acting --------------------------------------------------------------------------------
 
     def _check_obs(self, frames: np.ndarray | torch.Tensor, batched: bool) -> torch.Tensor:
+        if isinstance(frames, dict):
+            raise ValueError(
+                f"expected the uint8 frames array, got SimounObservation's whole dict (keys "
+                f"{sorted(frames)}); pass its 'frames' entry: agent.act(obs['frames'])"
+            )
         expected = ((-1,) if batched else ()) + self.obs_shape
         shape = tuple(frames.shape)
         ok_shape = len(shape) == len(expected) and shape[-4:] == self.obs_shape

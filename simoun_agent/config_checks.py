@@ -25,6 +25,8 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
+from gymnasium import spaces
+
 
 @dataclass(frozen=True)
 class Rule:
@@ -367,6 +369,13 @@ def check_agent_inputs(frame_shape: Sequence[int], action_dim: int, config: Any)
         raise ValueError(
             f"frame_shape {shape} looks channel-last (H, W, C); pass it channel-first, "
             f"({width}, {channels}, {height}), as SimounObservation's frames are"
+        )
+    if isinstance(action_dim, spaces.Space) and not isinstance(action_dim, spaces.Box):
+        raise ValueError(
+            f"SimounAgent is a SAC agent for continuous actions (a 1-D Box), got the action space "
+            f"{action_dim}; use the env's continuous version (e.g. highway-env's "
+            f"ContinuousAction, LunarLander continuous=True), or a discrete-action learner such "
+            f"as SB3's PPO or DQN with 'CnnPolicy' on SimounObservation(env, fold_frames=True)"
         )
     if not _is_int(action_dim) or action_dim < 1:
         raise ValueError(

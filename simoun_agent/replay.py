@@ -2,13 +2,34 @@
 
 from __future__ import annotations
 
+import functools
+import inspect
 import json
 import os
+from collections.abc import Callable
 from typing import IO
 
 import numpy as np
 
 _MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
+
+
+class _ClassOrInstanceMethod:
+    """A method given both its class and, when called on an instance, that instance (else None):
+    as a classmethod, ``replay.load(path)`` would build a new buffer and leave ``replay`` empty."""
+
+    def __init__(self, function: Callable) -> None:
+        self.function = function
+        signature = inspect.signature(function)
+        self.signature = signature.replace(parameters=list(signature.parameters.values())[2:])
+
+    def __get__(self, instance: object, owner: type) -> Callable:
+        @functools.wraps(self.function)
+        def bound(*args, **kwargs):
+            return self.function(owner, instance, *args, **kwargs)
+
+        bound.__signature__ = self.signature  # help() shows load(path), as users call it
+        return bound
 
 
 class FrameReplay:
@@ -265,14 +286,35 @@ class FrameReplay:
             with open(path, "wb") as f:
                 np.savez(f, **arrays)
 
-    @classmethod
-    def load(cls, path: str | os.PathLike | IO[bytes]) -> FrameReplay:
-        """Rebuild a buffer written by :meth:`save`, RNG state included."""
+    @_ClassOrInstanceMethod
+    def load(cls, into: FrameReplay | None, path: str | os.PathLike | IO[bytes]) -> FrameReplay:
+        """Read a buffer written by :meth:`save`, RNG state included.
+
+        ``FrameReplay.load(path)`` returns a new buffer built as the saved one was.
+        ``replay.load(path)`` loads the file into ``replay`` and returns it; ``replay`` must have
+        the file's capacity, frame_shape, action_dim and num_frames, else ValueError names both.
+        """
         with np.load(path) as data:
             meta = json.loads(data["meta"].tobytes().decode())
-            replay = cls(
-                meta["capacity"], tuple(meta["frame_shape"]), meta["action_dim"], meta["num_frames"]
-            )
+            built = {
+                "capacity": meta["capacity"],
+                "frame_shape": tuple(meta["frame_shape"]),
+                "action_dim": meta["action_dim"],
+                "num_frames": meta["num_frames"],
+            }
+            if into is not None:
+                differ = [key for key, value in built.items() if getattr(into, key) != value]
+                if differ:
+                    found = "; ".join(
+                        f"{k} {built[k]} in the file, {getattr(into, k)} here" for k in differ
+                    )
+                    wanted = ", ".join(f"{k}={built[k]}" for k in differ)
+                    raise ValueError(
+                        f"cannot load {getattr(path, 'name', path)} into this FrameReplay: "
+                        f"{found}. Load it as a new buffer with FrameReplay.load(path), or create "
+                        f"this one with {wanted}"
+                    )
+            replay = cls(**built)
             used = data["frames"].shape[0]
             for name in ("frames", "actions", "rewards", "terminated", "truncated", "steps"):
                 getattr(replay, name)[:used] = data[name]
@@ -280,4 +322,7 @@ class FrameReplay:
         replay.transitions = meta["transitions"]
         replay.episode_step = meta["episode_step"]
         replay.rng.bit_generator.state = meta["rng"]
-        return replay
+        if into is None:
+            return replay
+        vars(into).update(vars(replay))
+        return into
