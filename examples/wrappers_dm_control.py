@@ -6,7 +6,7 @@ python examples/wrappers_dm_control.py
 import gymnasium as gym
 import numpy as np
 
-# simoun_wrappers first: it sets MUJOCO_GL=egl before dm_control loads.
+# simoun_wrappers first: without a display it sets MUJOCO_GL=egl before dm_control loads.
 # isort: off
 from simoun_wrappers import ActionRepeat, SimounObservation
 import shimmy

@@ -10,7 +10,7 @@ import gymnasium as gym
 import highway_env
 import imageio.v3 as iio
 
-# simoun_wrappers first: it sets MUJOCO_GL=egl before dm_control loads.
+# simoun_wrappers first: without a display it sets MUJOCO_GL=egl before dm_control loads.
 # isort: off
 from simoun_wrappers import MultiCamera, SimounObservation
 import shimmy
