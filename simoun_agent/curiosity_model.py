@@ -16,10 +16,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 import torch
-import torch.nn.functional as F
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
@@ -28,7 +26,6 @@ from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
 from simoun_agent.online_model import OnlineModel, default_device, frozen_copy
 from simoun_wrappers.augment import random_conv
-from simoun_wrappers.intrinsic_reward import triplet_shape
 
 __all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions"]
 
@@ -222,12 +219,7 @@ class CuriosityModel(OnlineModel):
             device: torch device; None picks cuda when available, else cpu.
         """
         self.config = config = config or CuriosityConfig()
-        self.frame_shape = tuple(int(v) for v in frame_shape)
-        if len(self.frame_shape) != 3:
-            raise ValueError(f"frame_shape must be one frame's (C, H, W), got {frame_shape}.")
-        c, h, w = self.frame_shape
-        self.pool = max(1, min(h, w) // config.encoder_size) if config.encoder_size else 1
-        self.encoded_shape = (c, h // self.pool, w // self.pool)
+        self._init_frames(frame_shape, config.encoder_size)
         smallest = 23 if config.interactive else 15
         if min(self.encoded_shape[1:]) < smallest:
             raise ValueError(
@@ -270,39 +262,6 @@ class CuriosityModel(OnlineModel):
         self._head = 0
         self.feature_version = 0
         self._init_schedule(self.encoder)
-
-    @classmethod
-    def for_env(
-        cls,
-        env: gym.Env | gym.vector.VectorEnv,
-        config: CuriosityConfig | None = None,
-        device: str | torch.device | None = None,
-    ) -> CuriosityModel:
-        """A model sized for ``env``'s Simoun observations and action space (single or vector)."""
-        vector = isinstance(env, gym.vector.VectorEnv)
-        obs_space = env.single_observation_space if vector else env.observation_space
-        act_space = env.single_action_space if vector else env.action_space
-        return cls(triplet_shape(obs_space)[1:], act_space, config, device)
-
-    def _check(self, triplets: np.ndarray, name: str) -> np.ndarray:
-        triplets = np.asarray(triplets)
-        if triplets.dtype != np.uint8 or triplets.shape[1:] != (3, *self.frame_shape):
-            expected = ", ".join(map(str, (3, *self.frame_shape)))
-            raise ValueError(
-                f"CuriosityModel expects {name} as uint8 (B, {expected}), "
-                f"got {triplets.dtype} {triplets.shape}; it was built for frames of shape "
-                f"{self.frame_shape} (build it with CuriosityModel.for_env(env))."
-            )
-        return triplets
-
-    def _pooled(self, frames: np.ndarray) -> np.ndarray:
-        """uint8 ``(..., C, H, W)`` average-pooled by ``self.pool`` (rounded back to uint8)."""
-        if self.pool == 1:
-            return frames
-        x = torch.from_numpy(np.ascontiguousarray(frames))
-        flat = x.reshape(-1, *x.shape[-3:]).float()
-        pooled = F.avg_pool2d(flat, self.pool).round_().to(torch.uint8)
-        return pooled.reshape(*x.shape[:-3], *self.encoded_shape).numpy()
 
     @torch.no_grad()
     def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -18,9 +18,13 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import torch
+import torch.nn.functional as F
 from torch import nn
+
+from simoun_wrappers.intrinsic_reward import triplet_shape
 
 __all__ = ["OnlineModel", "UpdateThread", "default_device", "frozen_copy", "run_now"]
 
@@ -105,15 +109,30 @@ class OnlineModel(ABC):
     the same with and without the thread, whatever its timing. A failed step is raised by the
     first call after it failed, and the model refuses to go on until :meth:`load_state_dict`.
 
-    Subclasses set ``config`` (with ``update_every``, ``learning_starts``, ``background``,
-    ``batch_size``, ``lr``, ``seed``), ``device``, ``size`` (transitions stored), call
-    :meth:`_init_schedule` once their modules exist, and define ``_store``, ``_sample``,
-    ``_train_step``, ``_trained`` and ``_modules_state`` / ``_load_modules_state``.
+    Subclasses are built as ``Model(frame_shape, action_space, config=None, device=None)`` (what
+    :meth:`for_env` calls); they set ``config`` (with ``update_every``, ``learning_starts``,
+    ``background``, ``batch_size``, ``lr``, ``seed``), ``device`` and ``size`` (transitions
+    stored), call :meth:`_init_frames` and, once their modules exist, :meth:`_init_schedule`,
+    and define ``_store``, ``_sample``, ``_train_step``, ``_trained`` and ``_modules_state`` /
+    ``_load_modules_state``.
     """
 
     config: Any
     device: torch.device
     size: int
+
+    @classmethod
+    def for_env(
+        cls,
+        env: gym.Env | gym.vector.VectorEnv,
+        config: Any = None,
+        device: str | torch.device | None = None,
+    ) -> OnlineModel:
+        """A model sized for ``env``'s Simoun observations and action space (single or vector)."""
+        vector = isinstance(env, gym.vector.VectorEnv)
+        obs_space = env.single_observation_space if vector else env.observation_space
+        act_space = env.single_action_space if vector else env.action_space
+        return cls(triplet_shape(obs_space)[1:], act_space, config, device)
 
     def _init_schedule(self, published: nn.Module) -> None:
         """Counters, RNGs, and the first published weights (a frozen copy of ``published``)."""
@@ -153,9 +172,37 @@ class OnlineModel(ABC):
     def _load_modules_state(self, state: dict[str, Any]) -> None:
         """Load what :meth:`_modules_state` returned."""
 
-    @abstractmethod
+    def _init_frames(self, frame_shape: tuple[int, ...], encoder_size: int | None) -> None:
+        """Set ``frame_shape`` (C, H, W as the env gives it), the integer average-pooling factor
+        ``pool`` that brings the shorter side to about ``encoder_size`` (1 when None or below 2)
+        and ``encoded_shape``, the frame's shape after pooling."""
+        self.frame_shape = tuple(int(v) for v in frame_shape)
+        if len(self.frame_shape) != 3:
+            raise ValueError(f"frame_shape must be one frame's (C, H, W), got {frame_shape}.")
+        c, h, w = self.frame_shape
+        self.pool = max(1, min(h, w) // encoder_size) if encoder_size else 1
+        self.encoded_shape = (c, h // self.pool, w // self.pool)
+
+    def _pooled(self, frames: np.ndarray) -> np.ndarray:
+        """uint8 ``(..., C, H, W)`` average-pooled by ``self.pool`` (rounded back to uint8)."""
+        if self.pool == 1:
+            return frames
+        x = torch.from_numpy(np.ascontiguousarray(frames))
+        flat = x.reshape(-1, *x.shape[-3:]).float()
+        pooled = F.avg_pool2d(flat, self.pool).round_().to(torch.uint8)
+        return pooled.reshape(*x.shape[:-3], *self.encoded_shape).numpy()
+
     def _check(self, triplets: np.ndarray, name: str) -> np.ndarray:
         """``triplets`` as an array, or an error naming ``name`` and the expected shape."""
+        triplets = np.asarray(triplets)
+        if triplets.dtype != np.uint8 or triplets.shape[1:] != (3, *self.frame_shape):
+            expected = ", ".join(map(str, (3, *self.frame_shape)))
+            raise ValueError(
+                f"{type(self).__name__} expects {name} as uint8 (B, {expected}), "
+                f"got {triplets.dtype} {triplets.shape}; it was built for frames of shape "
+                f"{self.frame_shape} (build it with {type(self).__name__}.for_env(env))."
+            )
+        return triplets
 
     def watch(
         self,

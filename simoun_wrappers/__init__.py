@@ -17,6 +17,7 @@ from simoun_wrappers.distractors import ColorShift, MovingBackground
 from simoun_wrappers.frames import FrameTriplet
 from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
+from simoun_wrappers.rnd import RNDReward, RNDVectorReward
 from simoun_wrappers.sb3_check import check_sb3_policy
 
 __all__ = [
@@ -28,6 +29,8 @@ __all__ = [
     "FrameTriplet",
     "MovingBackground",
     "MultiCamera",
+    "RNDReward",
+    "RNDVectorReward",
     "RandomConvolution",
     "ResidualMotion",
     "SimounObservation",

@@ -1,0 +1,241 @@
+"""Random network distillation (Burda et al. 2019, "Exploration by Random Network Distillation")
+as a novelty source for ``simoun_wrappers.rnd.RNDReward``: the standard comparator for Simoun's
+consistency curiosity.
+
+A fixed, randomly initialised target network f maps an observation to a feature vector; a
+predictor f^ is trained online to match it on the observations the agent reaches. Its error
+``|| f^(x) - f(x) ||^2`` stays high on observations unlike those seen, so it measures novelty.
+Both networks see the newest frame of each triplet, normalized per pixel by a running mean/std
+of the watched frames and clipped to [-5, 5], as in the paper.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import torch
+from gymnasium import spaces
+from gymnasium.wrappers.utils import RunningMeanStd
+from torch import nn
+
+from simoun_agent.online_model import OnlineModel, default_device, frozen_copy
+
+__all__ = ["RNDConfig", "RNDModel", "rnd_network"]
+
+SMALLEST_SIDE = 36
+"""the three convolutions (8/4, 4/2, 3/1) need frames of at least 36x36"""
+
+
+@dataclass
+class RNDConfig:
+    """Hyperparameters of :class:`RNDModel` (network and learning rate as in Burda et al.)."""
+
+    feature_dim: int = 512
+    """output size of the target and the predictor (the paper: 512)"""
+    encoder_size: int | None = 42
+    """frames are average-pooled by the integer factor ``min(H, W) // encoder_size`` first
+    (84x84 -> 42x42; MiniGrid's 56x56 views are kept as they are); None never pools"""
+    capacity: int = 1000
+    """frames kept in the buffer the predictor is trained on"""
+    batch_size: int = 64
+    """frames per gradient step"""
+    update_every: int = 8
+    """one gradient step every this many ``watch`` calls (env steps, or vector steps: with 8
+    sub-envs each watched frame is trained on about once)"""
+    learning_starts: int = 256
+    """frames stored before the first gradient step"""
+    background: bool = True
+    """take the gradient steps in a background thread (same schedule and rewards as
+    ``CuriosityConfig.background``)"""
+    lr: float = 1e-4
+    """Adam learning rate of the predictor (the paper: 1e-4)"""
+    seed: int | None = None
+    """seeds both networks and the buffer sampling (None: nondeterministic)"""
+
+    def __post_init__(self) -> None:
+        for name in ("feature_dim", "capacity", "batch_size", "update_every"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"RNDConfig.{name} must be >= 1, got {getattr(self, name)}")
+        if self.encoder_size is not None and self.encoder_size < 1:
+            raise ValueError(
+                f"RNDConfig.encoder_size must be None (no pooling) or a side >= 1 in pixels, got "
+                f"{self.encoder_size}; the default 42 pools 84x84 frames to 42x42."
+            )
+        if not self.batch_size <= self.learning_starts <= self.capacity:
+            raise ValueError(
+                f"RNDConfig needs batch_size <= learning_starts <= capacity, got "
+                f"{self.batch_size}, {self.learning_starts}, {self.capacity}."
+            )
+        if not (math.isfinite(self.lr) and self.lr > 0):
+            raise ValueError(f"RNDConfig.lr must be a number > 0, got {self.lr}; e.g. lr=1e-4.")
+
+
+def rnd_network(
+    channels: int, side: tuple[int, int], feature_dim: int, predictor: bool
+) -> nn.Module:
+    """The paper's network: conv 32x8x8/4, 64x4x4/2, 64x3x3/1 (leaky ReLU), a linear layer to
+    ``feature_dim``; the predictor adds two ReLU layers of ``feature_dim`` before its output.
+    Orthogonal initialisation (gain sqrt 2), biases 0."""
+    convs = nn.Sequential(
+        nn.Conv2d(channels, 32, 8, stride=4),
+        nn.LeakyReLU(),
+        nn.Conv2d(32, 64, 4, stride=2),
+        nn.LeakyReLU(),
+        nn.Conv2d(64, 64, 3, stride=1),
+        nn.LeakyReLU(),
+        nn.Flatten(),
+    )
+    with torch.no_grad():
+        flat = convs(torch.zeros(1, channels, *side)).shape[1]
+    head: list[nn.Module] = [nn.Linear(flat, feature_dim)]
+    if predictor:
+        head += [nn.ReLU(), nn.Linear(feature_dim, feature_dim)]
+        head += [nn.ReLU(), nn.Linear(feature_dim, feature_dim)]
+    network = nn.Sequential(convs, *head)
+    for module in network.modules():
+        if isinstance(module, (nn.Conv2d, nn.Linear)):
+            nn.init.orthogonal_(module.weight, math.sqrt(2))
+            nn.init.zeros_(module.bias)
+    return network
+
+
+class RNDModel(OnlineModel):
+    """Random network distillation trained online, as a ``NoveltySource`` for ``RNDReward``.
+
+    Calling it returns, for each uint8 triplet, the published predictor's mean squared error
+    against the fixed target on the newest frame (float32 ``(B,)``). The wrapper hands it every
+    transition through :meth:`watch`; it keeps the last ``capacity`` reached frames (pooled,
+    uint8), updates the per-pixel running mean/std with them and, once ``learning_starts`` are
+    stored, takes one Adam step of the predictor on ``batch_size`` of them every
+    ``update_every`` calls, in a background thread, on the schedule of
+    :class:`~simoun_agent.online_model.OnlineModel` (weights published whole, the same rewards
+    with and without the thread). A batch is normalized with the statistics of the moment it
+    is sampled. ``last_metrics`` holds the last published step's ``loss``, ``update_ms`` and
+    ``wait_ms``. Actions are not used (RND scores states).
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import SimounObservation
+        >>> from simoun_wrappers.rnd import RNDReward
+        >>> from simoun_agent.rnd_model import RNDConfig, RNDModel
+        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=36)
+        >>> config = RNDConfig(batch_size=8, learning_starts=8, update_every=4, seed=0)
+        >>> env = RNDReward(env, RNDModel.for_env(env, config, device="cpu"), warmup=4)
+        >>> _ = env.reset(seed=0)
+        >>> rewards = [env.step(t % 2)[4]["reward_intrinsic"] for t in range(12)]
+        >>> rewards[:4], all(r > 0 for r in rewards[4:])  # the first 4 only set the statistics
+        ([0.0, 0.0, 0.0, 0.0], True)
+        >>> env.close()  # stops the update thread
+    """
+
+    def __init__(
+        self,
+        frame_shape: tuple[int, int, int],
+        action_space: spaces.Space | None = None,
+        config: RNDConfig | None = None,
+        device: str | torch.device | None = None,
+    ) -> None:
+        """Build the model.
+
+        Args:
+            frame_shape: ``(C, H, W)`` of one frame as the env gives it (at least 36x36 after
+                the pooling of ``config.encoder_size``).
+            action_space: the env's action space (not used: RND scores states; accepted so
+                that ``RNDModel.for_env(env)`` builds it like ``CuriosityModel``).
+            config: hyperparameters; ``RNDConfig()`` when None.
+            device: torch device; None picks cuda when available, else cpu.
+        """
+        self.config = config = config or RNDConfig()
+        self._init_frames(frame_shape, config.encoder_size)
+        c, h, w = self.encoded_shape
+        if min(h, w) < SMALLEST_SIDE:
+            raise ValueError(
+                f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
+                f"{self.pool}, RNDConfig.encoder_size={config.encoder_size}); RND's convolutions "
+                f"need H, W >= {SMALLEST_SIDE}. Render larger frames (SimounObservation(env, "
+                "size=42) or more) or raise encoder_size."
+            )
+        self.action_space = action_space
+        self.device = default_device(device)
+        with torch.random.fork_rng(devices=[]):
+            if config.seed is not None:
+                torch.manual_seed(config.seed)
+            self.target = rnd_network(c, (h, w), config.feature_dim, predictor=False)
+            self.predictor = rnd_network(c, (h, w), config.feature_dim, predictor=True)
+        self.target.to(self.device).requires_grad_(False)
+        self.predictor.to(self.device)
+        self.optimizer = torch.optim.Adam(self.predictor.parameters(), lr=config.lr)
+        # epsilon=0: exact statistics, so a pixel that never changed normalizes to 0
+        self.observations = RunningMeanStd(epsilon=0.0, shape=self.encoded_shape)
+        """per-pixel running mean/std of the watched frames (after pooling)"""
+        self._frames = np.zeros((config.capacity, *self.encoded_shape), dtype=np.uint8)
+        self.size = 0
+        self._head = 0
+        self._init_schedule(self.predictor)
+
+    def _normalized(self, frames: np.ndarray) -> torch.Tensor:
+        """uint8 pooled frames as float32, normalized by the running statistics, in [-5, 5]."""
+        std = np.sqrt(self.observations.var + 1e-8)
+        x = ((frames - self.observations.mean) / std).clip(-5.0, 5.0).astype(np.float32)
+        return torch.as_tensor(x, device=self.device)
+
+    @torch.no_grad()
+    def __call__(self, triplets: np.ndarray) -> np.ndarray:
+        """The published predictor's mean squared error on the newest frame of each triplet."""
+        self._raise_failure()
+        x = self._normalized(self._pooled(self._check(triplets, "triplets")[:, -1]))
+        error = (self.published(x) - self.target(x)).pow(2).mean(-1)
+        return error.float().cpu().numpy()
+
+    def _store(self, triplets: np.ndarray, actions: np.ndarray, next_triplets: np.ndarray) -> None:
+        """Keep the frame each transition reached and add it to the running statistics."""
+        frames = self._pooled(next_triplets[:, -1])
+        self.observations.update(frames.astype(np.float64))
+        n = len(frames)
+        slots = (self._head + np.arange(n)) % self.config.capacity
+        self._frames[slots] = frames
+        self._head = int((self._head + n) % self.config.capacity)
+        self.size = min(self.size + n, self.config.capacity)
+
+    def _sample(self) -> tuple[torch.Tensor]:
+        self._need_batch()
+        idx = self.rng.integers(0, self.size, size=self.config.batch_size)
+        return (self._normalized(self._frames[idx]),)
+
+    def _train_step(self, x: torch.Tensor) -> tuple[dict[str, float], nn.Module]:
+        start = time.perf_counter()
+        with torch.no_grad():
+            target = self.target(x)
+        loss = (self.predictor(x) - target).pow(2).mean()
+        if not torch.isfinite(loss):
+            raise FloatingPointError(f"the RND loss is {float(loss)} before this step")
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        self.optimizer.step()
+        metrics = {"loss": float(loss.detach()), "update_ms": 1000 * (time.perf_counter() - start)}
+        return metrics, frozen_copy(self.predictor)
+
+    def _trained(self) -> nn.Module:
+        return self.predictor
+
+    def _modules_state(self) -> dict[str, Any]:
+        return {
+            "predictor": self.predictor.state_dict(),
+            "target": self.target.state_dict(),
+            "optimizer": self.optimizer.state_dict(),
+            "observation_mean": self.observations.mean.copy(),
+            "observation_var": self.observations.var.copy(),
+            "observation_count": self.observations.count,
+        }
+
+    def _load_modules_state(self, state: dict[str, Any]) -> None:
+        self.predictor.load_state_dict(state["predictor"])
+        self.target.load_state_dict(state["target"])
+        self.optimizer.load_state_dict(state["optimizer"])
+        self.observations.mean = np.array(state["observation_mean"], dtype=np.float64)
+        self.observations.var = np.array(state["observation_var"], dtype=np.float64)
+        self.observations.count = float(state["observation_count"])
