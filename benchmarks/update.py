@@ -8,6 +8,11 @@ observation and the replay bytes per transition at 84x84 RGB.
 
     python benchmarks/update.py                      # batch 32 and 128, all threads
     python benchmarks/update.py --threads 1 --batch-sizes 128 --repeats 7
+
+``--n-step-curiosity`` instead times the cpu preset's Simoun update (48x48, 3-step returns,
+random shift, batch 64, one thread) with Eq. 13's intrinsic reward of every step of the return
+(issue 17) against the same agent adding only that of the state at t (the behaviour before),
+alternating in each repeat.
 """
 
 from __future__ import annotations
@@ -32,17 +37,70 @@ FRAME = (3, 84, 84)
 ACTION_DIM = 6
 
 
-def filled_replay(transitions: int, episode_length: int = 100, seed: int = 0) -> FrameReplay:
+def filled_replay(
+    transitions: int, episode_length: int = 100, seed: int = 0, frame: tuple = FRAME
+) -> FrameReplay:
     """A replay of random frames, in episodes of ``episode_length`` steps."""
     rng = np.random.default_rng(seed)
-    replay = FrameReplay(transitions, FRAME, ACTION_DIM, seed=seed)
+    replay = FrameReplay(transitions, frame, ACTION_DIM, seed=seed)
     for t in range(transitions):
         if t % episode_length == 0:
-            replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
+            replay.start_episode(rng.integers(0, 256, frame, dtype=np.uint8))
         end = (t + 1) % episode_length == 0
-        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
-        replay.add(rng.uniform(-1, 1, ACTION_DIM), rng.random(), frame, False, end)
+        image = rng.integers(0, 256, frame, dtype=np.uint8)
+        replay.add(rng.uniform(-1, 1, ACTION_DIM), rng.random(), image, False, end)
     return replay
+
+
+def first_step_curiosity(agent: SimounAgent, replay: FrameReplay):
+    """Like ``stepper``, but through the n-step call without ``return_mask``: only r^i(s_t)
+    enters each n-step target, as before issue 17 (the same encoder passes but the triplet at
+    t+2)."""
+    counter = itertools.count()
+    cfg = agent.config
+
+    def step() -> None:
+        batch = replay.sample(cfg.batch_size, cfg.n_step, cfg.discount)
+        put = {name: torch.from_numpy(value) for name, value in batch.items()}
+        bootstrap = (put["bootstrap_obs"], put["return"])
+        agent.update_window(
+            put["window"], put["action"], put["reward"], put["discount"], next(counter), bootstrap
+        )
+
+    return step
+
+
+def n_step_curiosity(args: argparse.Namespace) -> None:
+    """Per-step against first-step curiosity at the cpu preset's settings."""
+    from simoun_agent.run.presets import resolve
+
+    torch.set_num_threads(1)
+    config = resolve("cpu", {}).agent
+    size = resolve("cpu", {}).image_size
+    replay = filled_replay(1000, frame=(3, size, size))
+    agents = []
+    for _ in range(2):
+        torch.manual_seed(0)
+        agents.append(SimounAgent((3, size, size), ACTION_DIM, config, device="cpu"))
+    per_step, first = stepper(agents[0], replay), first_step_curiosity(agents[1], replay)
+    per_step()
+    first()
+    print(
+        f"torch {torch.__version__}, 1 thread, cpu preset: {size}x{size} RGB, batch "
+        f"{config.batch_size}, n_step {config.n_step}, augmentation {config.augmentation}, "
+        f"encoder {config.encoder}; {args.steps} steps x {args.repeats} interleaved repeats"
+    )
+    times: dict[str, list[tuple[float, float]]] = {"first": [], "per_step": []}
+    for _ in range(args.repeats):
+        times["first"].append(time_steps(first, args.steps))
+        times["per_step"].append(time_steps(per_step, args.steps))
+    for kind, label in ((0, "wall"), (1, "cpu")):
+        old = statistics.median(t[kind] for t in times["first"])
+        new = statistics.median(t[kind] for t in times["per_step"])
+        print(
+            f"ms per update ({label}), median: r_i of s_t only {old:.1f}, r_i of every step "
+            f"{new:.1f}, ratio {new / old:.3f}"
+        )
 
 
 def stepper(agent: SimounAgent, replay: FrameReplay):
@@ -73,7 +131,15 @@ def main() -> None:
     parser.add_argument(
         "--curl-channels-last", action="store_true", help="give the baseline channels-last too"
     )
+    parser.add_argument(
+        "--n-step-curiosity",
+        action="store_true",
+        help="per-step against first-step curiosity in 3-step targets (cpu preset)",
+    )
     args = parser.parse_args()
+    if args.n_step_curiosity:
+        n_step_curiosity(args)
+        return
     torch.set_num_threads(args.threads)
     torch.manual_seed(0)
     replay = filled_replay(1000)

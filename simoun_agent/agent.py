@@ -1,10 +1,12 @@
-"""The Simoun SAC agent: one update step = critic + auxiliary losses, actor, EMA targets."""
+"""The Simoun SAC agent: one update step = augment, encode, TD target, critic + auxiliary
+losses, actor, EMA targets."""
 
 from __future__ import annotations
 
 import copy
 import math
 from dataclasses import asdict
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -12,22 +14,38 @@ import torch
 from simoun_agent.config import AgentConfig
 from simoun_agent.config_checks import check_agent_inputs
 from simoun_agent.losses import (
-    actor_loss,
     contrastive_loss,
     critic_loss,
+    intrinsic_return,
     reward_loss,
-    soft_value,
     td_target,
     temperature_loss,
     total_loss,
     transition_loss,
 )
+from simoun_agent.models.actors import ACTORS, make_actor
 from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight_init
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
-from simoun_agent.models.sac import Actor, Critic
+from simoun_agent.models.sac import Critic
 from simoun_agent.replay import FrameReplay
 from simoun_wrappers.augment import random_conv, random_shift, shift_pad
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
+
+
+class Views(NamedTuple):
+    """The augmented inputs of one update (:meth:`SimounAgent.augment`)."""
+
+    windows: list[torch.Tensor]
+    """per RL view, uint8 ``(B, L, C, H, W)``: the update's window (frames t-2 .. t+1, or .. t+n
+    with per-step curiosity), every frame of a sample under the view's one offset"""
+    next_obs: list[torch.Tensor]
+    """per target view, uint8 ``(B, 3, C, H, W)``: the triplet the TD target bootstraps from,
+    under the same offset as the view's window"""
+    shared: int
+    """how many target views bootstrap from the triplet at t+1 of a critic view, whose online
+    state the encoder pass of the critic views already gives (the shared-frame trick)"""
+    key: torch.Tensor | None
+    """the contrastive positive (Eq. 3) as float frames; None without L_con"""
 
 
 class SimounAgent:
@@ -64,9 +82,7 @@ class SimounAgent:
         self.encoder = make_encoder(config, self.frame_shape).to(self.device)
         repr_dim = self.encoder.repr_dim
         self.critic = Critic(repr_dim, action_dim, config.hidden_dim).to(self.device)
-        self.actor = Actor(
-            repr_dim, action_dim, config.hidden_dim, config.log_std_min, config.log_std_max
-        ).to(self.device)
+        self.actor = make_actor(config, repr_dim, action_dim).to(self.device)
         self.motion_path = ENCODERS[config.encoder].motion_path
         # L_tran predicts f^m of a dual encoder, or the whole state of a single-path one (whose
         # size is feature_dim too), so every Fig. 6 encoder trains with the same losses
@@ -93,9 +109,12 @@ class SimounAgent:
                 net.apply(weight_init)
         self.encoder_target = copy.deepcopy(self.encoder).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
-        self.log_alpha = torch.tensor(
-            math.log(config.init_temperature), device=self.device, requires_grad=True
+        self.log_alpha = (
+            torch.tensor(math.log(config.init_temperature), device=self.device, requires_grad=True)
+            if ACTORS[config.actor].temperature
+            else None
         )
+        """log of SAC's temperature; None for an actor without one"""
         self.target_entropy = -float(action_dim)
 
         heads = (self.critic, self.reward_model, self.similarity, self.transition)
@@ -105,16 +124,24 @@ class SimounAgent:
             [p for m in representation for p in m.parameters()], lr=config.lr, fused=True
         )
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=config.lr, fused=True)
-        self.alpha_optimizer = torch.optim.Adam(
-            [self.log_alpha], lr=config.alpha_lr, betas=(config.alpha_beta, 0.999), fused=True
+        self.alpha_optimizer = (
+            torch.optim.Adam(
+                [self.log_alpha], lr=config.alpha_lr, betas=(config.alpha_beta, 0.999), fused=True
+            )
+            if self.log_alpha is not None
+            else None
         )
         self.running_max = RunningMax(config.r_e_max_init, config.r_i_max_init).to(self.device)
         self.num_updates = 0
         """gradient steps taken; drives the actor / target update schedules"""
+        self.env_step = 0
+        """global env step of the latest update; :meth:`act`'s default for the exploration
+        schedule of an actor that has one"""
 
     @property
-    def alpha(self) -> torch.Tensor:
-        return self.log_alpha.exp()
+    def alpha(self) -> torch.Tensor | None:
+        """SAC's temperature; None for an actor without one."""
+        return None if self.log_alpha is None else self.log_alpha.exp()
 
     # -- acting --------------------------------------------------------------------------------
 
@@ -135,11 +162,17 @@ class SimounAgent:
             )
         return torch.as_tensor(frames, device=self.device)
 
-    def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:
-        """Action in [-1, 1]^action_dim for one observation ``uint8 (3, C, H, W)``."""
+    def act(
+        self, frames: np.ndarray, deterministic: bool = False, step: int | None = None
+    ) -> np.ndarray:
+        """Action in [-1, 1]^action_dim for one observation ``uint8 (3, C, H, W)``: the policy's
+        mode when ``deterministic`` (evaluation), else its exploration. ``step``: the global env
+        step, which sets the noise of a scheduled actor (DrQ-v2's); None: that of the latest
+        :meth:`update`."""
         obs = self._check_obs(frames, batched=False).unsqueeze(0)
+        step = self.env_step if step is None else step
         with torch.inference_mode():
-            action, _ = self.actor(self.encoder(obs).state, deterministic)
+            action = self.actor.act(self.encoder(obs).state, deterministic, step)
         return action[0].cpu().numpy()
 
     def encoder_features(
@@ -163,8 +196,8 @@ class SimounAgent:
     def update(self, replay: FrameReplay, step: int) -> dict[str, torch.Tensor]:
         """One gradient step on ``config.batch_size`` transitions sampled from ``replay``.
 
-        ``step`` is the global environment step (curiosity decay). Returns detached 0-d tensors
-        (no host sync here); call ``float()`` on the ones you log.
+        ``step`` is the global environment step (curiosity decay, exploration schedule). Returns
+        detached 0-d tensors (no host sync here); call ``float()`` on the ones you log.
         """
         cfg = self.config
         batch = replay.sample(cfg.batch_size, cfg.n_step, cfg.discount)
@@ -172,28 +205,18 @@ class SimounAgent:
         def put(name: str) -> torch.Tensor:
             return torch.from_numpy(batch[name]).to(self.device, non_blocking=True)
 
-        bootstrap = (put("bootstrap_obs"), put("return")) if cfg.n_step > 1 else None
+        action, reward, discount = put("action"), put("reward"), put("discount")
+        if cfg.n_step == 1:
+            return self.update_window(put("window"), action, reward, discount, step)
         return self.update_window(
-            put("window"), put("action"), put("reward"), put("discount"), step, bootstrap
+            put("n_step_window"),
+            action,
+            reward,
+            discount,
+            step,
+            bootstrap=(put("bootstrap_obs"), put("return")),
+            return_mask=put("return_mask"),
         )
-
-    def intrinsic_reward(
-        self, enc: Encoding, extrinsic: torch.Tensor, step: int
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Eq. 13 on the online features of the batch (no gradient): updates the running maxima
-        with the batch first, then returns ``(r_i, d)``."""
-        with torch.no_grad():
-            distance = consistency_distance(enc.motion.detach(), enc.appearance)
-            self.running_max.update(extrinsic, distance)
-            r_i = consistency_reward(
-                distance,
-                step,
-                self.running_max.r_e_max,
-                self.running_max.r_i_max,
-                self.config.curiosity_scale,
-                self.config.curiosity_decay,
-            )
-        return r_i, distance
 
     def update_window(
         self,
@@ -203,6 +226,7 @@ class SimounAgent:
         discount: torch.Tensor,
         step: int,
         bootstrap: tuple[torch.Tensor, torch.Tensor] | None = None,
+        return_mask: torch.Tensor | None = None,
     ) -> dict[str, torch.Tensor]:
         """One gradient step on a batch already on the device (what :meth:`update` samples).
 
@@ -212,55 +236,206 @@ class SimounAgent:
         targets, the uint8 triplet to bootstrap from ``(B, 3, C, H, W)`` and the n-step return
         ``(B,)`` that replaces ``reward`` in the TD target (``FrameReplay.sample``'s
         ``bootstrap_obs`` and ``return``; ``discount`` then carries gamma^(m-1)); L_re and L_tran
-        keep the one-step reward and frame t+1.
+        keep the one-step reward and frame t+1. ``return_mask`` (with ``bootstrap``): float
+        ``(B, n)``, 1 for each step j < m of the n-step return (the replay's ``return_mask``);
+        ``window`` then holds frames t-2 .. t+n (its ``n_step_window``) and Eq. 13's intrinsic
+        reward of every state s_{t+j}, j < m, enters the target, discounted by gamma^j. Without
+        it only r^i(s_t) does.
 
-        With ``augmentation="shift"`` the critic and actor see the window shifted by one random
-        offset per sample (all four frames alike); the contrastive key is a random convolution
-        of those same frames (Eq. 3), or, with ``contrastive_view="shift"`` (CURL), an
-        independently shifted view of the unshifted window.
+        The steps, each a method returning its metrics: :meth:`augment` (the RL views: with
+        ``augmentation="shift"`` each view shifts a sample's frames by one random offset; the
+        contrastive key: a random convolution of the view's frames (Eq. 3), or, with
+        ``contrastive_view="shift"`` (CURL), an independent shift of the unshifted ones),
+        :meth:`encode`, :meth:`td_target` (averaged over ``target_augmentations`` views),
+        :meth:`update_critic` (L_Q averaged over ``critic_augmentations`` views and the
+        auxiliary losses), :meth:`update_actor` every ``actor_update_every`` and
+        :meth:`update_targets` every ``target_update_every`` gradient steps.
         """
         cfg = self.config
-        contrastive = self.similarity is not None
-        seen = random_shift(window, self.shift_pad) if cfg.augmentation == "shift" else window
-        enc, following = self.encoder.encode_transition(seen, frame_features=cfg.curiosity)
+        self.env_step = step
+        steps = 1 if return_mask is None else return_mask.shape[1]
+        if window.shape[1] != cfg.num_frames + steps:
+            raise ValueError(
+                f"window holds {window.shape[1]} frames; with {steps} return step(s) it must hold "
+                f"{cfg.num_frames + steps} (frames t-{cfg.num_frames - 1} .. t+{steps}): pass "
+                "FrameReplay.sample's 'window', or its 'n_step_window' with 'return_mask'"
+            )
+        bootstrap_obs, n_return = bootstrap if bootstrap is not None else (None, reward)
+        views = self.augment(window, bootstrap_obs)
+        per_step = cfg.curiosity and steps > 1
+        enc, following = self.encode(views, next_features=per_step)
+        q_target, metrics = self.td_target(
+            views, enc, following, reward, n_return, discount, return_mask, step
+        )
+        metrics.update(self.update_critic(views, enc, following, action, reward, q_target))
+        if self.num_updates % cfg.actor_update_every == 0:
+            metrics.update(self.update_actor(enc.state[: len(action)].detach(), step))
+        if self.num_updates % cfg.target_update_every == 0:
+            self.update_targets()
+        self.num_updates += 1
+        return metrics
+
+    def augment(self, window: torch.Tensor, bootstrap_obs: torch.Tensor | None) -> Views:
+        """The augmented inputs of one update, in this order of random draws: the
+        max(critic_augmentations, target_augmentations) RL views, each the window and the
+        bootstrap triplet under one random shift per sample (or unchanged with augmentation
+        "none"), then the contrastive key's view."""
+        cfg = self.config
+        k, length = cfg.num_frames, window.shape[1]
+        count = max(cfg.critic_augmentations, cfg.target_augmentations)
+        frames = window if bootstrap_obs is None else torch.cat([window, bootstrap_obs], dim=1)
+        if cfg.augmentation == "shift":
+            views = [random_shift(frames, self.shift_pad) for _ in range(count)]
+        else:
+            views = [frames] * count
+        next_obs = [v[:, length:] if bootstrap_obs is not None else v[:, 1 : k + 1] for v in views]
+        windows = [v[:, :length] for v in views]
+        key = None
+        if self.similarity is not None:
+            if cfg.contrastive_view == "shift":
+                key = self.encoder.key_frames(random_shift(window[:, :k], self.shift_pad))
+            else:
+                key = random_conv(
+                    self.encoder.key_frames(windows[0][:, :k]), cfg.random_conv_kernel
+                )
+        shared = 0 if bootstrap_obs is not None else min(count, cfg.critic_augmentations)
+        return Views(windows, next_obs[: cfg.target_augmentations], shared, key)
+
+    def encode(self, views: Views, next_features: bool = False) -> tuple[Encoding, Encoding | None]:
+        """The online encoder on the critic views stacked into one batch of M*B: the state at t
+        with gradient and, when the target, L_tran or per-step curiosity reads it, at t+1
+        without (each unique frame through each path once; per-frame f^a at t+1 when
+        ``next_features``)."""
+        cfg = self.config
+        k, views_m = cfg.num_frames, cfg.critic_augmentations
+        windows = [w[:, : k + 1] for w in views.windows[:views_m]]
+        stacked = windows[0] if views_m == 1 else torch.cat(windows)
+        if views.shared or next_features or self.transition is not None:
+            return self.encoder.encode_transition(
+                stacked, frame_features=cfg.curiosity, next_frame_features=next_features
+            )
+        return self.encoder(stacked[:, :k], frame_features=cfg.curiosity), None
+
+    def td_target(
+        self,
+        views: Views,
+        enc: Encoding,
+        following: Encoding | None,
+        reward: torch.Tensor,
+        n_return: torch.Tensor,
+        discount: torch.Tensor,
+        return_mask: torch.Tensor | None,
+        step: int,
+    ) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
+        """The target of Eq. 9, ``(B, 1)``, without gradient: the (n-step) return plus Eq. 13's
+        intrinsic return, plus gamma * discount * V of the next state (the actor's
+        :meth:`next_value`), V averaged over the target views (DrQ's K)."""
+        cfg = self.config
         with torch.no_grad():
-            if contrastive:
-                if cfg.contrastive_view == "shift":
-                    other = random_shift(window[:, :-1], self.shift_pad)
-                    view = self.encoder.key_frames(other)
-                else:
-                    view = random_conv(
-                        self.encoder.key_frames(seen[:, :-1]), cfg.random_conv_kernel
-                    )
-                key = self.encoder_target.encode_key(view)
-            target_state, td_reward = following.state, reward
-            if bootstrap is not None:
-                frames, td_reward = bootstrap
-                if cfg.augmentation == "shift":
-                    frames = random_shift(frames, self.shift_pad)
-                target_state = self.encoder(frames).state
-            next_action, next_log_prob = self.actor(target_state)
-            next_q = self.critic_target(target_state, next_action)
-            value = soft_value(*next_q, next_log_prob, self.alpha)
+            policy_state, value_state = self.next_states(views, following)
+            value = self.actor.next_value(
+                self.critic_target, policy_state, value_state, self.alpha, step
+            )
+            value = value.unflatten(0, (cfg.target_augmentations, -1)).mean(0)
             metrics = {}
             if cfg.curiosity:
-                r_i, _ = self.intrinsic_reward(enc, reward, step)
-                td_reward = td_reward + r_i
+                r_i = self.intrinsic_reward(views, enc, following, reward, return_mask, step)
+                n_return = n_return + r_i
                 metrics["intrinsic_reward"] = r_i.mean()
-            q_target = td_target(td_reward, discount, cfg.discount, value)
+            return td_target(n_return, discount, cfg.discount, value), metrics
 
-        q1, q2 = self.critic(enc.state, action)
-        l_q = critic_loss(q1, q2, q_target)
+    def next_states(
+        self, views: Views, following: Encoding | None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """The next state of each target view, stacked ``(K*B, D)``: as the actor sees it (the
+        online encoder; the critic views' t+1 states are reused where they are the same frames)
+        and as the target Q heads read it (``next_state_encoder``)."""
+        cfg = self.config
+        rows = views.shared * len(views.windows[0])
+        parts = [following.state[:rows]] if views.shared else []
+        if len(views.next_obs) > views.shared:
+            parts.append(self.encoder(torch.cat(views.next_obs[views.shared :])).state)
+        policy_state = parts[0] if len(parts) == 1 else torch.cat(parts)
+        if cfg.next_state_encoder == "target":
+            return policy_state, self.encoder_target(torch.cat(views.next_obs)).state
+        return policy_state, policy_state
+
+    def intrinsic_reward(
+        self,
+        views: Views,
+        enc: Encoding,
+        following: Encoding | None,
+        extrinsic: torch.Tensor,
+        return_mask: torch.Tensor | None,
+        step: int,
+    ) -> torch.Tensor:
+        """Eq. 13 for each step of the return, ``(B,)``: sum_j gamma^j r^i(s_{t+j}) over the steps
+        j < m in ``return_mask`` (j = 0 alone without it), each r^i on the online features of the
+        first view's triplet ending at t+j (s_t and s_{t+1} from the encoding, later ones
+        encoded here), without gradient. The running maxima are raised with the batch first
+        (the distances of steps past the episode's end count as 0)."""
+        cfg = self.config
+        batch = len(extrinsic)
+        steps = 1 if return_mask is None else return_mask.shape[1]
+        motion, appearance = [enc.motion[:batch]], [enc.appearance[:batch]]
+        if steps > 1:
+            motion.append(following.motion[:batch])
+            appearance.append(following.appearance[:batch])
+        if steps > 2:
+            k = cfg.num_frames
+            ahead = [views.windows[0][:, j : j + k] for j in range(2, steps)]
+            later = self.encoder(torch.cat(ahead), frame_features=True)
+            motion.append(later.motion)
+            appearance.append(later.appearance)
+        distance = consistency_distance(torch.cat(motion).detach(), torch.cat(appearance))
+        mask = extrinsic.new_ones(1, batch) if return_mask is None else return_mask.T
+        distance = distance.unflatten(0, (steps, batch)) * mask
+        self.running_max.update(extrinsic, distance)
+        r_i = consistency_reward(
+            distance,
+            step,
+            self.running_max.r_e_max,
+            self.running_max.r_i_max,
+            cfg.curiosity_scale,
+            cfg.curiosity_decay,
+        )
+        return intrinsic_return(r_i, mask, cfg.discount)
+
+    def update_critic(
+        self,
+        views: Views,
+        enc: Encoding,
+        following: Encoding | None,
+        action: torch.Tensor,
+        reward: torch.Tensor,
+        q_target: torch.Tensor,
+    ) -> dict[str, torch.Tensor]:
+        """Eq. 14 without L_pi, one optimiser step of the encoder and its heads: L_Q (Eq. 9) over
+        the M critic views (the mean, as DrQ's paper writes it; its code sums the views, the
+        same step under Adam), L_tran, L_con and L_re on the first view."""
+        cfg = self.config
+        batch, views_m = len(action), cfg.critic_augmentations
+        actions = action if views_m == 1 else action.repeat(views_m, 1)
+        targets = q_target if views_m == 1 else q_target.repeat(views_m, 1)
+        q1, q2 = self.critic(enc.state, actions)
+        l_q = critic_loss(q1, q2, targets)
         l_tran = (
             transition_loss(
-                self.transition, self.dynamics(enc), action, self.dynamics(following)
+                self.transition,
+                self.dynamics(enc)[:batch],
+                action,
+                self.dynamics(following)[:batch],
             )
             if self.transition is not None
             else None
         )
-        l_con = contrastive_loss(enc.anchor, key, self.similarity) if contrastive else None
+        l_con = None
+        if views.key is not None:
+            with torch.no_grad():
+                key = self.encoder_target.encode_key(views.key)
+            l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity)
         l_re = (
-            reward_loss(self.reward_model, enc.state, action, reward)
+            reward_loss(self.reward_model, enc.state[:batch], action, reward)
             if self.reward_model is not None
             else None
         )
@@ -277,8 +452,7 @@ class SimounAgent:
         loss.backward()
         self.critic_optimizer.step()
 
-        metrics["critic_loss"] = l_q.detach()
-        metrics["q"] = q1.detach().mean()
+        metrics = {"critic_loss": l_q.detach(), "q": q1.detach().mean()}
         for name, term in (
             ("transition_loss", l_tran),
             ("contrastive_loss", l_con),
@@ -286,35 +460,31 @@ class SimounAgent:
         ):
             if term is not None:
                 metrics[name] = term.detach()
-        if self.num_updates % cfg.actor_update_every == 0:
-            metrics.update(self.update_actor(enc.state.detach()))
-        if self.num_updates % cfg.target_update_every == 0:
-            self.update_targets()
-        self.num_updates += 1
         return metrics
 
     def dynamics(self, enc: Encoding) -> torch.Tensor:
         """What L_tran predicts the next value of: f^m with a motion path, else the state."""
         return enc.motion if self.motion_path else enc.state
 
-    def update_actor(self, state: torch.Tensor) -> dict[str, torch.Tensor]:
-        """Eq. 11 on detached features, then the temperature; the critic is held fixed."""
+    def update_actor(self, state: torch.Tensor, step: int | None = None) -> dict[str, torch.Tensor]:
+        """The actor's loss (Eq. 11 for SAC's) on detached features, then the temperature when
+        the actor has one; the critic is held fixed. ``step``: the global env step (None: that
+        of the latest update)."""
+        step = self.env_step if step is None else step
         self.critic.requires_grad_(False)
-        action, log_prob = self.actor(state)
-        l_pi = actor_loss(self.alpha, log_prob, *self.critic(state, action))
+        l_pi, log_prob, extra = self.actor.loss(self.critic, state, self.alpha, step)
         self.critic.requires_grad_(True)
         self.actor_optimizer.zero_grad(set_to_none=True)
         l_pi.backward()
         self.actor_optimizer.step()
-        l_alpha = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
-        self.alpha_optimizer.zero_grad(set_to_none=True)
-        l_alpha.backward()
-        self.alpha_optimizer.step()
-        return {
-            "actor_loss": l_pi.detach(),
-            "alpha": self.alpha.detach(),
-            "entropy": -log_prob.detach().mean(),
-        }
+        metrics = {"actor_loss": l_pi.detach()}
+        if self.log_alpha is not None:
+            l_alpha = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
+            self.alpha_optimizer.zero_grad(set_to_none=True)
+            l_alpha.backward()
+            self.alpha_optimizer.step()
+            metrics.update(alpha=self.alpha.detach(), entropy=-log_prob.detach().mean())
+        return {**metrics, **extra}
 
     def update_targets(self) -> None:
         """EMA: target <- target + tau (online - target), encoder and Q heads at their own tau."""
@@ -342,27 +512,36 @@ class SimounAgent:
         return {name: net for name, net in nets.items() if net is not None}
 
     def state_dict(self) -> dict:
-        """Networks, targets, optimisers, temperature, running maxima, update counter, config."""
+        """Networks, targets, optimisers, temperature (when the actor has one), running maxima,
+        update counter, env step, config."""
         state = {name: net.state_dict() for name, net in self.modules().items()}
         state.update(
-            log_alpha=self.log_alpha.detach().clone(),
             critic_optimizer=self.critic_optimizer.state_dict(),
             actor_optimizer=self.actor_optimizer.state_dict(),
-            alpha_optimizer=self.alpha_optimizer.state_dict(),
             running_max=self.running_max.state_dict(),
             num_updates=self.num_updates,
+            env_step=self.env_step,
             config=asdict(self.config),
         )
+        if self.log_alpha is not None:
+            state.update(
+                log_alpha=self.log_alpha.detach().clone(),
+                alpha_optimizer=self.alpha_optimizer.state_dict(),
+            )
         return state
 
     def load_state_dict(self, state: dict) -> None:
         """Restore what :meth:`state_dict` saved (into an agent built with the same config)."""
         for name, net in self.modules().items():
             net.load_state_dict(state[name])
-        with torch.no_grad():
-            self.log_alpha.copy_(state["log_alpha"])
+        if self.log_alpha is not None:
+            with torch.no_grad():
+                self.log_alpha.copy_(state["log_alpha"])
+            self.alpha_optimizer.load_state_dict(state["alpha_optimizer"])
         self.critic_optimizer.load_state_dict(state["critic_optimizer"])
         self.actor_optimizer.load_state_dict(state["actor_optimizer"])
-        self.alpha_optimizer.load_state_dict(state["alpha_optimizer"])
         self.running_max.load_state_dict(state["running_max"])
         self.num_updates = int(state["num_updates"])
+        # saved since the deterministic actor; older checkpoints hold only Gaussian actors,
+        # which do not read it
+        self.env_step = int(state.get("env_step", 0))

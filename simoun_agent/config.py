@@ -8,6 +8,7 @@ from simoun_agent.config_checks import check_agent_config
 
 AUGMENTATIONS = ("none", "shift")
 CONTRASTIVE_VIEWS = ("random_conv", "shift")
+NEXT_STATE_ENCODERS = ("online", "target")
 
 
 @dataclass
@@ -16,8 +17,8 @@ class AgentConfig:
 
     recipe: str | None = None
     """name of the agent recipe these values started from (simoun_agent.recipes: simoun, drq,
-    curl, sac and the Fig. 6 encoders); applied before the user's overrides. None: these
-    dataclass defaults"""
+    drqv2, rad, curl, sac and the Fig. 6 encoders); applied before the user's overrides. None:
+    these dataclass defaults"""
     encoder: str = "dual_interactive"
     """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6;
     the registry simoun_agent.models.encoder.ENCODERS)"""
@@ -26,6 +27,18 @@ class AgentConfig:
     shift: replicate-pad, random crop back, one offset per sample for its whole window)"""
     shift_pad: int | None = None
     """padding of the "shift" augmentation in pixels; None: 4 px per 84 px of image height"""
+    critic_augmentations: int = 1
+    """M of DrQ: augmented views of each sample whose critic losses are averaged (each view one
+    shift offset per sample for its whole window); the auxiliary losses, curiosity and the actor
+    use the first. More than 1 needs augmentation "shift" """
+    target_augmentations: int = 1
+    """K of DrQ: augmented views of the next state whose TD targets are averaged; view k shares
+    the offsets of critic view k (views beyond M get their own). More than 1 needs augmentation
+    "shift" """
+    next_state_encoder: str = "online"
+    """encoder of the next state read by the target Q heads: "online" (no gradient; DrQ-v2,
+    CURL-style agents), or "target", the EMA encoder (DrQ, whose target critic holds its own
+    encoder, EMA rate encoder_tau). The next action is drawn from the online encoder's state"""
     contrastive_view: str = "random_conv"
     """positive view of L_con: "random_conv" (Eq. 3, a random convolution of the same frames)
     or "shift" (CURL: an independently shifted view of the same input)"""
@@ -58,6 +71,20 @@ class AgentConfig:
     """update the actor and temperature every this many gradient steps"""
     target_update_every: int = 2
     """update the EMA targets every this many gradient steps"""
+    actor: str = "gaussian"
+    """the policy: "gaussian" (SAC, learned temperature) or "deterministic" (DrQ-v2: tanh(mu),
+    scheduled exploration noise, no entropy term); the registry simoun_agent.models.actors.ACTORS"""
+    exploration_std_start: float = 1.0
+    """deterministic actor: exploration noise std at env step 0 (DrQ-v2)"""
+    exploration_std_end: float = 0.1
+    """deterministic actor: exploration noise std from exploration_steps on (DrQ-v2)"""
+    exploration_steps: int = 1_000_000
+    """deterministic actor: env steps over which the std falls linearly from start to end.
+    DrQ-v2's "medium" schedule is 500k of its agent steps, i.e. 1M env steps (frames) at its
+    action repeat 2"""
+    noise_clip: float = 0.3
+    """deterministic actor: the noise of the TD target's and the policy loss's action is clipped
+    to +- this (DrQ-v2's stddev_clip)"""
     init_temperature: float = 0.1
     """initial SAC temperature alpha"""
     log_std_min: float = -10.0

@@ -205,7 +205,8 @@ AGENT = "agent."
 @lru_cache(maxsize=1)
 def agent_rules() -> dict[str, Rule]:
     """The rule of every ``AgentConfig`` field (built on first use: the registries need torch)."""
-    from simoun_agent.config import AUGMENTATIONS, CONTRASTIVE_VIEWS
+    from simoun_agent.config import AUGMENTATIONS, CONTRASTIVE_VIEWS, NEXT_STATE_ENCODERS
+    from simoun_agent.models.actors import ACTORS
     from simoun_agent.models.encoder import ENCODERS
     from simoun_agent.recipes import RECIPES
 
@@ -217,6 +218,9 @@ def agent_rules() -> dict[str, Rule]:
         "encoder": one_of(list(ENCODERS)),
         "augmentation": one_of(AUGMENTATIONS),
         "shift_pad": integer(0, optional=True),
+        "critic_augmentations": positive,
+        "target_augmentations": positive,
+        "next_state_encoder": one_of(NEXT_STATE_ENCODERS),
         "contrastive_view": one_of(CONTRASTIVE_VIEWS),
         "feature_dim": positive,
         "num_filters": positive,
@@ -234,6 +238,11 @@ def agent_rules() -> dict[str, Rule]:
         "encoder_tau": rate,
         "actor_update_every": positive,
         "target_update_every": positive,
+        "actor": one_of(list(ACTORS)),
+        "exploration_std_start": real(0.0),
+        "exploration_std_end": real(0.0),
+        "exploration_steps": positive,
+        "noise_clip": real(0.0),
         "init_temperature": real(0.0, open_low=True),
         "log_std_min": finite(),
         "log_std_max": finite(),
@@ -266,6 +275,16 @@ def check_agent_config(config: Any) -> None:
             config.log_std_min,
             f"must be below --agent.log-std-max {config.log_std_max:g}; e.g. -10 and 2",
         )
+    for name in ("critic_augmentations", "target_augmentations"):
+        if getattr(config, name) > 1 and config.augmentation == "none":
+            raise fail(
+                AGENT,
+                name,
+                getattr(config, name),
+                "several views of one sample need a random augmentation, and augmentation is "
+                f"'none' (every view would be the same); set --agent.augmentation shift or "
+                f"--agent.{name.replace('_', '-')} 1",
+            )
     motion_path = ENCODERS[config.encoder].motion_path
     if config.num_frames != 3 and motion_path:
         raise fail(

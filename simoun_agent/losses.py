@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import torch
 import torch.nn.functional as F
 
-from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
+if TYPE_CHECKING:  # annotations only: the actor heads (models/sac.py) import these losses
+    from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 
 
 def transition_loss(
@@ -43,6 +46,20 @@ def soft_value(
     return torch.min(next_q1, next_q2) - alpha * next_log_prob
 
 
+def deterministic_value(next_q1: torch.Tensor, next_q2: torch.Tensor) -> torch.Tensor:
+    """DrQ-v2's V(o_{t+1}) = min(Qbar_1, Qbar_2)(o_{t+1}, a~_{t+1}) at the target-smoothed action
+    a~ (clipped noise, Fujimoto et al. 2018): no entropy term."""
+    return torch.min(next_q1, next_q2)
+
+
+def intrinsic_return(intrinsic: torch.Tensor, mask: torch.Tensor, gamma: float) -> torch.Tensor:
+    """Eq. 13's part of an n-step target: sum_j gamma^j r^i(s_{t+j}) over the steps j < m of the
+    return. ``intrinsic`` and ``mask`` ``(n, B)`` (row j: r^i of s_{t+j}, and 1 where step j
+    lies in the episode); returns ``(B,)``. With n = 1 it is r^i(s_t), the one-step target's."""
+    weights = gamma ** torch.arange(len(intrinsic), dtype=intrinsic.dtype, device=intrinsic.device)
+    return (weights[:, None] * mask * intrinsic).sum(0)
+
+
 def td_target(
     reward: torch.Tensor, discount: torch.Tensor, gamma: float, value: torch.Tensor
 ) -> torch.Tensor:
@@ -63,6 +80,12 @@ def actor_loss(
 ) -> torch.Tensor:
     """Eq. 11: E[alpha log pi(a_t | o_t) - min(Q1, Q2)(o_t, a_t)], alpha held fixed."""
     return (alpha.detach() * log_prob - torch.min(q1, q2)).mean()
+
+
+def deterministic_actor_loss(q1: torch.Tensor, q2: torch.Tensor) -> torch.Tensor:
+    """DrQ-v2's policy loss: -E[min(Q1, Q2)(o_t, a~_t)] at the noisy action a~_t (DDPG with
+    clipped double Q), the critic held fixed; no entropy term."""
+    return -torch.min(q1, q2).mean()
 
 
 def temperature_loss(

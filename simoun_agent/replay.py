@@ -184,6 +184,12 @@ class FrameReplay:
         one (bootstrapped from the frame it reached) and at the newest frame stored; it never
         crosses an episode boundary. With ``n_step=1`` ``return`` equals ``reward`` and
         ``discount`` is 1 - terminated.
+
+        For a per-step term of the target (Eq. 13's intrinsic reward of each state s_{t+j}):
+        float32 ``return_mask`` ``(B, n)``, 1 for the m steps j < m that ``return`` sums, 0
+        after, and uint8 ``n_step_window`` ``(B, k+n, C, H, W)``, frames t-k+1 .. t+n (its first
+        k+1 frames are ``window``; frame t+m is repeated after t+m, so it never holds a frame of
+        another episode), whose k frames ending at t+j are s_{t+j}.
         """
         if n_step < 1:
             raise ValueError(f"n_step must be >= 1, got {n_step}")
@@ -203,6 +209,7 @@ class FrameReplay:
         window = self._frames_ending_at(chosen, self.num_frames + 1)
         end, n_return = chosen.copy(), self.rewards[slot].astype(np.float64)
         going = np.ones(batch_size, bool)
+        mask = np.ones((batch_size, n_step), np.float32)
         for j in range(1, n_step):
             following = chosen + j
             previous = (following - 1) % self.slots
@@ -214,8 +221,11 @@ class FrameReplay:
             )
             n_return += np.where(going, discount**j * self.rewards[following % self.slots], 0.0)
             end = np.where(going, following, end)
+            mask[:, j] = going
         steps_taken = end - chosen + 1
         alive = 1.0 - self.terminated[end % self.slots].astype(np.float64)
+        # frames t+2 .. t+n of n_step_window (chosen holds frame t+1), clamped at frame t+m
+        ahead = [self.frames[np.minimum(chosen + j, end) % self.slots] for j in range(1, n_step)]
         return {
             "obs": window[:, :-1],
             "next_obs": window[:, 1:],
@@ -228,6 +238,8 @@ class FrameReplay:
             else self._frames_ending_at(end, self.num_frames),
             "discount": (alive * discount ** (steps_taken - 1)).astype(np.float32),
             "truncated": self.truncated[slot],
+            "return_mask": mask,
+            "n_step_window": np.concatenate([window, np.stack(ahead, 1)], 1) if ahead else window,
         }
 
     def _frames_ending_at(self, index: np.ndarray, count: int) -> np.ndarray:

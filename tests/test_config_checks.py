@@ -40,6 +40,9 @@ BAD = {
     "agent.encoder": "triple",
     "agent.augmentation": "flip",
     "agent.shift_pad": -1,
+    "agent.critic_augmentations": 0,
+    "agent.target_augmentations": 2,  # with augmentation "none": every view the same
+    "agent.next_state_encoder": "momentum",
     "agent.contrastive_view": "crop",
     "agent.feature_dim": 0,
     "agent.num_filters": 0,
@@ -55,6 +58,11 @@ BAD = {
     "agent.encoder_tau": 2.0,
     "agent.actor_update_every": 0,
     "agent.target_update_every": 0,
+    "agent.actor": "stochastic",
+    "agent.exploration_std_start": -1.0,
+    "agent.exploration_std_end": math.nan,
+    "agent.exploration_steps": 0,
+    "agent.noise_clip": -0.3,
     "agent.init_temperature": 0.0,
     "agent.log_std_min": 5.0,  # above log_std_max
     "agent.log_std_max": math.inf,

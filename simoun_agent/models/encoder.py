@@ -138,13 +138,14 @@ class PixelEncoder(nn.Module):
         raise NotImplementedError
 
     def encode_transition(
-        self, window: torch.Tensor, frame_features: bool = False
+        self, window: torch.Tensor, frame_features: bool = False, next_frame_features: bool = False
     ) -> tuple[Encoding, Encoding]:
         """Encodings of the triplets at t (with gradient) and t+1 (without) from the uint8 window
-        ``(B, k+1, C, H, W)`` of frames t-k+1 .. t+1."""
+        ``(B, k+1, C, H, W)`` of frames t-k+1 .. t+1; ``frame_features`` / ``next_frame_features``
+        ask for the per-frame f^a of the one at t / at t+1."""
         current = self(window[:, :-1], frame_features)
         with torch.no_grad():
-            following = self(window[:, 1:])
+            following = self(window[:, 1:], next_frame_features)
         return current, following
 
 
@@ -340,7 +341,7 @@ class DualPathEncoder(PixelEncoder):
         return self.encode_maps(self.motion_maps(x), frames, reduced, True, frame_features)
 
     def encode_transition(
-        self, window: torch.Tensor, frame_features: bool = False
+        self, window: torch.Tensor, frame_features: bool = False, next_frame_features: bool = False
     ) -> tuple[Encoding, Encoding]:
         """Each unique frame through each path once, with gradient only where a loss needs it:
         F^a of frame t with gradient, of t+1 without, of t-2 and t-1 without when
@@ -364,7 +365,7 @@ class DualPathEncoder(PixelEncoder):
                     self.interaction.reduce_appearance(frames_next[2]),
                 ]
             following = self.encode_maps(
-                self.motion_maps(x[1:]), frames_next, reduced_next, anchor=False
+                self.motion_maps(x[1:]), frames_next, reduced_next, False, next_frame_features
             )
         return current, following
 

@@ -7,6 +7,8 @@ import math
 import torch
 from torch import nn
 
+from simoun_agent.losses import actor_loss, soft_value
+
 
 def mlp(in_dim: int, hidden_dim: int, out_dim: int, hidden_layers: int = 2) -> nn.Sequential:
     """Linear-ReLU stack with ``hidden_layers`` hidden layers of ``hidden_dim`` units."""
@@ -18,7 +20,12 @@ def mlp(in_dim: int, hidden_dim: int, out_dim: int, hidden_layers: int = 2) -> n
 
 
 class Actor(nn.Module):
-    """Tanh-squashed Gaussian policy pi(a | f_t) with log-std bounded by a tanh rescale (SAC-AE)."""
+    """Tanh-squashed Gaussian policy pi(a | f_t) with log-std bounded by a tanh rescale (SAC-AE).
+
+    The ``"gaussian"`` entry of :data:`simoun_agent.models.actors.ACTORS`: it explores by
+    sampling, and its TD target and loss carry SAC's entropy term with the learned temperature
+    alpha. ``step`` (the exploration schedule of other actors) is unused.
+    """
 
     def __init__(
         self,
@@ -47,6 +54,30 @@ class Actor(nn.Module):
         log_prob = log_prob - 0.5 * math.log(2 * math.pi) * mu.shape[-1]
         log_prob = log_prob - torch.log1p(-action.pow(2) + 1e-6).sum(-1, keepdim=True)
         return action, log_prob
+
+    def act(self, state: torch.Tensor, deterministic: bool, step: int) -> torch.Tensor:
+        """The action to take: a sample of pi, or its mode when ``deterministic``."""
+        return self(state, deterministic)[0]
+
+    def next_value(
+        self,
+        critic_target: Critic,
+        policy_state: torch.Tensor,
+        value_state: torch.Tensor,
+        alpha: torch.Tensor,
+        step: int,
+    ) -> torch.Tensor:
+        """Eq. 10 for the TD target: a_{t+1} ~ pi(. | policy_state), Q-bar read on
+        ``value_state`` (the same state, or the target encoder's)."""
+        action, log_prob = self(policy_state)
+        return soft_value(*critic_target(value_state, action), log_prob, alpha)
+
+    def loss(
+        self, critic: Critic, state: torch.Tensor, alpha: torch.Tensor, step: int
+    ) -> tuple[torch.Tensor, torch.Tensor, dict[str, torch.Tensor]]:
+        """Eq. 11, with log pi of the sampled actions for the temperature loss."""
+        action, log_prob = self(state)
+        return actor_loss(alpha, log_prob, *critic(state, action)), log_prob, {}
 
 
 class Critic(nn.Module):
