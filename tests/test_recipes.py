@@ -1,19 +1,26 @@
-"""Agent recipes (simoun, drq, curl, sac, Fig. 6 encoders), the random shift and the generic
-nested config: each recipe builds the losses it promises and no others."""
+"""Agent recipes (simoun, drq, drqv2, rad, curl, sac, Fig. 6 encoders), the random shift and the
+generic nested config: each recipe builds the losses, networks and augmented views it promises
+and no others; DrQ's K/M averaging and target encoder and DrQ-v2's deterministic actor are
+checked against values computed here."""
 
+import copy
 import dataclasses
 import json
+import re
 
+import numpy as np
 import pytest
 import torch
 import torch.nn.functional as F
 from test_train_resume import TINY
 
-from simoun_agent import AgentConfig, SimounAgent
+from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+from simoun_agent.models.actors import DeterministicActor
 from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.recipes import RECIPES
 from simoun_agent.run import train
-from simoun_agent.run.presets import SetupError, config_sections, resolve
+from simoun_agent.run.presets import SetupError, config_sections, from_dict, resolve, to_dict
+from simoun_agent.sweep.report import with_defaults
 from simoun_wrappers.augment import random_shift, shift_pad
 
 FRAME = (3, 24, 24)
@@ -47,6 +54,8 @@ def losses_of(agent: SimounAgent) -> set[str]:
     [
         ("simoun", AUX_LOSSES),
         ("drq", set()),
+        ("drqv2", set()),
+        ("rad", set()),
         ("sac", set()),
         ("curl", {"contrastive_loss"}),
         *((name, AUX_LOSSES) for name in ("single", "stacked", "flare", "dual", "stacked_wide")),
@@ -90,17 +99,236 @@ class Spy:
         agent.encoder_target.encode_key = spy_key
 
 
-def test_sac_sees_unshifted_frames_and_drq_shifted_ones():
+def test_sac_sees_unshifted_frames_and_rad_shifted_ones():
     frames, *rest = window()
-    sac, drq = recipe_agent("sac"), recipe_agent("drq")
+    sac, rad = recipe_agent("sac"), recipe_agent("rad")
     seen = {}
-    for name, agent in (("sac", sac), ("drq", drq)):
+    for name, agent in (("sac", sac), ("rad", rad)):
         spy = Spy(agent)
         agent.update_window(frames, *rest, step=0)
         seen[name] = spy.windows[0]
     assert torch.equal(seen["sac"], frames)
-    assert not torch.equal(seen["drq"], frames)
-    assert drq.shift_pad == shift_pad(FRAME[1]) == 1
+    assert not torch.equal(seen["rad"], frames)
+    assert rad.shift_pad == shift_pad(FRAME[1]) == 1
+    # one view of the critic and one of the target, the online encoder for the next state
+    assert len(spy.windows) == 1 and spy.windows[0].shape == frames.shape
+
+
+def test_rad_is_what_drq_meant_before_it_followed_drq_s_k_m_averaging():
+    """The values the 'drq' recipe had until it followed DrQ as published."""
+    before = {"encoder": "stacked", "augmentation": "shift", "transition_weight": 0.0}
+    before.update(contrastive_weight=0.0, reward_weight=0.0, curiosity=False)
+    before.update(alpha_lr=1e-3, alpha_beta=0.9)
+    assert RECIPES["rad"].values == before
+    rad = resolve(None, {"agent.recipe": "rad"}).agent
+    defaults = AgentConfig()
+    assert (rad.critic_augmentations, rad.target_augmentations) == (1, 1)
+    assert (rad.next_state_encoder, rad.actor, rad.n_step) == ("online", "gaussian", 1)
+    assert (rad.init_temperature, rad.critic_tau, rad.encoder_tau, rad.lr) == (
+        defaults.init_temperature, defaults.critic_tau, defaults.encoder_tau, defaults.lr,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("name", ["drq", "drqv2", "rad", "curl", "sac"])
+def test_each_baseline_cites_its_paper_and_names_its_deviations(name):
+    recipe = RECIPES[name]
+    assert re.search(r"\([A-Z][^()]* (et al\. |& [A-Z]\w+ )?(19|20)\d\d\)", recipe.description)
+    if name != "sac":
+        assert recipe.deviations and all(len(item) > 20 for item in recipe.deviations)
+    if name in ("rad", "curl"):  # the crop of 100x100 renders the papers use
+        assert any("random crop of 100x100" in item for item in recipe.deviations)
+
+
+def perturb(module: torch.nn.Module, seed: int) -> None:
+    gen = torch.Generator().manual_seed(seed)
+    with torch.no_grad():
+        for p in module.parameters():
+            p.add_(torch.randn(p.shape, generator=gen) * 0.2)
+
+
+def drq_critic_loss_by_hand(agent, frames, action, reward, discount, seed, value_encoder):
+    """DrQ's critic loss written out: K = 2 shifted next states, each through ``value_encoder``
+    for the target Q heads and the online encoder for the actor, their targets averaged; M = 2
+    shifted current states, each against that target, the losses averaged."""
+    agent = copy.deepcopy(agent)
+    torch.manual_seed(seed)
+    views = [random_shift(frames, agent.shift_pad) for _ in range(2)]  # the update's draws
+    gamma, alpha = agent.config.discount, float(agent.alpha.detach())
+    with torch.no_grad():
+        next_obs = torch.cat([v[:, 1:] for v in views])
+        next_action, log_prob = agent.actor(agent.encoder(next_obs).state)
+        q1_bar, q2_bar = agent.critic_target(value_encoder(agent)(next_obs).state, next_action)
+        value = (torch.min(q1_bar, q2_bar) - alpha * log_prob)[:, 0].view(2, -1)
+        targets = reward + gamma * discount * value  # (K, B): one target per next view
+        y = targets.mean(0)
+        q1, q2 = agent.critic(agent.encoder(torch.cat([v[:, :3] for v in views])).state,
+                              torch.cat([action, action]))  # fmt: skip
+    y = torch.cat([y, y])[:, None]
+    loss = F.mse_loss(q1, y) + F.mse_loss(q2, y)
+    return float(loss), views, targets
+
+
+def test_drq_averages_two_augmented_targets_through_the_target_encoder_and_two_critic_views():
+    agent = recipe_agent("drq")
+    perturb(agent.encoder_target, seed=1)  # the target encoder differs from the online one
+    frames, action, reward, _ = window()
+    discount = torch.tensor([1.0, 0.0, 1.0, 1.0, 0.0, 1.0])
+    target_encoder, online_encoder = (lambda a: a.encoder_target), (lambda a: a.encoder)
+    expected, views, targets = drq_critic_loss_by_hand(
+        agent, frames, action, reward, discount, 4, target_encoder
+    )
+    with_online, _, _ = drq_critic_loss_by_hand(
+        agent, frames, action, reward, discount, 4, online_encoder
+    )
+    assert not torch.equal(views[0], views[1])  # two independent shifts of the window
+    assert not torch.allclose(targets[0], targets[1])  # two different targets are averaged
+    torch.manual_seed(4)
+    metrics = agent.update_window(frames, action, reward, discount, step=0)
+    assert float(metrics["critic_loss"]) == pytest.approx(expected, rel=1e-5)
+    assert abs(with_online - expected) > 1e-3 * abs(expected)  # the test tells them apart
+
+
+def test_drq_values_are_drq_s_published_ones():
+    drq = resolve(None, {"agent.recipe": "drq"}).agent
+    assert (drq.critic_augmentations, drq.target_augmentations) == (2, 2)
+    assert (drq.next_state_encoder, drq.encoder_tau, drq.critic_tau) == ("target", 0.01, 0.01)
+    assert (drq.init_temperature, drq.alpha_lr, drq.alpha_beta) == (0.1, 1e-3, 0.9)
+    assert (drq.encoder, drq.augmentation, drq.actor, drq.n_step) == (
+        "stacked", "shift", "gaussian", 1,
+    )  # fmt: skip
+    assert (drq.actor_update_every, drq.target_update_every) == (2, 2)
+    with pytest.raises(ValueError, match="augmentation shift"):
+        AgentConfig(encoder="stacked", curiosity=False, critic_augmentations=2)
+
+
+def test_drqv2_has_no_temperature_and_acts_deterministically_at_evaluation():
+    agent = recipe_agent("drqv2")
+    assert isinstance(agent.actor, DeterministicActor)
+    assert agent.log_alpha is None and agent.alpha is None
+    assert "log_alpha" not in agent.state_dict() and "alpha_optimizer" not in agent.state_dict()
+    frames, action, reward, discount = window()
+    metrics = agent.update_window(frames, action, reward, discount, step=0)
+    assert not {"alpha", "entropy"} & set(metrics) and "actor_loss" in metrics
+    obs = frames[0, :3].numpy()
+    with torch.no_grad():
+        mu = agent.actor(agent.encoder(frames[:1, :3]).state)[0].numpy()
+    evaluation = [agent.act(obs, deterministic=True) for _ in range(2)]
+    np.testing.assert_allclose(evaluation[0], mu, rtol=1e-6)
+    np.testing.assert_array_equal(evaluation[0], evaluation[1])
+    assert not np.allclose(agent.act(obs), mu)  # exploration adds noise
+
+
+def test_drqv2_noise_std_follows_the_linear_schedule_of_the_env_step():
+    agent = recipe_agent("drqv2")
+    config = agent.config
+    assert (config.exploration_std_start, config.exploration_std_end) == (1.0, 0.1)
+    assert (config.exploration_steps, config.noise_clip) == (1_000_000, 0.3)
+    schedule = {0: 1.0, 250_000: 0.775, 500_000: 0.55, 1_000_000: 0.1, 3_000_000: 0.1}
+    for step, std in schedule.items():
+        assert agent.actor.std(step) == pytest.approx(std)
+    with torch.no_grad():  # mu = 0, so the action is the clamped noise itself
+        agent.actor.trunk[-1].weight.zero_()
+        agent.actor.trunk[-1].bias.zero_()
+    state = torch.zeros(20_000, agent.encoder.repr_dim)
+    torch.manual_seed(0)
+    for step in (800_000, 1_000_000):  # stds 0.28 and 0.1: the clamp at +-1 hardly matters
+        noise = agent.actor.act(state, deterministic=False, step=step)
+        assert float(noise.detach().std()) == pytest.approx(agent.actor.std(step), rel=0.02)
+    # act() without a step uses the step of the latest update; the trainer passes its own
+    frames, action, reward, discount = window()
+    agent.update_window(frames, action, reward, discount, step=1_000_000)
+    obs = frames[0, :3].numpy()
+    samples = np.stack([agent.act(obs) for _ in range(400)])
+    assert samples.std() == pytest.approx(0.1, rel=0.15)
+    samples = np.stack([agent.act(obs, step=0) for _ in range(400)])
+    assert samples.std() > 0.5
+
+
+def test_drqv2_target_and_actor_loss_read_min_q_at_the_clipped_noisy_action():
+    """TD target r + gamma d min(Qbar)(s', clamp(mu(s') + clip(std eps, +-0.3))) through the
+    online encoder, no entropy term; actor loss -min Q(s, clamp(mu(s) + clip(std eps)))."""
+    agent = recipe_agent("drqv2")
+    perturb(agent.encoder_target, seed=1)  # never read: DrQ-v2's target uses the online one
+    frames, action, reward, discount = window()
+    discount[1] = 0.0
+    step, gamma = 300_000, agent.config.discount
+    std = agent.actor.std(step)
+    by_hand = copy.deepcopy(agent)
+    torch.manual_seed(5)
+    with torch.no_grad():
+        shifted = random_shift(frames, by_hand.shift_pad)
+        next_state = by_hand.encoder(shifted[:, 1:]).state
+        mu = by_hand.actor(next_state)
+        noise = (std * torch.randn_like(mu)).clamp(-0.3, 0.3)
+        q1_bar, q2_bar = by_hand.critic_target(next_state, (mu + noise).clamp(-1, 1))
+        y = (reward + gamma * discount * torch.min(q1_bar, q2_bar)[:, 0])[:, None]
+        state = by_hand.encoder(shifted[:, :3]).state
+        q1, q2 = by_hand.critic(state, action)
+    expected_critic = float(F.mse_loss(q1, y) + F.mse_loss(q2, y))
+    critic = copy.deepcopy(agent)
+    torch.manual_seed(5)
+    metrics = critic.update_window(frames, action, reward, discount, step=step)
+    assert float(metrics["critic_loss"]) == pytest.approx(expected_critic, rel=1e-5)
+    assert float(metrics["exploration_std"]) == pytest.approx(std)
+
+    state = torch.randn(6, agent.encoder.repr_dim)
+    torch.manual_seed(6)
+    with torch.no_grad():
+        mu = agent.actor(state)
+        noise = (std * torch.randn_like(mu)).clamp(-0.3, 0.3)
+        expected_actor = -float(torch.min(*agent.critic(state, (mu + noise).clamp(-1, 1))).mean())
+    assert float(noise.abs().max()) == pytest.approx(0.3)  # the clip was active
+    torch.manual_seed(6)
+    assert float(agent.update_actor(state, step)["actor_loss"]) == pytest.approx(
+        expected_actor, rel=1e-5
+    )
+
+
+def test_drqv2_trains_the_actor_every_step_and_the_targets_every_second_on_3_step_returns():
+    agent = recipe_agent("drqv2")
+    assert agent.config.n_step == 3 and agent.config.lr == 1e-4
+    rng = np.random.default_rng(0)
+    replay = FrameReplay(100, FRAME, 2, seed=0)
+    replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
+    for _ in range(30):
+        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
+        replay.add(rng.uniform(-1, 1, 2), rng.normal(), frame, False, False)
+    moved = []
+    for step in range(4):
+        before = {name: copy.deepcopy(getattr(agent, name)) for name in ("actor", "critic_target")}
+        agent.update(replay, step)
+        moved.append(
+            {
+                name
+                for name, old in before.items()
+                if any(
+                    not torch.equal(a, b)
+                    for a, b in zip(
+                        old.parameters(), getattr(agent, name).parameters(), strict=True
+                    )
+                )
+            }
+        )
+    assert moved == [{"actor", "critic_target"}, {"actor"}] * 2
+
+
+def test_a_run_saved_as_the_old_drq_loads_with_this_version_s_defaults():
+    """config.json of a run made when 'drq' was SAC + shift: its values load as saved, the keys
+    it predates take this version's defaults, which are its behaviour (one view, online next
+    state, Gaussian actor); simoun-report's with_defaults reads it too."""
+    saved = to_dict(resolve("cpu", {"agent.recipe": "rad"}))
+    saved["agent"]["recipe"] = "drq"
+    new_keys = ("critic_augmentations", "target_augmentations", "next_state_encoder", "actor")
+    new_keys += ("exploration_std_start", "exploration_std_end", "exploration_steps")
+    for key in (*new_keys, "noise_clip"):
+        del saved["agent"][key]
+    config = from_dict(json.loads(json.dumps(saved)))
+    assert config.agent.recipe == "drq" and config.agent.augmentation == "shift"
+    assert (config.agent.critic_augmentations, config.agent.target_augmentations) == (1, 1)
+    assert (config.agent.next_state_encoder, config.agent.actor) == ("online", "gaussian")
+    report = with_defaults(saved)
+    assert report["agent"]["critic_augmentations"] == 1 and report["agent"]["recipe"] == "drq"
+    SimounAgent(FRAME, 2, dataclasses.replace(config.agent, **SMALL), device="cpu")
 
 
 def test_curl_key_is_an_independent_shift_of_the_unshifted_stack():
@@ -140,11 +368,11 @@ def test_random_shift_equals_replicate_pad_then_crop():
 
 
 def test_recipe_applies_after_the_preset_and_before_user_overrides():
-    config = resolve("cpu", {"agent.recipe": "drq", "agent.alpha_lr": 5e-4})
+    config = resolve("cpu", {"agent.recipe": "rad", "agent.alpha_lr": 5e-4})
     assert config.agent.encoder == "stacked" and config.agent.augmentation == "shift"
     assert config.agent.alpha_lr == 5e-4  # the user's value wins over the recipe's 1e-3
     assert config.agent.batch_size == 64  # the preset's value stays
-    assert not config.agent.curiosity and config.agent.recipe == "drq"
+    assert not config.agent.curiosity and config.agent.recipe == "rad"
 
 
 def test_recipe_is_saved_and_reloaded_with_the_run(tmp_path):

@@ -355,7 +355,7 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
             if counters.agent_step < config.warmup_agent_steps:
                 action = run.rng.uniform(-1.0, 1.0, action_dim).astype(np.float32)
             else:
-                action = agent.act(obs["frames"])
+                action = agent.act(obs["frames"], step=counters.env_step)
             # the environment steps (in a background process with env_process) while the agent
             # updates on the transitions before this one; both runners give the same results
             env.step_async(action)
