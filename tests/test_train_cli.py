@@ -2,10 +2,12 @@
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -107,3 +109,18 @@ def test_help_lists_every_preset_and_config_key(capsys):
     text = capsys.readouterr().out
     for name in ("cartpole-swingup", "highway", "cpu", "--agent.batch-size", "--action-repeat"):
         assert name in text
+
+
+def test_setup_script_announces_every_step_before_it_runs():
+    """scripts/setup.sh runs for minutes with pip kept quiet: each command that installs is
+    preceded by its own numbered step line, so a log shows where it is."""
+    path = Path(__file__).parents[1] / "scripts" / "setup.sh"
+    script = path.read_text().splitlines()
+    commands = [
+        i for i, line in enumerate(script) if re.match(r"(python3 -m venv|\.venv/bin/)", line)
+    ]
+    steps = [int(m.group(1)) for line in script if (m := re.match(r"step (\d+) ", line))]
+    total = int(re.search(r"\[\$1/(\d+)", "\n".join(script)).group(1))
+    assert steps == list(range(1, total + 1)) and len(commands) == total
+    assert all(script[i - 1].startswith("step ") for i in commands)
+    assert subprocess.run(["bash", "-n", str(path)], timeout=120).returncode == 0
