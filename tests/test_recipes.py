@@ -5,6 +5,7 @@ checked against values computed here."""
 
 import copy
 import dataclasses
+import io
 import json
 import re
 
@@ -402,3 +403,36 @@ def test_config_sections_are_found_from_the_dataclass_fields():
     assert set(sections) == {"", "agent."}
     config = resolve(None, {"env_kwargs": {"agent": {"lr": 1}}})
     assert config.env_kwargs == {"agent": {"lr": 1}}  # a dict value, not a section
+
+
+@pytest.mark.parametrize("name", ["drq", "drqv2"])
+def test_state_dict_resumes_drq_and_drqv2_bit_exactly(name):
+    """Their extra state: DrQ's target encoder, DrQ-v2's env step (act()'s default schedule
+    step) and its lack of a temperature."""
+    rng = np.random.default_rng(0)
+    replay = FrameReplay(100, FRAME, 2, seed=0)
+    replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
+    for _ in range(30):
+        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
+        replay.add(rng.uniform(-1, 1, 2), rng.normal(), frame, False, False)
+    agent = recipe_agent(name)
+    for step in range(2):
+        agent.update(replay, 1000 * step)
+    checkpoint = io.BytesIO()  # as simoun-train's checkpoints do
+    torch.save(agent.state_dict(), checkpoint)
+    saved = torch.get_rng_state(), copy.deepcopy(replay)
+    runs = []
+    for candidate in (agent, recipe_agent(name)):
+        checkpoint.seek(0)
+        candidate.load_state_dict(torch.load(checkpoint, weights_only=False))
+        torch.set_rng_state(saved[0])
+        again = copy.deepcopy(saved[1])
+        assert candidate.env_step == 1000
+        actions = [candidate.act(again.sample(1)["obs"][0])]
+        candidate.update(again, 2000)
+        actions.append(candidate.act(again.sample(1)["obs"][0]))
+        runs.append(
+            (actions, [p.clone() for n in candidate.modules().values() for p in n.parameters()])
+        )
+    assert all(np.array_equal(a, b) for a, b in zip(runs[0][0], runs[1][0], strict=True))
+    assert all(torch.equal(a, b) for a, b in zip(runs[0][1], runs[1][1], strict=True))
