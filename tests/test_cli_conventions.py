@@ -4,6 +4,7 @@ no silent overwrite of an evaluation; simoun-eval stops promptly on SIGTERM (iss
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -12,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+import torch
 
 from simoun_agent.run import evaluate, train
 from simoun_agent.run.logger import read_csv
@@ -124,7 +126,9 @@ def test_rerun_after_a_crash_before_the_first_checkpoint_offers_overwrite(tmp_pa
     run_dir = tmp_path / "run"
     flags = run_flags(run_dir, 20, "--no-progress", "--no-video")
     crashed = subprocess.run(
-        [sys.executable, "-c", CRASH_AFTER_FIRST_EVALUATION, *flags], capture_output=True
+        [sys.executable, "-c", CRASH_AFTER_FIRST_EVALUATION, *flags],
+        capture_output=True,
+        timeout=300,
     )
     assert crashed.returncode == -signal.SIGKILL
     assert (run_dir / "config.json").exists() and not (run_dir / "checkpoint.pt").exists()
@@ -208,3 +212,133 @@ def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
 def test_simoun_eval_refuses_a_negative_seed(finished, capsys):
     err = exit_message(capsys, evaluate.main, [str(finished), "--seed", "-1", "--no-video"])
     assert "--seed -1" in err
+
+
+ENV_MODULE = """
+import gymnasium as gym
+
+gym.register("simoun-test/WideReach-v0", entry_point="simoun_agent.envs.point_reach:PointReach",
+             kwargs={"size": 40}, max_episode_steps=20)
+"""
+
+
+def test_env_module_is_saved_so_resume_and_simoun_eval_rebuild_the_env(tmp_path, monkeypatch):
+    (tmp_path / "simoun_test_envs.py").write_text(ENV_MODULE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    run_dir = tmp_path / "run"
+    flags = [*TINY, "--env", "simoun_test_envs:simoun-test/WideReach-v0", "--no-progress"]
+    assert train.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "20"]) == 0
+    config = json.loads((run_dir / "config.json").read_text())
+    assert (config["env"], config["env_module"]) == ("simoun-test/WideReach-v0", "simoun_test_envs")
+    assert train.main(["--resume", str(run_dir), "--total-env-steps", "40", "--no-video"]) == 0
+    # a fresh interpreter knows the id only by importing the module that config.json names
+    done = subprocess.run(
+        [sys.executable, "-m", "simoun_agent.run.evaluate", str(run_dir), "--episodes", "1"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+    )
+    assert done.returncode == 0, done.stderr
+    assert json.loads((run_dir / "eval-40" / "metrics.json").read_text())["env_step"] == 40
+
+
+def test_a_missing_env_module_and_bad_env_kwargs_end_in_one_line_not_a_traceback(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    flags = [*run_flags(run_dir, 20), "--env", "simoun_no_such_package:Thing-v0"]
+    err = exit_message(capsys, train.main, flags)
+    assert "'simoun_no_such_package' is not installed" in err and "pip install" in err
+    flags = [*run_flags(run_dir, 20), "--env-kwargs", '{"foo": 1}']
+    err = exit_message(capsys, train.main, flags)
+    assert err == (
+        "simoun-train: error: --env-kwargs: simoun/PointReach-v0 takes no keyword 'foo'; it "
+        "accepts: max_steps, size, step_size\n"
+    )
+    assert not run_dir.exists()  # refused before anything was built or written
+
+
+def test_set_with_a_misspelled_key_suggests_by_meaning_and_takes_the_flag_spelling(
+    tmp_path, capsys
+):
+    err = exit_message(
+        capsys, train.main, [*run_flags(tmp_path / "run"), "--set", "agent.learning_rate=3e-4"]
+    )
+    assert "unknown config key agent.learning_rate (did you mean agent.lr?)" in err
+    argv = [
+        *run_flags(tmp_path / "run", 20, "--no-progress", "--no-video"),
+        "--set",
+        "agent.batch-size=10",
+    ]
+    assert train.main(argv) == 0
+    assert json.loads((tmp_path / "run" / "config.json").read_text())["agent"]["batch_size"] == 10
+
+
+def test_frames_too_large_for_the_memory_are_refused_before_anything_is_built(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    # 512x512 frames at batch 512: hundreds of GB for one update, on any machine
+    flags = [*run_flags(run_dir, 20), "--image-size", "512", "--agent.batch-size", "512"]
+    err = exit_message(capsys, train.main, [*flags, "--replay-capacity", "1000"])
+    assert "--image-size 512 with --agent.batch-size 512" in err
+    assert "GB" in err and "Lower --agent.batch-size to about" in err
+    assert not run_dir.exists()
+
+
+def test_resume_changes_torch_threads_even_to_the_saved_value(finished, tmp_path):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished, run_dir)
+    saved = json.loads((run_dir / "config.json").read_text())["torch_threads"]
+    for threads, steps in ((saved, 60), (saved + 1, 80)):
+        argv = ["--resume", str(run_dir), "--torch-threads", str(threads), "--no-video"]
+        assert train.main([*argv, "--total-env-steps", str(steps), "--no-progress"]) == 0
+        assert json.loads((run_dir / "config.json").read_text())["torch_threads"] == threads
+
+
+def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path):
+    threads = torch.get_num_threads()
+    saved = json.loads((finished / "config.json").read_text())["torch_threads"]
+    try:
+        torch.set_num_threads(saved + 1)
+        argv = [str(finished), "--episodes", "1", "--no-video", "--out", str(tmp_path / "ev")]
+        assert evaluate.main(argv) == 0
+        assert torch.get_num_threads() == saved
+        assert evaluate.main([*argv, "--overwrite", "--torch-threads", str(saved + 1)]) == 0
+        assert torch.get_num_threads() == saved + 1
+    finally:
+        torch.set_num_threads(threads)
+
+
+def test_help_says_evaluations_wait_for_the_episode_end(capsys):
+    with pytest.raises(SystemExit):
+        train.main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "environment steps between evaluations (run at the next episode end)" in text
+
+
+def test_a_refused_distraction_leaves_no_report_directory(finished, capsys):
+    err = exit_message(capsys, evaluate.main, [str(finished), "--distraction", "color_hard"])
+    assert "needs a dm_control task" in err
+    assert not (finished / "generalization").exists()
+
+
+@pytest.mark.skipif(shutil.which("unshare") is None, reason="needs util-linux's unshare")
+def test_resume_of_a_read_only_run_directory_is_one_clear_error(finished):
+    # a read-only bind mount in a user namespace: read-only even for root, nothing changed
+    # outside the child
+    script = (
+        f'mount --bind -o ro "{finished}" "{finished}" && exec "{sys.executable}" -m '
+        f'simoun_agent.run.train --resume "{finished}" --total-env-steps 400'
+    )
+    probe = subprocess.run(
+        ["unshare", "-rm", "sh", "-c", f'mount --bind -o ro "{finished}" "{finished}"'],
+        capture_output=True,
+        timeout=120,
+    )
+    if probe.returncode != 0:
+        pytest.skip(f"no read-only bind mount here: {probe.stderr.decode().strip()}")
+    done = subprocess.run(
+        ["unshare", "-rm", "sh", "-c", script], capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr
+    assert f"cannot write to the run directory {finished} (Read-only file system)" in done.stderr
+    assert "Make it writable" in done.stderr and "--resume the copy" in done.stderr

@@ -30,6 +30,7 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
     if args.random_policy:
         parser.error("--random-policy does not combine with --distraction")
     run_dirs = [Path(path) for path in args.checkpoint]
+    created, out = False, None
     try:
         modes = parse_distractions(args.distraction)
         missing = [str(path) for path in run_dirs if not path.exists()]
@@ -56,6 +57,9 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
                 progress=_status if args.progress else None,
             )
     except SetupError as err:
+        # a run or mode refused while loading: leave no empty report directory behind
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
         parser.exit(2, f"{parser.prog}: error: {err}\n")
     except Stopped as stop:
         if created:

@@ -192,6 +192,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
     parser.add_argument(
+        "--torch-threads",
+        type=int,
+        default=None,
+        metavar="INT",
+        help="torch intra-op threads (default: the run's torch_threads, else torch's default)",
+    )
+    parser.add_argument(
         "--distraction",
         metavar="MODES",
         default=None,
@@ -225,6 +232,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--episodes must be at least 1")
     if args.seed is not None and not 0 <= args.seed < 2**32:
         parser.error(f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
+    if args.torch_threads is not None and args.torch_threads < 1:
+        parser.error(f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
     if args.distraction is not None:
         from simoun_agent.generalization.cli import evaluate_distractions
 
@@ -238,7 +247,13 @@ def main(argv: list[str] | None = None) -> int:
         payload = load_checkpoint(Path(args.checkpoint[0]))
         saved = payload["config"]
         # The machine may differ from the training one: --device applies before the checks.
-        config = from_dict({**saved, "device": args.device} if args.device else saved)
+        machine = {"device": args.device, "torch_threads": args.torch_threads}
+        config = from_dict({**saved, **{k: v for k, v in machine.items() if v is not None}})
+        if config.torch_threads:
+            # torch's default of one thread per core oversubscribes a shared machine: 3 episodes
+            # of a cpu-preset checkpoint took 63 and 47 s with 2 threads, 19 and 31 s with the
+            # run's one (simoun-eval RUN --episodes 3 --torch-threads N, 2 busy cores)
+            torch.set_num_threads(config.torch_threads)
         env = make_env(config)
         step = payload["state"]["env_step"]
         suffix = "-random" if args.random_policy else ""

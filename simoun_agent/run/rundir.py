@@ -60,7 +60,15 @@ def lock_run_dir(run_dir: Path) -> IO[str]:
         # This process held it already (a run that raised, in a notebook or a Ray worker): flock
         # would refuse a second handle of our own, so the old one goes.
         earlier.close()
-    handle = path.open("a+")
+    try:
+        handle = path.open("a+")
+    except OSError as err:
+        raise SetupError(
+            f"cannot write to the run directory {run_dir} ({err.strerror}): a run writes its "
+            "lock, checkpoints and logs there. Make it writable (a read-only mount, or files "
+            "of another user: chmod -R u+w), or copy the run to a writable place and --resume "
+            "the copy"
+        ) from None
     try:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:

@@ -53,6 +53,7 @@ from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
 from simoun_agent.run.flags import add_version
 from simoun_agent.run.logger import CURVE_PNG, RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.memory import check_memory
 from simoun_agent.run.presets import (
     PRESETS,
     RESUMABLE_FIELDS,
@@ -580,6 +581,9 @@ def main(argv: list[str] | None = None) -> int:
             run = resume_run(Path(args.resume), overrides)
         else:
             config = resolve(args.preset, overrides)
+            warning = check_memory(config)  # before anything is built
+            if warning:
+                print(f"simoun-train: warning: {warning}", file=sys.stderr)
             run = create_run(config, overwrite=args.overwrite)
     except SetupError as err:
         parser.exit(2, f"simoun-train: error: {err}\n")

@@ -1,0 +1,188 @@
+"""The memory a run will need, estimated from its config before anything is built.
+
+Frames of 512x512 at the cpu preset's batch of 64 need about 80 GB for one gradient update (the
+interactive module's attention maps grow with the fourth power of the image side), which a run
+would find out only by being killed after building its envs. :func:`update_bytes` runs the
+agent's real update on torch's meta device (shapes only: nothing is allocated or computed, about
+0.2 s) and records the peak of the bytes its tensors hold at once; :func:`check_memory` compares
+that, with the replay's frames, to the machine's memory.
+
+The estimate is a lower bound: it counts the tensors, not the allocator's caching or the conv
+libraries' workspaces. ``python benchmarks/memory_estimate.py --sizes 64 96 128`` measured the
+real peak (resident memory growth over two updates, cpu preset) at 1.34, 1.31 and 1.52 times the
+estimate of 0.12, 0.30 and 0.67 GB (2 cores, one torch thread).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+import torch
+from torch.utils._python_dispatch import TorchDispatchMode
+
+from simoun_agent.run.presets import SetupError, TrainConfig
+
+ACTION_DIM = 2
+"""Action size assumed before the env is built; the networks' share of memory barely depends
+on it."""
+
+WARN_FRACTION = 0.5
+"""Above this share of the memory (and below all of it) a run starts with a warning: the real
+peak is higher than the estimate."""
+
+GB = 1e9
+
+
+class PeakBytes(TorchDispatchMode):
+    """Counts the bytes of every tensor an op creates (views and in-place results share their
+    input's storage and are skipped) until the tensor is freed; ``peak`` is the most held at
+    once."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.live = 0
+        self.peak = 0
+
+    def _free(self, size: int) -> None:
+        self.live -= size
+
+    def __torch_dispatch__(self, func: Any, types: Any, args: Any = (), kwargs: Any = None) -> Any:
+        out = func(*args, **(kwargs or {}))
+        outputs = out if isinstance(out, (tuple, list)) else (out,)
+        for result, declared in zip(outputs, func._schema.returns, strict=False):
+            if isinstance(result, torch.Tensor) and declared.alias_info is None:
+                size = result.untyped_storage().nbytes()
+                self.live += size
+                self.peak = max(self.peak, self.live)
+                weakref.finalize(result, self._free, size)
+        return out
+
+
+def frame_shape(config: TrainConfig) -> tuple[int, int, int]:
+    """``(C, H, W)`` of the frames the agent of ``config`` sees (cameras side by side)."""
+    channels = 1 if config.grayscale else 3
+    return channels, config.image_size, config.image_size * config.cameras
+
+
+def update_bytes(config: TrainConfig) -> int:
+    """Peak bytes of one gradient update of ``config``'s agent: its networks, optimiser states,
+    the batch and every intermediate tensor, from the real update run on the meta device."""
+    from simoun_agent import SimounAgent
+
+    shape = frame_shape(config)
+    agent_config = config.agent
+    with torch.device("meta"):
+        agent = SimounAgent(shape, ACTION_DIM, agent_config, device="meta")
+    held = 0
+    for part in vars(agent).values():
+        if isinstance(part, torch.optim.Optimizer):
+            # fused Adam has no meta kernel; the plain one allocates the same states
+            part.defaults["fused"] = False
+            for group in part.param_groups:
+                group["fused"] = False
+        if isinstance(part, torch.nn.Module):
+            held += sum(t.numel() * t.element_size() for t in part.state_dict().values())
+    batch = agent_config.batch_size
+    counter = PeakBytes()
+    with counter, torch.device("meta"):
+        window = torch.zeros(batch, agent_config.num_frames + 1, *shape, dtype=torch.uint8)
+        bootstrap = None
+        if agent_config.n_step > 1:
+            frames = torch.zeros(batch, agent_config.num_frames, *shape, dtype=torch.uint8)
+            bootstrap = (frames, torch.zeros(batch))
+        action, reward = torch.zeros(batch, ACTION_DIM), torch.zeros(batch)
+        agent.update_window(window, action, reward, torch.ones(batch), 1, bootstrap)
+    return held + counter.peak
+
+
+def replay_bytes(config: TrainConfig) -> int:
+    """Bytes of the replay's frames when full (each frame stored once, uint8)."""
+    return config.replay_capacity * math.prod(frame_shape(config))
+
+
+def device_memory(device: str | None) -> tuple[str, int | None]:
+    """The device a run of ``device`` trains on and its memory in bytes (None: unknown)."""
+    name = device or ("cuda" if torch.cuda.is_available() else "cpu")
+    kind = torch.device(name)
+    if kind.type == "cuda":
+        return name, torch.cuda.get_device_properties(kind.index or 0).total_memory
+    if hasattr(os, "sysconf") and "SC_PHYS_PAGES" in os.sysconf_names:
+        return name, os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    return name, None
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    """What a run of a config needs against what the machine has."""
+
+    update: int
+    """bytes of one gradient update on the training device (:func:`update_bytes`)"""
+    replay: int
+    """bytes of the full replay, in host memory"""
+    device: str
+    """the training device"""
+    device_bytes: int | None
+    """memory of the training device (None: unknown)"""
+    host_bytes: int | None
+    """host memory (None: unknown)"""
+
+    def shortfall(self) -> tuple[float, str] | None:
+        """The largest need / have ratio and what it is about, or None when memory is unknown."""
+        ratios = []
+        on_host = self.device.startswith(("cpu", "mps"))
+        if self.host_bytes:
+            host_need = self.replay + (self.update if on_host else 0)
+            ratios.append((host_need / self.host_bytes, "host"))
+        if self.device_bytes and not on_host:
+            ratios.append((self.update / self.device_bytes, self.device))
+        return max(ratios) if ratios else None
+
+
+def estimate(config: TrainConfig) -> MemoryEstimate:
+    """The memory estimate of ``config`` (about 0.2 s: the update runs on the meta device)."""
+    device, device_bytes = device_memory(config.device)
+    _, host_bytes = device_memory("cpu")
+    return MemoryEstimate(
+        update_bytes(config), replay_bytes(config), device, device_bytes, host_bytes
+    )
+
+
+def check_memory(config: TrainConfig) -> str | None:
+    """Raise SetupError when ``config`` needs more memory than the machine has, naming the
+    estimate and the fix; return a warning when it needs more than :data:`WARN_FRACTION` of it,
+    else None."""
+    need = estimate(config)
+    worst = need.shortfall()
+    if worst is None or worst[0] <= WARN_FRACTION:
+        return None
+    ratio, where = worst
+    have = need.host_bytes if where == "host" else need.device_bytes
+    batch = config.agent.batch_size
+    c, h, w = frame_shape(config)
+    owner = "this machine" if where == "host" else f"the {where} device"
+    text = (
+        f"--image-size {config.image_size} with --agent.batch-size {batch}: one gradient update "
+        f"needs at least {need.update / GB:.1f} GB on {need.device} ({batch} windows of "
+        f"{config.agent.num_frames + 1} frames of {c}x{h}x{w}, estimated on torch's meta device) "
+        f"and the full replay {need.replay / GB:.1f} GB of host memory "
+        f"(--replay-capacity {config.replay_capacity}); {owner} has {have / GB:.1f} GB"
+    )
+    if ratio <= 1:
+        return f"{text}. It may not fit: the real peak is higher than this estimate."
+    raise SetupError(f"{text}, so the run would be killed. {_fix(config, need, have, where)}")
+
+
+def _fix(config: TrainConfig, need: MemoryEstimate, have: int, where: str) -> str:
+    """What to lower: the replay when it alone fills the host, else the batch (the update is
+    linear in it; half of what is left, as the real peak exceeds the estimate) or the image."""
+    room = have - (need.replay if where == "host" else 0)
+    if room <= 0:
+        frames = int(WARN_FRACTION * have / (need.replay / config.replay_capacity))
+        return f"Lower --replay-capacity to about {frames}, or --image-size (84 is the paper's)"
+    fits = int(WARN_FRACTION * room / (need.update / config.agent.batch_size))
+    batch = f"--agent.batch-size to about {fits}, or " if fits >= 1 else ""
+    return f"Lower {batch}--image-size (84 is the paper's), or --replay-capacity"
