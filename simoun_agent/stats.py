@@ -104,15 +104,27 @@ def iqm_over_steps(scores: Scores) -> np.ndarray:
     return _trimmed_mean(np.concatenate([np.atleast_2d(runs) for runs in scores.values()]))
 
 
-def _draw_indices(rng: np.random.RandomState, counts: list[int]) -> np.ndarray:
-    """One stratified resample: ``(max count, tasks)`` run indices, column ``j`` drawn from
-    ``range(counts[j])`` (only its first ``counts[j]`` rows are used). With equal counts this
-    is exactly rliable's ``np.random.choice(runs, (runs, tasks))``."""
-    return rng.randint(0, np.asarray(counts), size=(max(counts), len(counts)))
+def _draw_indices(
+    rng: np.random.RandomState, counts: list[list[int]], reps: int
+) -> list[np.ndarray]:
+    """``reps`` stratified resamples of each of several score sets (``counts[k]``: the run count
+    of each task of set k): for each set, ``(reps, max count, tasks)`` run indices, column
+    ``j`` drawn from ``range(counts[k][j])`` (its first ``counts[k][j]`` rows are used).
+
+    One resample of every set after the other, set by set, as rliable draws them (its
+    ``np.random.choice(runs, (runs, tasks))`` for each set in turn); one ``randint`` call with
+    a bound per element gives the same stream as those calls made one by one
+    (tests/test_stats.py finds rliable's intervals).
+    """
+    bounds = [np.broadcast_to(np.asarray(c), (max(c), len(c))) for c in counts]
+    sizes = [bound.size for bound in bounds]
+    draws = rng.randint(0, np.concatenate([b.ravel() for b in bounds]), size=(reps, sum(sizes)))
+    parts = np.split(draws, np.cumsum(sizes)[:-1], axis=1)
+    return [part.reshape(reps, *bound.shape) for part, bound in zip(parts, bounds, strict=True)]
 
 
 def _take(scores: Scores, indices: np.ndarray) -> dict[str, np.ndarray]:
-    """The resample that ``indices`` (from :func:`_draw_indices`) picks, as task -> runs."""
+    """The resample that ``indices`` (one of :func:`_draw_indices`) picks, as task -> runs."""
     return {
         task: np.asarray(runs)[indices[: len(runs), column]]
         for column, (task, runs) in enumerate(scores.items())
@@ -134,8 +146,8 @@ def bootstrap_replicates(
     within each task, each task keeping its number of runs): ``(reps, *statistic's shape)``."""
     _check(scores, "bootstrap")
     rng = np.random.RandomState(seed)
-    counts = [len(runs) for runs in scores.values()]
-    return np.array([statistic(_take(scores, _draw_indices(rng, counts))) for _ in range(reps)])
+    (draws,) = _draw_indices(rng, [[len(runs) for runs in scores.values()]], reps)
+    return np.array([statistic(_take(scores, indices)) for indices in draws])
 
 
 def percentile_interval(
@@ -223,14 +235,13 @@ def probability_of_improvement_ci(
     _same_tasks(x, y)
     y = {task: y[task] for task in x}
     rng = np.random.RandomState(seed)
-    counts_x = [len(runs) for runs in x.values()]
-    counts_y = [len(runs) for runs in y.values()]
-    draws = [(_draw_indices(rng, counts_x), _draw_indices(rng, counts_y)) for _ in range(reps)]
+    counts = [[len(runs) for runs in x.values()], [len(runs) for runs in y.values()]]
+    draws_x, draws_y = _draw_indices(rng, counts, reps)
     per_task = []
     for column, task in enumerate(x):
         runs_x, runs_y = np.ravel(x[task]), np.ravel(y[task])
-        resampled_x = np.stack([runs_x[ix[: len(runs_x), column]] for ix, _ in draws])
-        resampled_y = np.stack([runs_y[iy[: len(runs_y), column]] for _, iy in draws])
+        resampled_x = runs_x[draws_x[:, : len(runs_x), column]]
+        resampled_y = runs_y[draws_y[:, : len(runs_y), column]]
         per_task.append(_improvement(resampled_x, resampled_y))
     low, high = percentile_interval(np.mean(per_task, axis=0), confidence)
     return probability_of_improvement(x, y), float(low), float(high)
