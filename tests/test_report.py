@@ -5,6 +5,13 @@ import csv
 import itertools
 import json
 import math
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import matplotlib.colors
 import matplotlib.image
@@ -12,10 +19,12 @@ import numpy as np
 import pytest
 from test_train_resume import TINY as RESUME_TINY
 
+from simoun_agent import stats
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.presets import resolve, to_dict
 from simoun_agent.sweep import report
+from simoun_agent.sweep.grid import SweepSpec
 
 TINY = {key: value for key, value in RESUME_TINY.items() if key != "seed"}
 """The tiny run of tests/test_train_resume.py, each run choosing its own seed."""
@@ -181,3 +190,207 @@ def test_equal_budget_cuts_every_run_at_it_and_counts_unfinished_runs_that_reach
 def test_a_dict_valued_key_stays_one_value_so_it_can_name_a_variant():
     flat = report.flatten({"env_kwargs": {"config": {"lanes": 4}}, "agent": {"lr": 1e-3}})
     assert flat == {"env_kwargs": {"config": {"lanes": 4}}, "agent.lr": 1e-3}
+
+
+def finals_of(root, names):
+    return [
+        json.loads((root / name / "summary.json").read_text())["final_eval"]["return_mean"]
+        for name in names
+    ]
+
+
+def copy_runs(source, names, dest):
+    """Real run directories, copied so that a test can add to or take from them."""
+    for name in names:
+        shutil.copytree(source / name, dest / name)
+    return dest
+
+
+@pytest.fixture(scope="module")
+def grid_run(tmp_path_factory):
+    """A finished run like a-s0/a-s1 (lr 1e-3) but of seed 2, evaluated every 40 env steps
+    (0, 40, 80, 120) instead of every 60."""
+    root = tmp_path_factory.mktemp("grid")
+    config = resolve(
+        None, {**TINY, "agent.lr": 1e-3, "seed": 2, "eval_every": 40, "run_dir": str(root / "c")}
+    )
+    run = train.create_run(config)
+    train.train(run)
+    run.env.close()
+    run.eval_env.close()
+    return root / "c"
+
+
+def test_report_gives_the_iqm_and_mean_with_bootstrap_intervals(runs_dir):
+    row = rows_of(runs_dir)[0]
+    finals = finals_of(runs_dir, ("a-s0", "a-s1"))
+    task = {"simoun-PointReach-v0": np.array(finals)}
+    assert float(row["iqm"]) == pytest.approx(np.mean(finals))  # 2 runs: int(0.5) = 0 cut
+    iqm_ci = stats.stratified_bootstrap_ci(task, stats.aggregate_iqm, 2000, 0.95, 0)
+    mean_ci = stats.stratified_bootstrap_ci(task, stats.aggregate_mean, 2000, 0.95, 0)
+    assert [float(row[k]) for k in ("iqm", "iqm_low", "iqm_high")] == pytest.approx(iqm_ci)
+    assert [float(row[k]) for k in ("norm_mean", "norm_mean_low", "norm_mean_high")] == (
+        pytest.approx(mean_ci)
+    )
+    # two runs: a resample is (x, x), (x, y) or (y, y), so the 95 % bounds are the two finals
+    assert float(row["iqm_low"]) == pytest.approx(min(finals))
+    assert float(row["iqm_high"]) == pytest.approx(max(finals))
+    assert row["score_max"] == ""  # PointReach has no known maximum: raw returns
+    assert (
+        "simoun-PointReach-v0: raw return (no known maximum)"
+        in (runs_dir / report.REPORT_MD).read_text()
+    )
+
+
+def test_dm_control_returns_are_normalized_by_their_maximum_of_1000(tmp_path):
+    """The committed main job: 3 seeds of cartpole-swingup, real run directories."""
+    main_job = Path(__file__).parent.parent / "docs" / "main-job"
+    report.write_report(main_job, tmp_path)
+    (row,) = rows_of(tmp_path)
+    finals = finals_of(main_job, ("s1", "s2", "s3"))
+    assert float(row["score_max"]) == 1000
+    assert float(row["iqm"]) == pytest.approx(np.mean(finals) / 1000)  # 3 runs: none cut
+    assert float(row["iqm_low"]) < float(row["iqm"]) < float(row["iqm_high"])
+    assert float(row["final_return_mean"]) == pytest.approx(np.mean(finals))  # kept, raw
+
+
+def test_probability_of_improvement_and_aggregate_tables(runs_dir):
+    finals_a = finals_of(runs_dir, ("a-s0", "a-s1"))
+    (final_b,) = finals_of(runs_dir, ("b-s0",))
+    by_hand = np.mean([(a > final_b) + (a == final_b) / 2 for a in finals_a])
+    with (runs_dir / report.IMPROVEMENT_CSV).open(newline="") as f:
+        pairs = {(r["x"], r["y"]): r for r in csv.DictReader(f)}
+    a, b = "agent.lr=0.001", "agent.lr=0.0003"
+    assert set(pairs) == {(a, b), (b, a)}
+    assert float(pairs[a, b]["p"]) == pytest.approx(by_hand)
+    assert float(pairs[b, a]["p"]) == pytest.approx(1 - by_hand)
+    assert pairs[a, b]["tasks"] == "simoun-PointReach-v0"
+    assert 0 <= float(pairs[a, b]["low"]) <= float(pairs[a, b]["p"]) <= float(pairs[a, b]["high"])
+    with (runs_dir / report.AGGREGATE_CSV).open(newline="") as f:
+        aggregate = {r["variant"]: r for r in csv.DictReader(f)}
+    assert aggregate[a]["runs"] == "2"
+    assert float(aggregate[a]["iqm"]) == pytest.approx(np.mean(finals_a))
+    table = (runs_dir / report.REPORT_MD).read_text()
+    assert f"| (1) {a} | – | {float(pairs[a, b]['p']):.3g} [" in table
+
+
+def test_iqm_curve_and_performance_profile_figures(runs_dir):
+    comparison = report.compare_runs(runs_dir)
+    bands = report.iqm_bands(comparison.groups)["simoun-PointReach-v0"]
+    steps, point, low, high = bands["agent.lr=0.001 (n=2)"]
+    curves = [read_csv(runs_dir / name / "eval.csv") for name in ("a-s0", "a-s1")]
+    assert list(steps) == [0, 60, 120]
+    expected = [np.mean([curve[i]["return_mean"] for curve in curves]) for i in range(3)]
+    assert point == pytest.approx(expected)
+    assert np.all(low <= point) and np.all(point <= high)
+    profiles = report.profile_bands(report.variant_scores(comparison.groups))
+    taus, fraction, _, _ = profiles["agent.lr=0.001"]
+    finals = finals_of(runs_dir, ("a-s0", "a-s1"))
+    assert fraction == pytest.approx([np.mean([f > tau for f in finals]) for tau in taus])
+    for name in (report.IQM_STEPS_PNG, report.PROFILE_PNG):
+        image = matplotlib.image.imread(runs_dir / name)
+        assert image.ndim == 3 and image.shape[0] > 100
+
+
+def test_at_step_counts_only_runs_with_an_evaluation_at_that_step(runs_dir, grid_run, tmp_path):
+    root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "runs")
+    shutil.copytree(grid_run, root / "c")
+    report.write_report(root, tmp_path / "at-40", budget=("env_step", 40))
+    rows = {row["variant"]: row for row in rows_of(tmp_path / "at-40")}
+    assert rows["eval_every=40"]["n"] == "1" and rows["eval_every=60"]["n"] == "0"
+    table = (tmp_path / "at-40" / report.REPORT_MD).read_text()
+    assert "- a-s0: no evaluation at 40 env steps (last before it 0, next 60)" in table
+    report.write_report(root, tmp_path / "at-60", budget=("env_step", 60))
+    rows = {row["variant"]: row for row in rows_of(tmp_path / "at-60")}
+    assert rows["eval_every=60"]["n"] == "2" and rows["eval_every=40"]["n"] == "0"
+    table = (tmp_path / "at-60" / report.REPORT_MD).read_text()
+    assert "- c: no evaluation at 60 env steps (last before it 40, next 80)" in table
+    report.write_report(root, tmp_path / "at-200", budget=("env_step", 200))
+    assert "- c: reached only 120 env steps" in (tmp_path / "at-200" / report.REPORT_MD).read_text()
+
+
+def test_a_row_holds_runs_of_one_evaluation_grid(runs_dir, grid_run, tmp_path):
+    """In a sweep's directory the grid keys alone name the variants, so a run of the same lr on
+    another evaluation grid would join the row: it is listed and left out."""
+    root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "sweep")
+    shutil.copytree(grid_run, root / "c")
+    base = {key: value for key, value in TINY.items() if key not in ("agent.lr", "torch_threads")}
+    SweepSpec.create(None, base, ["agent.lr=0.001,0.0003"], "0-2", None).save(root)
+    report.write_report(root, tmp_path / "out")
+    (row,) = rows_of(tmp_path / "out")
+    assert (row["variant"], row["n"]) == ("agent.lr=0.001", "2")
+    table = (tmp_path / "out" / report.REPORT_MD).read_text()
+    assert (
+        "## Runs on another evaluation grid (not counted)\n\n- c (eval_every=40; its row: 60)"
+        in table
+    )
+
+
+def test_at_wall_time_uses_the_last_evaluation_within_it_of_runs_that_trained_past_it(
+    runs_dir, tmp_path
+):
+    root = copy_runs(runs_dir, ("a-s0",), tmp_path / "runs")
+    evaluations = read_csv(root / "a-s0" / "eval.csv")
+    between = (evaluations[1]["wall_time_s"] + evaluations[2]["wall_time_s"]) / 2
+    report.write_report(root, tmp_path / "between", budget=("wall_time_s", between))
+    (row,) = rows_of(tmp_path / "between")
+    assert row["n"] == "1"
+    assert float(row["final_return_mean"]) == pytest.approx(evaluations[1]["return_mean"])
+    assert int(row["env_steps"]) == 60
+    beyond = evaluations[2]["wall_time_s"] + 100
+    report.write_report(root, tmp_path / "beyond", budget=("wall_time_s", beyond))
+    assert rows_of(tmp_path / "beyond")[0]["n"] == "0"
+    trained = f"trained only {evaluations[2]['wall_time_s']:.0f} s"
+    assert f"- a-s0: {trained}" in (tmp_path / "beyond" / report.REPORT_MD).read_text()
+
+
+def test_a_seed_counts_once_the_finished_run_then_the_most_recent_kept(runs_dir, tmp_path):
+    """A plain run and a sweep trial of the same config and seed (issue 22) count once."""
+    root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "runs")
+    trial = root / "sweep" / "agent.lr=0.001" / "simoun-PointReach-v0" / "s0"
+    shutil.copytree(root / "a-s0", trial)
+    (trial / "summary.json").unlink()  # the trial never finished; it is the newer one
+    os.utime(trial / "eval.csv", (time.time() + 60, time.time() + 60))
+    report.write_report(root, tmp_path / "unfinished-copy")
+    (row,) = rows_of(tmp_path / "unfinished-copy")
+    assert (row["n"], row["unfinished"]) == ("2", "0")  # a-s0 and a-s1, the copy dropped
+    table = (tmp_path / "unfinished-copy" / report.REPORT_MD).read_text()
+    dropped = "sweep/agent.lr=0.001/simoun-PointReach-v0/s0"
+    assert "## Duplicate seeds (dropped)" in table
+    assert f"- {dropped} (seed 0; kept a-s0)" in table
+    shutil.copy(root / "a-s0" / "summary.json", trial / "summary.json")  # both finished now
+    report.write_report(root, tmp_path / "finished-copy")
+    assert rows_of(tmp_path / "finished-copy")[0]["n"] == "2"
+    table = (tmp_path / "finished-copy" / report.REPORT_MD).read_text()
+    assert f"- a-s0 (seed 0; kept {dropped})" in table  # the more recent one is kept
+
+
+def test_a_single_run_directory_gets_its_report_beside_it(runs_dir, tmp_path, capsys):
+    run_dir = copy_runs(runs_dir, ("a-s0",), tmp_path)
+    before = sorted(p.name for p in (run_dir / "a-s0").iterdir())
+    assert report.main([str(run_dir / "a-s0")]) == 0
+    assert sorted(p.name for p in (run_dir / "a-s0").iterdir()) == before
+    assert (tmp_path / "report-a-s0" / report.REPORT_CSV).is_file()
+    assert f"written: {tmp_path / 'report-a-s0' / report.REPORT_MD}" in capsys.readouterr().out
+
+
+def test_a_read_only_directory_is_refused_naming_it_and_the_out_flag(runs_dir, tmp_path):
+    """Root writes through permission bits, so as root the directory is made a read-only bind
+    mount in a user and mount namespace of its own (as a read-only share would be); as any
+    other user its write bits are taken away."""
+    root = copy_runs(runs_dir, ("a-s0",), tmp_path / "runs")
+    command = [sys.executable, "-m", "simoun_agent.sweep.report", str(root)]
+    if os.geteuid() == 0:
+        mount = f"mount --bind {root} {root} && mount -o remount,bind,ro {root} {root}"
+        command = ["unshare", "-rm", "sh", "-c", f"{mount} && exec {shlex.join(command)}"]
+    else:
+        root.chmod(0o555)
+    try:
+        result = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
+    finally:
+        root.chmod(0o755)
+    assert result.returncode == 2, result.stderr
+    assert f"cannot write to the output directory {root}" in result.stderr
+    assert "pass a writable --out" in result.stderr
+    assert "Traceback" not in result.stderr
+    assert not (root / report.REPORT_MD).exists()

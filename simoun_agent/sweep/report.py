@@ -1,5 +1,6 @@
 """``simoun-report DIR``: compare the runs of a sweep, or of any directory of ``simoun-train``
-runs, per variant and env, over seeds (the paper's Table 1 and Fig. 6). Needs no Ray.
+runs, per variant and env, over seeds (the paper's Table 1 and Fig. 6), with the statistics of
+Agarwal et al. 2021 (rliable; :mod:`simoun_agent.stats`). Needs no Ray.
 
     simoun-report sweeps/baselines
     simoun-report runs/ --out runs/report
@@ -8,41 +9,61 @@ Runs are found by their ``config.json``. A *variant* is the config values that t
 the same env apart, seeds aside: a sweep's ``--grid`` keys, or, for plain runs, every key that
 differs between two runs of one env (``seed``, ``run_dir`` and output-only keys excepted).
 Only finished runs (``summary.json`` present) are counted; unfinished and failed ones are
-listed. ``--at-step N`` / ``--at-wall-time SECONDS`` compare at an equal budget instead: every
-run that reached it, finished or not, counts with its last evaluation within it. Writes:
+listed. ``--at-step N`` / ``--at-wall-time SECONDS`` compare at an equal budget instead
+(:func:`at_budget`). A row counts each seed once (:func:`drop_duplicate_seeds`) and runs of
+one evaluation grid (:func:`one_evaluation_grid`). Writes:
 
 - ``report.md`` and ``report.csv``: per variant x env, the number of seeds n and mean ± std
   over seeds (sample std, ddof=1) of the final evaluation return, of the area under the
-  learning curve, of the wall time and of the env steps per second;
+  learning curve, of the wall time and of the env steps per second; and on the final returns
+  normalized by the task's maximum (:func:`simoun_agent.stats.normalize`), the IQM and the mean
+  with their 95 % stratified-bootstrap confidence intervals (columns ``iqm``, ``iqm_low``,
+  ``iqm_high``, ``norm_mean``, ``norm_mean_low``, ``norm_mean_high``, ``score_max``);
+- ``aggregate.csv``: per variant, the IQM and mean over all runs of all its tasks, with CIs;
+- ``probability_of_improvement.csv``: for each ordered pair of variants, P(X > Y) with its CI;
 - ``curves_env_steps.png`` and ``curves_wall_time.png``: the evaluation return's mean ± std
-  band per variant against env steps and against wall-clock seconds, one panel per env.
+  band per variant against env steps and against wall-clock seconds, one panel per env;
+- ``iqm_env_steps.png``: the IQM over seeds of the normalized return at each evaluation, with
+  its 95 % CI band, one panel per env (sample efficiency);
+- ``performance_profile.png``: per variant, the fraction of runs (all tasks pooled) whose
+  normalized score exceeds each threshold, with its 95 % CI band.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import io
 import itertools
 import json
 import math
 import sys
-from dataclasses import dataclass
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from simoun_agent import stats
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_agent.run.presets import SetupError, config_sections, from_dict, to_dict
+from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
+from simoun_agent.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
 REPORT_CSV = "report.csv"
+AGGREGATE_CSV = "aggregate.csv"
+IMPROVEMENT_CSV = "probability_of_improvement.csv"
 CURVES_STEPS_PNG = "curves_env_steps.png"
 CURVES_TIME_PNG = "curves_wall_time.png"
+IQM_STEPS_PNG = "iqm_env_steps.png"
+PROFILE_PNG = "performance_profile.png"
 ERROR_FILE = "error.txt"
 """Written by a failed sweep trial into its run directory (:mod:`simoun_agent.sweep.trainable`)."""
 
@@ -58,8 +79,23 @@ NOT_VARIANT = {
 """Keys that differ between runs without making them another method: the seed and where or how
 the run was executed."""
 
+GRID_KEY = "eval_every"
+"""The config key that sets a run's evaluation grid (an evaluation every that many env steps)."""
+
 CURVE_POINTS = 100
 """Points of the common wall-time grid the runs of a variant are interpolated onto."""
+
+PROFILE_POINTS = 101
+"""Thresholds tau at which the performance profiles are drawn."""
+
+BOOTSTRAP_REPS = 2000
+"""Stratified bootstrap resamples per confidence interval (rliable's profiles use 2,000)."""
+
+BOOTSTRAP_SEED = 0
+"""Seed of every resampling, so a report is reproducible to the digit."""
+
+CONFIDENCE = 0.95
+"""Coverage of every confidence interval."""
 
 
 @dataclass
@@ -72,13 +108,25 @@ class RunRecord:
     curve: dict[str, np.ndarray]
     """eval.csv columns env_step, return_mean, wall_time_s"""
     summary: dict[str, Any] | None
-    """summary.json, present only when the run finished"""
+    """summary.json, present only when the run finished (or reached the compared budget)"""
     error: str | None
     """last line of error.txt when a sweep trial failed"""
+    modified: float = 0.0
+    """when the run last wrote (eval.csv's or config.json's mtime): the most recent of two runs
+    of one seed is kept"""
 
     @property
     def env(self) -> str:
         return self.config["env"]
+
+    @property
+    def seed(self) -> Any:
+        return self.config["seed"]
+
+    def label(self, root: Path) -> str:
+        """The run directory relative to the report's root (its name when it is the root)."""
+        relative = self.run_dir.relative_to(root).as_posix()
+        return self.run_dir.name if relative == "." else relative
 
 
 def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -130,7 +178,8 @@ def find_runs(root: Path) -> list[RunRecord]:
         if error_path.is_file() and summary is None:
             lines = error_path.read_text().strip().splitlines()
             error = lines[-1] if lines else "failed"
-        records.append(RunRecord(run_dir, config, curve, summary, error))
+        written = run_dir / EVAL_CSV if (run_dir / EVAL_CSV).is_file() else config_path
+        records.append(RunRecord(run_dir, config, curve, summary, error, written.stat().st_mtime))
     return records
 
 
@@ -182,17 +231,36 @@ def mean_std(values: list[float]) -> tuple[float, float]:
     return float(array.mean()), std
 
 
+def _ci_cells(prefix: str, estimate: tuple[float, float, float]) -> dict[str, float]:
+    point, low, high = estimate
+    return {prefix: point, f"{prefix}_low": low, f"{prefix}_high": high}
+
+
+NO_ESTIMATE = (math.nan, math.nan, math.nan)
+
+
 @dataclass
 class Group:
     """The runs of one variant on one env."""
 
     variant: str
     env: str
+    """the env's label (``cartpole-swingup``)"""
     runs: list[RunRecord]
 
     @property
+    def env_id(self) -> str:
+        return self.runs[0].env
+
+    @property
     def done(self) -> list[RunRecord]:
+        """The runs that count: finished, or cut at the compared budget."""
         return [run for run in self.runs if run.summary is not None]
+
+    def scores(self) -> np.ndarray:
+        """The counted runs' final evaluation returns, normalized (:func:`stats.normalize`)."""
+        finals = [run.summary["final_eval"]["return_mean"] for run in self.done]
+        return stats.normalize(self.env_id, np.array(finals, dtype=float))
 
     def row(self) -> dict[str, Any]:
         done = self.done
@@ -210,7 +278,22 @@ class Group:
             row[f"{name}_mean"], row[f"{name}_std"] = mean_std(values)
         row["env_steps"] = int(np.mean([run.summary["env_step"] for run in done])) if done else 0
         row["unfinished"] = len(self.runs) - len(done)
+        scores = {self.env: self.scores()} if done else {}
+        row.update(_ci_cells("iqm", _bootstrap(scores, stats.aggregate_iqm)))
+        row.update(_ci_cells("norm_mean", _bootstrap(scores, stats.aggregate_mean)))
+        row["score_max"] = stats.max_return(self.env_id) or ""
         return row
+
+
+def _bootstrap(
+    scores: stats.Scores, statistic: Callable[[stats.Scores], float]
+) -> tuple[float, float, float]:
+    """The report's seeded 95 % stratified-bootstrap estimate; NaN without runs."""
+    if not scores:
+        return NO_ESTIMATE
+    return stats.stratified_bootstrap_ci(
+        scores, statistic, BOOTSTRAP_REPS, CONFIDENCE, BOOTSTRAP_SEED
+    )
 
 
 def group_runs(records: list[RunRecord], keys: list[str], root: Path) -> list[Group]:
@@ -228,55 +311,196 @@ def group_runs(records: list[RunRecord], keys: list[str], root: Path) -> list[Gr
     return sorted(groups.values(), key=lambda group: order.index(group.variant))
 
 
-def _pm(mean: float, std: float) -> str:
-    if math.isnan(mean):
-        return "–"
-    return f"{mean:.4g}" if math.isnan(std) else f"{mean:.4g} ± {std:.2g}"
+BUDGETS = {"env_step": "env steps", "wall_time_s": "seconds of wall time"}
+"""What ``--at-step`` and ``--at-wall-time`` cut the runs at (an eval.csv column)."""
+
+BUDGET_RULE = (
+    "--at-step N counts a run only if it has an evaluation at exactly N env steps (so every "
+    "row compares evaluations at N, never at 20k beside 30k); --at-wall-time S counts a run "
+    "only if it trained past S (an evaluation at or after S seconds) and uses its last "
+    "evaluation at or before S. Runs that fall short are listed. Each row holds runs of one "
+    "evaluation grid (eval_every): runs on another grid than most of their row are listed and "
+    "left out."
+)
+"""The equal-budget rule, as ``--help`` and the report say it."""
 
 
-def markdown(
-    rows: list[dict[str, Any]],
-    failures: list[str],
-    unfinished: list[str],
-    budget: tuple[str, float] | None = None,
-) -> str:
-    counted = "finished runs only"
-    if budget is not None:
-        counted = (
-            f"every run cut at an equal budget of {budget[1]:g} {BUDGETS[budget[0]]} (its last "
-            "evaluation within it; runs that had not reached it are not counted)"
+def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None:
+    """``record`` as if it had ended at ``budget`` of ``column`` (``env_step`` or
+    ``wall_time_s``), or None when it does not count there (:func:`shortfall` says why).
+
+    For env steps the run needs an evaluation at exactly ``budget``, so runs evaluated every
+    20k and every 30k steps are never mixed at 30k. For wall time, evaluations land at no
+    common second: the run must have trained past ``budget`` (an evaluation at or after it),
+    and its last evaluation at or before ``budget`` counts.
+    """
+    if shortfall(record, column, budget) is not None:
+        return None
+    keep = record.curve[column] <= budget
+    curve = {key: values[keep] for key, values in record.curve.items()}
+    summary = {
+        "env_step": float(curve["env_step"][-1]),
+        "wall_time_s": float(curve["wall_time_s"][-1]),
+        "final_eval": {"return_mean": float(curve["return_mean"][-1])},
+    }
+    return RunRecord(record.run_dir, record.config, curve, summary, None, record.modified)
+
+
+def shortfall(record: RunRecord, column: str, budget: float) -> str | None:
+    """Why ``record`` does not count at ``budget`` of ``column`` (None when it does)."""
+    x = record.curve[column]
+    if not len(x):
+        return "no evaluation yet"
+    if column == "env_step":
+        if np.any(x == budget):
+            return None
+        if x.max() < budget:
+            return f"reached only {x.max():g} env steps"
+        before, after = x[x < budget], x[x > budget]
+        last = f"{before.max():g}" if len(before) else "none"
+        return (
+            f"no evaluation at {budget:g} env steps (last before it {last}, next {after.min():g})"
         )
-    lines = [
-        "# Sweep report",
-        "",
-        f"Mean ± std over seeds (sample std, ddof=1; none for n = 1), {counted}. Final "
-        "return: the last evaluation's mean return. AUC: normalized area under the learning "
-        "curve (trapezoid of the evaluation return over env steps, divided by the env-step "
-        "span: the run's average evaluation return). Wall time: seconds in the training loop, "
-        "evaluations included.",
-        "",
-        "| variant | env | n | final return | AUC | wall time (s) | env steps/s | env steps |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
-    ]
-    for row in rows:
-        cells = [
-            row["variant"],
-            row["env"],
-            str(row["n"]),
-            _pm(row["final_return_mean"], row["final_return_std"]),
-            _pm(row["auc_mean"], row["auc_std"]),
-            _pm(row["wall_time_s_mean"], row["wall_time_s_std"]),
-            _pm(row["env_steps_per_s_mean"], row["env_steps_per_s_std"]),
-            str(row["env_steps"]),
+    if x.max() < budget:
+        return f"trained only {x.max():.0f} s (its last evaluation)"
+    if not np.any(x <= budget):
+        return f"no evaluation within {budget:g} s"
+    return None
+
+
+def drop_duplicate_seeds(runs: list[RunRecord]) -> tuple[list[RunRecord], list[tuple]]:
+    """One run per seed: of two runs with one seed (a plain run and a sweep trial of the same
+    config), the one that counts (finished or at the budget) is kept, then one that did not
+    fail, then the most recent. Returns the kept runs and (dropped, kept) pairs."""
+    kept: dict[Any, RunRecord] = {}
+    dropped = []
+    for run in sorted(runs, key=_preference, reverse=True):
+        seed = json.dumps(run.seed)
+        if seed in kept:
+            dropped.append((run, kept[seed]))
+        else:
+            kept[seed] = run
+    return [run for run in runs if run in kept.values()], dropped
+
+
+def _preference(run: RunRecord) -> tuple[bool, bool, float]:
+    return run.summary is not None, run.error is None, run.modified
+
+
+def one_evaluation_grid(runs: list[RunRecord]) -> tuple[list[RunRecord], list[RunRecord]]:
+    """The runs on the evaluation grid (``eval_every``) of most counted runs of the row (of
+    most runs when none counts; the first found on a tie), and those on another grid."""
+    counted = [run for run in runs if run.summary is not None] or runs
+    grid = Counter(json.dumps(run.config.get(GRID_KEY)) for run in counted).most_common(1)[0][0]
+    on_grid = [run for run in runs if json.dumps(run.config.get(GRID_KEY)) == grid]
+    return on_grid, [run for run in runs if run not in on_grid]
+
+
+@dataclass
+class Comparison:
+    """What the report compares: the rows' runs and the runs it lists without counting."""
+
+    root: Path
+    budget: tuple[str, float] | None
+    groups: list[Group]
+    unfinished: list[str] = field(default_factory=list)
+    """runs not finished (or short of the budget), with the reason at a budget"""
+    failures: list[str] = field(default_factory=list)
+    duplicates: list[str] = field(default_factory=list)
+    """runs dropped for repeating a seed of their row, with the run kept instead"""
+    off_grid: list[str] = field(default_factory=list)
+    """runs left out for another evaluation grid than their row's"""
+
+
+def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Comparison:
+    """Find the runs under ``root``, cut them at ``budget`` (:func:`at_budget`), group them,
+    keep one evaluation grid per row (:func:`one_evaluation_grid`) and one run per seed
+    (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run."""
+    root = Path(root)
+    records = find_runs(root)
+    if not records:
+        raise SetupError(
+            f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
+            "directory of simoun-train runs"
+        )
+    reasons: dict[Path, str] = {}
+    if budget is not None:
+        column, value = budget
+        cut_records = []
+        for record in records:
+            cut = at_budget(record, column, value)
+            if cut is None and record.error is None:
+                reasons[record.run_dir] = shortfall(record, column, value) or ""
+                record.summary = None
+            cut_records.append(cut or record)
+        records = cut_records
+    comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
+    for group in comparison.groups:
+        # the grid first, so that a copy of a seed on another grid cannot displace its peer
+        group.runs, others = one_evaluation_grid(group.runs)
+        grid = show(group.runs[0].config.get(GRID_KEY))
+        comparison.off_grid += [
+            f"{run.label(root)} ({GRID_KEY}={show(run.config.get(GRID_KEY))}; its row: {grid})"
+            for run in others
         ]
-        lines.append("| " + " | ".join(cells) + " |")
-    if unfinished:
-        title = "Unfinished runs" if budget is None else "Runs short of the budget"
-        lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in unfinished]
-    if failures:
-        lines += ["", "## Failed runs", ""] + [f"- {f}" for f in failures]
-    lines += ["", f"![learning curves]({CURVES_STEPS_PNG})", f"![wall time]({CURVES_TIME_PNG})"]
-    return "\n".join(lines) + "\n"
+        group.runs, dropped = drop_duplicate_seeds(group.runs)
+        comparison.duplicates += [
+            f"{run.label(root)} (seed {show(run.seed)}; kept {kept.label(root)})"
+            for run, kept in dropped
+        ]
+        for run in group.runs:
+            if run.error is not None:
+                comparison.failures.append(f"{run.label(root)}: {run.error}")
+            elif run.summary is None:
+                reason = reasons.get(run.run_dir)
+                comparison.unfinished.append(
+                    f"{run.label(root)}: {reason}" if reason else run.label(root)
+                )
+    return comparison
+
+
+def variant_scores(groups: list[Group]) -> dict[str, dict[str, np.ndarray]]:
+    """variant -> env -> the normalized final scores of its counted runs (envs without a
+    counted run left out): the input of every statistic across tasks."""
+    scores: dict[str, dict[str, np.ndarray]] = {}
+    for group in groups:
+        if group.done:
+            scores.setdefault(group.variant, {})[group.env] = group.scores()
+    return scores
+
+
+def aggregate_rows(scores: dict[str, dict[str, np.ndarray]]) -> list[dict[str, Any]]:
+    """Per variant, the IQM and the mean over all runs of all its tasks, with 95 % CIs."""
+    rows = []
+    for variant, tasks in scores.items():
+        row: dict[str, Any] = {
+            "variant": variant,
+            "tasks": " ".join(tasks),
+            "runs": sum(len(runs) for runs in tasks.values()),
+        }
+        row.update(_ci_cells("iqm", _bootstrap(tasks, stats.aggregate_iqm)))
+        row.update(_ci_cells("mean", _bootstrap(tasks, stats.aggregate_mean)))
+        rows.append(row)
+    return rows
+
+
+def improvement_rows(scores: dict[str, dict[str, np.ndarray]]) -> list[dict[str, Any]]:
+    """For each ordered pair of variants with a task in common, P(X > Y) over the tasks both
+    have, with its 95 % CI (:func:`stats.probability_of_improvement_ci`)."""
+    rows = []
+    for x, y in itertools.permutations(scores, 2):
+        tasks = [task for task in scores[x] if task in scores[y]]
+        if not tasks:
+            continue
+        p, low, high = stats.probability_of_improvement_ci(
+            {task: scores[x][task] for task in tasks},
+            {task: scores[y][task] for task in tasks},
+            BOOTSTRAP_REPS,
+            CONFIDENCE,
+            BOOTSTRAP_SEED,
+        )
+        rows.append({"x": x, "y": y, "tasks": " ".join(tasks), "p": p, "low": low, "high": high})
+    return rows
 
 
 def band(
@@ -300,133 +524,331 @@ def band(
     return grid, values.mean(axis=0), std
 
 
-def plot_curves(groups: list[Group], x_key: str, xlabel: str, path: Path, points: int | None):
-    """One panel per env, one mean ± std band per variant (finished runs)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    envs = list(dict.fromkeys(group.env for group in groups))
-    fig, axes = plt.subplots(1, len(envs), figsize=(5.5 * len(envs), 4), dpi=110, squeeze=False)
-    for ax, env in zip(axes[0], envs, strict=True):
-        for group in (g for g in groups if g.env == env and g.done):
-            x, mean, std = band(group.done, x_key, points)
-            ax.plot(x, mean, label=f"{group.variant} (n={len(group.done)})")
-            ax.fill_between(x, mean - std, mean + std, alpha=0.2)
-        ax.set_title(env)
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel("evaluation return")
-        ax.grid(alpha=0.3)
-        if not ax.lines:
-            ax.text(0.5, 0.5, "no finished run", ha="center", transform=ax.transAxes)
-    fig.tight_layout()
-    # one legend under the panels: ten recipes' labels inside a panel would hide its curves
-    labelled = {line.get_label(): line for ax in axes[0] for line in ax.lines}
-    if labelled:
-        fig.legend(
-            labelled.values(),
-            labelled.keys(),
-            loc="upper center",
-            bbox_to_anchor=(0.5, 0.0),
-            ncol=min(3, len(labelled)),
-            fontsize="small",
+def std_bands(groups: list[Group], x_key: str, points: int | None) -> dict[str, dict[str, Band]]:
+    """env -> variant -> mean ± std of the counted runs' evaluation returns (:func:`band`)."""
+    panels: dict[str, dict[str, Band]] = {group.env: {} for group in groups}
+    for group in (group for group in groups if group.done):
+        x, mean, std = band(group.done, x_key, points)
+        panels[group.env][f"{group.variant} (n={len(group.done)})"] = (
+            x,
+            mean,
+            mean - std,
+            mean + std,
         )
-    atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", bbox_inches="tight"))
-    plt.close(fig)
+    return panels
 
 
-BUDGETS = {"env_step": "env steps", "wall_time_s": "seconds of wall time"}
-"""What ``--at-step`` and ``--at-wall-time`` cut the runs at (an eval.csv column)."""
+def iqm_bands(groups: list[Group]) -> dict[str, dict[str, Band]]:
+    """env -> variant -> the IQM over seeds of the normalized evaluation return at each env
+    step that all the counted runs evaluated, with its 95 % stratified-bootstrap band."""
+    panels: dict[str, dict[str, Band]] = {group.env: {} for group in groups}
+    for group in (group for group in groups if group.done):
+        by_step = [
+            dict(zip(run.curve["env_step"], run.curve["return_mean"], strict=True))
+            for run in group.done
+        ]
+        steps = np.array(sorted(functools.reduce(set.intersection, map(set, by_step))))
+        if not len(steps):
+            continue
+        curves = np.array([[returns[step] for step in steps] for returns in by_step])
+        point, low, high = stats.stratified_bootstrap_band(
+            {group.env: stats.normalize(group.env_id, curves)},
+            stats.iqm_over_steps,
+            BOOTSTRAP_REPS,
+            CONFIDENCE,
+            BOOTSTRAP_SEED,
+        )
+        panels[group.env][f"{group.variant} (n={len(group.done)})"] = (steps, point, low, high)
+    return panels
 
 
-def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None:
-    """``record`` as if it had ended at its last evaluation within ``budget`` of ``column``
-    (``env_step`` or ``wall_time_s``); None if the run has not reached the budget yet (so every
-    run counted had the same budget)."""
-    x = record.curve[column]
-    if not len(x) or x[-1] < budget:
-        return None
-    keep = x <= budget
-    curve = {key: values[keep] for key, values in record.curve.items()}
-    summary = {
-        "env_step": float(curve["env_step"][-1]),
-        "wall_time_s": float(curve["wall_time_s"][-1]),
-        "final_eval": {"return_mean": float(curve["return_mean"][-1])},
-    }
-    return RunRecord(record.run_dir, record.config, curve, summary, None)
+def profile_bands(scores: dict[str, dict[str, np.ndarray]]) -> dict[str, Band]:
+    """variant -> its performance profile (all tasks pooled) with the 95 % band, on thresholds
+    from 0 (or the lowest score) to a little above the highest score."""
+    values = [runs for tasks in scores.values() for runs in tasks.values()]
+    if not values:
+        return {}
+    pooled = np.concatenate(values)
+    low, high = min(0.0, pooled.min()), pooled.max()
+    taus = np.linspace(low, high + 0.05 * (high - low or 1.0), PROFILE_POINTS)
+    bands = {}
+    for variant, tasks in scores.items():
+        point, low, high = stats.stratified_bootstrap_band(
+            tasks,
+            lambda s: stats.performance_profile(s, taus),
+            BOOTSTRAP_REPS,
+            CONFIDENCE,
+            BOOTSTRAP_SEED,
+        )
+        bands[variant] = (taus, point, low, high)
+    return bands
+
+
+def _pm(mean: float, std: float) -> str:
+    if math.isnan(mean):
+        return "–"
+    return f"{mean:.4g}" if math.isnan(std) else f"{mean:.4g} ± {std:.2g}"
+
+
+def _ci(point: float, low: float, high: float) -> str:
+    if math.isnan(point):
+        return "–"
+    return f"{point:.3g} [{low:.3g}, {high:.3g}]"
+
+
+def normalization_note(groups: list[Group]) -> str:
+    """Which envs' returns are divided by what (:data:`stats.NORMALIZERS`)."""
+    parts = []
+    for env, env_id in dict.fromkeys((group.env, group.env_id) for group in groups):
+        maximum = stats.max_return(env_id)
+        parts.append(
+            f"{env}: return / {maximum:g}" if maximum else f"{env}: raw return (no known maximum)"
+        )
+    return "; ".join(parts)
+
+
+def markdown(
+    comparison: Comparison,
+    rows: list[dict[str, Any]],
+    aggregates: list[dict[str, Any]],
+    improvements: list[dict[str, Any]],
+) -> str:
+    budget = comparison.budget
+    counted = "finished runs only"
+    rule = []
+    if budget is not None:
+        counted = f"every run cut at an equal budget of {budget[1]:g} {BUDGETS[budget[0]]}"
+        rule = [f"Budget rule: {BUDGET_RULE}", ""]
+    lines = [
+        "# Sweep report",
+        "",
+        *rule,
+        f"Mean ± std over seeds (sample std, ddof=1; none for n = 1), {counted}. Final "
+        "return: the last evaluation's mean return. AUC: normalized area under the learning "
+        "curve (trapezoid of the evaluation return over env steps, divided by the env-step "
+        "span: the run's average evaluation return). Wall time: seconds in the training loop, "
+        "evaluations included. Each seed counts once per row.",
+        "",
+        "| variant | env | n | final return | AUC | wall time (s) | env steps/s | env steps |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for row in rows:
+        cells = [
+            row["variant"],
+            row["env"],
+            str(row["n"]),
+            _pm(row["final_return_mean"], row["final_return_std"]),
+            _pm(row["auc_mean"], row["auc_std"]),
+            _pm(row["wall_time_s_mean"], row["wall_time_s_std"]),
+            _pm(row["env_steps_per_s_mean"], row["env_steps_per_s_std"]),
+            str(row["env_steps"]),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += [
+        "",
+        "## Normalized scores, IQM and 95 % confidence intervals",
+        "",
+        "Score: the final return divided by the task's maximum "
+        f"({normalization_note(comparison.groups)}). "
+        "IQM: interquartile mean over seeds, the mean of the middle 50 % of runs (25 % cut at "
+        "each end, so 3 seeds keep all 3). Intervals: 95 % percentile intervals over "
+        f"{BOOTSTRAP_REPS} stratified bootstrap resamples of the seeds (seed {BOOTSTRAP_SEED}; "
+        "Agarwal et al. 2021). A wide interval says the seeds disagree: more seeds narrow it.",
+        "",
+        "| variant | env | n | IQM [95 % CI] | mean [95 % CI] |",
+        "|---|---|---:|---:|---:|",
+    ]
+    for row in rows:
+        iqm = _ci(row["iqm"], row["iqm_low"], row["iqm_high"])
+        mean = _ci(row["norm_mean"], row["norm_mean_low"], row["norm_mean_high"])
+        lines.append(f"| {row['variant']} | {row['env']} | {row['n']} | {iqm} | {mean} |")
+    lines += [
+        "",
+        "### Across tasks",
+        "",
+        "IQM over all runs of all the variant's tasks; mean: the mean over tasks of each task's "
+        "mean. The seeds are resampled within each task.",
+        "",
+        "| variant | tasks | runs | IQM [95 % CI] | mean [95 % CI] |",
+        "|---|---|---:|---:|---:|",
+    ]
+    for row in aggregates:
+        iqm = _ci(row["iqm"], row["iqm_low"], row["iqm_high"])
+        mean = _ci(row["mean"], row["mean_low"], row["mean_high"])
+        lines.append(f"| {row['variant']} | {row['tasks']} | {row['runs']} | {iqm} | {mean} |")
+    if improvements:
+        lines += _improvement_table(improvements)
+    lines += [
+        "",
+        f"![IQM over env steps]({IQM_STEPS_PNG})",
+        f"![performance profiles]({PROFILE_PNG})",
+        f"![learning curves]({CURVES_STEPS_PNG})",
+        f"![wall time]({CURVES_TIME_PNG})",
+    ]
+    if comparison.unfinished:
+        title = "Unfinished runs" if budget is None else "Runs short of the budget"
+        lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in comparison.unfinished]
+    if comparison.duplicates:
+        lines += [
+            "",
+            "## Duplicate seeds (dropped)",
+            "",
+            "A seed counts once per row: of two runs with one seed, the one that counts "
+            "(finished, or at the budget) is kept, then one that did not fail, then the most "
+            "recent.",
+            "",
+        ] + [f"- {d}" for d in comparison.duplicates]
+    if comparison.off_grid:
+        lines += [
+            "",
+            "## Runs on another evaluation grid (not counted)",
+            "",
+        ] + [f"- {o}" for o in comparison.off_grid]
+    if comparison.failures:
+        lines += ["", "## Failed runs", ""] + [f"- {f}" for f in comparison.failures]
+    return "\n".join(lines) + "\n"
+
+
+def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
+    """P(row > column) for every pair of variants, as a matrix whose columns are numbered (the
+    variants' names are too long for headers)."""
+    variants = list(dict.fromkeys(row["x"] for row in improvements))
+    cell = {(row["x"], row["y"]): _ci(row["p"], row["low"], row["high"]) for row in improvements}
+    numbers = [f"({i})" for i in range(1, len(variants) + 1)]
+    lines = [
+        "",
+        "### Probability of improvement",
+        "",
+        "P(row > column): the probability that a run of the row's variant scores above a run of "
+        "the column's on the same task (ties count one half), averaged over the tasks both ran, "
+        "with its 95 % CI (the two variants' seeds resampled independently). Above 0.5 the row "
+        "tends to win; an interval that excludes 0.5 is a difference these seeds support.",
+        "",
+        "| P(row > column) | " + " | ".join(numbers) + " |",
+        "|---|" + "---:|" * len(variants),
+    ]
+    for number, x in zip(numbers, variants, strict=True):
+        cells = ["–" if x == y else cell.get((x, y), "no common task") for y in variants]
+        lines.append(f"| {number} {x} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def _csv_text(rows: list[dict[str, Any]], columns: list[str]) -> str:
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, columns)
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+AGGREGATE_COLUMNS = ["variant", "tasks", "runs", "iqm", "iqm_low", "iqm_high", "mean", "mean_low"]
+AGGREGATE_COLUMNS += ["mean_high"]
+IMPROVEMENT_COLUMNS = ["x", "y", "tasks", "p", "low", "high"]
+
+
+def default_out(root: Path) -> Path:
+    """Where the report goes without ``--out``: into ``root``, except for a single run
+    directory (its own ``config.json``), whose report goes beside it
+    (``<parent>/report-<name>``) so the run directory stays as simoun-train wrote it."""
+    root = Path(root)
+    if (root / CONFIG_NAME).is_file():
+        return root.parent / f"report-{root.name}"
+    return root
 
 
 def write_report(
     root: Path, out: Path | None = None, budget: tuple[str, float] | None = None
 ) -> list[Path]:
-    """Write the tables and curves of the runs under ``root`` into ``out`` (default: ``root``);
-    returns the files written. Raises SetupError when ``root`` holds no run.
+    """Write the tables and figures of the runs under ``root`` into ``out`` (default:
+    :func:`default_out`); returns the files written. Raises SetupError when ``root`` holds no
+    run or ``out`` cannot be written.
 
     ``budget`` = (``"env_step"`` or ``"wall_time_s"``, value) compares the runs at an equal
-    budget instead of at their ends: each run that reached it, finished or not, counts with its
-    last evaluation within it; the others are listed as not having reached it.
+    budget instead of at their ends (:func:`at_budget`); the runs short of it are listed.
     """
-    root, out = Path(root), Path(out or root)
-    records = find_runs(root)
-    if not records:
-        raise SetupError(
-            f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
-            "directory of simoun-train runs"
-        )
-    if budget is not None:
-        column, value = budget
-        cut = {id(record): at_budget(record, column, value) for record in records}
-        short = [r for r in records if cut[id(r)] is None and r.error is None]
-        records = [cut[id(r)] or r for r in records]
-        for record in short:
-            record.summary = None
-    groups = group_runs(records, variant_keys(records, root), root)
+    root = Path(root)
+    out = Path(out) if out is not None else default_out(root)
+    comparison = compare_runs(root, budget)
+    make_output_dir(out, "--out")
+    groups = comparison.groups
     rows = [group.row() for group in groups]
-    unfinished = [
-        str(run.run_dir.relative_to(root))
-        for run in records
-        if run.summary is None and run.error is None
-    ]
-    failures = [
-        f"{run.run_dir.relative_to(root)}: {run.error}" for run in records if run.error is not None
-    ]
-    out.mkdir(parents=True, exist_ok=True)
-    text = markdown(rows, failures, unfinished, budget)
+    scores = variant_scores(groups)
+    aggregates = aggregate_rows(scores)
+    improvements = improvement_rows(scores)
+    text = markdown(comparison, rows, aggregates, improvements)
     atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, list(rows[0]))
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write(out / REPORT_CSV, lambda tmp: tmp.write_text(buffer.getvalue()))
-    plot_curves(groups, "env_step", "environment steps", out / CURVES_STEPS_PNG, None)
-    plot_curves(groups, "wall_time_s", "wall-clock seconds", out / CURVES_TIME_PNG, CURVE_POINTS)
-    return [out / name for name in (REPORT_MD, REPORT_CSV, CURVES_STEPS_PNG, CURVES_TIME_PNG)]
+    report_csv = _csv_text(rows, list(rows[0]))
+    atomic_write(out / REPORT_CSV, lambda tmp: tmp.write_text(report_csv))
+    aggregate_csv = _csv_text(aggregates, AGGREGATE_COLUMNS)
+    atomic_write(out / AGGREGATE_CSV, lambda tmp: tmp.write_text(aggregate_csv))
+    improvement_csv = _csv_text(improvements, IMPROVEMENT_COLUMNS)
+    atomic_write(out / IMPROVEMENT_CSV, lambda tmp: tmp.write_text(improvement_csv))
+    score = "normalized score (final return / task maximum; raw where none is known)"
+    plot_panels(
+        std_bands(groups, "env_step", None),
+        "environment steps",
+        "evaluation return (mean ± std)",
+        out / CURVES_STEPS_PNG,
+    )
+    plot_panels(
+        std_bands(groups, "wall_time_s", CURVE_POINTS),
+        "wall-clock seconds",
+        "evaluation return (mean ± std)",
+        out / CURVES_TIME_PNG,
+    )
+    plot_panels(
+        iqm_bands(groups),
+        "environment steps",
+        "IQM of the normalized return (95 % CI)",
+        out / IQM_STEPS_PNG,
+    )
+    plot_panels(
+        {"all tasks": profile_bands(scores)},
+        f"tau, {score}",
+        "fraction of runs with score > tau (95 % CI)",
+        out / PROFILE_PNG,
+        steps=True,
+    )
+    names = (REPORT_MD, REPORT_CSV, AGGREGATE_CSV, IMPROVEMENT_CSV)
+    names += (CURVES_STEPS_PNG, CURVES_TIME_PNG, IQM_STEPS_PNG, PROFILE_PNG)
+    return [out / name for name in names]
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""
     parser = argparse.ArgumentParser(
         prog="simoun-report",
-        description="Tables (Markdown, CSV) and learning curves (PNG) of a sweep or of a "
-        "directory of simoun-train runs, per variant and env, over seeds.",
+        description="Tables (Markdown, CSV) and figures (PNG) of a sweep or of a directory of "
+        "simoun-train runs, per variant and env, over seeds: mean ± std, and on returns "
+        "normalized by the task's maximum the IQM and mean with 95 % stratified-bootstrap "
+        "confidence intervals, probabilities of improvement, performance profiles and IQM "
+        "curves (Agarwal et al. 2021). A row counts each seed once (the run that finished, or "
+        "reached the budget, then the most recent; the others are listed) and runs of one "
+        "evaluation grid (eval_every: runs on another grid than most of their row are listed "
+        "and left out).",
     )
     parser.add_argument("root", metavar="DIR", help="a sweep directory or a directory of runs")
-    parser.add_argument("--out", metavar="DIR", help="where to write the report (default: DIR)")
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="where to write the report (default: DIR; for a single run directory, "
+        "report-<name> beside it, so the run directory is left as simoun-train wrote it)",
+    )
     equal = parser.add_mutually_exclusive_group()
     equal.add_argument(
         "--at-step",
         type=int,
         metavar="N",
-        help="compare at an equal budget of N env steps: every run that reached N, finished or "
-        "not, counts with its last evaluation at or before N",
+        help="compare at an equal budget of N env steps: a run counts, finished or not, only "
+        "with an evaluation at exactly N (runs evaluated elsewhere are listed as short)",
     )
     equal.add_argument(
         "--at-wall-time",
         type=float,
         metavar="SECONDS",
-        help="compare at an equal wall-time budget: every run that trained that long counts "
-        "with its last evaluation within it",
+        help="compare at an equal wall-time budget: a run counts, finished or not, if it "
+        "trained past SECONDS (an evaluation at or after it), with its last evaluation at or "
+        "before SECONDS (runs that stopped earlier are listed as short)",
     )
     args = parser.parse_args(argv)
     budget = None
