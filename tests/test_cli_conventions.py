@@ -293,7 +293,7 @@ def test_resume_changes_torch_threads_even_to_the_saved_value(finished, tmp_path
         assert json.loads((run_dir / "config.json").read_text())["torch_threads"] == threads
 
 
-def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path):
+def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path, capsys):
     threads = torch.get_num_threads()
     saved = json.loads((finished / "config.json").read_text())["torch_threads"]
     try:
@@ -303,6 +303,9 @@ def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path)
         assert torch.get_num_threads() == saved
         assert evaluate.main([*argv, "--overwrite", "--torch-threads", str(saved + 1)]) == 0
         assert torch.get_num_threads() == saved + 1
+        report = [*argv, "--torch-threads", "2", "--distraction", "train"]
+        err = exit_message(capsys, evaluate.main, report)
+        assert "--torch-threads" in err and "each run's own" in err
     finally:
         torch.set_num_threads(threads)
 

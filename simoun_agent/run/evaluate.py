@@ -196,7 +196,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         default=None,
         metavar="INT",
-        help="torch intra-op threads (default: the run's torch_threads, else torch's default)",
+        help="torch intra-op threads (default: the run's torch_threads, else torch's default; "
+        "not with --distraction, where each run uses its own)",
     )
     parser.add_argument(
         "--distraction",
@@ -234,6 +235,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
     if args.torch_threads is not None and args.torch_threads < 1:
         parser.error(f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
+    if args.distraction is not None and args.torch_threads is not None:
+        parser.error(
+            "--torch-threads goes with one run; with --distraction each run's own "
+            "torch_threads (from its config.json) applies: drop --torch-threads"
+        )
     if args.distraction is not None:
         from simoun_agent.generalization.cli import evaluate_distractions
 
