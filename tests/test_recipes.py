@@ -316,7 +316,7 @@ def test_drqv2_trains_the_actor_every_step_and_the_targets_every_second_on_3_ste
 def test_a_run_saved_as_the_old_drq_loads_with_this_version_s_defaults():
     """config.json of a run made when 'drq' was SAC + shift: its values load as saved, the keys
     it predates take this version's defaults, which are its behaviour (one view, online next
-    state, Gaussian actor); simoun-report's with_defaults reads it too."""
+    state, Gaussian actor); simoun-report's with_defaults relabels it 'rad', what it ran."""
     saved = to_dict(resolve("cpu", {"agent.recipe": "rad"}))
     saved["agent"]["recipe"] = "drq"
     new_keys = ("critic_augmentations", "target_augmentations", "next_state_encoder", "actor")
@@ -328,7 +328,9 @@ def test_a_run_saved_as_the_old_drq_loads_with_this_version_s_defaults():
     assert (config.agent.critic_augmentations, config.agent.target_augmentations) == (1, 1)
     assert (config.agent.next_state_encoder, config.agent.actor) == ("online", "gaussian")
     report = with_defaults(saved)
-    assert report["agent"]["critic_augmentations"] == 1 and report["agent"]["recipe"] == "drq"
+    assert report["agent"]["critic_augmentations"] == 1 and report["agent"]["recipe"] == "rad"
+    faithful = to_dict(resolve("cpu", {"agent.recipe": "drq"}))
+    assert with_defaults(faithful)["agent"]["recipe"] == "drq"
     SimounAgent(FRAME, 2, dataclasses.replace(config.agent, **SMALL), device="cpu")
 
 

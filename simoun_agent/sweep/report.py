@@ -145,7 +145,14 @@ def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 def with_defaults(saved: dict[str, Any]) -> dict[str, Any]:
     """A saved config with this version's defaults for the keys it predates, so a run saved
     before a key existed groups with runs that have its default; as saved when it no longer
-    loads (a key since removed, a value now refused)."""
+    loads (a key since removed, a value now refused).
+
+    A run saved with recipe "drq" before DrQ's K/M augmented views existed (no
+    ``critic_augmentations`` key) ran SAC + shift, which is the "rad" recipe now: it is
+    relabelled so it does not group with faithful DrQ runs."""
+    agent = saved.get("agent", {})
+    if agent.get("recipe") == "drq" and "critic_augmentations" not in agent:
+        saved = {**saved, "agent": {**agent, "recipe": "rad"}}
     try:
         return to_dict(from_dict(saved))
     except (SetupError, TypeError, ValueError):
