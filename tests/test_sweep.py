@@ -158,7 +158,7 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
         assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
         time.sleep(0.1)
     proc.send_signal(signal.SIGINT)
-    proc.wait(timeout=60)
+    proc.wait(timeout=300)  # generous: a loaded CI machine must not fail the test
     output = log.read_text()
     assert proc.returncode == 130, output
     assert "simoun-sweep --resume --sweep-dir" in output
@@ -209,10 +209,11 @@ def test_sigterm_stops_every_trial_with_a_checkpoint_and_resume_finishes(ray_add
         time.sleep(0.1)
     sent = time.monotonic()
     proc.send_signal(signal.SIGTERM)
-    proc.wait(timeout=60)
+    proc.wait(timeout=300)  # generous: a loaded CI machine must not fail the test
     output = log.read_text()
     assert proc.returncode == 143, output
-    assert time.monotonic() - sent < 30, output
+    # the stop must not wait for the 100k-step trial (minutes); 90 s leaves room for a loaded box
+    assert time.monotonic() - sent < 90, output
     assert "simoun-sweep --resume --sweep-dir" in output
     assert not (run_dir / "summary.json").exists() and not (sweep_dir / "STOP").exists()
     stopped_at = load_checkpoint(run_dir)["state"]["env_step"]
@@ -302,9 +303,11 @@ def test_unreachable_address_fails_within_seconds(tmp_path):
         [sys.executable, "-m", "simoun_agent.sweep.cli", *argv, "--address", f"127.0.0.1:{port}"],
         capture_output=True,
         text=True,
-        timeout=60,
+        timeout=300,
     )
-    assert time.monotonic() - start < 20  # the interpreter and imports take most of it
+    # Ray's own GCS wait is minutes; the probe answers in CONNECT_TIMEOUT_S (5 s) plus the
+    # interpreter and imports, which a loaded CI machine can stretch to tens of seconds
+    assert time.monotonic() - start < 60
     assert result.returncode == 2
     assert f"--address 127.0.0.1:{port}: no Ray cluster answers" in result.stderr
     assert "ray start --head" in result.stderr
