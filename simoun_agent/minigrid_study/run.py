@@ -1,0 +1,225 @@
+"""One run of the study: SB3 PPO on MiniGrid pixels with one arm's reward, evaluated on fixed
+held-out env seeds, its records written to a run directory (``summary.json`` last).
+
+Files: ``eval.csv`` (per evaluation: ``env_step``, ``wall_s``, ``success_rate``,
+``return_mean`` of the env's own reward), ``train.csv`` (per PPO rollout: time in env stepping
+and in the update, training episodes, and the intrinsic reward's mean, std and correlation with
+state novelty), ``config.json`` and ``summary.json``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import time
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from stable_baselines3 import PPO
+from stable_baselines3.common.callbacks import BaseCallback, CallbackList
+
+from simoun_agent.minigrid_study.arms import ARMS
+from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
+from simoun_agent.minigrid_study.spec import Run, StudySpec
+from simoun_agent.minigrid_study.timing import RolloutClock, TimedVecEnv
+from simoun_agent.run.checkpoint import atomic_write
+
+__all__ = ["EVAL_CSV", "RUN_FILES", "SUMMARY", "TRAIN_CSV", "evaluate", "train_run"]
+
+EVAL_CSV, TRAIN_CSV, CONFIG, SUMMARY = "eval.csv", "train.csv", "config.json", "summary.json"
+RUN_FILES = (CONFIG, EVAL_CSV, TRAIN_CSV, SUMMARY)
+"""a run's files, ``summary.json`` last: its presence marks a finished run"""
+
+
+def evaluate(ppo: PPO, envs: SB3VecEnv, first_seed: int) -> dict[str, float]:
+    """One episode per sub-env of ``envs`` (seeds ``first_seed``, ``first_seed + 1``, ...),
+    actions sampled from the policy under a fixed torch seed; success rate and mean return."""
+    envs.seed(first_seed)
+    obs = envs.reset()
+    returns = np.zeros(envs.num_envs)
+    running = np.ones(envs.num_envs, dtype=bool)
+    success = np.zeros(envs.num_envs, dtype=bool)
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(first_seed)
+        while running.any():
+            actions, _ = ppo.predict(obs, deterministic=False)
+            obs, rewards, dones, infos = envs.step(actions)
+            returns += np.where(running, rewards, 0.0)
+            for i in np.flatnonzero(dones & running):
+                # DoorKey pays only for reaching the goal, so a positive return is a success
+                success[i] = rewards[i] > 0 and not infos[i]["TimeLimit.truncated"]
+            running &= ~dones
+    return {"success_rate": float(success.mean()), "return_mean": float(returns.mean())}
+
+
+class StudyLog(BaseCallback):
+    """Evaluations at even intervals, and per rollout the training episodes and what the
+    intrinsic reward looks like: its mean and std, its Pearson correlation with the novelty
+    ``1 / sqrt(N(s))`` of the state reached (N: visits so far of the symbolic state: position,
+    direction, carrying, door open), and its mean on still triplets (three equal frames: a
+    no-op, a move into a wall) against the others."""
+
+    def __init__(
+        self, spec: StudySpec, run: Run, eval_envs: SB3VecEnv, clock: RolloutClock
+    ) -> None:
+        super().__init__()
+        self.spec, self.run, self.eval_envs, self.clock = spec, run, eval_envs, clock
+        self.interval = run.task.steps // spec.evaluations
+        self.next_eval = 0
+        self.start = time.perf_counter()
+        self.eval_s = 0.0
+        """seconds spent evaluating, left out of the training wall time"""
+        self._rollout_eval_s = 0.0
+        self.visits: Counter[tuple[int, ...]] = Counter()
+        self.eval_rows: list[dict[str, float]] = []
+        self.rollout_rows: list[dict[str, float]] = []
+        self._reset_rollout()
+        n = spec.ppo.n_envs
+        self._returns, self._intrinsic_returns = np.zeros(n), np.zeros(n)
+
+    def _reset_rollout(self) -> None:
+        self._intrinsic: list[float] = []
+        self._novelty: list[float] = []
+        self._still: list[bool] = []
+        self._episodes: list[tuple[float, float, bool]] = []
+
+    def training_wall_s(self) -> float:
+        """Seconds since training started, evaluations left out."""
+        return time.perf_counter() - self.start - self.eval_s
+
+    def evaluate_now(self) -> None:
+        """Evaluate the policy now and add a row to ``eval_rows``."""
+        start, wall = time.perf_counter(), self.training_wall_s()
+        scores = evaluate(self.model, self.eval_envs, self.spec.eval_seed)
+        self.eval_rows.append({"env_step": self.num_timesteps, "wall_s": wall, **scores})
+        spent = time.perf_counter() - start
+        self.eval_s += spent
+        self._rollout_eval_s += spent
+
+    def _on_training_start(self) -> None:
+        self.start = time.perf_counter()
+        self.evaluate_now()
+        self.next_eval = self.interval
+
+    def _on_step(self) -> bool:
+        infos, dones = self.locals["infos"], self.locals["dones"]
+        rewards, new_obs = self.locals["rewards"], self.locals["new_obs"]
+        for i, info in enumerate(infos):
+            extrinsic = float(info.get("reward_extrinsic", rewards[i]))
+            intrinsic = float(info.get("reward_intrinsic", 0.0))
+            state = tuple(int(v) for v in info[STATE_KEY])
+            self.visits[state] += 1
+            frames = info.get("terminal_observation", new_obs[i])
+            frames = frames.reshape(3, -1)
+            self._intrinsic.append(intrinsic)
+            self._novelty.append(1.0 / np.sqrt(self.visits[state]))
+            self._still.append(bool(np.all(frames == frames[:1])))
+            self._returns[i] += extrinsic
+            self._intrinsic_returns[i] += intrinsic
+            if dones[i]:
+                won = extrinsic > 0 and not info["TimeLimit.truncated"]
+                self._episodes.append((self._returns[i], self._intrinsic_returns[i], won))
+                self._returns[i] = self._intrinsic_returns[i] = 0.0
+        if self.num_timesteps >= self.next_eval:
+            self.evaluate_now()
+            self.next_eval += self.interval
+        return True
+
+    def _on_rollout_end(self) -> None:
+        intrinsic, novelty = np.array(self._intrinsic), np.array(self._novelty)
+        still = np.array(self._still)
+        episodes = np.array(self._episodes, dtype=np.float64).reshape(-1, 3)
+        varies = intrinsic.std() > 0 and novelty.std() > 0
+        row = {
+            "env_step": self.num_timesteps,
+            "wall_s": self.training_wall_s(),
+            "eval_s": self._rollout_eval_s,
+            "episodes": len(episodes),
+            "success_rate": episodes[:, 2].mean() if len(episodes) else np.nan,
+            "return_extrinsic": episodes[:, 0].mean() if len(episodes) else np.nan,
+            "return_intrinsic": episodes[:, 1].mean() if len(episodes) else np.nan,
+            "intrinsic_mean": intrinsic.mean(),
+            "intrinsic_std": intrinsic.std(),
+            "novelty_corr": np.corrcoef(intrinsic, novelty)[0, 1] if varies else np.nan,
+            "still_fraction": still.mean(),
+            "intrinsic_still_mean": intrinsic[still].mean() if still.any() else np.nan,
+            "intrinsic_moving_mean": intrinsic[~still].mean() if (~still).any() else np.nan,
+            "states_visited": len(self.visits),
+        }
+        self.rollout_rows.append(row)
+        self._rollout_eval_s = 0.0
+        self._reset_rollout()
+
+
+def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
+    fields = list(dict.fromkeys(key for row in rows for key in row))
+
+    def write(tmp: Path) -> None:
+        with tmp.open("w", newline="") as file:
+            writer = csv.DictWriter(file, fieldnames=fields, restval="")
+            writer.writeheader()
+            writer.writerows(rows)
+
+    atomic_write(path, write)
+
+
+def write_json(path: Path, value: Any) -> None:
+    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(value, indent=2) + "\n"))
+
+
+def train_run(
+    spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None
+) -> dict[str, Any]:
+    """Train and evaluate ``run``, writing its files into ``run_dir``; returns the summary.
+
+    One ``SeedSequence(seed)`` spawns the training envs', PPO's and the intrinsic model's seeds,
+    so two seeds share no stream; the evaluation episodes use the spec's fixed env seeds.
+    ``commit`` (the code's git commit) is recorded in ``config.json``.
+    """
+    run_dir.mkdir(parents=True, exist_ok=True)
+    torch.set_num_threads(1)
+    env_seed, ppo_seed, model_seed = (
+        int(s.generate_state(1)[0] % 2**31) for s in np.random.SeedSequence(run.seed).spawn(3)
+    )
+    device = torch.device(spec.device)
+    seeds = {"env": env_seed, "ppo": ppo_seed, "model": model_seed}
+    config = {"run": run.name, "commit": commit, "seeds": seeds, "spec": spec.to_json()}
+    write_json(run_dir / CONFIG, config)
+    envs = ARMS[run.arm](pixel_vector_env(run.task.env_id, spec.ppo.n_envs), model_seed, device)
+    timed = TimedVecEnv(SB3VecEnv(envs))
+    timed.seed(env_seed)
+    eval_envs = SB3VecEnv(pixel_vector_env(run.task.env_id, spec.eval_episodes))
+    ppo = PPO("CnnPolicy", timed, seed=ppo_seed, device=device, **spec.ppo.kwargs())
+    clock = RolloutClock(timed)
+    log = StudyLog(spec, run, eval_envs, clock)
+    start = time.perf_counter()
+    try:
+        ppo.learn(run.task.steps, callback=CallbackList([clock, log]))
+        if log.eval_rows[-1]["env_step"] < ppo.num_timesteps:
+            log.evaluate_now()  # after the last update
+    finally:
+        timed.close()
+        eval_envs.close()
+    wall = time.perf_counter() - start
+    rows = [
+        {**rollout, **times} for rollout, times in zip(log.rollout_rows, clock.rows, strict=True)
+    ]
+    write_csv(run_dir / EVAL_CSV, log.eval_rows)
+    write_csv(run_dir / TRAIN_CSV, rows)
+    final = log.eval_rows[-1]
+    summary = {
+        "run": run.name,
+        "env_steps": ppo.num_timesteps,
+        "wall_s": wall,
+        "training_wall_s": wall - log.eval_s,
+        "steps_per_s": ppo.num_timesteps / (wall - log.eval_s),
+        "env_s": sum(r["env_s"] for r in clock.rows),
+        "update_s": sum(r.get("update_s", 0.0) for r in clock.rows),
+        "final_success_rate": final["success_rate"],
+        "final_return_mean": final["return_mean"],
+    }
+    write_json(run_dir / SUMMARY, summary)
+    return summary

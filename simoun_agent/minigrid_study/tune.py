@@ -1,0 +1,153 @@
+"""The study on Ray Tune: every unfinished run as a trial, two at a time, one torch thread each,
+each finished run's files copied into the archive as its trial reports them.
+
+Resuming is by run: a run whose ``summary.json`` is in the archive is finished and skipped; one
+interrupted mid-way starts again from scratch. The files travel in the trial's result (not
+through a shared disk), so trials on the machines of a Ray cluster (``--address``) archive on
+the machine that runs the study.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
+from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
+from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.presets import SetupError
+from simoun_agent.sweep.cli import connect, load_ray
+
+__all__ = ["SPEC_FILE", "finished_runs", "run_study"]
+
+SPEC_FILE = "spec.json"
+"""the spec the archive's runs were trained with"""
+
+
+def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
+    """The names of the spec's runs whose summary is in the archive."""
+    return [run.name for run in spec.runs() if (archive / run.name / SUMMARY).is_file()]
+
+
+def git_commit() -> str | None:
+    """The commit of simoun's checkout, recorded with each run (None outside git)."""
+    try:
+        done = subprocess.run(
+            ["git", "rev-parse", "HEAD"],
+            cwd=Path(__file__).resolve().parent,
+            capture_output=True,
+            text=True,
+            timeout=30,
+            check=True,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return done.stdout.strip()
+
+
+def record_spec(spec: StudySpec, archive: Path) -> None:
+    """Write the spec into the archive, or refuse a spec that differs from the one there (the
+    finished runs would be compared with runs of another design)."""
+    path = archive / SPEC_FILE
+    wanted = spec.to_json()
+    if path.is_file():
+        recorded = json.loads(path.read_text())
+        if recorded != wanted:
+            changed = sorted(k for k in wanted if recorded.get(k) != wanted[k])
+            raise SetupError(
+                f"--archive {archive} holds runs of another spec (keys {changed} differ from "
+                f"{path}); pass the spec it was run with, or a new --archive"
+            )
+        return
+    archive.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(wanted, indent=2) + "\n"))
+
+
+def trainable(config: dict[str, Any], spec: dict[str, Any], commit: str | None) -> None:
+    """One Tune trial: train the run ``config["run"]`` and report its files."""
+    from ray import tune
+
+    study = spec_from_dict(spec, "the study's spec")
+    run = {r.name: r for r in study.runs()}[config["run"]]
+    run_dir = Path(tune.get_context().get_trial_dir()) / "run"
+    train_run(study, run, run_dir, commit=commit)
+    files = {name: (run_dir / name).read_text() for name in RUN_FILES}
+    tune.report({"finished": 1, "files_json": json.dumps(files)})
+
+
+def archive_files(archive: Path, name: str, files: dict[str, str]) -> None:
+    """Write a finished run's files under ``archive/name``, each atomically, the summary last."""
+    run_dir = archive / name
+    run_dir.mkdir(parents=True, exist_ok=True)
+    for file in sorted(files, key=lambda f: f == SUMMARY):
+        text = files[file]
+        atomic_write(run_dir / file, lambda tmp, text=text: tmp.write_text(text))
+
+
+def archive_callback(archive: Path) -> Any:
+    """A Tune callback that archives each run as its trial reports its files."""
+    from ray import tune
+
+    class ArchiveOnResult(tune.Callback):
+        def on_trial_result(self, iteration: int, trials: list, trial: Any, result: dict, **info):
+            if "files_json" in result:
+                archive_files(archive, trial.config["run"], json.loads(result["files_json"]))
+
+    return ArchiveOnResult()
+
+
+def run_study(
+    spec: StudySpec,
+    archive: Path,
+    work_dir: Path,
+    address: str | None = None,
+    concurrent: int = 2,
+    verbose: int = 1,
+) -> dict[str, list[str]]:
+    """Run every unfinished run of ``spec`` (Ray Tune's records under ``work_dir``), archiving
+    each as it finishes; returns the run names grouped as skipped (finished before), finished
+    and failed."""
+    if concurrent < 1:
+        raise SetupError(f"--concurrent must be >= 1, got {concurrent}")
+    record_spec(spec, archive)
+    done = set(finished_runs(spec, archive))
+    todo = [run.name for run in spec.runs() if run.name not in done]
+    print(f"{len(done)} of {len(spec.runs())} runs finished in {archive}; {len(todo)} to run")
+    outcome = {"skipped": sorted(done), "finished": [], "failed": []}
+    if not todo:
+        return outcome
+    ray = load_ray()
+    from ray import tune
+
+    started = connect(ray, address, None)
+    try:
+        tuner = tune.Tuner(
+            tune.with_resources(
+                tune.with_parameters(trainable, spec=spec.to_json(), commit=git_commit()),
+                {"cpu": 1},
+            ),
+            param_space={"run": tune.grid_search(todo)},
+            tune_config=tune.TuneConfig(
+                trial_name_creator=lambda t: t.config["run"].replace("/", "_"),
+                trial_dirname_creator=lambda t: t.config["run"].replace("/", "_"),
+                max_concurrent_trials=concurrent,
+            ),
+            run_config=tune.RunConfig(
+                name="minigrid_study-" + datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S"),
+                storage_path=str(work_dir.resolve()),
+                failure_config=tune.FailureConfig(max_failures=0, fail_fast=False),
+                verbose=verbose,
+                callbacks=[archive_callback(archive)],
+            ),
+        )
+        tuner.fit()
+    finally:
+        if started:
+            ray.shutdown()
+    now_done = set(finished_runs(spec, archive))
+    outcome["finished"] = [name for name in todo if name in now_done]
+    outcome["failed"] = [name for name in todo if name not in now_done]
+    return outcome
