@@ -15,7 +15,7 @@ import argparse
 import signal
 import socket
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
@@ -175,26 +175,46 @@ def run_sweep(
     ray: ModuleType, spec: SweepSpec, sweep_dir: Path, gpus: float, verbose: int
 ) -> dict[str, list[Trial]]:
     """Run the unfinished trials on Tune; returns them grouped as finished / failed / stopped."""
+    trials = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
+    return run_trials(trials, sweep_dir, spec.cpus_per_trial, gpus, verbose)
+
+
+def run_trials(
+    trials: list[Trial],
+    sweep_dir: Path,
+    cpus_per_trial: int,
+    gpus: float,
+    verbose: int,
+    callbacks: Sequence[Any] = (),
+    max_concurrent_trials: int | None = None,
+    name: str = "",
+) -> dict[str, list[Trial]]:
+    """Run ``trials`` as one Tune experiment under ``sweep_dir/tune``, named ``name`` and the
+    UTC time (``callbacks``: Tune callbacks, e.g. ``simoun-study``'s archiving;
+    ``max_concurrent_trials`` None: as many as fit); returns them grouped as finished / failed /
+    stopped."""
     from ray import tune
 
-    trials = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
-    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    stamp = name + datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
     tuner = tune.Tuner(
         tune.with_resources(
             tune.with_parameters(
                 run_trial, trials=trial_table(trials), stop_file=str(sweep_dir / STOP_FILE)
             ),
-            {"cpu": spec.cpus_per_trial, "gpu": gpus},
+            {"cpu": cpus_per_trial, "gpu": gpus},
         ),
         param_space={"trial": tune.grid_search([trial.name for trial in trials])},
         tune_config=tune.TuneConfig(
-            trial_name_creator=lambda t: t.config["trial"], reuse_actors=True
+            trial_name_creator=lambda t: t.config["trial"],
+            reuse_actors=True,
+            max_concurrent_trials=max_concurrent_trials,
         ),
         run_config=tune.RunConfig(
             name=stamp,
             storage_path=str((sweep_dir / "tune").resolve()),
             failure_config=tune.FailureConfig(max_failures=0, fail_fast=False),
             verbose=verbose,
+            callbacks=list(callbacks),
         ),
     )
     results = tuner.fit()
@@ -363,8 +383,11 @@ def summarize(
     sweep_dir: Path,
     written: list[Path],
     terminated: bool = False,
+    resume: str | None = None,
 ) -> int:
-    """Say what happened to each trial and how to go on; the exit status."""
+    """Say what happened to each trial and how to go on (``resume``: the command that continues,
+    by default simoun-sweep's); the exit status."""
+    resume = resume or f"simoun-sweep --resume --sweep-dir {sweep_dir}"
     for trial in outcome.get("failed", []):
         error = Path(trial.run_dir) / ERROR_FILE
         last = error.read_text().strip().splitlines()[-1] if error.is_file() else "see Tune's log"
@@ -373,15 +396,14 @@ def summarize(
         print(f"report: {', '.join(map(str, written))}")
     if outcome.get("stopped"):
         print(
-            f"stopped with {len(outcome['stopped'])} trials unfinished; continue with: "
-            f"simoun-sweep --resume --sweep-dir {sweep_dir}",
+            f"stopped with {len(outcome['stopped'])} trials unfinished; continue with: {resume}",
             file=sys.stderr,
         )
         return 143 if terminated else 130
     if outcome.get("failed"):
         print(
             f"{len(outcome['failed'])} trials failed, the others finished; fix the cause and "
-            f"rerun them with: simoun-sweep --resume --sweep-dir {sweep_dir}",
+            f"rerun them with: {resume}",
             file=sys.stderr,
         )
         return 1

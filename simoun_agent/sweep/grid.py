@@ -240,7 +240,7 @@ class SweepSpec:
                     "torch_threads": self.cpus_per_trial,
                 }
                 trials.append(
-                    Trial(variant, env, seed, str(run_dir), self.preset, _typed(overrides))
+                    Trial(variant, env, seed, str(run_dir), self.preset, typed(overrides))
                 )
         return trials
 
@@ -296,7 +296,7 @@ class SweepSpec:
             raise SetupError(f"{path} is corrupt ({err}); start a new sweep") from None
 
 
-def _typed(overrides: dict[str, Any]) -> dict[str, Any]:
+def typed(overrides: dict[str, Any]) -> dict[str, Any]:
     """Lists back to tuples for tuple-typed keys (JSON has no tuples)."""
     fields = config_fields()
     return {
