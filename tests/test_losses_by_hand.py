@@ -18,6 +18,9 @@ from simoun_agent.losses import (
     actor_loss,
     contrastive_loss,
     critic_loss,
+    deterministic_actor_loss,
+    deterministic_value,
+    intrinsic_return,
     reward_loss,
     soft_value,
     td_target,
@@ -25,6 +28,7 @@ from simoun_agent.losses import (
     total_loss,
     transition_loss,
 )
+from simoun_agent.models.actors import DeterministicActor, exploration_std
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Actor, Critic
 
@@ -279,3 +283,49 @@ def test_twin_critic_heads_read_state_then_action_each_with_its_own_weights():
     np.testing.assert_allclose(np64(q1), mlp_by_hand(critic.q1, x), rtol=1e-5, atol=1e-6)
     np.testing.assert_allclose(np64(q2), mlp_by_hand(critic.q2, x), rtol=1e-5, atol=1e-6)
     assert not torch.allclose(q1, q2)
+
+
+# -- DrQ-v2's deterministic actor and the per-step curiosity of n-step targets -------------------
+
+
+def test_deterministic_value_and_actor_loss_are_the_clipped_double_q_without_entropy():
+    value = deterministic_value(Q1, Q2)
+    np.testing.assert_allclose(np64(value), np.minimum(np64(Q1), np64(Q2)))
+    q1, q2 = Q1.clone().requires_grad_(True), Q2.clone().requires_grad_(True)
+    loss = deterministic_actor_loss(q1, q2)
+    assert float(loss.detach()) == pytest.approx(-np.minimum(np64(Q1), np64(Q2)).mean())
+    loss.backward()
+    smaller_is_1 = np64(Q1) < np64(Q2)
+    np.testing.assert_allclose(np64(q1.grad)[smaller_is_1], -1 / B)
+    assert not np64(q1.grad)[np64(Q1) > np64(Q2)].any()
+
+
+def test_intrinsic_return_discounts_each_step_and_stops_at_the_mask():
+    intrinsic = torch.tensor([[1.0, 2.0, 3.0], [10.0, 20.0, 30.0], [100.0, 200.0, 300.0]])
+    mask = torch.tensor([[1.0, 1.0, 1.0], [1.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    expected = [1 + 0.5 * 10 + 0.25 * 100, 2 + 0.5 * 20, 3.0]
+    np.testing.assert_allclose(np64(intrinsic_return(intrinsic, mask, 0.5)), expected)
+    np.testing.assert_allclose(np64(intrinsic_return(intrinsic[:1], mask[:1], 0.5)), [1, 2, 3])
+
+
+def test_exploration_std_is_drqv2_linear_schedule():
+    assert [exploration_std(s, 1.0, 0.1, 100) for s in (-5, 0, 25, 100, 10**6)] == pytest.approx(
+        [1.0, 1.0, 0.775, 0.1, 0.1]
+    )
+
+
+def test_smoothed_action_clips_the_noise_clamps_the_action_and_passes_the_gradient():
+    torch.manual_seed(0)
+    actor = DeterministicActor(D, A, 16, std_start=5.0, std_end=5.0, std_steps=1, noise_clip=0.3)
+    state = rand(B, D, seed=1, scale=10.0, grad=True)  # |mu| near 1: some actions get clamped
+    torch.manual_seed(4)
+    action = actor.smoothed(state, step=0)
+    torch.manual_seed(4)
+    noise = np.clip(5.0 * np64(torch.randn(B, A)), -0.3, 0.3)
+    mu = np.tanh(mlp_by_hand(actor.trunk, np64(state)))
+    np.testing.assert_allclose(np64(action), np.clip(mu + noise, -1, 1), rtol=1e-5, atol=1e-6)
+    assert np.abs(noise).max() == pytest.approx(0.3)  # std 5: the clip is what bounds it
+    # the clamp's gradient is the identity: d a / d mu = 1 even where the action is clamped
+    assert (np.abs(mu + noise) > 1).any()
+    expected = torch.autograd.grad(actor(state).sum(), state)[0]
+    torch.testing.assert_close(torch.autograd.grad(action.sum(), state)[0], expected)
