@@ -1,8 +1,9 @@
 """Learning evidence: a short CPU run on the tiny pixel task must beat a random policy."""
 
 from simoun_agent.run import train
-from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, RandomPolicy, evaluate
+from simoun_agent.run.evaluate import RandomPolicy, evaluate
 from simoun_agent.run.presets import resolve
+from simoun_agent.run.seeds import first_eval_seed
 
 EPISODES = 20
 MARGIN = 6.0
@@ -54,5 +55,5 @@ def test_short_run_on_point_reach_beats_a_random_policy(tmp_path):
     run = train.create_run(config)
     trained = train.train(run)
     random_policy = RandomPolicy(run.eval_env.action_space.shape[0], seed=0)
-    baseline, _ = evaluate(random_policy, run.eval_env, EPISODES, config.seed + EVAL_SEED_OFFSET)
+    baseline, _ = evaluate(random_policy, run.eval_env, EPISODES, first_eval_seed(config.seed))
     assert trained["return_mean"] > baseline["return_mean"] + MARGIN, (trained, baseline)

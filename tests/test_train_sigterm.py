@@ -98,7 +98,7 @@ def tensors(state: object, prefix: str = "") -> dict[str, torch.Tensor]:
 
 
 @pytest.mark.parametrize("suite", list(ENVS))
-def test_sigterm_checkpoints_within_10_s_and_resume_reaches_the_end(suite, tmp_path):
+def test_sigterm_checkpoints_at_the_next_step_and_resume_reaches_the_end(suite, tmp_path):
     env_flags, _ = ENVS[suite]
     run_dir = tmp_path / "run"
     flags = [*TINY, *env_flags, "--run-dir", str(run_dir)]
@@ -123,8 +123,10 @@ def test_sigterm_checkpoints_within_10_s_and_resume_reaches_the_end(suite, tmp_p
     finally:
         process.kill()
     assert process.returncode == 143, output
-    assert took < 10, f"{took:.1f} s from SIGTERM to exit"
-    assert "SIGTERM" in output and f"--resume {run_dir}" in output, output
+    # at the next step (a few ms), not at the end of 100000 steps; generous for a loaded machine
+    assert took < 60, f"{took:.1f} s from SIGTERM to exit"
+    assert "SIGTERM received: stopping at the next step" in output, output
+    assert "stopped by SIGTERM during " in output and f"--resume {run_dir}" in output, output
     assert not (run_dir / "summary.json").exists()
     stopped_at = load_checkpoint(run_dir)["state"]["env_step"]
     assert stopped_at > 0

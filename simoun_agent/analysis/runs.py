@@ -11,10 +11,10 @@ import torch
 
 from simoun_agent.agent import SimounAgent
 from simoun_agent.run.checkpoint import load_checkpoint
-from simoun_agent.run.evaluate import EVAL_SEED_OFFSET
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.presets import SetupError, TrainConfig, from_dict
 from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.seeds import first_eval_seed
 
 
 @dataclass
@@ -35,7 +35,7 @@ class LoadedRun:
     @property
     def first_seed(self) -> int:
         """Seed of episode 0: the run's evaluation episodes, never its training ones."""
-        return self.config.seed + EVAL_SEED_OFFSET
+        return first_eval_seed(self.config.seed)
 
 
 def load_run(path: Path, device: str | None = None) -> LoadedRun:

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import gymnasium as gym
 
 from simoun_agent.generalization.suite import make_distracted_env
+from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.train import TrainCallback
 
 if TYPE_CHECKING:
@@ -21,7 +22,8 @@ class DistractionEvaluation(TrainCallback):
     Adds ``<mode>/return_mean`` and ``<mode>/return_std`` to the evaluation's metrics, which go
     to eval.csv, TensorBoard and the learning curve beside the training env's return. The
     episodes use the run's evaluation seeds, so every mode sees the same starts as the training
-    env; the distracted envs are built once, on the first evaluation.
+    env; the distracted envs are built when training starts and closed when it ends, however it
+    ends (a signal, an error).
 
     Args:
         modes: distraction modes (``simoun_agent.generalization.DISTRACTIONS``, not ``train``).
@@ -33,24 +35,25 @@ class DistractionEvaluation(TrainCallback):
         self.videos = videos
         self._envs: dict[str, gym.Env] = {}
 
+    def on_start(self, run: Run) -> None:
+        for mode in self.modes:
+            self._envs[mode] = make_distracted_env(run.config, mode, self.videos)
+
     def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
-        from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate
+        from simoun_agent.run.evaluate import evaluate
 
         config = run.config
-        for mode in self.modes:
-            if mode not in self._envs:
-                self._envs[mode] = make_distracted_env(config, mode, self.videos)
-            result, _ = evaluate(
-                run.agent, self._envs[mode], config.eval_episodes, config.seed + EVAL_SEED_OFFSET
-            )
+        for mode, env in self._envs.items():
+            episodes, first = config.eval_episodes, first_eval_seed(config.seed)
+            result, _ = evaluate(run.agent, env, episodes, first, stop=run.stop.is_set)
             metrics[f"{mode}/return_mean"] = result["return_mean"]
             metrics[f"{mode}/return_std"] = result["return_std"]
 
-    def on_end(self, run: Run, metrics: dict[str, float]) -> None:
+    def on_end(self, run: Run, metrics: dict[str, float] | None) -> None:
         self.close()
 
     def close(self) -> None:
-        """Close the distracted envs (training may also end by Ctrl-C, without ``on_end``)."""
+        """Close the distracted envs."""
         for env in self._envs.values():
             env.close()
         self._envs.clear()

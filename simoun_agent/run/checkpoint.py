@@ -5,14 +5,20 @@ optimizers, running maxima, counters, the RNG states of python, numpy, torch and
 and the config) and ``replay-<step>.npz`` (the replay, with its own RNG state), named in the
 checkpoint. Each file is written to a temporary name in the same directory and renamed over
 the old one (``os.replace`` is atomic on POSIX and Windows), the replay first: a crash at any
-moment leaves the previous complete checkpoint in place.
+moment leaves the previous complete checkpoint in place, and a full disk too (:class:`NoSpace`).
+A process killed while writing (``kill -9``) leaves its temporary behind; the next trainer of
+the directory removes it (:func:`remove_leftovers`).
 """
 
 from __future__ import annotations
 
+import errno
+import io
 import os
 import pickle
 import random
+import re
+import shutil
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -22,10 +28,34 @@ import numpy as np
 import torch
 
 from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError, config_sections
+from simoun_agent.run.seeds import SEED_SCHEME
 
 CHECKPOINT_NAME = "checkpoint.pt"
 FORMAT = "simoun-checkpoint/1"
 _REQUIRED = ("format", "config", "agent", "replay_file", "rng", "state")
+_TEMPORARY = re.compile(r"^\..+\.(?P<pid>\d+)\.tmp(\.[^.]+)?$")
+"""The name :func:`atomic_write` gives its temporary: ``.<stem>.<pid>.tmp<suffix>``."""
+SPACE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+"""Write errors that mean the data did not fit: a full disk, a full quota, a file size limit."""
+
+
+class NoSpace(OSError):
+    """A checkpoint did not fit (:data:`SPACE_ERRNOS`, or too little free space to start); the
+    previous checkpoint is intact. ``str()`` is ``no space left on <dir>: N MB needed, ...``."""
+
+    def __init__(self, directory: Path, needed: int, reason: str) -> None:
+        message = f"no space left on {directory}: {_mb(needed)} needed, {reason}"
+        super().__init__(errno.ENOSPC, message)
+        self.directory = directory
+        self.needed = needed
+        """bytes the new checkpoint needs beside the old one"""
+
+    def __str__(self) -> str:
+        return self.strerror
+
+
+def _mb(size: float) -> str:
+    return f"{size / 1e6:.1f} MB"
 
 
 def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
@@ -36,6 +66,34 @@ def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def remove_leftovers(run_dir: Path, replay_file: str | None = None) -> list[Path]:
+    """Remove what writers killed halfway left in ``run_dir`` and return it: the temporaries of
+    :func:`atomic_write` whose process is dead (a live one may still be writing), and every
+    ``replay-*.npz`` but ``replay_file`` (the one the checkpoint names; none for a new run), which
+    a kill between a checkpoint's two renames leaves. Call it holding the run directory's lock."""
+    removed = []
+    for path in run_dir.glob(".*.tmp*"):
+        match = _TEMPORARY.match(path.name)
+        if match and not _alive(int(match["pid"])):
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    for path in run_dir.glob("replay-*.npz"):
+        if path.name != replay_file:
+            path.unlink(missing_ok=True)
+            removed.append(path)
+    return removed
 
 
 def capture_rng() -> dict[str, Any]:
@@ -64,6 +122,10 @@ def save_checkpoint(
 ) -> Path:
     """Write the checkpoint of a run atomically; return the path of ``checkpoint.pt``.
 
+    Raises :class:`NoSpace`, with nothing of the new checkpoint left behind and the previous one
+    intact, when the free space is short of what it needs (checked first: a disk filled to the
+    last byte fails other writers too) or a write fails for lack of space.
+
     Args:
         run_dir: the run directory.
         config: the run's config as a dict (``presets.to_dict``).
@@ -72,21 +134,44 @@ def save_checkpoint(
         state: the trainer's counters and its own RNG state, restored as given.
     """
     replay_path = run_dir / f"replay-{state['env_step']}.npz"
-    atomic_write(replay_path, replay.save)
     payload = {
         "format": FORMAT,
+        "seed_scheme": SEED_SCHEME,
         "config": config,
         "agent": agent.state_dict(),
         "replay_file": replay_path.name,
         "rng": capture_rng(),
         "state": state,
     }
+    # Serialized in memory first: torch.save's own file writer turns a full disk into an opaque
+    # "RuntimeError: [enforce fail at inline_container.cc]"; a plain write raises OSError(ENOSPC).
+    buffer = io.BytesIO()
+    torch.save(payload, buffer)
+    needed = _replay_file_bytes(replay) + buffer.getbuffer().nbytes
+    free = shutil.disk_usage(run_dir).free
+    if free < needed:
+        raise NoSpace(run_dir, needed, f"{_mb(free)} free")
+    replaced = replay_path.exists()  # a second checkpoint at the same step: the same replay
     path = run_dir / CHECKPOINT_NAME
-    atomic_write(path, lambda tmp: torch.save(payload, tmp))
+    try:
+        atomic_write(replay_path, replay.save)
+        atomic_write(path, lambda tmp: tmp.write_bytes(buffer.getbuffer()))
+    except OSError as err:
+        if err.errno not in SPACE_ERRNOS:
+            raise
+        if not replaced:
+            replay_path.unlink(missing_ok=True)
+        limit = " (a file size limit: ulimit -f)" if err.errno == errno.EFBIG else ""
+        raise NoSpace(run_dir, needed, f"a write failed: {err.strerror}{limit}") from None
     for old in run_dir.glob("replay-*.npz"):
         if old != replay_path:
             old.unlink(missing_ok=True)
     return path
+
+
+def _replay_file_bytes(replay: Any) -> int:
+    """Size of the replay's ``.npz``: uncompressed, it is the stored part of its arrays."""
+    return int(replay.nbytes * min(replay.written, replay.slots) / replay.slots)
 
 
 def load_checkpoint(path: Path) -> dict[str, Any]:
@@ -139,6 +224,25 @@ def config_differences(saved: dict, current: dict, prefix: str = "") -> list[str
         elif old != new:
             differences.append(f"{name}: {old!r} in the checkpoint, {new!r} now")
     return differences
+
+
+def check_seed_scheme(payload: dict, path: Path) -> None:
+    """Refuse to continue a run whose episodes were seeded another way (runs started before
+    :mod:`simoun_agent.run.seeds`): its training and evaluation episodes would change halfway,
+    so its curve would no longer compare with itself. ``simoun-eval`` still reads it."""
+    found = payload.get("seed_scheme")
+    if found != SEED_SCHEME:
+        was = (
+            "before seed streams, when training episode i reset with seed + i and evaluation "
+            "episode i with seed + 1000000 + i"
+            if found is None
+            else f"under seed scheme {found!r}"
+        )
+        raise SetupError(
+            f"{path} was started {was}; this version seeds episodes from SeedSequence streams "
+            f"({SEED_SCHEME}) and cannot continue it exactly. Start a new run, or resume it "
+            "with the simoun version that started it."
+        )
 
 
 def check_config(payload: dict, current: dict, path: Path) -> None:

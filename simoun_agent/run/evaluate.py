@@ -28,11 +28,13 @@ from simoun_agent.run import driving_metrics
 from simoun_agent.run.flags import add_version, bool_argv
 from simoun_agent.run.presets import SetupError
 from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.signals import Stopped, stop_at_once
 
-EVAL_SEED_OFFSET = 1_000_000
-"""Evaluation episode i resets with seed ``config.seed + EVAL_SEED_OFFSET + i``: the same
-episodes at every evaluation, never the training ones."""
+
+class EvaluationStopped(Exception):
+    """An evaluation abandoned between two steps because its ``stop()`` said so; nothing of it
+    is returned, so no partial evaluation is ever logged."""
 
 
 def evaluate(
@@ -42,14 +44,17 @@ def evaluate(
     seed: int,
     record: bool = False,
     on_episode: Callable[[int, float], None] | None = None,
+    stop: Callable[[], bool] | None = None,
 ) -> tuple[dict[str, float], list[np.ndarray]]:
-    """Play ``episodes`` episodes with deterministic actions.
+    """Play ``episodes`` episodes with deterministic actions; episode ``i`` resets with seed
+    ``seed + i`` (a run's own: :func:`simoun_agent.run.seeds.first_eval_seed`).
 
     Leaves every global RNG as it found it, so evaluating does not change what training does
     next (a resumed run stays bit-exact). highway-env runs add the driving measures of
     :mod:`simoun_agent.run.driving_metrics`.
 
-    ``on_episode(index, return)`` is called after each episode (progress reports).
+    ``on_episode(index, return)`` is called after each episode (progress reports). ``stop()`` is
+    asked before every step: True raises :class:`EvaluationStopped` (a Ctrl-C during training).
 
     Returns:
         metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
@@ -67,6 +72,8 @@ def evaluate(
                 frames.append(obs["frames"][-1])
             total, length, done = 0.0, 0, False
             while not done:
+                if stop is not None and stop():
+                    raise EvaluationStopped
                 action = agent.act(obs["frames"], deterministic=True)
                 obs, reward, terminated, truncated, info = env.step(action)
                 total += float(reward)
@@ -271,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
                 "to write this one elsewhere"
             )
         created = make_output_dir(out)
-        seed = args.seed if args.seed is not None else config.seed + EVAL_SEED_OFFSET
+        seed = args.seed if args.seed is not None else first_eval_seed(config.seed)
         if args.random_policy:
             agent = RandomPolicy(env.action_space.shape[0], seed)
         else:

@@ -30,12 +30,15 @@ class CsvLog:
     def __init__(self, path: Path, resume_step: int | None = None) -> None:
         self.path = path
         self.columns: list[str] | None = None
+        self.last_row: dict[str, str] | None = None
+        """the last row kept on resume (None for a new log)"""
         if resume_step is not None and path.exists():
             with path.open(newline="") as f:
                 reader = csv.DictReader(f)
                 self.columns = reader.fieldnames
                 rows = [row for row in reader if int(row["env_step"]) <= resume_step]
             self._rewrite(rows)
+            self.last_row = rows[-1] if rows else None
         elif path.exists():
             path.unlink()
 
@@ -119,8 +122,13 @@ class RunLogger:
         self.eval_log = CsvLog(run_dir / EVAL_CSV, resume_step)
         self.train_log = CsvLog(run_dir / TRAIN_CSV, resume_step)
         self.tensorboard = SummaryWriter(run_dir / "tb", purge_step=resume_step)
-        self.last_eval_step: int | None = None
-        """env step of the latest evaluation logged by this logger"""
+        last = self.eval_log.last_row
+        self.last_eval_step: int | None = None if last is None else int(last["env_step"])
+        """env step of the latest evaluation in eval.csv (a resumed run's included)"""
+        self.last_eval: dict[str, float] | None = None
+        """its metrics (as logged, without env_step)"""
+        if last is not None:
+            self.last_eval = {k: float(v or "nan") for k, v in last.items() if k != "env_step"}
 
     def train_episode(self, env_step: int, row: dict[str, Any]) -> None:
         """One finished training episode: return, length, speed and the last update's losses."""
@@ -132,7 +140,7 @@ class RunLogger:
     def evaluation(self, env_step: int, metrics: dict[str, float]) -> None:
         """One evaluation: append to eval.csv, TensorBoard, and redraw the learning curve."""
         self.eval_log.write({"env_step": env_step, **metrics})
-        self.last_eval_step = env_step
+        self.last_eval_step, self.last_eval = env_step, dict(metrics)
         for key, value in metrics.items():
             if math.isfinite(value):
                 self.tensorboard.add_scalar(f"eval/{key}", value, env_step)

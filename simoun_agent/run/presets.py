@@ -73,7 +73,8 @@ class TrainConfig:
     preset: str | None = None
     """name of the preset this config started from (informational)"""
     seed: int = 1
-    """seed of the environments, the replay, torch, numpy and python"""
+    """seed of every random stream (episodes, replay, torch, numpy, python): each is a child of
+    numpy's SeedSequence(seed), so runs of different seeds share no episode"""
     action_repeat: int | None = None
     """env steps per agent decision (frame skip); None: the paper's value for its six DMC tasks,
     else 1"""
@@ -101,7 +102,10 @@ class TrainConfig:
     env's (dm_control tasks; repeat the flag, e.g. --eval-distraction video_hard; modes in
     simoun_agent.generalization.DISTRACTIONS)"""
     checkpoint_every: int = 50_000
-    """environment steps between checkpoints (written at the next episode end)"""
+    """environment steps between checkpoints (written at the next episode end). One that does
+    not fit on the disk keeps the previous one and is tried again at the next; after 3 failures
+    in a row, or at a stop or the run's end, the run stops with exit status 75 (free space, then
+    --resume)"""
     video: bool = True
     """record one evaluation episode to video.mp4 at the end of the run"""
     device: str | None = None

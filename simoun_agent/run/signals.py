@@ -1,9 +1,11 @@
 """Stopping a run cleanly on Ctrl-C (SIGINT) or SIGTERM (schedulers, Ray, ``kill``).
 
 The first signal is a request that the training loop answers at its next clean point: it
-finishes the current step, writes the checkpoint atomically and exits with 128 + the signal
-number, the shell's convention: **130** after SIGINT, **143** after SIGTERM. A second signal
-stops at once (SIGINT raises ``KeyboardInterrupt``, SIGTERM kills the process the default way).
+finishes the current step (an evaluation is abandoned between two of its steps), writes the
+checkpoint atomically and exits with 128 + the signal number, the shell's convention: **130**
+after SIGINT, **143** after SIGTERM. It is acknowledged at once with a line on stderr. A second
+signal stops at once (SIGINT raises ``KeyboardInterrupt``, SIGTERM kills the process the default
+way).
 
 Python can only catch signals whose C-level handler is its own. pygame's SDL installs its own
 SIGINT/SIGTERM handlers when it initialises (highway-env renders through it), unless
@@ -33,13 +35,23 @@ def exit_code(signum: int) -> int:
 
 
 class StopRequest:
-    """Set by the first stop signal; the loop polls :meth:`is_set` between steps."""
+    """Set by the first stop signal, or by one of ``sources``; the loop and the evaluations poll
+    :meth:`is_set` between steps."""
 
     def __init__(self) -> None:
         self.signum: int | None = None
         """the signal that asked to stop, None while running"""
+        self.sources: list[Callable[[], int | None]] = []
+        """asked by :meth:`is_set` while no signal came: a signal number stops as that signal
+        would (supervisors that cannot signal the loop's thread, such as a Ray Tune trial)"""
 
     def is_set(self) -> bool:
+        for source in self.sources:
+            if self.signum is not None:
+                break
+            asked = source()
+            if asked is not None and self.signum is None:  # a signal may have come meanwhile
+                self.signum = asked
         return self.signum is not None
 
 
@@ -77,18 +89,33 @@ def foreign_handlers(before: dict[int, int | None], python_handler: int | None) 
     ]
 
 
+def acknowledge(signum: int) -> None:
+    """Say on stderr, at once, that the signal was heard and what comes next. ``os.write``: the
+    handler may interrupt a write to ``sys.stderr`` (a progress bar), which a second buffered
+    write would fail with "reentrant call"."""
+    name = signal.Signals(signum).name
+    again = "Ctrl-C again" if signum == signal.SIGINT else f"a second {name}"
+    text = (
+        f"{name} received: stopping at the next step with a checkpoint, then exit "
+        f"{exit_code(signum)}; {again} stops at once, without one\n"
+    )
+    os.write(2, (("\n" if os.isatty(2) else "") + text).encode())
+
+
 @contextmanager
-def deferred_stop() -> Iterator[StopRequest]:
-    """Turn the first SIGINT or SIGTERM into a :class:`StopRequest` the loop answers between
-    steps; a second one stops at once. Enter it after the environments are built: a library
-    that installed its own C-level handlers while they were made (SDL) is replaced and named in
-    a warning. Outside the main thread signals cannot be caught: the request never gets set.
+def deferred_stop(request: StopRequest | None = None) -> Iterator[StopRequest]:
+    """Turn the first SIGINT or SIGTERM into a :class:`StopRequest` (``request``, or a new one)
+    that the loop answers between steps, acknowledged at once on stderr; a second one stops at
+    once. Enter it after the environments are built: a library that installed its own C-level
+    handlers while they were made (SDL) is replaced and named in a warning. Outside the main
+    thread signals cannot be caught: only the request's sources can set it.
     """
-    request = StopRequest()
+    request = StopRequest() if request is None else request
 
     def handler(signum: int, frame: Any) -> None:
-        if not request.is_set():
+        if request.signum is None:
             request.signum = signum
+            acknowledge(signum)
             return
         if signum == signal.SIGTERM:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -8,29 +8,37 @@ A run directory holds ``config.json`` (the resolved config, written once set-up 
 succeeded), ``eval.csv`` / ``train.csv`` / ``tb/`` (logs), ``learning_curve.png`` (redrawn at
 each evaluation), ``checkpoint.pt`` + ``replay-<step>.npz`` (the latest checkpoint),
 ``video.mp4`` (an evaluation episode) and ``summary.json`` (written only when the run ends).
+Episodes and every random stream come from the run's seed (:mod:`simoun_agent.run.seeds`).
 
-Ctrl-C or SIGTERM (a scheduler's preemption, ``kill``) finishes the current step, writes a
-checkpoint atomically, prints how to resume and exits with status **130** after Ctrl-C or
-**143** after SIGTERM (128 + the signal number); a second signal stops at once
-(:mod:`simoun_agent.run.signals`). ``--resume`` continues. One trainer at a time holds a run
-directory (:mod:`simoun_agent.run.rundir`); ``--overwrite`` starts over a run that stopped before
-its first checkpoint.
+Ctrl-C or SIGTERM (a scheduler's preemption, ``kill``), in any phase (warm-up, training, an
+evaluation, the final video), is acknowledged at once on stderr; the run finishes its step (an
+evaluation is abandoned, and runs again on resume), writes a checkpoint atomically, prints how
+to resume and exits with status **130** after Ctrl-C or **143** after SIGTERM (128 + the signal
+number); a second signal stops at once (:mod:`simoun_agent.run.signals`). ``--resume``
+continues. During set-up there is nothing to save: a signal stops it at once. One trainer at a
+time holds a run directory (:mod:`simoun_agent.run.rundir`); ``--overwrite`` starts over a run
+that stopped before its first checkpoint.
+
+Other ends of a run that keep a checkpoint to resume from: a non-finite reward from the env
+stops it (exit 1) with a checkpoint from before that step, naming the step and the env; a full
+disk is the rule of :data:`CHECKPOINT_TRIES` (exit 75).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import random
 import signal
 import sys
 import time
 import typing
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, NoReturn
 
 import gymnasium as gym
 import numpy as np
@@ -42,14 +50,19 @@ from simoun_agent.generalization.suite import check_eval_distractions
 from simoun_agent.recipes import RECIPES
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.checkpoint import (
+    CHECKPOINT_NAME,
+    SPACE_ERRNOS,
+    NoSpace,
     atomic_write,
     check_config,
+    check_seed_scheme,
     load_checkpoint,
+    remove_leftovers,
     restore_rng,
     save_checkpoint,
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
-from simoun_agent.run.evaluate import EVAL_SEED_OFFSET, evaluate, metrics_json
+from simoun_agent.run.evaluate import EvaluationStopped, evaluate, metrics_json
 from simoun_agent.run.flags import add_version
 from simoun_agent.run.logger import CURVE_PNG, RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
@@ -67,12 +80,24 @@ from simoun_agent.run.presets import (
     resolve,
     to_dict,
 )
+from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
-from simoun_agent.run.signals import Stopped, deferred_stop
+from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
+from simoun_agent.run.signals import Stopped, StopRequest, deferred_stop, stop_at_once
 from simoun_agent.run.video import write_video
 
 CONFIG_NAME = "config.json"
 SUMMARY_NAME = "summary.json"
+
+CHECKPOINT_TRIES = 3
+"""A checkpoint that does not fit on the disk (:class:`~simoun_agent.run.checkpoint.NoSpace`)
+leaves the previous one intact and training goes on, to try again at the next checkpoint: space
+freed meanwhile saves all the work. After this many failures in a row, or when the checkpoint of
+a stop or of the run's end fails, the run stops with :data:`NO_SPACE_EXIT` (training on would
+only add work that cannot be saved) and ``--resume`` continues from the last checkpoint. A log
+write that fails for lack of space stops it the same way."""
+NO_SPACE_EXIT = 75
+"""Exit status after a stop for lack of space: sysexits' EX_TEMPFAIL (free space, then retry)."""
 
 
 @dataclass
@@ -84,9 +109,12 @@ class Counters:
     agent_step: int = 0
     """agent decisions taken"""
     episode: int = 0
-    """training episodes begun; episode i resets with seed config.seed + i"""
+    """training episodes begun; episode i resets with seed ``seeds.train_episode_seed(seed, i)``"""
     updates: int = 0
     """gradient updates done"""
+    eval_pending: bool = True
+    """an evaluation is due at ``env_step`` and not yet logged: a new run's first, or one that a
+    stop abandoned, which the resumed run plays first"""
     wall_time_s: float = field(default=0.0, compare=False)
     """seconds spent in the training loop, summed over resumed parts (evaluations included)"""
 
@@ -108,6 +136,9 @@ class Run:
     lock: IO[str] | None = None
     """the run directory's lock (:func:`~simoun_agent.run.rundir.lock_run_dir`), held while
     this process uses it"""
+    stop: StopRequest = field(default_factory=StopRequest)
+    """set by the first stop signal or a callback's :meth:`TrainCallback.stop_requested`; the
+    loop and every evaluation poll ``run.stop.is_set()`` between steps"""
 
 
 class TrainCallback:
@@ -117,21 +148,36 @@ class TrainCallback:
     instead of editing the loop.
     """
 
+    def on_start(self, run: Run) -> None:
+        """Once, when :func:`train` begins, before the first evaluation (build what you need)."""
+
     def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
         """After each evaluation (env step ``run.counters.env_step``), before it is logged; may
-        add entries to ``metrics``, which then go to eval.csv and TensorBoard too."""
+        add entries to ``metrics``, which then go to eval.csv and TensorBoard too. Evaluations of
+        your own should pass ``stop=run.stop.is_set`` to :func:`evaluate`."""
 
     def on_logged(self, run: Run, metrics: dict[str, float]) -> None:
         """After each evaluation has been logged (``metrics`` as written to eval.csv)."""
 
-    def on_end(self, run: Run, metrics: dict[str, float]) -> None:
-        """Once, after the final evaluation, checkpoint, video and summary.json."""
+    def on_end(self, run: Run, metrics: dict[str, float] | None) -> None:
+        """Once, whenever :func:`train` ends: ``metrics`` are the final evaluation's after the
+        video and summary.json, None when the run stopped early (a signal, an error). Close here
+        what :meth:`on_start` opened."""
 
     def stop_requested(self, run: Run) -> int | None:
-        """Polled after every step: a signal number stops the run as if that signal had
-        arrived (checkpoint, then :class:`Stopped`); None goes on. For supervisors that cannot
-        signal the loop's thread, such as a Ray Tune trial."""
+        """Polled between steps: a signal number stops the run as if that signal had arrived
+        (checkpoint, then :class:`Stopped`); None goes on. For supervisors that cannot signal the
+        loop's thread, such as a Ray Tune trial."""
         return None
+
+
+class TrainingError(RuntimeError):
+    """The run stopped for a reason the user must fix (a NaN reward, a full disk), after writing
+    what could be written; ``simoun-train`` prints the message and exits with ``exit_code``."""
+
+    def __init__(self, message: str, exit_code: int) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
 
 
 def default_run_dir(config: TrainConfig) -> Path:
@@ -143,23 +189,29 @@ def default_run_dir(config: TrainConfig) -> Path:
 
 def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
     """The training env's runner (in this process or a background one), the evaluation env,
-    the agent and an empty replay; seeds python, numpy and torch first."""
+    the agent and an empty replay; each random stream seeded from its child of the run's
+    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`)."""
+    seed = config.seed
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
-    random.seed(config.seed)
-    np.random.seed(config.seed)  # noqa: NPY002  (for libraries that draw from it)
-    torch.manual_seed(config.seed)
+    random.seed(int_seed(seed, Stream.GLOBAL))
+    np.random.seed(int_seed(seed, Stream.GLOBAL))  # noqa: NPY002  (for libraries that draw from it)
     check_eval_distractions(config)
     env, eval_env = make_runner(config), make_env(config)
+    train_space_seed, eval_space_seed = stream(seed, Stream.ACTION_SPACES).generate_state(2)
+    env.action_space.seed(int(train_space_seed))
+    eval_env.action_space.seed(int(eval_space_seed))
     frame_shape = env.observation_space["frames"].shape[1:]
     action_dim = env.action_space.shape[0]
+    torch.manual_seed(int_seed(seed, Stream.NETWORK_INIT))
     agent = SimounAgent(frame_shape, action_dim, config.agent, device=config.device)
+    torch.manual_seed(int_seed(seed, Stream.TORCH))
     replay = FrameReplay(
         config.replay_capacity,
         frame_shape,
         action_dim,
         num_frames=config.agent.num_frames,
-        seed=config.seed,
+        seed=int_seed(seed, Stream.REPLAY),
     )
     return env, eval_env, agent, replay
 
@@ -175,9 +227,10 @@ def create_run(config: TrainConfig, overwrite: bool = False) -> Run:
     env, eval_env, agent, replay = build(config)
     make_output_dir(run_dir, "--run-dir")
     lock = take_run_dir(run_dir, overwrite=overwrite)
+    remove_leftovers(run_dir)
     config.run_dir = str(run_dir)
     write_config(run_dir, config)
-    rng = np.random.default_rng(config.seed)
+    rng = np.random.default_rng(stream(config.seed, Stream.WARMUP_ACTIONS))
     return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters(), lock)
 
 
@@ -210,13 +263,16 @@ def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
     config.run_dir = str(run_dir)
     take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
+    check_seed_scheme(payload, run_dir)
     check_config(payload, to_dict(config), run_dir)
     done = payload["state"]["env_step"]
-    if config.total_env_steps <= done:
-        finished = " and is finished" if (run_dir / SUMMARY_NAME).exists() else ""
+    finished = (run_dir / SUMMARY_NAME).exists()
+    # At its last step without summary.json, a run stopped in its final evaluation or video.
+    if config.total_env_steps < done or (config.total_env_steps == done and finished):
+        is_finished = " and is finished" if finished else ""
         raise SetupError(
             f"--total-env-steps {config.total_env_steps}: this run is at env step {done}"
-            f"{finished}, so there is nothing to continue; pass a larger --total-env-steps "
+            f"{is_finished}, so there is nothing to continue; pass a larger --total-env-steps "
             f"(e.g. --total-env-steps {done + config.eval_every}) to train it further"
         )
     if not payload["replay_path"].is_file():
@@ -238,11 +294,13 @@ def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
     rng.bit_generator.state = payload["state"]["trainer_rng"]
     counters = Counters(**payload["state"]["counters"])
     lock = take_run_dir(run_dir, resume=True)
+    remove_leftovers(run_dir, payload["replay_file"])
     write_config(run_dir, config)
     return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
 
 
 def checkpoint(run: Run) -> None:
+    """Write the run's checkpoint (raises :class:`~simoun_agent.run.checkpoint.NoSpace`)."""
     state = {
         "env_step": run.counters.env_step,
         "counters": asdict(run.counters),
@@ -257,51 +315,6 @@ def checkpoint(run: Run) -> None:
     )
 
 
-class StatusLines(TrainCallback):
-    """One plain line per evaluation on stderr, instead of the progress bar when stderr is not a
-    terminal (nohup, cluster jobs, CI): logs get a line per evaluation, not bar redraws."""
-
-    def __init__(self, run: Run) -> None:
-        self.start_step = run.counters.env_step
-        self.start = time.perf_counter()
-
-    def on_logged(self, run: Run, metrics: dict[str, float]) -> None:
-        step, total = run.counters.env_step, run.config.total_env_steps
-        elapsed = time.perf_counter() - self.start
-        rate = (step - self.start_step) / elapsed if elapsed > 0 else 0.0
-        eta = f", ETA {_duration((total - step) / rate)}" if rate > 0 and step < total else ""
-        print(
-            f"env step {step}/{total}: eval return {metrics['return_mean']:.1f} +- "
-            f"{metrics['return_std']:.1f}, {rate:.1f} env steps/s, {_duration(elapsed)} "
-            f"elapsed{eta}",
-            file=sys.stderr,
-            flush=True,
-        )
-
-
-def _duration(seconds: float) -> str:
-    minutes, secs = divmod(int(seconds), 60)
-    return f"{minutes // 60}:{minutes % 60:02d}:{secs:02d}"
-
-
-def evaluate_and_log(
-    run: Run, logger: RunLogger, callbacks: Sequence[TrainCallback], clock: WallClock
-) -> dict[str, float]:
-    """Evaluate the agent, let the callbacks see (and extend) the metrics, log them."""
-    config = run.config
-    metrics, _ = evaluate(
-        run.agent, run.eval_env, config.eval_episodes, config.seed + EVAL_SEED_OFFSET
-    )
-    for callback in callbacks:
-        callback.on_evaluation(run, metrics)
-    run.counters.wall_time_s = clock.total()
-    metrics["wall_time_s"] = run.counters.wall_time_s
-    logger.evaluation(run.counters.env_step, metrics)
-    for callback in callbacks:
-        callback.on_logged(run, metrics)
-    return metrics
-
-
 class WallClock:
     """Seconds of training-loop time, continuing from what a resumed run had already spent."""
 
@@ -313,46 +326,124 @@ class WallClock:
         return self.already + time.perf_counter() - self.start
 
 
-def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
-    """The training loop; returns the final evaluation metrics (None if interrupted first)."""
-    config, counters, agent, replay, env = run.config, run.counters, run.agent, run.replay, run.env
-    if config.eval_distraction:
-        # Imported here: the callback's module builds on this one's TrainCallback.
-        from simoun_agent.generalization.callback import DistractionEvaluation
+class Trainer:
+    """One call of :func:`train`: the run and what the loop keeps beside it (callbacks, logs,
+    progress display, clock, the checkpoint rule's count)."""
 
-        callbacks = [DistractionEvaluation(config.eval_distraction), *callbacks]
-    clock = WallClock(counters.wall_time_s)
-    repeat = config.resolved_action_repeat()
-    action_dim = env.action_space.shape[0]
-    learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
-    title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
-    logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
-    next_eval = _next(counters, config.eval_every)
-    next_checkpoint = _next(counters, config.checkpoint_every)
-    last_eval: dict[str, float] | None = None
-    show_bar = config.progress and sys.stderr.isatty()
-    if config.progress and not show_bar:
-        callbacks = [*callbacks, StatusLines(run)]
-    if counters.env_step == 0:
-        last_eval = evaluate_and_log(run, logger, callbacks, clock)
-    update_metrics: dict[str, Any] = {}
+    def __init__(self, run: Run, callbacks: Sequence[TrainCallback]) -> None:
+        config, counters = run.config, run.counters
+        self.run, self.callbacks = run, list(callbacks)
+        self.clock = WallClock(counters.wall_time_s)
+        title = f"{config.env} ({config.preset or 'default'} preset, seed {config.seed})"
+        self.logger = RunLogger(run.run_dir, title, resume_step=counters.env_step or None)
+        label = title.split(" ")[0]
+        self.progress = Progress(config.total_env_steps, counters.env_step, label, config.progress)
+        self.phase = self.step_phase()
+        """what the run is doing, for the message of a stop"""
+        self.saved: Counters | None = None
+        """the counters of the latest checkpoint this trainer wrote (a state saved already is
+        not written again: a stop right after a checkpoint, or in the final video)"""
+        on_disk = (run.run_dir / CHECKPOINT_NAME).exists()  # a resumed run's
+        self.last_saved_step = counters.env_step if on_disk else None
+        """env step of the latest checkpoint on disk (None before the first)"""
+        self.failed_checkpoints = 0
+        """checkpoints in a row that did not fit (:data:`CHECKPOINT_TRIES`)"""
+        run.stop.sources = [lambda c=c: c.stop_requested(run) for c in self.callbacks]
 
-    obs = None  # an episode starts at the top of the loop, so checkpoints fall between episodes
-    bar = tqdm(
-        total=config.total_env_steps,
-        initial=counters.env_step,
-        unit="step",
-        desc=title.split(" ")[0],
-        dynamic_ncols=True,
-        disable=not show_bar,
-    )
-    # Entered after the envs were built, so a library that took the signals then (SDL) is found
-    with deferred_stop() as interrupt:
-        while counters.env_step < config.total_env_steps and not interrupt.is_set():
+    def evaluate(self, what: str = "an evaluation") -> dict[str, float]:
+        """Evaluate the agent, let the callbacks see (and extend) the metrics, log them. A stop
+        abandons it (:class:`EvaluationStopped`): nothing is logged, and ``eval_pending`` stays
+        set in the checkpoint, so the resumed run plays it."""
+        run, config, counters = self.run, self.run.config, self.run.counters
+        self.phase = f"{what} (abandoned: it runs first on resume)"
+        counters.eval_pending = True
+        self.progress.evaluation_start(counters.env_step, config.eval_episodes)
+        metrics, _ = evaluate(
+            run.agent,
+            run.eval_env,
+            config.eval_episodes,
+            first_eval_seed(config.seed),
+            on_episode=self.progress.evaluation_episode,
+            stop=run.stop.is_set,
+        )
+        for callback in self.callbacks:
+            callback.on_evaluation(run, metrics)
+        counters.wall_time_s = self.clock.total()
+        metrics["wall_time_s"] = counters.wall_time_s
+        self.logger.evaluation(counters.env_step, metrics)
+        counters.eval_pending = False
+        self.phase = self.step_phase()
+        for callback in self.callbacks:
+            callback.on_logged(run, metrics)
+        self.progress.evaluated(counters.env_step, metrics)
+        return metrics
+
+    def step_phase(self) -> str:
+        """The phase of the run's next step."""
+        counters, config = self.run.counters, self.run.config
+        return "the warm-up" if counters.agent_step < config.warmup_agent_steps else "training"
+
+    def checkpoint(self, required: str | None = None) -> None:
+        """Write the checkpoint unless this state is saved already. One that does not fit is
+        the rule of :data:`CHECKPOINT_TRIES`: when it is ``required`` (for a stop, the run's end:
+        the reason) or the last try, :class:`TrainingError` is raised, else training goes on."""
+        counters = self.run.counters
+        if self.saved == counters:
+            return
+        counters.wall_time_s = self.clock.total()
+        try:
+            checkpoint(self.run)
+        except NoSpace as err:
+            self.failed_checkpoints += 1
+            if required:
+                raise self.no_space(f"{err}; the checkpoint {required} failed") from None
+            if self.failed_checkpoints >= CHECKPOINT_TRIES:
+                failed = f"{CHECKPOINT_TRIES} checkpoints in a row failed"
+                raise self.no_space(f"{err}; {failed}") from None
+            self.progress.write(
+                f"simoun-train: {err}. The checkpoint at env step {counters.env_step} failed and "
+                f"the previous one is intact; training goes on and tries again at the next "
+                f"checkpoint ({self.failed_checkpoints} of {CHECKPOINT_TRIES} failures in a row "
+                "stop the run)"
+            )
+            return
+        self.failed_checkpoints = 0
+        self.saved = replace(counters)
+        self.last_saved_step = counters.env_step
+
+    def no_space(self, what: str) -> TrainingError:
+        """The error that ends a run for lack of space, saying where it can resume from."""
+        run_dir = self.run.run_dir
+        if self.last_saved_step is None:
+            then = f"no checkpoint was written: start over with --run-dir {run_dir} --overwrite"
+        else:
+            then = (
+                f"the latest checkpoint (env step {self.last_saved_step}) is intact: free space, "
+                f"then continue with: simoun-train --resume {run_dir}"
+            )
+        step = self.run.counters.env_step
+        return TrainingError(f"{what}. Stopped at env step {step}; {then}", NO_SPACE_EXIT)
+
+    def loop(self) -> None:
+        """Steps, updates, evaluations and checkpoints up to the last env step or a stop."""
+        run, config, counters = self.run, self.run.config, self.run.counters
+        agent, replay, env = run.agent, run.replay, run.env
+        repeat = config.resolved_action_repeat()
+        action_dim = env.action_space.shape[0]
+        learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
+        if counters.eval_pending:
+            self.evaluate("the initial evaluation" if counters.env_step == 0 else "an evaluation")
+        next_eval = _next(counters, config.eval_every)
+        next_checkpoint = _next(counters, config.checkpoint_every)
+        update_metrics: dict[str, Any] = {}
+        obs = None  # an episode starts at the top of the loop, so checkpoints fall between episodes
+        while counters.env_step < config.total_env_steps and not run.stop.is_set():
             if obs is None:
-                obs = env.reset(seed=config.seed + counters.episode)
+                episode_seed = train_episode_seed(config.seed, counters.episode)
+                obs = env.reset(seed=episode_seed)
                 replay.start_episode(obs["frames"][-1])
                 episode_return, episode_length, episode_start = 0.0, 0, time.perf_counter()
+            self.phase = self.step_phase()
             if counters.agent_step < config.warmup_agent_steps:
                 action = run.rng.uniform(-1.0, 1.0, action_dim).astype(np.float32)
             else:
@@ -366,21 +457,19 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
                     update_metrics.update(agent.update(replay, counters.env_step + repeat))
                     counters.updates += 1
             obs, reward, terminated, truncated = env.step_wait()
+            if not math.isfinite(reward):
+                self.bad_reward(reward, episode_seed, episode_length)
             replay.add(action, reward, obs["frames"][-1], terminated, truncated)
             counters.agent_step += 1
             counters.env_step += repeat
             episode_return += float(reward)
             episode_length += 1
-            bar.update(repeat)
-            for callback in callbacks:
-                asked = callback.stop_requested(run)
-                if asked is not None and not interrupt.is_set():
-                    interrupt.signum = asked
+            self.progress.advance(repeat)
 
             if not (terminated or truncated):
                 continue
             elapsed = time.perf_counter() - episode_start
-            logger.train_episode(
+            self.logger.train_episode(
                 counters.env_step,
                 {
                     "episode": counters.episode,
@@ -392,64 +481,118 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
             )
             counters.episode += 1
             if counters.env_step >= next_eval:
-                last_eval = evaluate_and_log(run, logger, callbacks, clock)
+                self.evaluate()
                 next_eval = _next(counters, config.eval_every)
             if counters.env_step >= next_checkpoint:
-                counters.wall_time_s = clock.total()
-                checkpoint(run)
+                self.checkpoint()
                 next_checkpoint = _next(counters, config.checkpoint_every)
-            bar.set_postfix(episode_return=f"{episode_return:.1f}", **_eval_postfix(last_eval))
+            self.progress.episode_end(episode_return)
             obs = None
-        bar.close()
 
-        if interrupt.is_set():
-            counters.wall_time_s = clock.total()
-            checkpoint(run)
-            logger.close()
-            release(run)
-            tqdm.write(
-                f"stopped by {signal.Signals(interrupt.signum).name} at env step "
-                f"{counters.env_step}: checkpoint written; continue with: simoun-train --resume "
-                f"{run.run_dir}"
+    def bad_reward(self, reward: float, episode_seed: int, episode_length: int) -> NoReturn:
+        """Stop with a checkpoint from before this step: a NaN would reach the Q targets and
+        turn every weight NaN a few updates later."""
+        run, counters = self.run, self.run.counters
+        step = counters.env_step + run.config.resolved_action_repeat()
+        self.checkpoint(required=f"before the non-finite reward at env step {step}")
+        raise TrainingError(
+            f"{run.config.env} returned the reward {reward} at env step {step} (step "
+            f"{episode_length + 1} of training episode {counters.episode}, reset seed "
+            f"{episode_seed}); rewards must be finite numbers. The run stopped with a checkpoint "
+            f"at env step {counters.env_step}: fix the environment, then continue with: "
+            f"simoun-train --resume {run.run_dir}",
+            1,
+        )
+
+    def finish(self) -> dict[str, float]:
+        """Final evaluation (unless the last one was at this step), checkpoint, video and
+        ``summary.json``, the mark of a whole run; a run resumed here does only what is left."""
+        run, config, counters = self.run, self.run.config, self.run.counters
+        if counters.eval_pending or self.logger.last_eval_step != counters.env_step:
+            self.evaluate("the final evaluation")
+        final = self.logger.last_eval
+        self.checkpoint(required="of the run's end")
+        files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
+        if config.video:
+            self.phase = "the final video (it is recorded on resume)"
+            _, frames = evaluate(
+                run.agent,
+                run.eval_env,
+                1,
+                first_eval_seed(config.seed),
+                record=True,
+                stop=run.stop.is_set,
             )
-            raise Stopped(interrupt.signum)
-        return finish(run, logger, last_eval, callbacks, clock)
+            fps = video_fps(run.eval_env, config.resolved_action_repeat())
+            write_video(run.run_dir / "video.mp4", frames, fps)
+            files["video"] = "video.mp4"
+        summary = {
+            "env_step": counters.env_step,
+            "wall_time_s": counters.wall_time_s,
+            "final_eval": final,
+            "files": files,
+        }
+        text = metrics_json(summary)
+        atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
+        return final
+
+    def stopped(self) -> NoReturn:
+        """Answer a stop: checkpoint, say how to resume, raise :class:`Stopped`."""
+        run = self.run
+        name = signal.Signals(run.stop.signum).name
+        self.checkpoint(required=f"of the stop by {name}")
+        self.progress.write(
+            f"stopped by {name} during {self.phase} at env step "
+            f"{run.counters.env_step}: checkpoint written; continue with: simoun-train --resume "
+            f"{run.run_dir}"
+        )
+        raise Stopped(run.stop.signum)
+
+    def close(self) -> None:
+        self.progress.close()
+        self.logger.close()
 
 
-def finish(
-    run: Run,
-    logger: RunLogger,
-    last_eval: dict[str, float] | None,
-    callbacks: Sequence[TrainCallback],
-    clock: WallClock,
-) -> dict[str, Any]:
-    """Final evaluation (with video), checkpoint and ``summary.json``, the mark of a whole run."""
-    config, counters = run.config, run.counters
-    eval_seed = config.seed + EVAL_SEED_OFFSET
-    logged = logger.last_eval_step == counters.env_step and last_eval is not None
-    if not logged:
-        last_eval = evaluate_and_log(run, logger, callbacks, clock)
-    counters.wall_time_s = clock.total()
-    checkpoint(run)
-    logger.close()
-    files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
-    if config.video:
-        _, frames = evaluate(run.agent, run.eval_env, 1, eval_seed, record=True)
-        fps = video_fps(run.eval_env, config.resolved_action_repeat())
-        write_video(run.run_dir / "video.mp4", frames, fps)
-        files["video"] = "video.mp4"
-    summary = {
-        "env_step": counters.env_step,
-        "wall_time_s": counters.wall_time_s,
-        "final_eval": last_eval,
-        "files": files,
-    }
-    text = metrics_json(summary)
-    atomic_write(run.run_dir / SUMMARY_NAME, lambda tmp: tmp.write_text(text))
-    release(run)
-    for callback in callbacks:
-        callback.on_end(run, last_eval)
-    return last_eval
+def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
+    """The training loop; returns the final evaluation metrics.
+
+    A stop (a first SIGINT/SIGTERM, a callback's ``stop_requested``) in any phase writes a
+    checkpoint and raises :class:`Stopped`; a NaN reward or a full disk raises
+    :class:`TrainingError` (see :data:`CHECKPOINT_TRIES`). The callbacks' ``on_start`` and
+    ``on_end`` run whatever happens.
+    """
+    if run.config.eval_distraction:
+        # Imported here: the callback's module builds on this one's TrainCallback.
+        from simoun_agent.generalization.callback import DistractionEvaluation
+
+        callbacks = [DistractionEvaluation(run.config.eval_distraction), *callbacks]
+    final = None
+    # Entered after the envs were built, so a library that took the signals then (SDL) is found
+    with deferred_stop(run.stop):
+        trainer = Trainer(run, callbacks)
+        try:
+            for callback in trainer.callbacks:
+                callback.on_start(run)
+            try:
+                trainer.loop()
+                if not run.stop.is_set():
+                    final = trainer.finish()
+            except EvaluationStopped:
+                pass
+            if final is None:
+                trainer.stopped()
+            return final
+        except OSError as err:  # a log, the learning curve, the video, summary.json
+            if err.errno not in SPACE_ERRNOS:
+                raise
+            written = f" writing {Path(err.filename).name}" if err.filename else ""
+            failed = f"no space left on {run.run_dir}: {err.strerror}{written}"
+            raise trainer.no_space(failed) from None
+        finally:
+            trainer.close()
+            release(run)
+            for callback in trainer.callbacks:
+                callback.on_end(run, final)
 
 
 def release(run: Run) -> None:
@@ -461,10 +604,6 @@ def release(run: Run) -> None:
 
 def _next(counters: Counters, every: int) -> int:
     return (counters.env_step // every + 1) * every
-
-
-def _eval_postfix(metrics: dict[str, float] | None) -> dict[str, str]:
-    return {} if metrics is None else {"eval_return": f"{metrics['return_mean']:.1f}"}
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -572,6 +711,38 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        with stop_at_once():  # nothing to save during set-up
+            run = setup(parser, args)
+    except Stopped as stop:
+        print(
+            f"simoun-train: stopped by {signal.Signals(stop.signum).name} during set-up, before "
+            "anything was trained",
+            file=sys.stderr,
+        )
+        return stop.exit_code
+    tqdm.write(f"run directory: {run.run_dir}")
+    try:
+        final = train(run)
+    except KeyboardInterrupt as stop:  # Stopped after a checkpoint, or a second Ctrl-C
+        return getattr(stop, "exit_code", 130)
+    except TrainingError as err:
+        print(f"simoun-train: error: {err}", file=sys.stderr)
+        return err.exit_code
+    finally:
+        run.env.close()
+        run.eval_env.close()
+        release(run)
+    tqdm.write(
+        f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
+        f"{run.counters.env_step} env steps; learning curve, logs, checkpoint"
+        f"{' and video' if run.config.video else ''} in {run.run_dir}"
+    )
+    return 0
+
+
+def setup(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Run:
+    """The run that ``args`` ask for, new or resumed; bad input exits with status 2."""
+    try:
         overrides = overrides_from(args)
         if args.resume:
             if args.preset:
@@ -587,21 +758,7 @@ def main(argv: list[str] | None = None) -> int:
             run = create_run(config, overwrite=args.overwrite)
     except SetupError as err:
         parser.exit(2, f"simoun-train: error: {err}\n")
-    tqdm.write(f"run directory: {run.run_dir}")
-    try:
-        final = train(run)
-    except KeyboardInterrupt as stop:  # Stopped after a checkpoint, or a second Ctrl-C
-        return getattr(stop, "exit_code", 130)
-    finally:
-        run.env.close()
-        run.eval_env.close()
-        release(run)
-    tqdm.write(
-        f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
-        f"{run.counters.env_step} env steps; learning curve, logs, checkpoint"
-        f"{' and video' if run.config.video else ''} in {run.run_dir}"
-    )
-    return 0
+    return run
 
 
 if __name__ == "__main__":
