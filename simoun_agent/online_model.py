@@ -16,7 +16,7 @@ import weakref
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from concurrent.futures import Future
-from typing import Any
+from typing import Any, TypeVar
 
 import gymnasium as gym
 import numpy as np
@@ -25,6 +25,8 @@ import torch.nn.functional as F
 from torch import nn
 
 from simoun_wrappers.intrinsic_reward import triplet_shape
+
+Model = TypeVar("Model", bound="OnlineModel")
 
 __all__ = ["OnlineModel", "UpdateThread", "default_device", "frozen_copy", "run_now"]
 
@@ -123,11 +125,11 @@ class OnlineModel(ABC):
 
     @classmethod
     def for_env(
-        cls,
+        cls: type[Model],
         env: gym.Env | gym.vector.VectorEnv,
         config: Any = None,
         device: str | torch.device | None = None,
-    ) -> OnlineModel:
+    ) -> Model:
         """A model sized for ``env``'s Simoun observations and action space (single or vector)."""
         vector = isinstance(env, gym.vector.VectorEnv)
         obs_space = env.single_observation_space if vector else env.observation_space
