@@ -1,0 +1,318 @@
+"""``simoun-study``: one protocol for every method, from a spec file, on Ray Tune.
+
+    simoun-study plan docs/studies/dmc100k.toml
+    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+        --archive docs/studies/dmc100k
+    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+        --archive docs/studies/dmc100k --resume
+
+``plan`` lists every run of both phases with a CPU-time estimate measured here; ``run`` tunes
+(every recipe x grid setting x tuning seed), selects each recipe's setting by the spec's rule,
+evaluates the selected settings on the held-out seeds and writes the report
+(:mod:`simoun_agent.study.report`). The runs go through ``simoun-sweep``'s code: the same trial
+directories, Tune experiments, STOP file on SIGTERM and failure handling.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.flags import add_version
+from simoun_agent.run.presets import SetupError, resolve
+from simoun_agent.study import archive as archiving
+from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
+from simoun_agent.study.plan import (
+    EVALUATION,
+    TUNING,
+    StudyRun,
+    check_layout,
+    describe,
+    evaluation_runs,
+    setting_label,
+    tuning_runs,
+)
+from simoun_agent.study.provenance import code_version, same_code
+from simoun_agent.study.report import REPORT_DIR, REPORT_MD, write_study_report
+from simoun_agent.study.spec import StudySpec, load_spec
+from simoun_agent.sweep import cli as sweep_cli
+
+STUDY_FILE = "study.json"
+"""The study record, in the study directory and the archive: the spec (its file, text and
+parsed form) and each part's code version."""
+
+
+def spec_from(path: str) -> StudySpec:
+    spec = load_spec(path)
+    check_layout(spec)
+    return spec
+
+
+def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
+    """The saved study record, from the study directory, else from the archive."""
+    for where in (study_dir, archive):
+        if where is not None and (where / STUDY_FILE).is_file():
+            return json.loads((where / STUDY_FILE).read_text())
+    places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
+    raise SetupError(
+        f"no study to resume: {places} holds no {STUDY_FILE}; drop --resume to start the study, "
+        "or pass the --study-dir (or --archive) of the study to continue"
+    )
+
+
+def open_study(spec: StudySpec, spec_path: str, args: argparse.Namespace) -> dict[str, Any]:
+    """The study record, new or resumed (same spec and, unless allowed, same commit)."""
+    study_dir, archive = args.study_dir, args.archive
+    code = code_version()
+    part = {"started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"), **code}
+    if not args.resume:
+        for where, flag in ((study_dir, "--study-dir"), (archive, "--archive")):
+            if where is not None and (where / STUDY_FILE).is_file():
+                raise SetupError(
+                    f"{where} already holds a study; continue it with --resume, or pass another "
+                    f"{flag}"
+                )
+        if study_dir.exists() and any(study_dir.iterdir()):
+            raise SetupError(f"{study_dir} is not empty; pass a new --study-dir")
+        text = Path(spec_path).read_text()
+        return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
+    record = load_record(study_dir, archive)
+    if record["spec"] != spec.to_json():
+        changed = [k for k in record["spec"] if record["spec"][k] != spec.to_json().get(k)]
+        raise SetupError(
+            f"{spec_path} is not the spec this study was started with ({', '.join(changed)} "
+            f"differ from the saved {STUDY_FILE}); resume with that spec (its text is in "
+            f"{STUDY_FILE}, spec_text), or start a new study in another --study-dir"
+        )
+    first = record["parts"][0]
+    if not same_code(first, code) and not args.allow_other_commit:
+        raise SetupError(
+            f"this study ran from commit {first['commit'] or first['version']}, and the code is "
+            f"now at {code['commit'] or code['version']}: the code under study must not change "
+            "within a study, or its runs would compare two versions of the methods. Check out "
+            f"{first['commit'] or first['version']} to resume, start a new study, or pass "
+            "--allow-other-commit if the change cannot affect the runs (the report lists every "
+            "commit)"
+        )
+    record["parts"].append({**part, "allowed_other_commit": not same_code(first, code)})
+    return record
+
+
+def save_record(record: dict[str, Any], places: list[Path]) -> None:
+    text = json.dumps(record, indent=2) + "\n"
+    for where in places:
+        where.mkdir(parents=True, exist_ok=True)
+        atomic_write(where / STUDY_FILE, lambda tmp: tmp.write_text(text))
+
+
+class Phases:
+    """Runs the study's phases on Ray Tune through simoun-sweep's trial code."""
+
+    def __init__(self, spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> None:
+        self.spec, self.args, self.ray = spec, args, ray
+        self.study_dir, self.archive = args.study_dir, args.archive
+        self.gpus: float | None = None
+        self.started = False
+        """whether Ray was started here (then the study shuts it down)"""
+        self.todo: list = []
+        """the trials of the phase running now"""
+        self.resume = f"simoun-study run {args.spec} --study-dir {args.study_dir} --resume" + (
+            f" --archive {args.archive}" if args.archive else ""
+        )
+
+    def restore(self, runs: list[StudyRun]) -> int:
+        """Bring back archived finished runs whose run directories are gone; how many."""
+        if self.archive is None:
+            return 0
+        return sum(archiving.restore_run(self.study_dir, self.archive, r.name) for r in runs)
+
+    def sync(self, runs: list[StudyRun]) -> None:
+        """Archive every finished run not archived yet (those the live callback missed)."""
+        if self.archive is not None:
+            for run in runs:
+                archiving.archive_run(self.study_dir, self.archive, run.name)
+
+    def run(self, phase: str, runs: list[StudyRun]) -> dict[str, list]:
+        """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
+        restored = self.restore(runs)
+        todo = [run for run in runs if not run.finished(self.study_dir)]
+        self.todo = [run.trial(self.spec, self.study_dir) for run in todo]
+        print(
+            f"{phase}: {len(todo)} runs to run, {len(runs) - len(todo)} already finished"
+            + (f" ({restored} restored from {self.archive})" if restored else ""),
+            flush=True,
+        )
+        if not todo:
+            self.sync(runs)
+            return {}
+        if self.gpus is None:  # Ray starts only once there is something to run
+            self.started = sweep_cli.connect(self.ray, self.args.address, self.args.num_cpus)
+            device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
+            wanted = str(self.spec.gpus_per_trial)
+            self.gpus = sweep_cli.gpus_per_trial(self.ray, wanted, device)
+            sweep_cli.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
+        callbacks = []
+        if self.archive is not None:
+            from simoun_agent.study.tune_callback import ArchiveOnComplete
+
+            names = {run.trial(self.spec, self.study_dir).name: run.name for run in todo}
+            callbacks.append(ArchiveOnComplete(self.study_dir, self.archive, names))
+        outcome = sweep_cli.run_trials(
+            self.todo,
+            self.study_dir,
+            self.spec.cpus_per_trial,
+            self.gpus,
+            self.args.verbose,
+            callbacks,
+            self.spec.max_concurrent_trials,
+            name=f"{phase}-",
+        )
+        self.sync(runs)
+        return outcome
+
+
+def run_study(spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> int:
+    """Tune, select, evaluate, report; the exit status (the sweep's: 130/143 stopped, 1 failed)."""
+    study_dir, archive = args.study_dir, args.archive
+    record = open_study(spec, args.spec, args)
+    save_record(record, [study_dir] + ([archive] if archive is not None else []))
+    phases = Phases(spec, args, ray)
+    choices: dict[str, Choice] | None = None
+    terminated: list[bool] = []
+    try:
+        with sweep_cli.stop_trials_on_sigterm(study_dir) as terminated:
+            outcome = phases.run(TUNING, tuning_runs(spec))
+            if not (outcome.get("failed") or outcome.get("stopped")):
+                choices = choose(spec, study_dir)
+                save_choices(choices, spec, study_dir / SELECTION_FILE)
+                if archive is not None:
+                    archiving.copy_file(study_dir / SELECTION_FILE, archive / SELECTION_FILE)
+                say_choices(choices)
+                selected = {recipe: choice.setting for recipe, choice in choices.items()}
+                outcome = phases.run(EVALUATION, evaluation_runs(spec, selected))
+    except KeyboardInterrupt:
+        outcome = {"stopped": phases.todo}
+    finally:
+        if phases.started:
+            ray.shutdown()
+    written = []
+    if choices is not None:
+        write_study_report(spec, study_dir, record, choices)
+        written = [study_dir / REPORT_DIR / REPORT_MD]
+        if archive is not None:
+            archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
+    return sweep_cli.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
+
+
+def say_choices(choices: dict[str, Choice]) -> None:
+    for recipe, choice in choices.items():
+        print(f"selected for {recipe}: {setting_label(choice.setting)} (score {choice.score:.4g})")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-study",
+        description="Run a study from its spec file: tune every recipe on one shared grid, "
+        "select each recipe's setting by one rule, evaluate the selected settings on held-out "
+        "seeds, and report IQM with confidence intervals (Agarwal et al. 2021).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        allow_abbrev=False,
+        epilog="examples:\n"
+        "  simoun-study plan docs/studies/dmc100k.toml\n"
+        "  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k "
+        "--archive docs/studies/dmc100k\n"
+        "  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k "
+        "--archive docs/studies/dmc100k --resume\n\n"
+        "The spec's layout is documented in simoun_agent/study/spec.py; "
+        "docs/studies/dmc100k.toml is a full example.",
+    )
+    add_version(parser)
+    commands = parser.add_subparsers(dest="command", required=True, metavar="{plan,run}")
+    planning = commands.add_parser(
+        "plan",
+        help="list every run of both phases and estimate their CPU time, running nothing",
+        description="List every run of both phases (phase, task, recipe, grid values, seed, "
+        "env steps) and estimate the CPU time of each from a short probe measured here.",
+    )
+    planning.add_argument("spec", metavar="SPEC", help="the study's TOML file")
+    planning.add_argument(
+        "--probe-updates",
+        type=int,
+        default=20,
+        metavar="N",
+        help="agent updates timed per configuration (default: 20; 0: no estimate)",
+    )
+    running = commands.add_parser(
+        "run",
+        help="run the study (tuning, selection, evaluation, report) on Ray Tune",
+        description="Run the tuning phase, select each recipe's setting, run the evaluation "
+        "phase on the held-out seeds and write the report into STUDY_DIR/report.",
+    )
+    running.add_argument("spec", metavar="SPEC", help="the study's TOML file")
+    running.add_argument(
+        "--study-dir",
+        required=True,
+        metavar="DIR",
+        help="where the runs and the report go; on a cluster, a directory every machine sees",
+    )
+    running.add_argument(
+        "--archive",
+        metavar="DIR",
+        help="copy each finished run's CSVs, config.json and summary.json (no checkpoints, "
+        "replays, videos or tb/) here as it completes, with the study record, the selection "
+        "and the report, e.g. docs/studies/NAME; a resumed study counts archived runs as done",
+    )
+    running.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the study: finished runs (in --study-dir, else in --archive) are kept, "
+        "the others go on from their checkpoints or start",
+    )
+    running.add_argument(
+        "--allow-other-commit",
+        action="store_true",
+        help="resume even though the code is at another commit than the study started from",
+    )
+    running.add_argument(
+        "--address",
+        metavar="auto|HOST:PORT|ray://HOST:PORT",
+        help="run on a Ray cluster (auto: the one `ray start` made here); default: a local "
+        "Ray instance",
+    )
+    running.add_argument(
+        "--num-cpus", type=int, metavar="N", help="CPUs of the local Ray instance (default: all)"
+    )
+    running.add_argument(
+        "--verbose", type=int, default=1, choices=(0, 1, 2), help="Tune's output (default: 1)"
+    )
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-study``."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        spec = spec_from(args.spec)
+        if args.command == "plan":
+            if args.probe_updates < 0:
+                raise SetupError("--probe-updates must be 0 or more")
+            print(describe(spec, args.spec, args.probe_updates))
+            return 0
+        # absolute: Tune runs each trial in a working directory of its own
+        args.study_dir = Path(args.study_dir).absolute()
+        args.archive = Path(args.archive).absolute() if args.archive else None
+        ray = sweep_cli.load_ray()
+        return run_study(spec, args, ray)
+    except SetupError as err:
+        parser.exit(2, f"simoun-study: error: {err}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

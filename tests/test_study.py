@@ -1,0 +1,385 @@
+"""simoun-study on a local Ray instance: a tiny end-to-end study on PointReach (2 recipes x a
+2-value grid x 2 tuning + 2 evaluation seeds), its plan, resume from the archive, the commit
+check, and the bad specs it refuses before Ray starts, each naming its line."""
+
+import json
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
+
+from simoun_agent.recipes import RECIPES
+from simoun_agent.run.presets import SetupError
+from simoun_agent.study import cli
+from simoun_agent.study.plan import evaluation_runs, tuning_runs
+from simoun_agent.study.provenance import code_version
+from simoun_agent.study.spec import load_spec
+from simoun_agent.study.toml_lines import key_line
+
+pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
+
+SPEC = """\
+description = "a tiny study for tests"
+recipes = ["simoun", "sac"]
+
+[base]
+image_size = 32
+warmup_agent_steps = 20
+replay_capacity = 1000
+eval_every = 40
+eval_episodes = 1
+checkpoint_every = 40
+video = false
+device = "cpu"
+agent.batch_size = 8
+agent.num_filters = 8
+agent.feature_dim = 16
+agent.hidden_dim = 32
+agent.aux_hidden_dim = 32
+
+[grid]
+agent.n_step = [1, 3]
+
+[tuning]
+tasks = ["simoun/PointReach-v0"]
+seeds = [101, 102]
+env_steps = 80
+
+[evaluation]
+tasks = ["simoun/PointReach-v0"]
+seeds = "1-2"
+env_steps = 80
+
+[resources]
+max_concurrent_trials = 2
+"""
+"""tests/test_sweep.py's tiny run, shortened to 80 env steps, as a study (a few seconds per run)."""
+
+
+def write_spec(path: Path, text: str = SPEC) -> Path:
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def ray_address():
+    """One local Ray instance for the module (each study would otherwise start its own)."""
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield ray.get_runtime_context().gcs_address
+    ray.shutdown()
+
+
+@pytest.fixture(scope="module")
+def study(ray_address, tmp_path_factory):
+    """The tiny study, run once with an archive: (spec, study dir, archive)."""
+    root = tmp_path_factory.mktemp("study")
+    spec = write_spec(root / "tiny.toml")
+    argv = ["run", str(spec), "--study-dir", str(root / "s"), "--archive", str(root / "a")]
+    assert cli.main([*argv, "--verbose", "0"]) == 0
+    return spec, root / "s", root / "a"
+
+
+def run_dirs(root: Path) -> list[str]:
+    return sorted(p.parent.relative_to(root).as_posix() for p in root.glob("*/**/summary.json"))
+
+
+def test_study_tunes_selects_evaluates_and_reports(study):
+    spec_path, study_dir, _ = study
+    spec = load_spec(spec_path)
+    names = [run.name for run in tuning_runs(spec)]
+    selection = json.loads((study_dir / "selection.json").read_text())
+    chosen = {r: c["setting"] for r, c in selection["recipes"].items()}
+    names += [run.name for run in evaluation_runs(spec, chosen)]
+    assert run_dirs(study_dir) == sorted(names)
+    assert len(names) == 12 and "tuning/simoun/agent.n_step=3/simoun-PointReach-v0/s102" in names
+    assert "evaluation/sac/simoun-PointReach-v0/s2" in names
+    for recipe, choice in selection["recipes"].items():
+        scores = {json.dumps(c["setting"]): c["score"] for c in choice["candidates"]}
+        assert choice["score"] == max(scores.values())  # the best setting won
+        assert len(scores) == 2 and all(
+            len(c["runs"]["simoun/PointReach-v0"]) == 2 for c in choice["candidates"]
+        )
+        config = json.loads(
+            (study_dir / f"evaluation/{recipe}/simoun-PointReach-v0/s1/config.json").read_text()
+        )
+        assert config["agent"]["recipe"] == recipe
+        assert config["agent"]["n_step"] == choice["setting"]["agent.n_step"]
+        assert config["seed"] == 1 and config["total_env_steps"] == 80
+    report = (study_dir / "report/report.md").read_text()
+    for recipe, choice in selection["recipes"].items():
+        setting = f"agent.n_step={choice['setting']['agent.n_step']}"
+        row = f"| {recipe} | {RECIPES[recipe].description} | `{setting}` | {choice['score']:.4g} |"
+        assert row in report
+    assert "| simoun-PointReach-v0 | simoun | 2 |" in report
+    assert "IQM score [95 % CI]" in report and "P(X > Y) [95 % CI]" in report
+    assert "| sac | simoun-PointReach-v0 | " in report  # P(simoun > sac)
+    assert "seeds 101, 102, 80 env steps" in report and "seeds 1, 2, 80 env steps" in report
+    for png in ("iqm_curves.png", "evaluation/curves_wall_time.png", "tuning/iqm_env_steps.png"):
+        assert (study_dir / "report" / png).stat().st_size > 1000
+    trial = json.loads((study_dir / names[0] / "trial.json").read_text())["parts"]
+    assert len(trial) == 1 and trial[0]["cpu_s"] > 0 and len(trial[0]["loadavg"]) == 3
+    assert trial[0]["env_step_start"] == 0 and trial[0]["env_step_end"] == 80
+
+
+def test_archive_holds_the_finished_runs_without_checkpoints(study):
+    _, study_dir, archive = study
+    assert run_dirs(archive) == run_dirs(study_dir)
+    files = {p.name for p in archive.rglob("*") if p.is_file()}
+    assert not any(name.endswith((".pt", ".npz", ".mp4")) for name in files)
+    assert not list(archive.rglob("tb"))
+    kept = archive / run_dirs(archive)[0]
+    assert sorted(p.name for p in kept.iterdir()) == [
+        "config.json", "eval.csv", "summary.json", "train.csv", "trial.json"
+    ]  # fmt: skip
+    record = json.loads((archive / "study.json").read_text())
+    assert record["spec"]["recipes"] == ["simoun", "sac"]
+    assert re.fullmatch("[0-9a-f]{40}", record["parts"][0]["commit"])  # tests run in a checkout
+    assert isinstance(record["parts"][0]["dirty"], bool)
+    assert (archive / "selection.json").is_file() and (archive / "report/report.md").is_file()
+
+
+def restamp(record_path: Path) -> None:
+    """Record the code's current commit as the study's: other work may be committed while this
+    test runs, and the commit check has a test of its own."""
+    record = json.loads(record_path.read_text())
+    record["parts"][0].update(code_version())
+    record_path.write_text(json.dumps(record))
+
+
+def test_resume_from_the_archive_reruns_only_the_missing_run(study, tmp_path, capsys):
+    spec_path, study_dir, archive = study
+    # the study directory is gone (another machine); the archive lost one evaluation run
+    shutil.copytree(archive, tmp_path / "a")
+    missing = "evaluation/sac/simoun-PointReach-v0/s2"
+    shutil.rmtree(tmp_path / "a" / missing)
+    restamp(tmp_path / "a" / "study.json")
+    kept = {name: (archive / name / "summary.json").read_bytes() for name in run_dirs(archive)}
+    argv = ["run", str(spec_path), "--study-dir", str(tmp_path / "s")]
+    assert cli.main([*argv, "--archive", str(tmp_path / "a"), "--resume", "--verbose", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "tuning: 0 runs to run, 8 already finished (8 restored from" in out
+    assert "evaluation: 1 runs to run, 3 already finished (3 restored from" in out
+    assert run_dirs(tmp_path / "s") == sorted(kept)
+    for name, summary in kept.items():
+        if name != missing:
+            assert (tmp_path / "s" / name / "summary.json").read_bytes() == summary
+            assert not (tmp_path / "s" / name / "checkpoint.pt").exists()  # restored, not rerun
+    assert (tmp_path / "s" / missing / "checkpoint.pt").is_file()  # trained again
+    assert (tmp_path / "a" / missing / "summary.json").is_file()  # and archived
+    # the same tuning runs, so the same selection
+    assert json.loads((tmp_path / "s/selection.json").read_text()) == json.loads(
+        (study_dir / "selection.json").read_text()
+    )
+    assert len(json.loads((tmp_path / "a/study.json").read_text())["parts"]) == 2
+
+
+def test_resume_from_another_commit_is_refused_unless_allowed(study, tmp_path, capsys):
+    spec_path, study_dir, _ = study
+    shutil.copytree(study_dir, tmp_path / "s", ignore=shutil.ignore_patterns("tune"))
+    record = json.loads((tmp_path / "s/study.json").read_text())
+    record["parts"][0].update(commit="0" * 40, dirty=False)
+    (tmp_path / "s/study.json").write_text(json.dumps(record))
+    argv = ["run", str(spec_path), "--study-dir", str(tmp_path / "s"), "--resume"]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"this study ran from commit {'0' * 40}" in err
+    assert "the code under study must not change" in err and "--allow-other-commit" in err
+    assert cli.main([*argv, "--allow-other-commit", "--verbose", "0"]) == 0  # all finished
+    parts = json.loads((tmp_path / "s/study.json").read_text())["parts"]
+    assert len(parts) == 2 and parts[1]["allowed_other_commit"] is True
+
+
+def test_resume_with_another_spec_and_a_new_study_over_an_old_one_are_refused(study, capsys):
+    spec_path, study_dir, _ = study
+    (spec_path.parent / "changed").mkdir(exist_ok=True)
+    other = write_spec(
+        spec_path.parent / "changed" / spec_path.name,
+        SPEC.replace('seeds = "1-2"', 'seeds = "1-3"'),
+    )
+    with pytest.raises(SystemExit):
+        cli.main(["run", str(other), "--study-dir", str(study_dir), "--resume"])
+    assert "is not the spec this study was started with" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        cli.main(["run", str(spec_path), "--study-dir", str(study_dir)])
+    assert "already holds a study; continue it with --resume" in capsys.readouterr().err
+
+
+def test_plan_lists_every_run_and_a_measured_estimate(tmp_path, capsys):
+    spec = write_spec(tmp_path / "tiny.toml")
+    assert cli.main(["plan", str(spec), "--probe-updates", "2"]) == 0
+    out = capsys.readouterr().out
+    rows = [
+        line.split() for line in out.splitlines() if line.startswith(("tuning ", "evaluation "))
+    ]
+    assert len(rows) == 12
+    assert rows[0][:6] == [
+        "tuning",
+        "simoun-PointReach-v0",
+        "simoun",
+        "agent.n_step=1",
+        "101",
+        "80",
+    ]
+    assert rows[-1][:6] == ["evaluation", "simoun-PointReach-v0", "sac", "(selected)", "2", "80"]
+    assert all(row[-1] == "s" and float(row[-2]) >= 0 for row in rows)  # "N s" estimates
+    assert "runs: 8 tuning + 4 evaluation = 12" in out
+    assert "estimated CPU time: tuning" in out and "with 2 runs at a time" in out
+    assert (
+        "for each of 4 configurations (recipe x task x setting x budget), 20 actions and 2 " in out
+    )
+
+
+def test_plan_without_a_probe_lists_the_runs_only(tmp_path, capsys):
+    spec = write_spec(tmp_path / "tiny.toml")
+    assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "runs: 8 tuning + 4 evaluation = 12" in out and "estimated" not in out
+
+
+BAD_SPECS = [
+    ('recipes = ["simoun", "sac"]', 'recipe = ["simoun", "sac"]',
+     "unknown key 'recipe' (did you mean 'recipes'"),
+    ('recipes = ["simoun", "sac"]', 'recipes = ["simon", "sac"]',
+     "unknown recipe 'simon' (did you mean 'simoun'?)"),
+    ('recipes = ["simoun", "sac"]', 'recipes = ["sac", "sac"]', "'sac' is listed twice"),
+    ('description = "a tiny study for tests"', 'selection = "best"',
+     "unknown selection rule 'best'; choose one of auc, final"),
+    ("agent.n_step = [1, 3]", "agent.n_stepp = [1, 3]",
+     "unknown config key 'agent.n_stepp' (did you mean agent.n_step?)"),
+    ("agent.n_step = [1, 3]", "agent.n_step = 3", "give a non-empty list of values"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 1]", "a value is listed twice"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 0]", "agent.n_step = 0"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3.5]", "cannot read agent.n_step='3.5'"),
+    ("agent.n_step = [1, 3]", '# no grid values', "the grid is empty"),
+    ("agent.n_step = [1, 3]", 'agent.augmentation = ["none", "shift"]',
+     "recipe 'sac' fixes agent.augmentation = none, and the grid would override it, so 'sac' "
+     'would no longer be itself; drop agent.augmentation from [grid], or, to tune it for every '
+     'recipe alike, list it in grid_overrides = ["agent.augmentation"]'),
+    ('recipes = ["simoun", "sac"]', 'recipes = ["simoun", "sac"]\ngrid_overrides = ["agent.lr"]',
+     "'agent.lr' is no key of [grid]"),
+    ("agent.n_step = [1, 3]", 'agent.recipe = ["drq"]', "the study sets agent.recipe itself"),
+    ("eval_episodes = 1", "eval_episodes = 1\nagent.encoder = \"single\"",
+     "recipe 'simoun' fixes agent.encoder = dual_interactive, and [base] would override it"),
+    ("eval_episodes = 1", 'eval_episodes = "many"', "cannot read eval_episodes='many'"),
+    ("eval_episodes = 1", "eval_episodes = 1\nseed = 3", "the study sets seed itself"),
+    ("eval_episodes = 1", "eval_episodes = 1\nagent.n_step = 3",
+     "agent.n_step is in [base] too (line 10)", "agent.n_step = [1, 3]"),
+    ("eval_episodes = 1", "eval_episodes = 1\npreset = \"cpuu\"",
+     "unknown preset 'cpuu' (did you mean 'cpu'?)"),
+    ('tasks = ["simoun/PointReach-v0"]\nseeds = [101, 102]',
+     'tasks = ["simoun/PointReech-v0"]\nseeds = [101, 102]',
+     "unknown environment id 'simoun/PointReech-v0'; did you mean simoun/PointReach-v0?",
+     'tasks = ["simoun/PointReech-v0"]'),
+    ("seeds = [101, 102]", "seeds = [101, 101]", "seed 101 is listed twice"),
+    ("seeds = [101, 102]", 'seeds = "102-101"', "runs backwards"),
+    ('seeds = "1-2"', 'seeds = "1-2,101"',
+     "seed 101 of simoun/PointReach-v0 is a tuning seed too; evaluation seeds must be held out"),
+    ('seeds = "1-2"', 'seeds = { "CartPole-v1" = [1] }',
+     "'CartPole-v1' is not one of this phase's tasks"),
+    ("env_steps = 80\n\n[evaluation]", "env_steps = 0\n\n[evaluation]",
+     "give a positive integer of env steps, not 0", "env_steps = 0"),
+    ("env_steps = 80\n\n[evaluation]", "env_steps = 80\nbudget = 5\n\n[evaluation]",
+     "unknown key 'budget'", "budget = 5"),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 2\ncpus_per_trial = 0",
+     "give a positive integer, not 0"),
+    ("[resources]", '[tasks."CartPole-v1"]\naction_repeat = 2\n\n[resources]',
+     "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
+     "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+]  # fmt: skip
+"""(text of the good spec, its replacement, what the error says[, the text of the line it
+names]): by default the error names the line where the replacement ends."""
+
+
+@pytest.mark.parametrize("case", BAD_SPECS, ids=[case[2][:40] for case in BAD_SPECS])
+def test_a_bad_spec_fails_naming_its_line_and_the_fix(case, tmp_path):
+    old, new, message, at = (*case, None)[:4]
+    assert old in SPEC
+    text = SPEC.replace(old, new, 1)
+    path = write_spec(tmp_path / "bad.toml", text)
+    with pytest.raises(SetupError) as error:
+        cli.spec_from(str(path))
+    line = text[: text.index(at or new) + len(at or new)].count("\n") + 1
+    if new.startswith("#"):  # nothing left in [grid]: its header's line
+        line = text.splitlines().index("[grid]") + 1
+    assert f"{path}:{line}: " in str(error.value)
+    assert message in str(error.value)
+
+
+def test_grid_overrides_lets_the_grid_tune_a_key_a_recipe_fixes(tmp_path):
+    text = SPEC.replace(
+        'recipes = ["simoun", "sac"]',
+        'recipes = ["simoun", "sac"]\ngrid_overrides = ["agent.augmentation"]',
+    )
+    text = text.replace("agent.n_step = [1, 3]", 'agent.augmentation = ["none", "shift"]')
+    spec = cli.spec_from(str(write_spec(tmp_path / "tuned.toml", text)))
+    assert spec.grid == {"agent.augmentation": ["none", "shift"]}
+    runs = tuning_runs(spec)
+    assert "tuning/sac/agent.augmentation=shift/simoun-PointReach-v0/s101" in [r.name for r in runs]
+    without = SPEC.replace("agent.n_step = [1, 3]", 'agent.augmentation = ["shift"]')
+    overriding = without.replace(
+        'recipes = ["simoun", "sac"]',
+        'recipes = ["simoun", "sac"]\ngrid_overrides = ["agent.augmentation"]',
+    )
+    path = write_spec(tmp_path / "unoffered.toml", overriding)
+    with pytest.raises(SetupError, match="which the grid does not offer; add none to its values"):
+        cli.spec_from(str(path))
+
+
+def test_bad_toml_and_missing_parts_fail_before_ray_starts(tmp_path, capsys):
+    path = write_spec(tmp_path / "broken.toml", SPEC.replace("[grid]", "[grid"))
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["run", str(path), "--study-dir", str(tmp_path / "s")])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("simoun-study: error: ") and "Traceback" not in err
+    assert f"{path}: not valid TOML" in err and "(at line 19, column 6)" in err
+    assert not (tmp_path / "s").exists()
+    path = write_spec(tmp_path / "half.toml", SPEC[: SPEC.index("[evaluation]")])
+    with pytest.raises(SetupError, match="no 'evaluation'; a study needs recipes, grid"):
+        cli.spec_from(str(path))
+
+
+def test_key_lines_follow_tables_dotted_keys_and_inline_tables():
+    text = (
+        'a = """\nb = 1\n"""\n[grid.agent]\nn_step = [1, 3]\n[evaluation]\n'
+        'seeds = { "dm_control/x-v0" = [1] }\n'
+    )
+    assert key_line(text, ("b",)) is None  # inside a multi-line string
+    assert key_line(text, ("grid", "agent", "n_step")) == 5
+    assert key_line(text, ("evaluation", "seeds", "dm_control/x-v0")) == 7
+    assert key_line(text, ("grid",)) == 4
+
+
+def test_help_runs_for_the_command_and_each_subcommand(capsys):
+    for argv in (["--help"], ["plan", "--help"], ["run", "--help"]):
+        with pytest.raises(SystemExit) as exit_info:
+            cli.main(argv)
+        assert exit_info.value.code == 0
+    out = capsys.readouterr().out
+    assert "simoun-study plan docs/studies/dmc100k.toml" in out
+    assert "--probe-updates N" in out and "--allow-other-commit" in out and "--archive DIR" in out
+
+
+def test_the_dmc100k_spec_of_issue_20_plans_its_runs():
+    spec = cli.spec_from("docs/studies/dmc100k.toml")
+    assert spec.recipes == ["simoun", "drq", "drqv2", "rad", "curl"]
+    assert spec.preset == "cpu" and spec.grid == {"agent.n_step": [1, 3]}
+    assert spec.base == {"eval_every": 10_000, "eval_episodes": 10, "video": False}
+    tuning, evaluation = tuning_runs(spec), evaluation_runs(spec)
+    assert len(tuning) == 5 * 2 * 2 and {r.seed for r in tuning} == {101, 102}
+    assert {r.task for r in tuning} == {"dm_control/cartpole-swingup-v0"}
+    assert {r.env_steps for r in tuning} == {50_000} and {r.env_steps for r in evaluation} == {
+        100_000
+    }
+    cheetah = [r for r in evaluation if r.task == "dm_control/cheetah-run-v0"]
+    assert len(evaluation) == 5 * (5 + 3) and {r.seed for r in cheetah} == {1, 2, 3}
+    assert spec.task_config == {
+        "dm_control/cartpole-swingup-v0": {"action_repeat": 8},
+        "dm_control/cheetah-run-v0": {"action_repeat": 4},
+    }
+    assert spec.cpus_per_trial == 1 and spec.max_concurrent_trials == 2
