@@ -157,15 +157,37 @@ def test_each_term_reads_the_online_or_target_network_it_should(network, changes
     assert changed == changes
 
 
-def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return():
+def intrinsic_return_by_hand(agent: SimounAgent, batch: dict) -> np.ndarray:
+    """Eq. 13 at each step j < m of the return, on the online features of the triplet ending at
+    t+j, discounted by gamma^j and summed; the running maxima raised first with every distance
+    of the batch (0 past the episode's end) and the one-step extrinsic rewards."""
+    window, mask = torch.from_numpy(batch["n_step_window"]), batch["return_mask"].T
+    distances = []
+    for j in range(len(mask)):
+        f_m, f_a = (np64(x) for x in agent.encoder_features(window[:, j : j + 3]))
+        flow = np.abs(f_a[:, 1] - f_a[:, 0]) + np.abs(f_a[:, 2] - f_a[:, 1])
+        distances.append(np.sqrt(((np.abs(f_m) - flow) ** 2).sum(-1)) * mask[j])
+    distance = np.stack(distances)
+    r_e_max = max(agent.config.r_e_max_init, np.abs(batch["reward"]).max())
+    r_i_max = max(agent.config.r_i_max_init, distance.max())
+    c, lam = agent.config.curiosity_scale, agent.config.curiosity_decay
+    r_i = c * np.exp(-lam * STEP) * distance * r_e_max / r_i_max
+    return (GAMMA ** np.arange(len(mask))[:, None] * mask * r_i).sum(0)
+
+
+@pytest.mark.parametrize("curiosity", [False, True])
+def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return(curiosity):
     """The cpu preset's 3-step returns on a hand-built replay: the TD target is
-    R + gamma * discount * V(bootstrap_obs), with FrameReplay.sample's R and discount (checked by
-    hand in test_n_step_return_discount_and_bootstrap_by_hand) and V read on the frame reached."""
-    agent = agent_for_targets(n_step=3, curiosity=False)
+    R + sum_j gamma^j r^i(s_{t+j}) + gamma * discount * V(bootstrap_obs), with FrameReplay.sample's
+    R, mask and discount (checked by hand in test_n_step_return_discount_and_bootstrap_by_hand)
+    and V read on the frame reached."""
+    agent = agent_for_targets(n_step=3, curiosity=curiosity)
     replay = hand_built_replay(FRAME, random_frames=True)
     batch = copy.deepcopy(replay).sample(agent.config.batch_size, 3, GAMMA)  # the same draw
     assert (batch["return"] != batch["reward"]).any()
     assert (batch["discount"] == 0).any() and (batch["discount"] > 0).any()
+    assert (batch["return_mask"].sum(1) > 1).any() and (batch["return_mask"].sum(1) < 3).any()
+    intrinsic = intrinsic_return_by_hand(agent, batch) if curiosity else 0.0
     with torch.no_grad():
         bootstrap_state = agent.encoder(torch.from_numpy(batch["bootstrap_obs"])).state
     target_q, actor, online_q = Calls(agent.critic_target), Calls(agent.actor), Calls(agent.critic)
@@ -177,9 +199,11 @@ def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return(
     _, (q1, q2) = online_q.with_grad(True)[0]
     torch.testing.assert_close(target_in, bootstrap_state)
     value = np.minimum(np64(q1_bar), np64(q2_bar))[:, 0] - ALPHA * np64(next_log_prob)[:, 0]
-    y = batch["return"].astype(np.float64) + GAMMA * batch["discount"] * value
+    y = batch["return"] + intrinsic + GAMMA * batch["discount"] * value
     expected = ((np64(q1)[:, 0] - y) ** 2).mean() + ((np64(q2)[:, 0] - y) ** 2).mean()
     assert float(metrics["critic_loss"]) == pytest.approx(expected, rel=1e-5)
+    if curiosity:
+        assert float(metrics["intrinsic_reward"]) == pytest.approx(intrinsic.mean(), rel=1e-5)
 
 
 # -- the n-step return on a replay built by hand ----------------------------------------------
@@ -227,6 +251,13 @@ N_STEP_BY_HAND = {
 }
 
 
+STEPS_SUMMED = {
+    ("a", 0): 3, ("a", 1): 3, ("a", 2): 2, ("a", 3): 1, ("b", 0): 3, ("b", 1): 2, ("b", 2): 1,
+    ("c", 0): 2, ("c", 1): 1,
+}  # fmt: skip
+"""m, the rewards each n-step return of N_STEP_BY_HAND sums."""
+
+
 def test_n_step_return_discount_and_bootstrap_by_hand():
     replay = hand_built_replay()
     assert len(replay) == len(N_STEP_BY_HAND)
@@ -240,6 +271,11 @@ def test_n_step_return_discount_and_bootstrap_by_hand():
             assert batch["return"][i] == pytest.approx(n_return)
             assert batch["discount"][i] == pytest.approx(discount)
             assert batch["bootstrap_obs"][i, :, 0, 0, 0].tolist() == bootstrap
+            # the steps summed, and frames t-2 .. t+3 held at the frame reached (per-step r_i)
+            m = STEPS_SUMMED[key]
+            assert batch["return_mask"][i].tolist() == [1.0] * m + [0.0] * (3 - m)
+            ahead = batch["n_step_window"][i, :, 0, 0, 0].tolist()
+            assert ahead == window[:-1] + [t_frame + min(j, m) for j in (1, 2, 3)]
             # the one-step parts stay one-step (L_re, L_tran); reset padding before frame 0
             assert batch["reward"][i] == EPISODES[key[0]][0][key[1]]
             base = FRAME_ID[key[0]]
