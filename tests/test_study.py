@@ -5,6 +5,7 @@ check, and the bad specs it refuses before Ray starts, each naming its line."""
 import json
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -383,3 +384,16 @@ def test_the_dmc100k_spec_of_issue_20_plans_its_runs():
         "dm_control/cheetah-run-v0": {"action_repeat": 4},
     }
     assert spec.cpus_per_trial == 1 and spec.max_concurrent_trials == 2
+
+
+def test_without_ray_a_study_plans_and_says_how_to_install_ray_to_run(
+    monkeypatch, tmp_path, capsys
+):
+    monkeypatch.setitem(sys.modules, "ray", None)  # what `import ray` meets when not installed
+    spec = write_spec(tmp_path / "tiny.toml")
+    assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["run", str(spec), "--study-dir", str(tmp_path / "s")])
+    assert exit_info.value.code == 2
+    assert "pip install 'simoun[sweep]'" in capsys.readouterr().err
+    assert not (tmp_path / "s").exists()
