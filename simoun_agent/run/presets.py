@@ -227,9 +227,13 @@ PRESETS["highway"] = Preset(
     },
     envs="highway",
 )
-CPU_PRESET_TIME = "about 40-55 min on 2 cores (measured 2026-11-29)"
-"""Wall time of one cpu-preset run (the README's three main-job runs took 39, 39 and 56 min, two
-side by side): the one figure the help text and the README quote; update both together."""
+CPU_PRESET_TIME = (
+    "about 30 min alone on 2 cores, 40-55 min beside a second run (measured 2026-11-29/30, "
+    "before per-step n-step curiosity made an update 1.31x slower)"
+)
+"""Wall time of one cpu-preset run (a reviewer's seed-1 run alone: 1,804 s; the README's three
+main-job runs: 39, 39 and 56 min, two side by side): the one figure the help text and the README
+quote; update both together."""
 
 PRESETS["cpu"] = Preset(
     description=f"sized for 2 CPU cores (the main job, {CPU_PRESET_TIME}): "
