@@ -193,6 +193,13 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper):
     """
 
     def __init__(self, env: gym.Env, signal: IntrinsicSignal, scale: float) -> None:
+        if isinstance(env, VectorEnv):
+            vector = type(self).__name__.replace("Reward", "VectorReward")
+            raise TypeError(
+                f"{type(self).__name__} wraps a single env, got the vector env {env}; use "
+                f"{vector}(envs, ...) on the vector env, or put {type(self).__name__} in each "
+                "sub-env (gym.make_vec(..., wrappers=[...]))"
+            )
         gym.Wrapper.__init__(self, env)
         self._read = triplet_reader(env.observation_space)
         self.scale = check_scale(scale)

@@ -277,3 +277,10 @@ def test_vector_version_watches_only_transitions_within_an_episode(mode):
     for triplet, following in pairs:
         np.testing.assert_array_equal(following[:2], triplet[1:])
     envs.close()
+
+
+def test_single_env_wrapper_given_a_vector_env_points_to_the_vector_wrapper():
+    envs = make_vec(2)
+    with pytest.raises(TypeError, match=r"use ConsistencyCuriosityVectorReward\(envs"):
+        ConsistencyCuriosityReward(envs, ProjectionFeatures(3 * SIZE * SIZE))
+    envs.close()
