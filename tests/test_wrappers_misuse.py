@@ -88,6 +88,15 @@ def test_dm_control_imported_first_without_mujoco_gl_warns_with_the_fix():
         assert "MUJOCO_GL" not in quiet.stderr
 
 
+def default_signal_state() -> None:
+    """The child starts as a shell would start it: no signal blocked, SIGTERM at its default.
+    A blocked or ignored SIGTERM is inherited across exec, and in CI (one pytest-xdist worker
+    that had run the Ray tests before) the child ignored SIGTERM for 300 s, though it dies at
+    once when this test runs alone: the test is about SDL, not about the worker's state."""
+    signal.pthread_sigmask(signal.SIG_SETMASK, [])
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 def test_sdl_leaves_sigterm_to_python_after_highway_env_renders():
     """pygame/SDL installs a SIGTERM handler that turns the signal into an unread quit event
     unless SDL_NO_SIGNAL_HANDLERS is set; then a plain process ignores SIGTERM."""
@@ -99,7 +108,11 @@ def test_sdl_leaves_sigterm_to_python_after_highway_env_renders():
     )
     env = {k: v for k, v in os.environ.items() if k != "SDL_NO_SIGNAL_HANDLERS"}
     proc = subprocess.Popen(
-        [sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, text=True
+        [sys.executable, "-c", code],
+        env=env,
+        stdout=subprocess.PIPE,
+        text=True,
+        preexec_fn=default_signal_state,
     )
     # Generous limits for a loaded machine: a child that ignores SIGTERM sleeps past them and
     # fails the test; a silent child is killed by the watchdog instead of hanging the suite.
