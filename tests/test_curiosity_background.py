@@ -88,13 +88,16 @@ def test_the_thread_changes_no_reward_and_a_seed_fixes_them(vector):
     thread, recorded = rollout(TINY, vector=vector)
     inline, recorded_inline = rollout(dataclasses.replace(TINY, background=False), vector=vector)
     again, _ = rollout(TINY, vector=vector)
-    np.testing.assert_array_equal(thread, inline)
-    np.testing.assert_array_equal(thread, again)
+    # The same updates from the same weights: equal up to float rounding (one run in CI differed
+    # by 1 ulp, 3.6e-8 in one of 24 rewards, between the thread and inline: the kernels torch
+    # picks may differ between threads); a different seed moves them by far more than 1e-6
+    np.testing.assert_allclose(thread, inline, rtol=1e-6, atol=0)
+    np.testing.assert_allclose(thread, again, rtol=1e-6, atol=0)
     versions = [call[3] for call in recorded.calls]
     assert versions == [call[3] for call in recorded_inline.calls]
     assert max(versions) >= 3  # the rewards span several published updates
     other, _ = rollout(dataclasses.replace(TINY, seed=1), vector=vector)
-    assert not np.array_equal(thread, other)
+    assert not np.allclose(thread, other, rtol=1e-3, atol=0)
 
 
 def test_features_come_only_from_weights_published_whole():

@@ -132,7 +132,9 @@ def test_the_thread_changes_no_reward_and_a_seed_fixes_them():
         rewards.append([env.step([0, 1, 2][t % 3])[4]["reward_intrinsic"] for t in range(40)])
         assert model.updates == (40 - 16) // 2  # one step due at each even call from 16 on
         env.close()
-    assert rewards[0] == rewards[1] == rewards[2]
+    # equal up to float rounding: torch's kernels may round differently in another thread
+    np.testing.assert_allclose(rewards[0], rewards[1], rtol=1e-6, atol=0)
+    np.testing.assert_allclose(rewards[0], rewards[2], rtol=1e-6, atol=0)
     assert len(set(rewards[0][4:])) > 30  # the rewards vary from step to step
 
 
