@@ -112,7 +112,9 @@ def test_ppo_trains_on_extrinsic_plus_intrinsic(arm):
         # watch call 40), the biases make |f_m| of no motion a constant the reward pays for.
         still, initial = np.array(seen.still), np.arange(256) < 40
         assert 0 < still[initial].sum() < initial.sum()
-        assert np.all(intrinsic[initial & still] == 0) and np.all(intrinsic[initial & ~still] > 0)
+        # 0 up to float rounding (one CI run gave 9.6e-8 for one still step; moves pay > 1e-3)
+        assert np.all(intrinsic[initial & still] < 1e-6)
+        assert np.all(intrinsic[initial & ~still] > 1e-6)
         assert np.all(intrinsic[~initial] > 0)
         assert env.state_dict()["step"] == 256
     else:
