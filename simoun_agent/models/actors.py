@@ -34,7 +34,8 @@ from torch import nn
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.losses import deterministic_actor_loss, deterministic_value
-from simoun_agent.models.sac import Actor, Critic, mlp
+from simoun_agent.models.networks import mlp
+from simoun_agent.models.sac import Actor, Critic
 
 
 def exploration_std(step: int, start: float, end: float, duration: int) -> float:

@@ -5,7 +5,14 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from simoun_agent.models.sac import mlp
+
+def mlp(in_dim: int, hidden_dim: int, out_dim: int, hidden_layers: int = 2) -> nn.Sequential:
+    """Linear-ReLU stack with ``hidden_layers`` hidden layers of ``hidden_dim`` units."""
+    layers: list[nn.Module] = []
+    for i in range(hidden_layers):
+        layers += [nn.Linear(in_dim if i == 0 else hidden_dim, hidden_dim), nn.ReLU()]
+    layers.append(nn.Linear(hidden_dim, out_dim))
+    return nn.Sequential(*layers)
 
 
 class TransitionModel(nn.Module):

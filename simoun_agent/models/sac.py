@@ -8,15 +8,7 @@ import torch
 from torch import nn
 
 from simoun_agent.losses import actor_loss, soft_value
-
-
-def mlp(in_dim: int, hidden_dim: int, out_dim: int, hidden_layers: int = 2) -> nn.Sequential:
-    """Linear-ReLU stack with ``hidden_layers`` hidden layers of ``hidden_dim`` units."""
-    layers: list[nn.Module] = []
-    for i in range(hidden_layers):
-        layers += [nn.Linear(in_dim if i == 0 else hidden_dim, hidden_dim), nn.ReLU()]
-    layers.append(nn.Linear(hidden_dim, out_dim))
-    return nn.Sequential(*layers)
+from simoun_agent.models.networks import mlp
 
 
 class Actor(nn.Module):
