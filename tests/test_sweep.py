@@ -144,7 +144,9 @@ def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path
 def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_path):
     sweep_dir = tmp_path / "interrupted"
     # The two short trials are scheduled first (2 CPUs, 1 per trial) and finish; Ctrl-C comes
-    # once a long one has written a checkpoint, well before it can finish.
+    # once both have and a long one has written a checkpoint, well before it can finish. (Under
+    # load the first long trial can checkpoint while the second short one still runs: CI saw it,
+    # so the test waits for both conditions; the second long trial starts only after both.)
     argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=120,360"]
     argv += ["--seeds", "0-1", "--sweep-dir"]
     argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
@@ -153,8 +155,16 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
     long_runs = [sweep_dir / f"total_env_steps=360/simoun-PointReach-v0/s{s}" for s in (0, 1)]
-    deadline = time.monotonic() + 120
-    while not any((d / "checkpoint.pt").exists() for d in long_runs):
+    short_runs = [sweep_dir / f"total_env_steps=120/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+
+    def ready() -> bool:
+        shorts_done = all((d / "summary.json").exists() for d in short_runs)
+        return shorts_done and any(
+            (d / "checkpoint.pt").exists() and not (d / "summary.json").exists() for d in long_runs
+        )
+
+    deadline = time.monotonic() + 300  # generous: a loaded CI machine must not fail the test
+    while not ready():
         assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
         time.sleep(0.1)
     proc.send_signal(signal.SIGINT)
@@ -163,7 +173,6 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     assert proc.returncode == 130, output
     assert "simoun-sweep --resume --sweep-dir" in output
 
-    short_runs = [sweep_dir / f"total_env_steps=120/simoun-PointReach-v0/s{s}" for s in (0, 1)]
     summaries = {d: (d / "summary.json").read_bytes() for d in short_runs}
     unfinished = [d for d in long_runs if not (d / "summary.json").exists()]
     assert unfinished
