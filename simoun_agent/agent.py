@@ -13,6 +13,7 @@ import torch
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.config_checks import check_agent_inputs
+from simoun_agent.device import default_device
 from simoun_agent.losses import (
     contrastive_loss,
     critic_loss,
@@ -76,7 +77,7 @@ class SimounAgent:
         check_agent_inputs(frame_shape, action_dim, config)
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
-        self.device = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+        self.device = default_device(device)
         self.obs_shape = (config.num_frames, *self.frame_shape)
 
         self.encoder = make_encoder(config, self.frame_shape).to(self.device)

@@ -24,15 +24,12 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from simoun_agent.device import default_device
 from simoun_wrappers.intrinsic_reward import triplet_shape
 
 Model = TypeVar("Model", bound="OnlineModel")
 
 __all__ = ["OnlineModel", "UpdateThread", "default_device", "frozen_copy", "run_now"]
-
-
-def default_device(device: str | torch.device | None) -> torch.device:
-    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
 
 
 class UpdateThread:

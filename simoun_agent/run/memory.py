@@ -24,6 +24,7 @@ from typing import Any
 import torch
 from torch.utils._python_dispatch import TorchDispatchMode
 
+from simoun_agent.device import default_device
 from simoun_agent.run.presets import SetupError, TrainConfig
 
 ACTION_DIM = 2
@@ -106,7 +107,7 @@ def replay_bytes(config: TrainConfig) -> int:
 
 def device_memory(device: str | None) -> tuple[str, int | None]:
     """The device a run of ``device`` trains on and its memory in bytes (None: unknown)."""
-    name = device or ("cuda" if torch.cuda.is_available() else "cpu")
+    name = str(default_device(device))
     kind = torch.device(name)
     if kind.type == "cuda":
         return name, torch.cuda.get_device_properties(kind.index or 0).total_memory

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_agent.run.presets import SetupError
 from simoun_agent.study.plan import StudyRun, tuning_runs

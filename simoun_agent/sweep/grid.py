@@ -24,7 +24,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.presets import SetupError, config_fields, dmc_task, parse_value, resolve
 
 SWEEP_FILE = "sweep.json"
