@@ -299,7 +299,11 @@ class SimounAgent:
                 key = random_conv(
                     self.encoder.key_frames(windows[0][:, :k]), cfg.random_conv_kernel
                 )
-        shared = 0 if bootstrap_obs is not None else min(count, cfg.critic_augmentations)
+        shared = (
+            0
+            if bootstrap_obs is not None
+            else min(cfg.target_augmentations, cfg.critic_augmentations)
+        )
         return Views(windows, next_obs[: cfg.target_augmentations], shared, key)
 
     def encode(self, views: Views, next_features: bool = False) -> tuple[Encoding, Encoding | None]:
