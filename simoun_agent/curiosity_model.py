@@ -21,6 +21,7 @@ import torch
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config.shapes import min_image_size
 from simoun_agent.losses import contrastive_loss, transition_loss
 from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
@@ -213,14 +214,16 @@ class CuriosityModel(OnlineModel):
 
         Args:
             frame_shape: ``(C, H, W)`` of one frame as the env gives it (after the pooling of
-                ``config.encoder_size``, H, W >= 23; >= 15 without the interactive module).
+                ``config.encoder_size``, H, W >= 19; >= 15 without the interactive module:
+                :func:`simoun_agent.config.shapes.min_image_size`).
             action_space: the env's action space (Discrete, MultiDiscrete, MultiBinary or Box).
             config: hyperparameters; ``CuriosityConfig()`` when None.
             device: torch device; None picks cuda when available, else cpu.
         """
         self.config = config = config or CuriosityConfig()
         self._init_frames(frame_shape, config.encoder_size)
-        smallest = 23 if config.interactive else 15
+        encoder = "dual_interactive" if config.interactive else "dual"
+        smallest = min_image_size(AgentConfig(encoder=encoder))
         if min(self.encoded_shape[1:]) < smallest:
             raise ValueError(
                 f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
@@ -235,7 +238,7 @@ class CuriosityModel(OnlineModel):
             if config.seed is not None:
                 torch.manual_seed(config.seed)
             encoder_config = AgentConfig(
-                encoder="dual_interactive" if config.interactive else "dual",
+                encoder=encoder,
                 feature_dim=config.feature_dim,
                 num_filters=config.num_filters,
                 channels_last=config.channels_last,

@@ -7,9 +7,9 @@ import shutil
 import numpy as np
 import pytest
 
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.generalization import DISTRACTIONS, check_supported, make_distracted_env
 from simoun_agent.run import evaluate, train
-from simoun_agent.run.presets import SetupError, resolve
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -11,8 +11,7 @@ from pathlib import Path
 import pytest
 import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
-from simoun_agent.recipes import RECIPES
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import RECIPES, SetupError
 from simoun_agent.study import cli
 from simoun_agent.study.plan import evaluation_runs, tuning_runs
 from simoun_agent.study.provenance import code_version

@@ -5,10 +5,10 @@ import json
 import pytest
 import torch
 
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
-from simoun_agent.run.presets import SetupError, resolve
 
 TINY = {
     "env": "simoun/PointReach-v0",

@@ -18,10 +18,10 @@ import numpy as np
 import pytest
 import torch
 
+from simoun_agent.config import resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.env_runner import BackgroundEnv
-from simoun_agent.run.presets import resolve
 
 TINY = [
     "--image-size", "32",

@@ -24,9 +24,9 @@ from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
 from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
 from simoun_agent.analysis.report import RunBias, write_report
 from simoun_agent.analysis.runs import LoadedRun, load_run, play_episode, prepare_output
+from simoun_agent.config import SetupError
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.make_env import video_fps
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.video import write_video
 
 MAX_BIAS_EPISODES = 200

@@ -10,9 +10,9 @@ import numpy as np
 import torch
 
 from simoun_agent.agent import SimounAgent
+from simoun_agent.config import SetupError, TrainConfig, from_dict
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.make_env import make_env
-from simoun_agent.run.presets import SetupError, TrainConfig, from_dict
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.seeds import first_eval_seed
 

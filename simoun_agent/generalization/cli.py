@@ -9,10 +9,10 @@ import signal
 import sys
 from pathlib import Path
 
+from simoun_agent.config import SetupError
 from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.generalization.report import TABLE_CSV, write_report
 from simoun_agent.generalization.suite import parse_distractions
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
 

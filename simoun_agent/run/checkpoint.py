@@ -27,7 +27,9 @@ from typing import Any
 import numpy as np
 import torch
 
-from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError, config_sections
+from simoun_agent.config import SetupError
+from simoun_agent.config.keys import config_sections
+from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.seeds import SEED_SCHEME
 
 CHECKPOINT_NAME = "checkpoint.pt"

@@ -24,9 +24,9 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from simoun_agent.config import SetupError
 from simoun_agent.run import driving_metrics
 from simoun_agent.run.flags import add_version, bool_argv
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.signals import Stopped, stop_at_once
@@ -228,9 +228,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
     from simoun_agent import SimounAgent
+    from simoun_agent.config import from_dict
     from simoun_agent.run.checkpoint import load_checkpoint
     from simoun_agent.run.make_env import make_env, video_fps
-    from simoun_agent.run.presets import from_dict
     from simoun_agent.run.video import write_video
 
     parser = build_parser()

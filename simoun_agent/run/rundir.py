@@ -18,7 +18,7 @@ import shutil
 from pathlib import Path
 from typing import IO
 
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import SetupError
 
 LOCK_NAME = ".lock"
 CHECKPOINT_NAME = "checkpoint.pt"

@@ -46,8 +46,19 @@ import torch
 from tqdm import tqdm
 
 from simoun_agent import SimounAgent
+from simoun_agent.config import (
+    PRESETS,
+    RECIPES,
+    SetupError,
+    TrainConfig,
+    from_dict,
+    resolve,
+    to_dict,
+)
+from simoun_agent.config.envs import dmc_task
+from simoun_agent.config.keys import check_keys, config_fields, parse_value
+from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.generalization.suite import check_eval_distractions
-from simoun_agent.recipes import RECIPES
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.checkpoint import (
     CHECKPOINT_NAME,
@@ -67,19 +78,6 @@ from simoun_agent.run.flags import add_version
 from simoun_agent.run.logger import CURVE_PNG, RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.memory import check_memory
-from simoun_agent.run.presets import (
-    PRESETS,
-    RESUMABLE_FIELDS,
-    SetupError,
-    TrainConfig,
-    check_keys,
-    config_fields,
-    dmc_task,
-    from_dict,
-    parse_value,
-    resolve,
-    to_dict,
-)
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.run.presets import SetupError, resolve
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.train import SUMMARY_NAME
 from simoun_agent.study import probe
 from simoun_agent.study.spec import StudySpec

@@ -22,10 +22,9 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from simoun_agent.recipes import RECIPES
+from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, Trial
 from simoun_agent.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table

@@ -22,9 +22,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import CHECKPOINT_NAME, atomic_write
-from simoun_agent.run.presets import resolve
 from simoun_agent.run.signals import Stopped
 from simoun_agent.sweep.grid import Trial
 from simoun_agent.sweep.report import ERROR_FILE
