@@ -25,7 +25,7 @@ from stable_baselines3.common.vec_env import VecEnv
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 from simoun_wrappers import ActionRepeat, SimounObservation
 from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
 

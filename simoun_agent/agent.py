@@ -13,6 +13,7 @@ import torch
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.config.shapes import check_agent_inputs
+from simoun_agent.device import default_device
 from simoun_agent.losses import (
     contrastive_loss,
     critic_loss,
@@ -76,7 +77,7 @@ class SimounAgent:
         check_agent_inputs(frame_shape, action_dim, config)
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
-        self.device = torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+        self.device = default_device(device)
         self.obs_shape = (config.num_frames, *self.frame_shape)
 
         self.encoder = make_encoder(config, self.frame_shape).to(self.device)
@@ -298,7 +299,11 @@ class SimounAgent:
                 key = random_conv(
                     self.encoder.key_frames(windows[0][:, :k]), cfg.random_conv_kernel
                 )
-        shared = 0 if bootstrap_obs is not None else min(count, cfg.critic_augmentations)
+        shared = (
+            0
+            if bootstrap_obs is not None
+            else min(cfg.target_augmentations, cfg.critic_augmentations)
+        )
         return Views(windows, next_obs[: cfg.target_augmentations], shared, key)
 
     def encode(self, views: Views, next_features: bool = False) -> tuple[Encoding, Encoding | None]:

@@ -12,7 +12,6 @@ Both follow :class:`simoun_wrappers.curiosity.FeatureSource`.
 from __future__ import annotations
 
 import copy
-import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,7 +24,7 @@ from simoun_agent.config.shapes import min_image_size
 from simoun_agent.losses import contrastive_loss, transition_loss
 from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
-from simoun_agent.online_model import OnlineModel, default_device, frozen_copy
+from simoun_agent.online_model import OnlineModel, check_online_config
 from simoun_wrappers.augment import random_conv
 
 __all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions"]
@@ -88,23 +87,11 @@ class CuriosityConfig:
     """seeds the weights, the buffer sampling and the augmentation (None: nondeterministic)"""
 
     def __post_init__(self) -> None:
-        for name in ("feature_dim", "num_filters", "capacity", "batch_size", "update_every"):
-            if getattr(self, name) < 1:
-                raise ValueError(f"CuriosityConfig.{name} must be >= 1, got {getattr(self, name)}")
-        if self.encoder_size is not None and self.encoder_size < 1:
-            raise ValueError(
-                f"CuriosityConfig.encoder_size must be None (full-size frames) or a side >= 1 in "
-                f"pixels, got {self.encoder_size}; the default 42 pools 84x84 frames to 42x42."
-            )
+        check_online_config(self, positive=("feature_dim", "num_filters"))
         if self.batch_size < 2:
             raise ValueError(
                 f"CuriosityConfig.batch_size must be >= 2: the contrastive loss needs negatives "
                 f"from the batch; got {self.batch_size}."
-            )
-        if not self.batch_size <= self.learning_starts <= self.capacity:
-            raise ValueError(
-                f"CuriosityConfig needs batch_size <= learning_starts <= capacity, got "
-                f"{self.batch_size}, {self.learning_starts}, {self.capacity}."
             )
 
 
@@ -158,7 +145,9 @@ class CuriosityModel(OnlineModel):
 
     The encoder is the agent's ``DualPathEncoder`` and its ``encode_transition`` (each of the
     four frames through each path once); the losses are ``simoun_agent.losses``'. Frames are
-    average-pooled to about ``encoder_size`` first (84x84 -> 42x42 by default).
+    average-pooled to about ``encoder_size`` first (84x84 -> 42x42 by default), and must then
+    be at least 19x19 (15x15 without the interactive module); the action space is Discrete,
+    MultiDiscrete, MultiBinary or Box.
 
     **Schedule and reproducibility.** The batch of the step due at watch call ``k`` is sampled
     at that call; the step runs in a background thread (``background=True``) or at once
@@ -203,53 +192,31 @@ class CuriosityModel(OnlineModel):
         >>> env.close()  # stops the update thread
     """
 
-    def __init__(
-        self,
-        frame_shape: tuple[int, int, int],
-        action_space: spaces.Space,
-        config: CuriosityConfig | None = None,
-        device: str | torch.device | None = None,
-    ) -> None:
-        """Build the model.
+    config_type = CuriosityConfig
 
-        Args:
-            frame_shape: ``(C, H, W)`` of one frame as the env gives it (after the pooling of
-                ``config.encoder_size``, H, W >= 19; >= 15 without the interactive module:
-                :func:`simoun_agent.config.shapes.min_image_size`).
-            action_space: the env's action space (Discrete, MultiDiscrete, MultiBinary or Box).
-            config: hyperparameters; ``CuriosityConfig()`` when None.
-            device: torch device; None picks cuda when available, else cpu.
-        """
-        self.config = config = config or CuriosityConfig()
-        self._init_frames(frame_shape, config.encoder_size)
-        encoder = "dual_interactive" if config.interactive else "dual"
-        smallest = min_image_size(AgentConfig(encoder=encoder))
-        if min(self.encoded_shape[1:]) < smallest:
-            raise ValueError(
-                f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
-                f"{self.pool}, CuriosityConfig.encoder_size={config.encoder_size}); the conv paths"
-                f"{' and the interactive module' if config.interactive else ''} need H, W >= "
-                f"{smallest}. Render larger frames (SimounObservation(env, size=32) or more) or "
-                "raise encoder_size."
-            )
-        self.action_space = action_space
-        self.device = default_device(device)
-        with torch.random.fork_rng(devices=[]):
-            if config.seed is not None:
-                torch.manual_seed(config.seed)
-            encoder_config = AgentConfig(
-                encoder=encoder,
-                feature_dim=config.feature_dim,
-                num_filters=config.num_filters,
-                channels_last=config.channels_last,
-            )
-            self.encoder = make_encoder(encoder_config, self.encoded_shape)
-            self.transition = TransitionModel(
-                config.feature_dim, action_dim(action_space), config.aux_hidden_dim
-            )
-        self.encoder.to(self.device)
+    def _smallest_frame(self) -> tuple[int, str, int]:
+        interactive = self.config.interactive
+        needs = "the conv paths" + (" and the interactive module" if interactive else "")
+        return min_image_size(AgentConfig(encoder=self._encoder_name())), needs, 32
+
+    def _encoder_name(self) -> str:
+        return "dual_interactive" if self.config.interactive else "dual"
+
+    def _build(self) -> PixelEncoder:
+        """The encoder, its momentum copy, G, the bilinear similarity, one Adam for all, and the
+        buffer of windows and encoded actions."""
+        config = self.config
+        encoder_config = AgentConfig(
+            encoder=self._encoder_name(),
+            feature_dim=config.feature_dim,
+            num_filters=config.num_filters,
+            channels_last=config.channels_last,
+        )
+        self.encoder = make_encoder(encoder_config, self.encoded_shape).to(self.device)
+        self.transition = TransitionModel(
+            config.feature_dim, action_dim(self.action_space), config.aux_hidden_dim
+        ).to(self.device)
         self.momentum = copy.deepcopy(self.encoder).requires_grad_(False)
-        self.transition.to(self.device)
         self.similarity = BilinearSimilarity(config.feature_dim).to(self.device)
         self.optimizer = torch.optim.Adam(
             [
@@ -260,11 +227,9 @@ class CuriosityModel(OnlineModel):
             lr=config.lr,
         )
         self._windows = np.zeros((config.capacity, 4, *self.encoded_shape), dtype=np.uint8)
-        self._actions = np.zeros((config.capacity, action_dim(action_space)), dtype=np.float32)
-        self.size = 0
-        self._head = 0
+        self._actions = np.zeros((config.capacity, action_dim(self.action_space)), dtype=np.float32)
         self.feature_version = 0
-        self._init_schedule(self.encoder)
+        return self.encoder
 
     @torch.no_grad()
     def __call__(self, triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -280,26 +245,21 @@ class CuriosityModel(OnlineModel):
 
     def _store(self, triplets: np.ndarray, actions: np.ndarray, next_triplets: np.ndarray) -> None:
         """Keep frames t-2 .. t+1 of each transition (pooled) and its encoded action."""
-        n = len(triplets)
-        slots = (self._head + np.arange(n)) % self.config.capacity
+        slots = self._next_slots(len(triplets))
         self._windows[slots, :3] = self._pooled(triplets)
         self._windows[slots, 3] = self._pooled(next_triplets[:, -1])
         self._actions[slots] = encode_actions(self.action_space, actions)
-        self._head = int((self._head + n) % self.config.capacity)
-        self.size = min(self.size + n, self.config.capacity)
 
     def _sample(self) -> tuple[torch.Tensor, torch.Tensor]:
         """A batch copied out of the buffer, on the caller's thread (the buffer keeps filling)."""
-        self._need_batch()
-        idx = self.rng.integers(0, self.size, size=self.config.batch_size)
+        idx = self._batch_indices()
         window = torch.as_tensor(self._windows[idx], device=self.device)
         return window, torch.as_tensor(self._actions[idx], device=self.device)
 
-    def _train_step(
+    def _loss(
         self, window: torch.Tensor, action: torch.Tensor
-    ) -> tuple[dict[str, float], PixelEncoder]:
-        """The gradient step (on the update thread when ``background``): metrics, new weights."""
-        start = time.perf_counter()
+    ) -> tuple[torch.Tensor, dict[str, float]]:
+        """L_tran + L_con + L_tran's InfoNCE form, weighted, on a batch of windows."""
         cfg = self.config
         enc, following = self.encoder.encode_transition(window)
         with torch.no_grad():
@@ -317,16 +277,6 @@ class CuriosityModel(OnlineModel):
             + cfg.contrastive_weight * l_con
             + cfg.motion_contrastive_weight * l_motion
         )
-        if not torch.isfinite(loss):
-            raise FloatingPointError(f"the curiosity loss is {float(loss)} before this step")
-        self.optimizer.zero_grad(set_to_none=True)
-        loss.backward()
-        self.optimizer.step()
-        with torch.no_grad():
-            for ema, online_param in zip(
-                self.momentum.parameters(), self.encoder.parameters(), strict=True
-            ):
-                ema.lerp_(online_param, cfg.encoder_tau)
         metrics = {
             "transition_loss": float(l_tran.detach()),
             "contrastive_loss": float(l_con.detach()),
@@ -334,27 +284,27 @@ class CuriosityModel(OnlineModel):
             "motion_std": float(enc.motion.detach().std(0).mean()),
             "appearance_std": float(enc.anchor.detach().std(0).mean()),
         }
-        metrics["update_ms"] = 1000.0 * (time.perf_counter() - start)
-        return metrics, frozen_copy(self.encoder)
+        return loss, metrics
+
+    def _after_step(self) -> None:
+        """The momentum encoder's EMA towards the online encoder."""
+        with torch.no_grad():
+            for ema, online_param in zip(
+                self.momentum.parameters(), self.encoder.parameters(), strict=True
+            ):
+                ema.lerp_(online_param, self.config.encoder_tau)
 
     def _trained(self) -> PixelEncoder:
         return self.encoder
 
-    def _modules_state(self) -> dict[str, Any]:
+    def _stateful(self) -> dict[str, Any]:
         return {
-            "encoder": self.encoder.state_dict(),
-            "momentum": self.momentum.state_dict(),
-            "transition": self.transition.state_dict(),
-            "similarity": self.similarity.state_dict(),
-            "optimizer": self.optimizer.state_dict(),
+            "encoder": self.encoder,
+            "momentum": self.momentum,
+            "transition": self.transition,
+            "similarity": self.similarity,
+            "optimizer": self.optimizer,
         }
-
-    def _load_modules_state(self, state: dict[str, Any]) -> None:
-        self.encoder.load_state_dict(state["encoder"])
-        self.momentum.load_state_dict(state["momentum"])
-        self.transition.load_state_dict(state["transition"])
-        self.similarity.load_state_dict(state["similarity"])
-        self.optimizer.load_state_dict(state["optimizer"])
 
 
 class AgentFeatures:

@@ -9,6 +9,7 @@ samples a batch and what one gradient step does.
 from __future__ import annotations
 
 import copy
+import math
 import queue
 import threading
 import time
@@ -16,7 +17,7 @@ import weakref
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from concurrent.futures import Future
-from typing import Any, TypeVar
+from typing import Any, ClassVar, TypeVar
 
 import gymnasium as gym
 import numpy as np
@@ -24,15 +25,19 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from simoun_agent.device import default_device
 from simoun_wrappers.intrinsic_reward import triplet_shape
 
 Model = TypeVar("Model", bound="OnlineModel")
 
-__all__ = ["OnlineModel", "UpdateThread", "default_device", "frozen_copy", "run_now"]
-
-
-def default_device(device: str | torch.device | None) -> torch.device:
-    return torch.device(device or ("cuda" if torch.cuda.is_available() else "cpu"))
+__all__ = [
+    "OnlineModel",
+    "UpdateThread",
+    "check_online_config",
+    "default_device",
+    "frozen_copy",
+    "run_now",
+]
 
 
 class UpdateThread:
@@ -89,6 +94,29 @@ def run_now(work: Callable[[], Any]) -> Future:
     return future
 
 
+def check_online_config(config: Any, positive: tuple[str, ...] = ()) -> None:
+    """The checks every online model's config shares, each error naming the field and a fix:
+    ``positive`` (e.g. ``feature_dim``), ``capacity``, ``batch_size`` and ``update_every`` >= 1,
+    ``encoder_size`` None or >= 1, ``batch_size <= learning_starts <= capacity`` and ``lr`` a
+    number > 0."""
+    name = type(config).__name__
+    for field in (*positive, "capacity", "batch_size", "update_every"):
+        if getattr(config, field) < 1:
+            raise ValueError(f"{name}.{field} must be >= 1, got {getattr(config, field)}")
+    if config.encoder_size is not None and config.encoder_size < 1:
+        raise ValueError(
+            f"{name}.encoder_size must be None (full-size frames, no pooling) or a side >= 1 in "
+            f"pixels, got {config.encoder_size}; the default 42 pools 84x84 frames to 42x42."
+        )
+    if not config.batch_size <= config.learning_starts <= config.capacity:
+        raise ValueError(
+            f"{name} needs batch_size <= learning_starts <= capacity, got "
+            f"{config.batch_size}, {config.learning_starts}, {config.capacity}."
+        )
+    if not (math.isfinite(config.lr) and config.lr > 0):
+        raise ValueError(f"{name}.lr must be a number > 0, got {config.lr}; e.g. lr=1e-4.")
+
+
 def frozen_copy(module: nn.Module) -> nn.Module:
     """A copy of ``module`` that no optimizer holds: the published weights rewards come from."""
     snapshot = copy.deepcopy(module)
@@ -111,17 +139,58 @@ class OnlineModel(ABC):
     the same with and without the thread, whatever its timing. A failed step is raised by the
     first call after it failed, and the model refuses to go on until :meth:`load_state_dict`.
 
-    Subclasses are built as ``Model(frame_shape, action_space, config=None, device=None)`` (what
-    :meth:`for_env` calls); they set ``config`` (with ``update_every``, ``learning_starts``,
-    ``background``, ``batch_size``, ``lr``, ``seed``), ``device`` and ``size`` (transitions
-    stored), call :meth:`_init_frames` and, once their modules exist, :meth:`_init_schedule`,
-    and define ``_store``, ``_sample``, ``_train_step``, ``_trained`` and ``_modules_state`` /
-    ``_load_modules_state``.
+    A subclass names its ``config_type`` (a dataclass with ``encoder_size``, ``capacity``,
+    ``update_every``, ``learning_starts``, ``background``, ``batch_size``, ``lr``, ``seed``) and
+    says only what differs: the smallest frame its networks take (``_smallest_frame``), its
+    networks and optimizer (``_build``, run under the config's seed), what it stores of a
+    transition (``_store``, into the ring-buffer slots of :meth:`_next_slots`), the batch it
+    samples (``_sample``, from :meth:`_batch_indices`), its loss (``_loss``) and the objects whose
+    state it saves (``_stateful``).
     """
 
+    config_type: ClassVar[type]
+    """the config class; ``config_type()`` when a model is built without a config"""
     config: Any
     device: torch.device
     size: int
+    """transitions stored (at most ``config.capacity``)"""
+    optimizer: torch.optim.Optimizer
+
+    def __init__(
+        self,
+        frame_shape: tuple[int, int, int],
+        action_space: gym.Space | None = None,
+        config: Any = None,
+        device: str | torch.device | None = None,
+    ) -> None:
+        """Build the model.
+
+        Args:
+            frame_shape: ``(C, H, W)`` of one frame as the env gives it (pooled by
+                ``config.encoder_size``, at least the subclass's smallest side).
+            action_space: the env's action space.
+            config: hyperparameters; ``config_type()`` when None.
+            device: torch device; None picks cuda when available, else cpu.
+        """
+        self.config = config = config if config is not None else self.config_type()
+        self._init_frames(frame_shape, config.encoder_size)
+        smallest, needs, size = self._smallest_frame()
+        if min(self.encoded_shape[1:]) < smallest:
+            raise ValueError(
+                f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
+                f"{self.pool}, {type(config).__name__}.encoder_size={config.encoder_size}); "
+                f"{needs} need H, W >= {smallest}. Render larger frames (SimounObservation(env, "
+                f"size={size}) or more) or raise encoder_size."
+            )
+        self.action_space = action_space
+        self.device = default_device(device)
+        with torch.random.fork_rng(devices=[]):
+            if config.seed is not None:
+                torch.manual_seed(config.seed)
+            trained = self._build()
+        self.size = 0
+        self._head = 0
+        self._init_schedule(trained)
 
     @classmethod
     def for_env(
@@ -151,6 +220,16 @@ class OnlineModel(ABC):
         self._thread: UpdateThread | None = None
 
     @abstractmethod
+    def _smallest_frame(self) -> tuple[int, str, int]:
+        """The smallest side the networks take after pooling, what needs it (for the error) and
+        a ``SimounObservation`` size to suggest."""
+
+    @abstractmethod
+    def _build(self) -> nn.Module:
+        """Build the networks and the optimizer (under the config's seed); the trained module,
+        whose frozen copies are published."""
+
+    @abstractmethod
     def _store(self, triplets: np.ndarray, actions: np.ndarray, next_triplets: np.ndarray) -> None:
         """Keep a batch of checked transitions in the buffer and raise ``size``."""
 
@@ -159,20 +238,65 @@ class OnlineModel(ABC):
         """A batch copied out of the buffer, on the caller's thread (the buffer keeps filling)."""
 
     @abstractmethod
-    def _train_step(self, *batch: torch.Tensor) -> tuple[dict[str, float], nn.Module]:
-        """One gradient step: its metrics and a frozen copy of the new weights."""
+    def _loss(self, *batch: torch.Tensor) -> tuple[torch.Tensor, dict[str, float]]:
+        """The loss of one gradient step on ``batch`` and its metrics."""
 
     @abstractmethod
     def _trained(self) -> nn.Module:
         """The module the optimizer trains (whose frozen copies are published)."""
 
     @abstractmethod
+    def _stateful(self) -> dict[str, Any]:
+        """The modules and the optimizer, by name, whose ``state_dict`` :meth:`state_dict`
+        saves."""
+
+    def _after_step(self) -> None:
+        """Run after each optimizer step (e.g. a momentum encoder's EMA); nothing by default."""
+        return None
+
+    def _train_step(self, *batch: torch.Tensor) -> tuple[dict[str, float], nn.Module]:
+        """One gradient step (on the update thread when ``background``): its metrics with its
+        duration ``update_ms``, and a frozen copy of the new weights."""
+        start = time.perf_counter()
+        loss, metrics = self._loss(*batch)
+        if not torch.isfinite(loss):
+            raise FloatingPointError(
+                f"the {type(self).__name__} loss is {float(loss)} before this step"
+            )
+        self.optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        self.optimizer.step()
+        self._after_step()
+        metrics["update_ms"] = 1000.0 * (time.perf_counter() - start)
+        return metrics, frozen_copy(self._trained())
+
     def _modules_state(self) -> dict[str, Any]:
         """The state of the modules and the optimizer, for :meth:`state_dict`."""
+        return {name: part.state_dict() for name, part in self._stateful().items()}
 
-    @abstractmethod
     def _load_modules_state(self, state: dict[str, Any]) -> None:
         """Load what :meth:`_modules_state` returned."""
+        for name, part in self._stateful().items():
+            part.load_state_dict(state[name])
+
+    def _next_slots(self, n: int) -> np.ndarray:
+        """The ring-buffer slots of the next ``n`` transitions (the oldest overwritten once
+        ``capacity`` are stored); moves the head on and raises ``size``."""
+        capacity = self.config.capacity
+        slots = (self._head + np.arange(n)) % capacity
+        self._head = int((self._head + n) % capacity)
+        self.size = min(self.size + n, capacity)
+        return slots
+
+    def _batch_indices(self) -> np.ndarray:
+        """``batch_size`` stored slots drawn with replacement, or an error while too few are
+        stored."""
+        if self.size < self.config.batch_size:
+            raise RuntimeError(
+                f"{type(self).__name__}.update needs {self.config.batch_size} stored "
+                f"transitions, has {self.size}; call watch() more first."
+            )
+        return self.rng.integers(0, self.size, size=self.config.batch_size)
 
     def _init_frames(self, frame_shape: tuple[int, ...], encoder_size: int | None) -> None:
         """Set ``frame_shape`` (C, H, W as the env gives it), the integer average-pooling factor
@@ -234,13 +358,6 @@ class OnlineModel(ABC):
     def pending(self) -> bool:
         """True while a gradient step has been started and its weights are not yet published."""
         return self._pending is not None
-
-    def _need_batch(self) -> None:
-        if self.size < self.config.batch_size:
-            raise RuntimeError(
-                f"{type(self).__name__}.update needs {self.config.batch_size} stored "
-                f"transitions, has {self.size}; call watch() more first."
-            )
 
     def _start(self, batch: tuple[torch.Tensor, ...]) -> None:
         def work() -> tuple[dict[str, float], nn.Module]:

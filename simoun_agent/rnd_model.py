@@ -12,17 +12,15 @@ of the watched frames and clipped to [-5, 5], as in the paper.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import torch
-from gymnasium import spaces
 from gymnasium.wrappers.utils import RunningMeanStd
 from torch import nn
 
-from simoun_agent.online_model import OnlineModel, default_device, frozen_copy
+from simoun_agent.online_model import OnlineModel, check_online_config
 
 __all__ = ["RNDConfig", "RNDModel", "rnd_network"]
 
@@ -57,21 +55,7 @@ class RNDConfig:
     """seeds both networks and the buffer sampling (None: nondeterministic)"""
 
     def __post_init__(self) -> None:
-        for name in ("feature_dim", "capacity", "batch_size", "update_every"):
-            if getattr(self, name) < 1:
-                raise ValueError(f"RNDConfig.{name} must be >= 1, got {getattr(self, name)}")
-        if self.encoder_size is not None and self.encoder_size < 1:
-            raise ValueError(
-                f"RNDConfig.encoder_size must be None (no pooling) or a side >= 1 in pixels, got "
-                f"{self.encoder_size}; the default 42 pools 84x84 frames to 42x42."
-            )
-        if not self.batch_size <= self.learning_starts <= self.capacity:
-            raise ValueError(
-                f"RNDConfig needs batch_size <= learning_starts <= capacity, got "
-                f"{self.batch_size}, {self.learning_starts}, {self.capacity}."
-            )
-        if not (math.isfinite(self.lr) and self.lr > 0):
-            raise ValueError(f"RNDConfig.lr must be a number > 0, got {self.lr}; e.g. lr=1e-4.")
+        check_online_config(self, positive=("feature_dim",))
 
 
 def rnd_network(
@@ -115,7 +99,8 @@ class RNDModel(OnlineModel):
     :class:`~simoun_agent.online_model.OnlineModel` (weights published whole, the same rewards
     with and without the thread). A batch is normalized with the statistics of the moment it
     is sampled. ``last_metrics`` holds the last published step's ``loss``, ``update_ms`` and
-    ``wait_ms``. Actions are not used (RND scores states).
+    ``wait_ms``. Actions are not used (RND scores states). Frames must be at least 36x36 after
+    the pooling of ``RNDConfig.encoder_size``.
 
     Example:
         >>> import gymnasium as gym
@@ -132,40 +117,19 @@ class RNDModel(OnlineModel):
         >>> env.close()  # stops the update thread
     """
 
-    def __init__(
-        self,
-        frame_shape: tuple[int, int, int],
-        action_space: spaces.Space | None = None,
-        config: RNDConfig | None = None,
-        device: str | torch.device | None = None,
-    ) -> None:
-        """Build the model.
+    config_type = RNDConfig
 
-        Args:
-            frame_shape: ``(C, H, W)`` of one frame as the env gives it (at least 36x36 after
-                the pooling of ``config.encoder_size``).
-            action_space: the env's action space (not used: RND scores states; accepted so
-                that ``RNDModel.for_env(env)`` builds it like ``CuriosityModel``).
-            config: hyperparameters; ``RNDConfig()`` when None.
-            device: torch device; None picks cuda when available, else cpu.
-        """
-        self.config = config = config or RNDConfig()
-        self._init_frames(frame_shape, config.encoder_size)
+    def _smallest_frame(self) -> tuple[int, str, int]:
+        return SMALLEST_SIDE, "RND's convolutions", 42
+
+    def _build(self) -> nn.Module:
+        """The fixed target, the predictor and its Adam, the buffer and the running statistics
+        (``action_space`` is not used: RND scores states; ``RNDModel.for_env(env)`` passes it
+        as for ``CuriosityModel``)."""
+        config = self.config
         c, h, w = self.encoded_shape
-        if min(h, w) < SMALLEST_SIDE:
-            raise ValueError(
-                f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
-                f"{self.pool}, RNDConfig.encoder_size={config.encoder_size}); RND's convolutions "
-                f"need H, W >= {SMALLEST_SIDE}. Render larger frames (SimounObservation(env, "
-                "size=42) or more) or raise encoder_size."
-            )
-        self.action_space = action_space
-        self.device = default_device(device)
-        with torch.random.fork_rng(devices=[]):
-            if config.seed is not None:
-                torch.manual_seed(config.seed)
-            self.target = rnd_network(c, (h, w), config.feature_dim, predictor=False)
-            self.predictor = rnd_network(c, (h, w), config.feature_dim, predictor=True)
+        self.target = rnd_network(c, (h, w), config.feature_dim, predictor=False)
+        self.predictor = rnd_network(c, (h, w), config.feature_dim, predictor=True)
         self.target.to(self.device).requires_grad_(False)
         self.predictor.to(self.device)
         self.optimizer = torch.optim.Adam(self.predictor.parameters(), lr=config.lr)
@@ -173,9 +137,7 @@ class RNDModel(OnlineModel):
         self.observations = RunningMeanStd(epsilon=0.0, shape=self.encoded_shape)
         """per-pixel running mean/std of the watched frames (after pooling)"""
         self._frames = np.zeros((config.capacity, *self.encoded_shape), dtype=np.uint8)
-        self.size = 0
-        self._head = 0
-        self._init_schedule(self.predictor)
+        return self.predictor
 
     def _normalized(self, frames: np.ndarray) -> torch.Tensor:
         """uint8 pooled frames as float32, normalized by the running statistics, in [-5, 5]."""
@@ -195,47 +157,33 @@ class RNDModel(OnlineModel):
         """Keep the frame each transition reached and add it to the running statistics."""
         frames = self._pooled(next_triplets[:, -1])
         self.observations.update(frames.astype(np.float64))
-        n = len(frames)
-        slots = (self._head + np.arange(n)) % self.config.capacity
-        self._frames[slots] = frames
-        self._head = int((self._head + n) % self.config.capacity)
-        self.size = min(self.size + n, self.config.capacity)
+        self._frames[self._next_slots(len(frames))] = frames
 
     def _sample(self) -> tuple[torch.Tensor]:
-        self._need_batch()
-        idx = self.rng.integers(0, self.size, size=self.config.batch_size)
-        return (self._normalized(self._frames[idx]),)
+        return (self._normalized(self._frames[self._batch_indices()]),)
 
-    def _train_step(self, x: torch.Tensor) -> tuple[dict[str, float], nn.Module]:
-        start = time.perf_counter()
+    def _loss(self, x: torch.Tensor) -> tuple[torch.Tensor, dict[str, float]]:
         with torch.no_grad():
             target = self.target(x)
         loss = (self.predictor(x) - target).pow(2).mean()
-        if not torch.isfinite(loss):
-            raise FloatingPointError(f"the RND loss is {float(loss)} before this step")
-        self.optimizer.zero_grad(set_to_none=True)
-        loss.backward()
-        self.optimizer.step()
-        metrics = {"loss": float(loss.detach()), "update_ms": 1000 * (time.perf_counter() - start)}
-        return metrics, frozen_copy(self.predictor)
+        return loss, {"loss": float(loss.detach())}
 
     def _trained(self) -> nn.Module:
         return self.predictor
 
+    def _stateful(self) -> dict[str, Any]:
+        return {"predictor": self.predictor, "target": self.target, "optimizer": self.optimizer}
+
     def _modules_state(self) -> dict[str, Any]:
         return {
-            "predictor": self.predictor.state_dict(),
-            "target": self.target.state_dict(),
-            "optimizer": self.optimizer.state_dict(),
+            **super()._modules_state(),
             "observation_mean": self.observations.mean.copy(),
             "observation_var": self.observations.var.copy(),
             "observation_count": self.observations.count,
         }
 
     def _load_modules_state(self, state: dict[str, Any]) -> None:
-        self.predictor.load_state_dict(state["predictor"])
-        self.target.load_state_dict(state["target"])
-        self.optimizer.load_state_dict(state["optimizer"])
+        super()._load_modules_state(state)
         self.observations.mean = np.array(state["observation_mean"], dtype=np.float64)
         self.observations.var = np.array(state["observation_var"], dtype=np.float64)
         self.observations.count = float(state["observation_count"])

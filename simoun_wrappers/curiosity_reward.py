@@ -98,7 +98,46 @@ class ConsistencySignal(IntrinsicSignal):
         self.step = int(state["step"])
 
 
-class ConsistencyCuriosityReward(IntrinsicReward, gym.utils.RecordConstructorArgs):
+class ConsistencyArguments:
+    """The consistency wrappers' constructor: ``features`` and Eq. 13's constants."""
+
+    signal_type = ConsistencySignal
+
+    def __init__(
+        self,
+        env: gym.Env | VectorEnv,
+        features: FeatureSource,
+        scale: float = 0.2,
+        decay: float = 2e-5,
+        r_e_max_init: float = 1.0,
+        r_i_max_init: float = 1.0,
+    ) -> None:
+        """Wrap ``env``, whose observations are Simoun triplets.
+
+        Args:
+            env: an env yielding ``SimounObservation`` observations (Dict with ``"frames"``, or
+                the folded ``(3C, H, W)`` Box): a single env for
+                :class:`ConsistencyCuriosityReward`, a vector env for
+                :class:`ConsistencyCuriosityVectorReward`.
+            features: the :class:`FeatureSource` giving ``f_m`` and ``f_a``.
+            scale: the temperature weight C of Eq. 13.
+            decay: lambda of Eq. 13, per environment step.
+            r_e_max_init: initial running maximum of ``|r_e|`` (> 0).
+            r_i_max_init: initial running maximum of ``d`` (> 0). Both defaults match
+                ``simoun_agent.AgentConfig``; a tiny ``r_i_max_init`` lets the first distances set
+                the scale instead.
+        """
+        super().__init__(
+            env,
+            scale,
+            features=features,
+            decay=decay,
+            r_e_max_init=r_e_max_init,
+            r_i_max_init=r_i_max_init,
+        )
+
+
+class ConsistencyCuriosityReward(ConsistencyArguments, IntrinsicReward):
     """Add Simoun's consistency-guided intrinsic reward (Eq. 13) to the env's reward.
 
     At every step the wrapper encodes the new observation's triplet ``[o_{t-1}, o_t, o_{t+1}]``
@@ -133,41 +172,8 @@ class ConsistencyCuriosityReward(IntrinsicReward, gym.utils.RecordConstructorArg
         True
     """
 
-    def __init__(
-        self,
-        env: gym.Env,
-        features: FeatureSource,
-        scale: float = 0.2,
-        decay: float = 2e-5,
-        r_e_max_init: float = 1.0,
-        r_i_max_init: float = 1.0,
-    ) -> None:
-        """Wrap ``env``, whose observations are Simoun triplets.
 
-        Args:
-            env: an env yielding ``SimounObservation`` observations (Dict with ``"frames"``, or
-                the folded ``(3C, H, W)`` Box).
-            features: the :class:`FeatureSource` giving ``f_m`` and ``f_a``.
-            scale: the temperature weight C of Eq. 13.
-            decay: lambda of Eq. 13, per environment step.
-            r_e_max_init: initial running maximum of ``|r_e|`` (> 0).
-            r_i_max_init: initial running maximum of ``d`` (> 0). Both defaults match
-                ``simoun_agent.AgentConfig``; a tiny ``r_i_max_init`` lets the first distances set
-                the scale instead.
-        """
-        gym.utils.RecordConstructorArgs.__init__(
-            self,
-            features=SharedSource(features),
-            scale=scale,
-            decay=decay,
-            r_e_max_init=r_e_max_init,
-            r_i_max_init=r_i_max_init,
-        )
-        signal = ConsistencySignal(features, decay, r_e_max_init, r_i_max_init)
-        IntrinsicReward.__init__(self, env, signal, scale)
-
-
-class ConsistencyCuriosityVectorReward(IntrinsicVectorReward, gym.utils.RecordConstructorArgs):
+class ConsistencyCuriosityVectorReward(ConsistencyArguments, IntrinsicVectorReward):
     """Eq. 13's intrinsic reward for every sub-env of a vector env, in one batched feature call.
 
     Same reward as :class:`ConsistencyCuriosityReward`, but one feature source and one running
@@ -196,24 +202,3 @@ class ConsistencyCuriosityVectorReward(IntrinsicVectorReward, gym.utils.RecordCo
         >>> rewards.shape, info["reward_intrinsic"].shape
         ((2,), (2,))
     """
-
-    def __init__(
-        self,
-        env: VectorEnv,
-        features: FeatureSource,
-        scale: float = 0.2,
-        decay: float = 2e-5,
-        r_e_max_init: float = 1.0,
-        r_i_max_init: float = 1.0,
-    ) -> None:
-        """Wrap the vector env ``env``; arguments as in :class:`ConsistencyCuriosityReward`."""
-        gym.utils.RecordConstructorArgs.__init__(
-            self,
-            features=SharedSource(features),
-            scale=scale,
-            decay=decay,
-            r_e_max_init=r_e_max_init,
-            r_i_max_init=r_i_max_init,
-        )
-        signal = ConsistencySignal(features, decay, r_e_max_init, r_i_max_init)
-        IntrinsicVectorReward.__init__(self, env, signal, scale)

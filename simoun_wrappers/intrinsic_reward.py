@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from typing import Any, SupportsFloat
+from typing import Any, ClassVar, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
@@ -122,18 +122,12 @@ class IntrinsicSignal(ABC):
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what :meth:`state_dict` returned."""
 
-    def watch(
-        self,
-        triplets: np.ndarray,
-        actions: np.ndarray,
-        next_triplets: np.ndarray,
-        terminated: np.ndarray,
-        truncated: np.ndarray,
-    ) -> None:
-        """Hand the transitions to the source when it learns online."""
+    def watch(self, *transitions: np.ndarray) -> None:
+        """Hand a batch of ``transitions`` (``triplets, actions, next_triplets, terminated,
+        truncated``, the source's ``watch`` arguments) to the source when it learns online."""
         watch = getattr(self.source, "watch", None)
-        if watch is not None and len(triplets):
-            watch(triplets, actions, next_triplets, terminated, truncated)
+        if watch is not None and len(transitions[0]):
+            watch(*transitions)
 
     def close(self) -> None:
         """Close the source when it has a ``close`` (a model's update thread)."""
@@ -163,9 +157,21 @@ def check_extrinsic(extrinsic: np.ndarray) -> None:
 
 
 class IntrinsicState:
-    """The wrappers' ``state_dict`` / ``load_state_dict`` / ``close``, from their signal."""
+    """What the two wrappers share: building their signal from the constructor's arguments, and
+    ``state_dict`` / ``load_state_dict`` / ``close`` from it."""
 
+    signal_type: ClassVar[type[IntrinsicSignal]]
+    """the signal a wrapper class builds, from its constructor's arguments but ``env`` and
+    ``scale``"""
     curiosity: IntrinsicSignal
+
+    def _build_signal(self, scale: float, arguments: dict[str, Any]) -> IntrinsicSignal:
+        """Record the constructor's arguments for ``env.spec`` (the source, the first of
+        ``arguments``, held by reference: see :class:`SharedSource`) and build the signal."""
+        name, source = next(iter(arguments.items()))
+        recorded = {**arguments, name: SharedSource(SharedSource.unwrap(source)), "scale": scale}
+        gym.utils.RecordConstructorArgs.__init__(self, **recorded)
+        return self.signal_type(**arguments)
 
     def state_dict(self) -> dict[str, Any]:
         """The signal's running statistics (the source keeps its own state)."""
@@ -184,15 +190,18 @@ class IntrinsicState:
             self.curiosity.close()
 
 
-class IntrinsicReward(IntrinsicState, gym.Wrapper):
-    """``r_e + scale * r_i`` for a single env, ``r_i`` from ``signal`` on the triplet reached.
+class IntrinsicReward(IntrinsicState, gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """``r_e + scale * r_i`` for a single env, ``r_i`` from the class's signal on the triplet
+    reached.
 
     ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` (``scale * r_i``); the
     reward returned is their sum. Subclasses (``ConsistencyCuriosityReward``, ``RNDReward``)
-    record their own constructor arguments and build their signal.
+    name their ``signal_type`` and give their constructor's signature.
     """
 
-    def __init__(self, env: gym.Env, signal: IntrinsicSignal, scale: float) -> None:
+    def __init__(self, env: gym.Env, scale: float, **arguments: Any) -> None:
+        """Wrap ``env``; ``arguments``: the signal's, its source first (recorded in
+        ``env.spec``)."""
         if isinstance(env, VectorEnv):
             vector = type(self).__name__.replace("Reward", "VectorReward")
             raise TypeError(
@@ -200,9 +209,10 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper):
                 f"{vector}(envs, ...) on the vector env, or put {type(self).__name__} in each "
                 "sub-env (gym.make_vec(..., wrappers=[...]))"
             )
+        self.scale = check_scale(scale)
+        signal = self._build_signal(scale, arguments)
         gym.Wrapper.__init__(self, env)
         self._read = triplet_reader(env.observation_space)
-        self.scale = check_scale(scale)
         self.curiosity = signal
         self._last_triplet: np.ndarray | None = None
 
@@ -234,7 +244,7 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper):
         return obs, extrinsic + intrinsic, terminated, truncated, info
 
 
-class IntrinsicVectorReward(IntrinsicState, VectorWrapper):
+class IntrinsicVectorReward(IntrinsicState, VectorWrapper, gym.utils.RecordConstructorArgs):
     """``r_e + scale * r_i`` for every sub-env of a vector env, in one batched signal call.
 
     One signal (one source, one set of running statistics) serves all sub-envs, and the triplets
@@ -247,10 +257,12 @@ class IntrinsicVectorReward(IntrinsicState, VectorWrapper):
     ``"reward_intrinsic"`` arrays of shape ``(num_envs,)``.
     """
 
-    def __init__(self, env: VectorEnv, signal: IntrinsicSignal, scale: float) -> None:
+    def __init__(self, env: VectorEnv, scale: float, **arguments: Any) -> None:
+        """Wrap the vector env ``env``; ``arguments`` as in :class:`IntrinsicReward`."""
+        self.scale = check_scale(scale)
+        signal = self._build_signal(scale, arguments)
         VectorWrapper.__init__(self, env)
         self._read = triplet_reader(env.single_observation_space)
-        self.scale = check_scale(scale)
         self.curiosity = signal
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
         self._prev_dones = np.zeros(self.num_envs, dtype=bool)

@@ -118,7 +118,33 @@ class RNDSignal(IntrinsicSignal):
         self.scored = int(state["scored"])
 
 
-class RNDReward(IntrinsicReward, gym.utils.RecordConstructorArgs):
+class RNDArguments:
+    """The RND wrappers' constructor: the novelty source, the scale and the warm-up."""
+
+    signal_type = RNDSignal
+
+    def __init__(
+        self,
+        env: gym.Env | VectorEnv,
+        novelty: NoveltySource,
+        scale: float = 0.05,
+        warmup: int = 1024,
+    ) -> None:
+        """Wrap ``env``, whose observations are Simoun triplets.
+
+        Args:
+            env: an env yielding ``SimounObservation`` observations (Dict with ``"frames"``, or
+                the folded ``(3C, H, W)`` Box): a single env for :class:`RNDReward`, a vector
+                env for :class:`RNDVectorReward`.
+            novelty: the :class:`NoveltySource`, e.g. ``RNDModel.for_env(env)``.
+            scale: the weight of the normalized error in the reward.
+            warmup: transitions that get reward 0 while the statistics settle (see
+                :class:`RNDSignal`); 1024 is one PPO rollout of 8 sub-envs x 128 steps.
+        """
+        super().__init__(env, scale, novelty=novelty, warmup=warmup)
+
+
+class RNDReward(RNDArguments, IntrinsicReward):
     """Add random network distillation's novelty bonus to the env's reward.
 
     ``r = r_e + scale * e / std(e)``: ``e`` is the novelty source's error on the newest frame of
@@ -143,30 +169,8 @@ class RNDReward(IntrinsicReward, gym.utils.RecordConstructorArgs):
         True
     """
 
-    def __init__(
-        self,
-        env: gym.Env,
-        novelty: NoveltySource,
-        scale: float = 0.05,
-        warmup: int = 1024,
-    ) -> None:
-        """Wrap ``env``, whose observations are Simoun triplets.
 
-        Args:
-            env: an env yielding ``SimounObservation`` observations (Dict with ``"frames"``, or
-                the folded ``(3C, H, W)`` Box).
-            novelty: the :class:`NoveltySource`, e.g. ``RNDModel.for_env(env)``.
-            scale: the weight of the normalized error in the reward.
-            warmup: transitions that get reward 0 while the statistics settle (see
-                :class:`RNDSignal`); 1024 is one PPO rollout of 8 sub-envs x 128 steps.
-        """
-        gym.utils.RecordConstructorArgs.__init__(
-            self, novelty=SharedSource(novelty), scale=scale, warmup=warmup
-        )
-        IntrinsicReward.__init__(self, env, RNDSignal(novelty, warmup), scale)
-
-
-class RNDVectorReward(IntrinsicVectorReward, gym.utils.RecordConstructorArgs):
+class RNDVectorReward(RNDArguments, IntrinsicVectorReward):
     """Random network distillation's bonus for every sub-env of a vector env, in one call.
 
     Same reward as :class:`RNDReward`; one source and one set of error statistics serve all
@@ -190,16 +194,3 @@ class RNDVectorReward(IntrinsicVectorReward, gym.utils.RecordConstructorArgs):
         >>> rewards.shape, info["reward_intrinsic"].shape
         ((2,), (2,))
     """
-
-    def __init__(
-        self,
-        env: VectorEnv,
-        novelty: NoveltySource,
-        scale: float = 0.05,
-        warmup: int = 1024,
-    ) -> None:
-        """Wrap the vector env ``env``; arguments as in :class:`RNDReward`."""
-        gym.utils.RecordConstructorArgs.__init__(
-            self, novelty=SharedSource(novelty), scale=scale, warmup=warmup
-        )
-        IntrinsicVectorReward.__init__(self, env, RNDSignal(novelty, warmup), scale)

@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 import torch
 
-from simoun_agent.run import evaluate, train
+from simoun_agent.cli import eval as eval_cli
+from simoun_agent.cli import train as train_cli
 from simoun_agent.run.logger import read_csv
 
 TINY = [
@@ -51,11 +52,11 @@ def exit_message(capsys, main, argv) -> str:
 def finished(tmp_path_factory) -> Path:
     """A finished 40-step run (evaluations at 0, 20 and 40)."""
     run_dir = tmp_path_factory.mktemp("runs") / "finished"
-    assert train.main(run_flags(run_dir, 40, "--no-progress", "--no-video")) == 0
+    assert train_cli.main(run_flags(run_dir, 40, "--no-progress", "--no-video")) == 0
     return run_dir
 
 
-@pytest.mark.parametrize("main", [train.main, evaluate.main])
+@pytest.mark.parametrize("main", [train_cli.main, eval_cli.main])
 def test_version(main, capsys):
     with pytest.raises(SystemExit) as exit_info:
         main(["--version"])
@@ -72,7 +73,7 @@ def test_version(main, capsys):
     ],
 )
 def test_boolean_switches_and_the_old_spelling(switches, progress, video, tmp_path):
-    assert train.main(run_flags(tmp_path / "run", 20, *switches)) == 0
+    assert train_cli.main(run_flags(tmp_path / "run", 20, *switches)) == 0
     config = json.loads((tmp_path / "run" / "config.json").read_text())
     assert (config["progress"], config["video"]) == (progress, video)
 
@@ -80,16 +81,16 @@ def test_boolean_switches_and_the_old_spelling(switches, progress, video, tmp_pa
 def test_simoun_eval_takes_the_same_switches(finished, tmp_path):
     out = tmp_path / "ev"
     argv = [str(finished), "--episodes", "1", "--out", str(out), "--no-video", "--no-progress"]
-    assert evaluate.main(argv) == 0
+    assert eval_cli.main(argv) == 0
     assert not (out / "video.mp4").exists()
-    assert evaluate.main([*argv[:-2], "--video", "true", "--overwrite"]) == 0
+    assert eval_cli.main([*argv[:-2], "--video", "true", "--overwrite"]) == 0
     assert (out / "video.mp4").stat().st_size > 0
 
 
 def test_without_a_terminal_one_status_line_per_evaluation_and_no_bar(tmp_path):
     run_dir = tmp_path / "run"
     done = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.run.train", *run_flags(run_dir, 40, "--no-video")],
+        [sys.executable, "-m", "simoun_agent.cli.train", *run_flags(run_dir, 40, "--no-video")],
         capture_output=True,
         text=True,
         timeout=300,
@@ -103,13 +104,17 @@ def test_without_a_terminal_one_status_line_per_evaluation_and_no_bar(tmp_path):
 
 def test_resume_to_fewer_steps_than_done_is_refused_and_changes_nothing(finished, capsys):
     before = {name: (finished / name).read_bytes() for name in ("eval.csv", "summary.json")}
-    err = exit_message(capsys, train.main, ["--resume", str(finished), "--total-env-steps", "20"])
+    err = exit_message(
+        capsys, train_cli.main, ["--resume", str(finished), "--total-env-steps", "20"]
+    )
     assert "--total-env-steps 20" in err and "40" in err
     assert {name: (finished / name).read_bytes() for name in before} == before
 
 
 CRASH_AFTER_FIRST_EVALUATION = """
 import os, signal, sys
+from simoun_agent.cli import train as train_cli
+from simoun_agent.cli import eval as eval_cli
 from simoun_agent.run import train
 
 class Crash(train.TrainCallback):
@@ -118,7 +123,7 @@ class Crash(train.TrainCallback):
 
 plain = train.train
 train.train = lambda run, callbacks=(): plain(run, [*callbacks, Crash()])
-sys.exit(train.main(sys.argv[1:]))
+sys.exit(train_cli.main(sys.argv[1:]))
 """
 
 
@@ -133,15 +138,15 @@ def test_rerun_after_a_crash_before_the_first_checkpoint_offers_overwrite(tmp_pa
     assert crashed.returncode == -signal.SIGKILL
     assert (run_dir / "config.json").exists() and not (run_dir / "checkpoint.pt").exists()
 
-    assert "--overwrite" in exit_message(capsys, train.main, flags)
-    assert "--overwrite" in exit_message(capsys, train.main, ["--resume", str(run_dir)])
-    assert train.main([*flags, "--overwrite"]) == 0
+    assert "--overwrite" in exit_message(capsys, train_cli.main, flags)
+    assert "--overwrite" in exit_message(capsys, train_cli.main, ["--resume", str(run_dir)])
+    assert train_cli.main([*flags, "--overwrite"]) == 0
     assert (run_dir / "summary.json").exists()
     assert [row["env_step"] for row in read_csv(run_dir / "eval.csv")] == [0, 20]
 
 
 def test_overwrite_never_deletes_a_run_with_a_checkpoint(finished, capsys):
-    err = exit_message(capsys, train.main, [*run_flags(finished, 40), "--overwrite"])
+    err = exit_message(capsys, train_cli.main, [*run_flags(finished, 40), "--overwrite"])
     assert "--resume" in err
     assert (finished / "checkpoint.pt").exists() and (finished / "summary.json").exists()
 
@@ -150,7 +155,7 @@ def test_a_second_trainer_on_the_same_run_dir_is_refused_with_the_first_pid(tmp_
     run_dir = tmp_path / "run"
     long_run = run_flags(run_dir, 1000000, "--no-progress", "--no-video", "--eval-every", "1000000")
     first = subprocess.Popen(
-        [sys.executable, "-m", "simoun_agent.run.train", *long_run],
+        [sys.executable, "-m", "simoun_agent.cli.train", *long_run],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
@@ -160,7 +165,7 @@ def test_a_second_trainer_on_the_same_run_dir_is_refused_with_the_first_pid(tmp_
             assert first.poll() is None and time.monotonic() < deadline
             time.sleep(0.2)
         for argv in (run_flags(run_dir, 40), ["--resume", str(run_dir)]):
-            assert f"PID {first.pid}" in exit_message(capsys, train.main, argv)
+            assert f"PID {first.pid}" in exit_message(capsys, train_cli.main, argv)
     finally:
         first.kill()
         first.wait()
@@ -168,21 +173,21 @@ def test_a_second_trainer_on_the_same_run_dir_is_refused_with_the_first_pid(tmp_
 
 def test_simoun_eval_does_not_overwrite_an_earlier_evaluation(finished, capsys):
     argv = [str(finished), "--episodes", "1", "--no-video"]
-    assert evaluate.main(argv) == 0
+    assert eval_cli.main(argv) == 0
     written = (finished / "eval-40" / "metrics.json").read_bytes()
-    err = exit_message(capsys, evaluate.main, argv)
+    err = exit_message(capsys, eval_cli.main, argv)
     assert "eval-40" in err and "--overwrite" in err and "--out" in err
     assert (finished / "eval-40" / "metrics.json").read_bytes() == written
-    assert evaluate.main([*argv, "--overwrite"]) == 0
+    assert eval_cli.main([*argv, "--overwrite"]) == 0
 
 
 def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
     run_dir = tmp_path / "highway"
     highway = '{"config": {"action": {"type": "ContinuousAction"}, "duration": 4}}'
     flags = [*TINY, "--env", "highway-fast-v0", "--env-kwargs", highway]
-    assert train.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "12"]) == 0
+    assert train_cli.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "12"]) == 0
     process = subprocess.Popen(
-        [sys.executable, "-m", "simoun_agent.run.evaluate", str(run_dir), "--episodes", "10000"],
+        [sys.executable, "-m", "simoun_agent.cli.eval", str(run_dir), "--episodes", "10000"],
         stderr=subprocess.PIPE,
         text=True,
         env={**os.environ, "SDL_NO_SIGNAL_HANDLERS": "0", "PYTHONUNBUFFERED": "1"},
@@ -210,7 +215,7 @@ def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
 
 
 def test_simoun_eval_refuses_a_negative_seed(finished, capsys):
-    err = exit_message(capsys, evaluate.main, [str(finished), "--seed", "-1", "--no-video"])
+    err = exit_message(capsys, eval_cli.main, [str(finished), "--seed", "-1", "--no-video"])
     assert "--seed -1" in err
 
 
@@ -227,13 +232,13 @@ def test_env_module_is_saved_so_resume_and_simoun_eval_rebuild_the_env(tmp_path,
     monkeypatch.syspath_prepend(str(tmp_path))
     run_dir = tmp_path / "run"
     flags = [*TINY, "--env", "simoun_test_envs:simoun-test/WideReach-v0", "--no-progress"]
-    assert train.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "20"]) == 0
+    assert train_cli.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "20"]) == 0
     config = json.loads((run_dir / "config.json").read_text())
     assert (config["env"], config["env_module"]) == ("simoun-test/WideReach-v0", "simoun_test_envs")
-    assert train.main(["--resume", str(run_dir), "--total-env-steps", "40", "--no-video"]) == 0
+    assert train_cli.main(["--resume", str(run_dir), "--total-env-steps", "40", "--no-video"]) == 0
     # a fresh interpreter knows the id only by importing the module that config.json names
     done = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.run.evaluate", str(run_dir), "--episodes", "1"],
+        [sys.executable, "-m", "simoun_agent.cli.eval", str(run_dir), "--episodes", "1"],
         capture_output=True,
         text=True,
         timeout=300,
@@ -246,10 +251,10 @@ def test_env_module_is_saved_so_resume_and_simoun_eval_rebuild_the_env(tmp_path,
 def test_a_missing_env_module_and_bad_env_kwargs_end_in_one_line_not_a_traceback(tmp_path, capsys):
     run_dir = tmp_path / "run"
     flags = [*run_flags(run_dir, 20), "--env", "simoun_no_such_package:Thing-v0"]
-    err = exit_message(capsys, train.main, flags)
+    err = exit_message(capsys, train_cli.main, flags)
     assert "'simoun_no_such_package' is not installed" in err and "pip install" in err
     flags = [*run_flags(run_dir, 20), "--env-kwargs", '{"foo": 1}']
-    err = exit_message(capsys, train.main, flags)
+    err = exit_message(capsys, train_cli.main, flags)
     assert err == (
         "simoun-train: error: --env-kwargs: simoun/PointReach-v0 takes no keyword 'foo'; it "
         "accepts: max_steps, size, step_size\n"
@@ -261,7 +266,7 @@ def test_set_with_a_misspelled_key_suggests_by_meaning_and_takes_the_flag_spelli
     tmp_path, capsys
 ):
     err = exit_message(
-        capsys, train.main, [*run_flags(tmp_path / "run"), "--set", "agent.learning_rate=3e-4"]
+        capsys, train_cli.main, [*run_flags(tmp_path / "run"), "--set", "agent.learning_rate=3e-4"]
     )
     assert "unknown config key agent.learning_rate (did you mean agent.lr?)" in err
     argv = [
@@ -269,7 +274,7 @@ def test_set_with_a_misspelled_key_suggests_by_meaning_and_takes_the_flag_spelli
         "--set",
         "agent.batch-size=10",
     ]
-    assert train.main(argv) == 0
+    assert train_cli.main(argv) == 0
     assert json.loads((tmp_path / "run" / "config.json").read_text())["agent"]["batch_size"] == 10
 
 
@@ -277,7 +282,7 @@ def test_frames_too_large_for_the_memory_are_refused_before_anything_is_built(tm
     run_dir = tmp_path / "run"
     # 512x512 frames at batch 512: hundreds of GB for one update, on any machine
     flags = [*run_flags(run_dir, 20), "--image-size", "512", "--agent.batch-size", "512"]
-    err = exit_message(capsys, train.main, [*flags, "--replay-capacity", "1000"])
+    err = exit_message(capsys, train_cli.main, [*flags, "--replay-capacity", "1000"])
     assert "--image-size 512 with --agent.batch-size 512" in err
     assert "GB" in err and "Lower --agent.batch-size to about" in err
     assert not run_dir.exists()
@@ -289,7 +294,7 @@ def test_resume_changes_torch_threads_even_to_the_saved_value(finished, tmp_path
     saved = json.loads((run_dir / "config.json").read_text())["torch_threads"]
     for threads, steps in ((saved, 60), (saved + 1, 80)):
         argv = ["--resume", str(run_dir), "--torch-threads", str(threads), "--no-video"]
-        assert train.main([*argv, "--total-env-steps", str(steps), "--no-progress"]) == 0
+        assert train_cli.main([*argv, "--total-env-steps", str(steps), "--no-progress"]) == 0
         assert json.loads((run_dir / "config.json").read_text())["torch_threads"] == threads
 
 
@@ -299,12 +304,12 @@ def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path,
     try:
         torch.set_num_threads(saved + 1)
         argv = [str(finished), "--episodes", "1", "--no-video", "--out", str(tmp_path / "ev")]
-        assert evaluate.main(argv) == 0
+        assert eval_cli.main(argv) == 0
         assert torch.get_num_threads() == saved
-        assert evaluate.main([*argv, "--overwrite", "--torch-threads", str(saved + 1)]) == 0
+        assert eval_cli.main([*argv, "--overwrite", "--torch-threads", str(saved + 1)]) == 0
         assert torch.get_num_threads() == saved + 1
         report = [*argv, "--torch-threads", "2", "--distraction", "train"]
-        err = exit_message(capsys, evaluate.main, report)
+        err = exit_message(capsys, eval_cli.main, report)
         assert "--torch-threads" in err and "each run's own" in err
     finally:
         torch.set_num_threads(threads)
@@ -312,13 +317,13 @@ def test_simoun_eval_uses_the_runs_torch_threads_unless_told(finished, tmp_path,
 
 def test_help_says_evaluations_wait_for_the_episode_end(capsys):
     with pytest.raises(SystemExit):
-        train.main(["--help"])
+        train_cli.main(["--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "environment steps between evaluations (run at the next episode end)" in text
 
 
 def test_a_refused_distraction_leaves_no_report_directory(finished, capsys):
-    err = exit_message(capsys, evaluate.main, [str(finished), "--distraction", "color_hard"])
+    err = exit_message(capsys, eval_cli.main, [str(finished), "--distraction", "color_hard"])
     assert "needs a dm_control task" in err
     assert not (finished / "generalization").exists()
 
@@ -329,7 +334,7 @@ def test_resume_of_a_read_only_run_directory_is_one_clear_error(finished):
     # outside the child
     script = (
         f'mount --bind -o ro "{finished}" "{finished}" && exec "{sys.executable}" -m '
-        f'simoun_agent.run.train --resume "{finished}" --total-env-steps 400'
+        f'simoun_agent.cli.train --resume "{finished}" --total-env-steps 400'
     )
     probe = subprocess.run(
         ["unshare", "-rm", "sh", "-c", f'mount --bind -o ro "{finished}" "{finished}"'],

@@ -8,7 +8,6 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
-import stable_baselines3 as sb3
 from stable_baselines3.common import callbacks
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
@@ -33,7 +32,7 @@ class RewardsSeen(callbacks.BaseCallback):
         return True
 
 
-def test_ppo_trains_on_extrinsic_plus_intrinsic_reward_through_the_wrapper():
+def test_ppo_trains_on_extrinsic_plus_intrinsic_reward_through_the_wrapper(small_ppo):
     # SB3's NatureCNN needs frames of at least 36x36; the folded triplet is its (9, H, W) image.
     env = SimounObservation(gym.make("simoun/PointReach-v0"), size=36, fold_frames=True)
     config = CuriosityConfig(
@@ -42,16 +41,7 @@ def test_ppo_trains_on_extrinsic_plus_intrinsic_reward_through_the_wrapper():
     )  # fmt: skip
     model = CuriosityModel.for_env(env, config, device="cpu")
     env = ConsistencyCuriosityReward(env, model)
-    ppo = sb3.PPO(
-        "CnnPolicy",
-        env,
-        n_steps=64,
-        batch_size=32,
-        n_epochs=1,
-        policy_kwargs={"features_extractor_kwargs": {"features_dim": 32}},
-        device="cpu",
-        seed=0,
-    )
+    ppo = small_ppo(env)
     seen = RewardsSeen()
     ppo.learn(total_timesteps=192, callback=seen)
     assert ppo.num_timesteps == 192

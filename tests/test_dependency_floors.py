@@ -13,7 +13,7 @@ import torch
 from packaging.requirements import Requirement
 from packaging.version import Version
 
-from simoun_agent.run import train
+from simoun_agent.cli import train as train_cli
 from simoun_agent.run.logger import CURVE_PNG
 
 EXTRAS = ("dmc", "highway", "minigrid", "multiagent", "sb3")
@@ -75,7 +75,7 @@ def test_a_tiny_training_run_draws_resizes_logs_and_records(tmp_path):
         "--agent.hidden-dim", "16", "--agent.aux-hidden-dim", "16", "--run-dir", str(run_dir),
         "--no-progress", "--video",
     ]  # fmt: skip
-    assert train.main(argv) == 0
+    assert train_cli.main(argv) == 0
     assert (run_dir / CURVE_PNG).stat().st_size > 1000
     assert (run_dir / "video.mp4").stat().st_size > 0
     assert any(path.name.startswith("events.out.tfevents") for path in (run_dir / "tb").iterdir())

@@ -7,9 +7,10 @@ import shutil
 import numpy as np
 import pytest
 
+from simoun_agent.cli import eval as eval_cli
+from simoun_agent.cli import train as train_cli
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.generalization import DISTRACTIONS, check_supported, make_distracted_env
-from simoun_agent.run import evaluate, train
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -46,14 +47,14 @@ MODES = list(DISTRACTIONS)
 def runs(tmp_path_factory):
     """One tiny trained run and an exact copy of it, as two runs of one report."""
     root = tmp_path_factory.mktemp("runs")
-    assert train.main([*TINY_FLAGS, "--run-dir", str(root / "a")]) == 0
+    assert train_cli.main([*TINY_FLAGS, "--run-dir", str(root / "a")]) == 0
     shutil.copytree(root / "a", root / "b")
     return root
 
 
 def test_simoun_eval_distraction_writes_table_csv_and_chart(runs, capsys):
     argv = [str(runs / "a"), str(runs / "b"), "--distraction", ",".join(MODES), "--episodes", "1"]
-    assert evaluate.main(argv) == 0
+    assert eval_cli.main(argv) == 0
     out = runs / "generalization"
     with (out / "generalization.csv").open(newline="") as f:
         rows = list(csv.DictReader(f))
@@ -69,7 +70,7 @@ def test_simoun_eval_distraction_writes_table_csv_and_chart(runs, capsys):
     # The train mode is the plain evaluation on the same episodes.
     plain = runs / "plain"
     assert (
-        evaluate.main([str(runs / "a"), "--episodes", "1", "--no-video", "--out", str(plain)]) == 0
+        eval_cli.main([str(runs / "a"), "--episodes", "1", "--no-video", "--out", str(plain)]) == 0
     )
     metrics = json.loads((plain / "metrics.json").read_text())
     assert float(rows[0]["return_mean"]) == pytest.approx(metrics["return_mean"])
@@ -95,23 +96,23 @@ def test_each_mode_changes_only_the_pixels_of_the_runs_stack():
 
 def test_bad_distraction_input_is_a_clear_error(runs, tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_info:
-        evaluate.main([str(runs / "a"), "--distraction", "train,colr_hard"])
+        eval_cli.main([str(runs / "a"), "--distraction", "train,colr_hard"])
     assert exit_info.value.code == 2
     assert "did you mean 'color_hard'?" in capsys.readouterr().err
 
     (tmp_path / "clip.mp4").write_bytes(b"not a video")
     with pytest.raises(SystemExit) as exit_info:
-        evaluate.main([str(runs / "a"), "--distraction", "video_hard", "--videos", str(tmp_path)])
+        eval_cli.main([str(runs / "a"), "--distraction", "video_hard", "--videos", str(tmp_path)])
     assert exit_info.value.code == 2
     assert "no readable video" in capsys.readouterr().err
 
     with pytest.raises(SystemExit) as exit_info:
-        evaluate.main([str(runs / "a"), str(runs / "b")])
+        eval_cli.main([str(runs / "a"), str(runs / "b")])
     assert "go with --distraction" in capsys.readouterr().err
 
     (tmp_path / "generalization.csv").write_text("run,mode\n")
     with pytest.raises(SystemExit) as exit_info:
-        evaluate.main([str(runs / "a"), "--distraction", "train", "--out", str(tmp_path)])
+        eval_cli.main([str(runs / "a"), "--distraction", "train", "--out", str(tmp_path)])
     assert "--overwrite" in capsys.readouterr().err
 
     point_reach = resolve(None, {"env": "simoun/PointReach-v0"})
@@ -125,7 +126,7 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
     from simoun_agent.run.logger import read_csv
 
     flags = ["--eval-distraction", "video_hard", "--eval-distraction", "color_easy"]
-    assert train.main([*TINY_FLAGS, *flags, "--run-dir", str(runs / "curves")]) == 0
+    assert train_cli.main([*TINY_FLAGS, *flags, "--run-dir", str(runs / "curves")]) == 0
     saved = json.loads((runs / "curves" / "config.json").read_text())
     assert saved["eval_distraction"] == ["video_hard", "color_easy"]
     rows = read_csv(runs / "curves" / "eval.csv")
@@ -148,7 +149,7 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
 )
 def test_bad_eval_distraction_is_refused_before_training(tmp_path, capsys, flags, message):
     with pytest.raises(SystemExit) as exit_info:
-        train.main([*TINY_FLAGS, *flags, "--run-dir", str(tmp_path / "run")])
+        train_cli.main([*TINY_FLAGS, *flags, "--run-dir", str(tmp_path / "run")])
     assert exit_info.value.code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "run" / "config.json").exists()

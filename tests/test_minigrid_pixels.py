@@ -6,7 +6,6 @@ import gymnasium as gym
 import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
 import numpy as np
 import pytest
-import stable_baselines3 as sb3
 from gymnasium.utils.env_checker import check_env
 from minigrid.wrappers import ImgObsWrapper, RGBImgPartialObsWrapper
 from stable_baselines3.common import callbacks
@@ -83,18 +82,9 @@ class RewardsSeen(callbacks.BaseCallback):
 
 
 @pytest.mark.parametrize("arm", ["consistency", "rnd"])
-def test_ppo_trains_on_extrinsic_plus_intrinsic(arm):
+def test_ppo_trains_on_extrinsic_plus_intrinsic(arm, small_ppo):
     env = consistency(pixels(fold_frames=True)) if arm == "consistency" else rnd(pixels(True))
-    ppo = sb3.PPO(
-        "CnnPolicy",
-        env,
-        n_steps=64,
-        batch_size=32,
-        n_epochs=1,
-        policy_kwargs={"features_extractor_kwargs": {"features_dim": 32}},
-        device="cpu",
-        seed=0,
-    )
+    ppo = small_ppo(env)
     seen = RewardsSeen()
     ppo.learn(total_timesteps=256, callback=seen)
     model = env.curiosity.source

@@ -20,6 +20,7 @@ import pytest
 from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent import stats
+from simoun_agent.cli import report as report_cli
 from simoun_agent.config import resolve, to_dict
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
@@ -133,12 +134,12 @@ def test_auc_is_the_normalized_trapezoid():
 
 
 def test_cli_prints_the_table_and_refuses_a_directory_without_runs(runs_dir, tmp_path, capsys):
-    assert report.main([str(runs_dir), "--out", str(tmp_path / "out")]) == 0
+    assert report_cli.main([str(runs_dir), "--out", str(tmp_path / "out")]) == 0
     out = capsys.readouterr().out
     assert "| agent.lr=0.001 | simoun-PointReach-v0 | 2 |" in out
     assert (tmp_path / "out" / report.REPORT_CSV).is_file()
     with pytest.raises(SystemExit) as exit_info:
-        report.main([str(tmp_path / "out")])
+        report_cli.main([str(tmp_path / "out")])
     assert exit_info.value.code == 2
     assert "no runs under" in capsys.readouterr().err
 
@@ -184,7 +185,7 @@ def test_equal_budget_cuts_every_run_at_it_and_counts_unfinished_runs_that_reach
     assert int(rows["agent.lr=0.0003"]["n"]) == 1  # b-s1 never trained: short of the budget
     assert "b-s1" in (out / report.REPORT_MD).read_text().split("short of the budget")[1]
     with pytest.raises(SystemExit):
-        report.main([str(runs_dir), "--at-step", "0"])
+        report_cli.main([str(runs_dir), "--at-step", "0"])
 
 
 def test_a_dict_valued_key_stays_one_value_so_it_can_name_a_variant():
@@ -368,7 +369,7 @@ def test_a_seed_counts_once_the_finished_run_then_the_most_recent_kept(runs_dir,
 def test_a_single_run_directory_gets_its_report_beside_it(runs_dir, tmp_path, capsys):
     run_dir = copy_runs(runs_dir, ("a-s0",), tmp_path)
     before = sorted(p.name for p in (run_dir / "a-s0").iterdir())
-    assert report.main([str(run_dir / "a-s0")]) == 0
+    assert report_cli.main([str(run_dir / "a-s0")]) == 0
     assert sorted(p.name for p in (run_dir / "a-s0").iterdir()) == before
     assert (tmp_path / "report-a-s0" / report.REPORT_CSV).is_file()
     assert f"written: {tmp_path / 'report-a-s0' / report.REPORT_MD}" in capsys.readouterr().out
@@ -379,7 +380,7 @@ def test_a_read_only_directory_is_refused_naming_it_and_the_out_flag(runs_dir, t
     mount in a user and mount namespace of its own (as a read-only share would be); as any
     other user its write bits are taken away."""
     root = copy_runs(runs_dir, ("a-s0",), tmp_path / "runs")
-    command = [sys.executable, "-m", "simoun_agent.sweep.report", str(root)]
+    command = [sys.executable, "-m", "simoun_agent.cli.report", str(root)]
     if os.geteuid() == 0:
         mount = f"mount --bind {root} {root} && mount -o remount,bind,ro {root} {root}"
         command = ["unshare", "-rm", "sh", "-c", f"{mount} && exec {shlex.join(command)}"]

@@ -13,9 +13,9 @@ from pathlib import Path
 import pytest
 import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
+from simoun_agent.cli import sweep as cli
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
-from simoun_agent.sweep import cli
 from simoun_agent.sweep.grid import SWEEP_FILE, parse_seeds, split_values
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
@@ -150,7 +150,7 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=120,360"]
     argv += ["--seeds", "0-1", "--sweep-dir"]
     argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
-    command = [sys.executable, "-m", "simoun_agent.sweep.cli", *argv]
+    command = [sys.executable, "-m", "simoun_agent.cli.sweep", *argv]
     log = tmp_path / "sweep.log"  # a file, not a pipe nobody reads until the end
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
@@ -181,7 +181,7 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
 
     resumed = [*argv, "--resume"]
     result = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.sweep.cli", *resumed],
+        [sys.executable, "-m", "simoun_agent.cli.sweep", *resumed],
         capture_output=True,
         text=True,
         timeout=180,
@@ -207,7 +207,7 @@ def test_sigterm_stops_every_trial_with_a_checkpoint_and_resume_finishes(ray_add
     argv[at + 1] = "1000000000"
     argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir), "--address", ray_address]
     argv += ["--verbose", "0"]
-    command = [sys.executable, "-m", "simoun_agent.sweep.cli", *argv]
+    command = [sys.executable, "-m", "simoun_agent.cli.sweep", *argv]
     log = tmp_path / "sweep.log"
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
@@ -233,7 +233,7 @@ def test_sigterm_stops_every_trial_with_a_checkpoint_and_resume_finishes(ray_add
         [
             sys.executable,
             "-m",
-            "simoun_agent.run.train",
+            "simoun_agent.cli.train",
             "--resume",
             str(run_dir),
             "--total-env-steps",
@@ -309,7 +309,7 @@ def test_unreachable_address_fails_within_seconds(tmp_path):
     argv = [*TINY, "--seeds", "0", "--sweep-dir", str(tmp_path / "s")]
     start = time.monotonic()
     result = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.sweep.cli", *argv, "--address", f"127.0.0.1:{port}"],
+        [sys.executable, "-m", "simoun_agent.cli.sweep", *argv, "--address", f"127.0.0.1:{port}"],
         capture_output=True,
         text=True,
         timeout=300,

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from simoun_agent.run import evaluate, train
+from simoun_agent.cli import eval as eval_cli
+from simoun_agent.cli import train as train_cli
 
 TINY_FLAGS = [
     "--env", "simoun/PointReach-v0",
@@ -36,7 +37,7 @@ def test_ctrl_c_writes_a_checkpoint_and_resume_finishes_the_run(tmp_path):
     command = [
         sys.executable,
         "-m",
-        "simoun_agent.run.train",
+        "simoun_agent.cli.train",
         *TINY_FLAGS,
         "--run-dir",
         str(run_dir),
@@ -62,7 +63,7 @@ def test_ctrl_c_writes_a_checkpoint_and_resume_finishes_the_run(tmp_path):
     assert stopped_at == 100000
 
     resume = ["--resume", str(run_dir), "--total-env-steps", "60", "--video", "true"]
-    assert train.main(resume) == 0
+    assert train_cli.main(resume) == 0
     summary = json.loads((run_dir / "summary.json").read_text())
     assert summary["env_step"] >= 60
     assert (run_dir / "video.mp4").stat().st_size > 0
@@ -71,8 +72,8 @@ def test_ctrl_c_writes_a_checkpoint_and_resume_finishes_the_run(tmp_path):
 def test_simoun_eval_writes_metrics_and_video(tmp_path, capsys):
     run_dir = tmp_path / "run"
     flags = [*TINY_FLAGS, "--run-dir", str(run_dir), "--total-env-steps", "40", "--video", "false"]
-    assert train.main(flags) == 0
-    assert evaluate.main([str(run_dir), "--episodes", "2", "--out", str(tmp_path / "ev")]) == 0
+    assert train_cli.main(flags) == 0
+    assert eval_cli.main([str(run_dir), "--episodes", "2", "--out", str(tmp_path / "ev")]) == 0
     metrics = json.loads((tmp_path / "ev" / "metrics.json").read_text())
     assert metrics["episodes"] == 2 and metrics["env_step"] == 40
     assert -40 < metrics["return_mean"] <= 0  # PointReach pays -distance for 20 steps
@@ -83,11 +84,11 @@ def test_simoun_eval_writes_metrics_and_video(tmp_path, capsys):
 def test_simoun_eval_random_policy_is_a_seeded_baseline_on_the_same_episodes(tmp_path):
     run_dir = tmp_path / "run"
     flags = [*TINY_FLAGS, "--run-dir", str(run_dir), "--total-env-steps", "40", "--video", "false"]
-    assert train.main(flags) == 0
+    assert train_cli.main(flags) == 0
     returns = []
     for _ in range(2):
         argv = [str(run_dir), "--episodes", "2", "--random-policy", "--no-video", "--overwrite"]
-        assert evaluate.main(argv) == 0
+        assert eval_cli.main(argv) == 0
         metrics = json.loads((run_dir / "eval-40-random" / "metrics.json").read_text())
         assert metrics["random_policy"] is True and metrics["episodes"] == 2
         returns.append(metrics["return_mean"])
@@ -98,14 +99,14 @@ def test_simoun_eval_random_policy_is_a_seeded_baseline_on_the_same_episodes(tmp
 def test_simoun_eval_refuses_a_corrupt_checkpoint(tmp_path, capsys):
     (tmp_path / "checkpoint.pt").write_bytes(b"\x00" * 100)
     with pytest.raises(SystemExit) as exit_info:
-        evaluate.main([str(tmp_path)])
+        eval_cli.main([str(tmp_path)])
     assert exit_info.value.code == 2
     assert "corrupt or incomplete" in capsys.readouterr().err
 
 
 def test_help_lists_every_preset_and_config_key(capsys):
     with pytest.raises(SystemExit):
-        train.main(["--help"])
+        train_cli.main(["--help"])
     text = capsys.readouterr().out
     for name in ("cartpole-swingup", "highway", "cpu", "--agent.batch-size", "--action-repeat"):
         assert name in text

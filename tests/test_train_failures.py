@@ -19,6 +19,7 @@ import pytest
 from test_train_resume import tiny_config
 from test_train_sigterm import TINY
 
+from simoun_agent.cli import train as train_cli
 from simoun_agent.envs import PointReach
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import NoSpace, atomic_write, load_checkpoint
@@ -29,12 +30,13 @@ LIMIT_S = 240
 
 UNDER_FILE_SIZE_LIMIT = """
 import resource, signal, sys
+from simoun_agent.cli import train as train_cli
 from simoun_agent.run import train
 
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG instead
 limit = int(sys.argv[1])
 resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
-sys.exit(train.main(sys.argv[2:]))
+sys.exit(train_cli.main(sys.argv[2:]))
 """
 FILE_SIZE_LIMIT = 300_000
 """Above every file of the run but the replay past about 90 frames (3 KB a frame at 32x32): the
@@ -67,7 +69,9 @@ def test_a_full_disk_keeps_the_last_checkpoint_and_stops_after_three_failures(tm
     assert not list(run_dir.glob(".*.tmp*"))
 
     # with space again, the run continues from that checkpoint
-    assert train.main(["--resume", str(run_dir), "--total-env-steps", str(stopped_at + 20)]) == 0
+    assert (
+        train_cli.main(["--resume", str(run_dir), "--total-env-steps", str(stopped_at + 20)]) == 0
+    )
     assert load_checkpoint(run_dir)["state"]["env_step"] == stopped_at + 20
 
 
@@ -144,7 +148,7 @@ def test_a_nan_reward_stops_with_a_checkpoint_and_a_clear_error(tmp_path, capsys
     run_dir = tmp_path / "run"
     flags = [*TINY, "--env", NAN_ENV, "--env-kwargs", '{"nan_at": 50}', "--run-dir", str(run_dir)]
     # The evaluation env, another instance, takes 20 steps before training reaches its 50th.
-    assert train.main([*flags, "--total-env-steps", "1000", "--eval-every", "1000"]) == 1
+    assert train_cli.main([*flags, "--total-env-steps", "1000", "--eval-every", "1000"]) == 1
     err = capsys.readouterr().err
     assert "Traceback" not in err
     assert f"{NAN_ENV} returned the reward nan at env step 50 (step 10 of training episode 2" in err
@@ -153,7 +157,7 @@ def test_a_nan_reward_stops_with_a_checkpoint_and_a_clear_error(tmp_path, capsys
     assert [row["episode"] for row in read_csv(run_dir / "train.csv")] == [0, 1]
 
     # resumable, no --overwrite needed: the resumed env's own 50th step fails again, later on
-    assert train.main(["--resume", str(run_dir)]) == 1
+    assert train_cli.main(["--resume", str(run_dir)]) == 1
     assert "returned the reward nan at env step 99" in capsys.readouterr().err
     assert load_checkpoint(run_dir)["state"]["env_step"] == 98
 

@@ -5,6 +5,7 @@ import json
 import pytest
 import torch
 
+from simoun_agent.cli import train as train_cli
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
@@ -131,7 +132,7 @@ def test_unwritable_output_directory_leaves_nothing_behind(tmp_path):
 def test_cli_reports_bad_input_without_a_traceback_and_creates_no_run(tmp_path, capsys):
     run_dir = tmp_path / "run"
     with pytest.raises(SystemExit) as exit_info:
-        train.main(["--env", "dm_control/cartpole-swingup-v9", "--run-dir", str(run_dir)])
+        train_cli.main(["--env", "dm_control/cartpole-swingup-v9", "--run-dir", str(run_dir)])
     assert exit_info.value.code == 2
     assert "did you mean dm_control/cartpole-swingup-v0" in capsys.readouterr().err
     assert not run_dir.exists()

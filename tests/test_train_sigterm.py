@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 import torch
 
+from simoun_agent.cli import train as train_cli
 from simoun_agent.config import resolve
-from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.env_runner import BackgroundEnv
 
@@ -62,6 +62,7 @@ ENVS = {
 
 SIGTERM_AT_FIRST_EVALUATION = """
 import os, signal, sys
+from simoun_agent.cli import train as train_cli
 from simoun_agent.run import train
 
 class SigtermAfterFirstEvaluation(train.TrainCallback):
@@ -72,7 +73,7 @@ class SigtermAfterFirstEvaluation(train.TrainCallback):
 
 plain = train.train
 train.train = lambda run, callbacks=(): plain(run, [*callbacks, SigtermAfterFirstEvaluation()])
-sys.exit(train.main(sys.argv[1:]))
+sys.exit(train_cli.main(sys.argv[1:]))
 """
 
 
@@ -103,7 +104,7 @@ def test_sigterm_checkpoints_at_the_next_step_and_resume_reaches_the_end(suite, 
     run_dir = tmp_path / "run"
     flags = [*TINY, *env_flags, "--run-dir", str(run_dir)]
     process = subprocess.Popen(
-        [sys.executable, "-m", "simoun_agent.run.train", *flags, "--total-env-steps", "100000"],
+        [sys.executable, "-m", "simoun_agent.cli.train", *flags, "--total-env-steps", "100000"],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -131,7 +132,7 @@ def test_sigterm_checkpoints_at_the_next_step_and_resume_reaches_the_end(suite, 
     stopped_at = load_checkpoint(run_dir)["state"]["env_step"]
     assert stopped_at > 0
 
-    assert train.main(["--resume", str(run_dir), "--total-env-steps", str(stopped_at + 8)]) == 0
+    assert train_cli.main(["--resume", str(run_dir), "--total-env-steps", str(stopped_at + 8)]) == 0
     summary = json.loads((run_dir / "summary.json").read_text())
     assert summary["env_step"] >= stopped_at + 8
 
@@ -154,9 +155,9 @@ def test_sigterm_between_episodes_resumes_to_the_uninterrupted_weights(suite, tm
     stopped_at = load_checkpoint(stopped_dir)["state"]["env_step"]
     assert 0 < stopped_at < total
 
-    assert train.main(["--resume", str(stopped_dir)]) == 0
+    assert train_cli.main(["--resume", str(stopped_dir)]) == 0
     straight = [*flags, "--run-dir", str(straight_dir), "--total-env-steps", str(total)]
-    assert train.main(straight) == 0
+    assert train_cli.main(straight) == 0
     expected = tensors(load_checkpoint(straight_dir)["agent"])
     got = tensors(load_checkpoint(stopped_dir)["agent"])
     assert expected.keys() == got.keys()

@@ -26,6 +26,7 @@ import torch
 from test_train_resume import tiny_config, weights, without_wall_time
 from test_train_sigterm import CARTPOLE, TINY
 
+from simoun_agent.cli import train as train_cli
 from simoun_agent.generalization.callback import DistractionEvaluation
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
@@ -119,7 +120,7 @@ def child():
 
 
 def trainer(run_dir: Path, *flags: str) -> list[str]:
-    return ["-m", "simoun_agent.run.train", *POINT_REACH, *flags, "--run-dir", str(run_dir)]
+    return ["-m", "simoun_agent.cli.train", *POINT_REACH, *flags, "--run-dir", str(run_dir)]
 
 
 def counters(run_dir: Path) -> dict:
@@ -185,6 +186,7 @@ def test_sigterm_in_a_later_evaluation_shown_on_the_progress_bar(child, tmp_path
 
 SIGTERM_AFTER_THE_FINAL_EVALUATION = """
 import os, signal, sys
+from simoun_agent.cli import train as train_cli
 from simoun_agent.run import train
 
 class SigtermAtTheEnd(train.TrainCallback):
@@ -196,7 +198,7 @@ class SigtermAtTheEnd(train.TrainCallback):
 
 plain = train.train
 train.train = lambda run, callbacks=(): plain(run, [*callbacks, SigtermAtTheEnd()])
-sys.exit(train.main(sys.argv[1:]))
+sys.exit(train_cli.main(sys.argv[1:]))
 """
 
 
@@ -209,7 +211,7 @@ def test_sigterm_before_the_final_video_and_resume_records_it(child, tmp_path):
     assert counters(run_dir)["env_step"] == 40 and not counters(run_dir)["eval_pending"]
     assert not (run_dir / "summary.json").exists() and not (run_dir / "video.mp4").exists()
 
-    assert train.main(["--resume", str(run_dir)]) == 0  # at its last step, with the end to do
+    assert train_cli.main(["--resume", str(run_dir)]) == 0  # at its last step, with the end to do
     assert (run_dir / "summary.json").exists() and (run_dir / "video.mp4").stat().st_size > 0
     assert logged_steps(run_dir) == [0, 40]  # the final evaluation is not played twice
 
@@ -310,3 +312,39 @@ def test_distraction_envs_are_closed_when_a_run_stops(tmp_path):
     assert len(distractions.opened) == 1
     # shimmy's close frees the MuJoCo data of the dm_control physics
     assert not hasattr(distractions.opened[0].unwrapped._env.physics, "_data")
+
+
+class SigtermAfterFirstEvaluation(train.TrainCallback):
+    """Sends this process a real SIGTERM once the first evaluation is logged."""
+
+    def on_logged(self, run: train.Run, metrics: dict[str, float]) -> None:
+        os.kill(os.getpid(), signal.SIGTERM)
+
+
+def test_distraction_envs_are_closed_when_a_signal_stops_the_run(tmp_path):
+    flags = {"env": CARTPOLE[1], "env_kwargs": {"task_kwargs": {"time_limit": 1}}}
+    config = tiny_config(tmp_path / "run", eval_distraction=("color_easy",), **flags)
+    distractions = WatchedDistractions(["color_easy"])
+    run = train.create_run(config)
+    try:
+        with pytest.raises(Stopped) as stopped:
+            train.train(run, [distractions, SigtermAfterFirstEvaluation()])
+    finally:
+        run.env.close()
+        run.eval_env.close()
+    assert stopped.value.signum == signal.SIGTERM
+    assert load_checkpoint(run.run_dir)["state"]["env_step"] == 0  # after the initial evaluation
+    assert len(distractions.opened) == 1
+    assert not hasattr(distractions.opened[0].unwrapped._env.physics, "_data")
+
+
+def test_a_distraction_setting_without_its_callback_is_refused(tmp_path):
+    flags = {"env": CARTPOLE[1], "env_kwargs": {"task_kwargs": {"time_limit": 1}}}
+    run = train.create_run(tiny_config(tmp_path / "run", eval_distraction=("color_easy",), **flags))
+    try:
+        with pytest.raises(ValueError, match="distraction_callbacks"):
+            train.train(run)
+    finally:
+        run.env.close()
+        run.eval_env.close()
+        train.release(run)

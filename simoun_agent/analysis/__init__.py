@@ -1,6 +1,6 @@
 """The paper's analyses for trained runs: structure masks (Fig. 7) and information bias (Fig. 5).
 
-The command ``simoun-analyze`` (:mod:`simoun_agent.analysis.cli`) runs both; the estimator
+The command ``simoun-analyze`` (:mod:`simoun_agent.cli.analyze`) runs both; the estimator
 (:func:`simoun_agent.analysis.bias.information_bias`) works on any features.
 """
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from simoun_agent.analysis import pairs
 from simoun_agent.analysis.bias import CATEGORIES, THRESHOLD, BiasEstimate
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 
 CATEGORY_COLOURS = {
     "static": "#E69F00",

@@ -1,4 +1,4 @@
-"""Reload a trained run (config, environment, agent) and play it deterministically."""
+"""Play a reloaded run (:func:`simoun_agent.run.load.load_run`) deterministically."""
 
 from __future__ import annotations
 
@@ -10,50 +10,8 @@ import numpy as np
 import torch
 
 from simoun_agent.agent import SimounAgent
-from simoun_agent.config import SetupError, TrainConfig, from_dict
-from simoun_agent.run.checkpoint import load_checkpoint
-from simoun_agent.run.make_env import make_env
+from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import make_output_dir
-from simoun_agent.run.seeds import first_eval_seed
-
-
-@dataclass
-class LoadedRun:
-    """A run rebuilt from its checkpoint, ready to be looked at."""
-
-    run_dir: Path
-    """the run directory (where checkpoint.pt lives)"""
-    config: TrainConfig
-    """the run's config, as saved in the checkpoint"""
-    env: gym.Env
-    """the run's own environment stack (make_env)"""
-    agent: SimounAgent
-    """the agent with the checkpoint's weights"""
-    env_step: int
-    """environment steps the run had taken at this checkpoint"""
-
-    @property
-    def first_seed(self) -> int:
-        """Seed of episode 0: the run's evaluation episodes, never its training ones."""
-        return first_eval_seed(self.config.seed)
-
-
-def load_run(path: Path, device: str | None = None) -> LoadedRun:
-    """Rebuild a run from its directory (or checkpoint.pt); SetupError when it cannot."""
-    payload = load_checkpoint(Path(path))
-    config = from_dict(payload["config"])
-    if config.torch_threads:
-        torch.set_num_threads(config.torch_threads)
-    env = make_env(config)
-    agent = SimounAgent(
-        env.observation_space["frames"].shape[1:],
-        env.action_space.shape[0],
-        config.agent,
-        device=device or config.device,
-    )
-    agent.load_state_dict(payload["agent"])
-    run_dir = payload["replay_path"].parent
-    return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
 
 
 @dataclass

@@ -5,6 +5,7 @@ evaluates runs on DMC-GB's four modes built procedurally (:mod:`simoun_wrappers.
 ``simoun-train --eval-distraction video_hard`` adds them to every evaluation of a run.
 """
 
+from simoun_agent.generalization.callback import DistractionEvaluation, distraction_callbacks
 from simoun_agent.generalization.suite import (
     DISTRACTIONS,
     check_eval_distractions,
@@ -16,8 +17,10 @@ from simoun_agent.generalization.suite import (
 
 __all__ = [
     "DISTRACTIONS",
+    "DistractionEvaluation",
     "check_eval_distractions",
     "check_supported",
+    "distraction_callbacks",
     "distractor",
     "make_distracted_env",
     "parse_distractions",

@@ -4,16 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import gymnasium as gym
 
-from simoun_agent.generalization.suite import make_distracted_env
+from simoun_agent.config import TrainConfig
+from simoun_agent.generalization.suite import check_eval_distractions, make_distracted_env
+from simoun_agent.run.callback import TrainCallback
+from simoun_agent.run.evaluate import evaluate
 from simoun_agent.run.seeds import first_eval_seed
-from simoun_agent.run.train import TrainCallback
-
-if TYPE_CHECKING:
-    from simoun_agent.run.train import Run
+from simoun_agent.run.state import Run
 
 
 class DistractionEvaluation(TrainCallback):
@@ -30,6 +29,8 @@ class DistractionEvaluation(TrainCallback):
         videos: a folder of video files for the ``video_*`` modes; None for procedural ones.
     """
 
+    serves = ("eval_distraction",)
+
     def __init__(self, modes: Sequence[str], videos: str | Path | None = None) -> None:
         self.modes = list(modes)
         self.videos = videos
@@ -40,8 +41,6 @@ class DistractionEvaluation(TrainCallback):
             self._envs[mode] = make_distracted_env(run.config, mode, self.videos)
 
     def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
-        from simoun_agent.run.evaluate import evaluate
-
         config = run.config
         for mode, env in self._envs.items():
             episodes, first = config.eval_episodes, first_eval_seed(config.seed)
@@ -57,3 +56,11 @@ class DistractionEvaluation(TrainCallback):
         for env in self._envs.values():
             env.close()
         self._envs.clear()
+
+
+def distraction_callbacks(config: TrainConfig) -> list[TrainCallback]:
+    """What a run of ``config`` passes to the loop for its ``eval_distraction`` modes: one
+    :class:`DistractionEvaluation`, or nothing when it names none. Raises SetupError for a bad
+    mode (:func:`~simoun_agent.generalization.suite.check_eval_distractions`)."""
+    modes = check_eval_distractions(config)
+    return [DistractionEvaluation(modes)] if modes else []

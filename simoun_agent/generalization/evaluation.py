@@ -7,6 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from simoun_agent.generalization.suite import check_supported, make_distracted_env
+from simoun_agent.run.evaluate import evaluate
+from simoun_agent.run.load import load_run
 
 
 @dataclass(frozen=True)
@@ -46,9 +48,6 @@ def evaluate_runs(
     seeds), so the modes differ only by the distraction. Raises SetupError for a run that
     cannot be loaded or a mode its env does not support, before any episode is played.
     """
-    from simoun_agent.analysis.runs import load_run
-    from simoun_agent.run.evaluate import evaluate
-
     loaded = [load_run(Path(run_dir), device) for run_dir in run_dirs]
     for run in loaded:
         check_supported(run.config, modes, videos)

@@ -3,16 +3,24 @@
 from __future__ import annotations
 
 import csv
+import os
 from collections.abc import Sequence
 from dataclasses import asdict, fields
 from pathlib import Path
 
 from simoun_agent.generalization.evaluation import ModeResult
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 
 TABLE_MD = "generalization.md"
 TABLE_CSV = "generalization.csv"
 CHART_PNG = "generalization.png"
+
+
+def default_out(run_dirs: list[Path]) -> Path:
+    """``<run dir>/generalization`` for one run, ``<their common folder>/generalization`` for
+    several (a run given by its checkpoint.pt counts as its folder)."""
+    folders = [path if path.is_dir() else path.parent for path in run_dirs]
+    return Path(os.path.commonpath([folder.resolve() for folder in folders])) / "generalization"
 
 
 def _order(results: Sequence[ModeResult]) -> tuple[list[str], list[str]]:

@@ -10,7 +10,6 @@ the machine that runs the study.
 from __future__ import annotations
 
 import json
-import subprocess
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -19,7 +18,8 @@ from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
 from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.sweep.cli import connect, load_ray
+from simoun_agent.study.provenance import code_version
+from simoun_agent.sweep.launch import connect, load_ray
 
 __all__ = ["SPEC_FILE", "finished_runs", "run_study"]
 
@@ -30,22 +30,6 @@ SPEC_FILE = "spec.json"
 def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
     """The names of the spec's runs whose summary is in the archive."""
     return [run.name for run in spec.runs() if (archive / run.name / SUMMARY).is_file()]
-
-
-def git_commit() -> str | None:
-    """The commit of simoun's checkout, recorded with each run (None outside git)."""
-    try:
-        done = subprocess.run(
-            ["git", "rev-parse", "HEAD"],
-            cwd=Path(__file__).resolve().parent,
-            capture_output=True,
-            text=True,
-            timeout=30,
-            check=True,
-        )
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return done.stdout.strip()
 
 
 def record_spec(spec: StudySpec, archive: Path) -> None:
@@ -126,7 +110,9 @@ def run_study(
     try:
         tuner = tune.Tuner(
             tune.with_resources(
-                tune.with_parameters(trainable, spec=spec.to_json(), commit=git_commit()),
+                tune.with_parameters(
+                    trainable, spec=spec.to_json(), commit=code_version()["commit"]
+                ),
                 {"cpu": 1},
             ),
             param_space={"run": tune.grid_search(todo)},

@@ -14,13 +14,10 @@ from __future__ import annotations
 
 import errno
 import io
-import os
 import pickle
 import random
-import re
 import shutil
 import zipfile
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,13 +27,12 @@ import torch
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
+from simoun_agent.run.atomic import atomic_write, dead_temporaries
+from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
 from simoun_agent.run.seeds import SEED_SCHEME
 
-CHECKPOINT_NAME = "checkpoint.pt"
 FORMAT = "simoun-checkpoint/1"
 _REQUIRED = ("format", "config", "agent", "replay_file", "rng", "state")
-_TEMPORARY = re.compile(r"^\..+\.(?P<pid>\d+)\.tmp(\.[^.]+)?$")
-"""The name :func:`atomic_write` gives its temporary: ``.<stem>.<pid>.tmp<suffix>``."""
 SPACE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 """Write errors that mean the data did not fit: a full disk, a full quota, a file size limit."""
 
@@ -60,38 +56,16 @@ def _mb(size: float) -> str:
     return f"{size / 1e6:.1f} MB"
 
 
-def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it to ``path``."""
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    return True
-
-
 def remove_leftovers(run_dir: Path, replay_file: str | None = None) -> list[Path]:
     """Remove what writers killed halfway left in ``run_dir`` and return it: the temporaries of
     :func:`atomic_write` whose process is dead (a live one may still be writing), and every
     ``replay-*.npz`` but ``replay_file`` (the one the checkpoint names; none for a new run), which
     a kill between a checkpoint's two renames leaves. Call it holding the run directory's lock."""
     removed = []
-    for path in run_dir.glob(".*.tmp*"):
-        match = _TEMPORARY.match(path.name)
-        if match and not _alive(int(match["pid"])):
-            path.unlink(missing_ok=True)
-            removed.append(path)
-    for path in run_dir.glob("replay-*.npz"):
+    for path in dead_temporaries(run_dir):
+        path.unlink(missing_ok=True)
+        removed.append(path)
+    for path in run_dir.glob(REPLAY_GLOB):
         if path.name != replay_file:
             path.unlink(missing_ok=True)
             removed.append(path)
@@ -130,12 +104,12 @@ def save_checkpoint(
 
     Args:
         run_dir: the run directory.
-        config: the run's config as a dict (``presets.to_dict``).
+        config: the run's config as a dict (``simoun_agent.config.to_dict``).
         agent: the SimounAgent (its ``state_dict()`` is saved).
         replay: the FrameReplay (``replay.save(path)``).
         state: the trainer's counters and its own RNG state, restored as given.
     """
-    replay_path = run_dir / f"replay-{state['env_step']}.npz"
+    replay_path = run_dir / replay_name(state["env_step"])
     payload = {
         "format": FORMAT,
         "seed_scheme": SEED_SCHEME,
@@ -165,7 +139,7 @@ def save_checkpoint(
             replay_path.unlink(missing_ok=True)
         limit = " (a file size limit: ulimit -f)" if err.errno == errno.EFBIG else ""
         raise NoSpace(run_dir, needed, f"a write failed: {err.strerror}{limit}") from None
-    for old in run_dir.glob("replay-*.npz"):
+    for old in run_dir.glob(REPLAY_GLOB):
         if old != replay_path:
             old.unlink(missing_ok=True)
     return path

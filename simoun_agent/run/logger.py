@@ -13,11 +13,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.run.checkpoint import atomic_write
-
-EVAL_CSV = "eval.csv"
-TRAIN_CSV = "train.csv"
-CURVE_PNG = "learning_curve.png"
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
 
 class CsvLog:
@@ -121,7 +118,7 @@ class RunLogger:
         self.title = title
         self.eval_log = CsvLog(run_dir / EVAL_CSV, resume_step)
         self.train_log = CsvLog(run_dir / TRAIN_CSV, resume_step)
-        self.tensorboard = SummaryWriter(run_dir / "tb", purge_step=resume_step)
+        self.tensorboard = SummaryWriter(run_dir / TENSORBOARD_DIR, purge_step=resume_step)
         last = self.eval_log.last_row
         self.last_eval_step: int | None = None if last is None else int(last["env_step"])
         """env step of the latest evaluation in eval.csv (a resumed run's included)"""

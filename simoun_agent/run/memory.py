@@ -25,6 +25,7 @@ import torch
 from torch.utils._python_dispatch import TorchDispatchMode
 
 from simoun_agent.config import SetupError, TrainConfig
+from simoun_agent.device import default_device
 
 ACTION_DIM = 2
 """Action size assumed before the env is built; the networks' share of memory barely depends
@@ -106,7 +107,7 @@ def replay_bytes(config: TrainConfig) -> int:
 
 def device_memory(device: str | None) -> tuple[str, int | None]:
     """The device a run of ``device`` trains on and its memory in bytes (None: unknown)."""
-    name = device or ("cuda" if torch.cuda.is_available() else "cpu")
+    name = str(default_device(device))
     kind = torch.device(name)
     if kind.type == "cuda":
         return name, torch.cuda.get_device_properties(kind.index or 0).total_memory

@@ -19,11 +19,7 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
-
-LOCK_NAME = ".lock"
-CHECKPOINT_NAME = "checkpoint.pt"
-TRAINER_FILES = ("config.json", "eval.csv", "train.csv", "learning_curve.png", "video.mp4")
-"""What a run writes before its first checkpoint (with ``tb/``): removed by ``--overwrite``."""
+from simoun_agent.run.layout import CHECKPOINT_NAME, LOCK_NAME, TENSORBOARD_DIR, TRAINER_FILES
 
 _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""
@@ -109,7 +105,7 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
         )
     for name in TRAINER_FILES:
         (run_dir / name).unlink(missing_ok=True)
-    shutil.rmtree(run_dir / "tb", ignore_errors=True)
+    shutil.rmtree(run_dir / TENSORBOARD_DIR, ignore_errors=True)
 
 
 def require_checkpoint(run_dir: Path) -> None:

@@ -1,4 +1,5 @@
-"""``simoun-train``: train the Simoun agent on any pixel or renderable Gymnasium env.
+"""The training loop behind ``simoun-train`` (:mod:`simoun_agent.cli.train`): train the Simoun
+agent on any pixel or renderable Gymnasium env.
 
     simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu
     simoun-train --preset walker-walk --agent.encoder dual --agent.curiosity false
@@ -7,7 +8,8 @@
 A run directory holds ``config.json`` (the resolved config, written once set-up has
 succeeded), ``eval.csv`` / ``train.csv`` / ``tb/`` (logs), ``learning_curve.png`` (redrawn at
 each evaluation), ``checkpoint.pt`` + ``replay-<step>.npz`` (the latest checkpoint),
-``video.mp4`` (an evaluation episode) and ``summary.json`` (written only when the run ends).
+``video.mp4`` (an evaluation episode) and ``summary.json`` (written only when the run ends);
+the names live in :mod:`simoun_agent.run.layout`.
 Episodes and every random stream come from the run's seed (:mod:`simoun_agent.run.seeds`).
 
 Ctrl-C or SIGTERM (a scheduler's preemption, ``kill``), in any phase (warm-up, training, an
@@ -26,45 +28,31 @@ disk is the rule of :data:`CHECKPOINT_TRIES` (exit 75).
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import random
 import signal
-import sys
 import time
-import typing
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field, replace
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import IO, Any, NoReturn
+from typing import Any, NoReturn
 
 import gymnasium as gym
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from simoun_agent import SimounAgent
-from simoun_agent.config import (
-    PRESETS,
-    RECIPES,
-    SetupError,
-    TrainConfig,
-    from_dict,
-    resolve,
-    to_dict,
-)
+from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
 from simoun_agent.config.envs import dmc_task
-from simoun_agent.config.keys import check_keys, config_fields, parse_value
 from simoun_agent.config.train import RESUMABLE_FIELDS
-from simoun_agent.generalization.suite import check_eval_distractions
 from simoun_agent.replay import FrameReplay
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.callback import TrainCallback
 from simoun_agent.run.checkpoint import (
-    CHECKPOINT_NAME,
     SPACE_ERRNOS,
     NoSpace,
-    atomic_write,
     check_config,
     check_seed_scheme,
     load_checkpoint,
@@ -74,18 +62,25 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EvaluationStopped, evaluate, metrics_json
-from simoun_agent.run.flags import add_version
-from simoun_agent.run.logger import CURVE_PNG, RunLogger
+from simoun_agent.run.layout import (
+    CHECKPOINT_NAME,
+    CONFIG_NAME,
+    CURVE_PNG,
+    SUMMARY_NAME,
+    VIDEO_NAME,
+)
+from simoun_agent.run.logger import RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
-from simoun_agent.run.memory import check_memory
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
-from simoun_agent.run.signals import Stopped, StopRequest, deferred_stop, stop_at_once
+from simoun_agent.run.signals import Stopped, deferred_stop
+from simoun_agent.run.state import Counters, Run
 from simoun_agent.run.video import write_video
 
-CONFIG_NAME = "config.json"
-SUMMARY_NAME = "summary.json"
+ConfigCheck = Callable[[TrainConfig], object]
+"""A check of the optional parts on a run's config, run before any env is built; raises
+SetupError (e.g. :func:`simoun_agent.generalization.check_eval_distractions`)."""
 
 CHECKPOINT_TRIES = 3
 """A checkpoint that does not fit on the disk (:class:`~simoun_agent.run.checkpoint.NoSpace`)
@@ -96,77 +91,6 @@ only add work that cannot be saved) and ``--resume`` continues from the last che
 write that fails for lack of space stops it the same way."""
 NO_SPACE_EXIT = 75
 """Exit status after a stop for lack of space: sysexits' EX_TEMPFAIL (free space, then retry)."""
-
-
-@dataclass
-class Counters:
-    """Where a run stands; saved in every checkpoint."""
-
-    env_step: int = 0
-    """environment steps taken (agent decisions x action repeat)"""
-    agent_step: int = 0
-    """agent decisions taken"""
-    episode: int = 0
-    """training episodes begun; episode i resets with seed ``seeds.train_episode_seed(seed, i)``"""
-    updates: int = 0
-    """gradient updates done"""
-    eval_pending: bool = True
-    """an evaluation is due at ``env_step`` and not yet logged: a new run's first, or one that a
-    stop abandoned, which the resumed run plays first"""
-    wall_time_s: float = field(default=0.0, compare=False)
-    """seconds spent in the training loop, summed over resumed parts (evaluations included)"""
-
-
-@dataclass
-class Run:
-    """A run ready to train: its config, directory, environments, agent and replay."""
-
-    config: TrainConfig
-    run_dir: Path
-    env: EnvRunner
-    """the training environment, stepped in this process or a background one"""
-    eval_env: gym.Env
-    agent: SimounAgent
-    replay: FrameReplay
-    rng: np.random.Generator
-    """the trainer's own generator (random warm-up actions)"""
-    counters: Counters
-    lock: IO[str] | None = None
-    """the run directory's lock (:func:`~simoun_agent.run.rundir.lock_run_dir`), held while
-    this process uses it"""
-    stop: StopRequest = field(default_factory=StopRequest)
-    """set by the first stop signal or a callback's :meth:`TrainCallback.stop_requested`; the
-    loop and every evaluation poll ``run.stop.is_set()`` between steps"""
-
-
-class TrainCallback:
-    """Hooks into :func:`train`; subclass and override what you need (all do nothing here).
-
-    Ray Tune's reporter (``simoun_agent.sweep``) and extra evaluation environments plug in here
-    instead of editing the loop.
-    """
-
-    def on_start(self, run: Run) -> None:
-        """Once, when :func:`train` begins, before the first evaluation (build what you need)."""
-
-    def on_evaluation(self, run: Run, metrics: dict[str, float]) -> None:
-        """After each evaluation (env step ``run.counters.env_step``), before it is logged; may
-        add entries to ``metrics``, which then go to eval.csv and TensorBoard too. Evaluations of
-        your own should pass ``stop=run.stop.is_set`` to :func:`evaluate`."""
-
-    def on_logged(self, run: Run, metrics: dict[str, float]) -> None:
-        """After each evaluation has been logged (``metrics`` as written to eval.csv)."""
-
-    def on_end(self, run: Run, metrics: dict[str, float] | None) -> None:
-        """Once, whenever :func:`train` ends: ``metrics`` are the final evaluation's after the
-        video and summary.json, None when the run stopped early (a signal, an error). Close here
-        what :meth:`on_start` opened."""
-
-    def stop_requested(self, run: Run) -> int | None:
-        """Polled between steps: a signal number stops the run as if that signal had arrived
-        (checkpoint, then :class:`Stopped`); None goes on. For supervisors that cannot signal the
-        loop's thread, such as a Ray Tune trial."""
-        return None
 
 
 class TrainingError(RuntimeError):
@@ -185,16 +109,19 @@ def default_run_dir(config: TrainConfig) -> Path:
     return Path("runs") / f"{task}-{config.preset or 'default'}-s{config.seed}-{stamp}"
 
 
-def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
+def build(
+    config: TrainConfig, check: ConfigCheck | None = None
+) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
     """The training env's runner (in this process or a background one), the evaluation env,
     the agent and an empty replay; each random stream seeded from its child of the run's
-    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`)."""
+    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first."""
     seed = config.seed
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
     random.seed(int_seed(seed, Stream.GLOBAL))
     np.random.seed(int_seed(seed, Stream.GLOBAL))  # noqa: NPY002  (for libraries that draw from it)
-    check_eval_distractions(config)
+    if check is not None:
+        check(config)
     env, eval_env = make_runner(config), make_env(config)
     train_space_seed, eval_space_seed = stream(seed, Stream.ACTION_SPACES).generate_state(2)
     env.action_space.seed(int(train_space_seed))
@@ -214,15 +141,18 @@ def build(config: TrainConfig) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameRe
     return env, eval_env, agent, replay
 
 
-def create_run(config: TrainConfig, overwrite: bool = False) -> Run:
+def create_run(
+    config: TrainConfig, overwrite: bool = False, check: ConfigCheck | None = None
+) -> Run:
     """Set up a new run; the run directory gets ``config.json`` only once all of it worked.
 
-    ``overwrite`` starts over in a directory whose run stopped before its first checkpoint.
+    ``overwrite`` starts over in a directory whose run stopped before its first checkpoint;
+    ``check(config)`` (:data:`ConfigCheck`) runs before any env is built.
     """
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
         take_run_dir(run_dir, overwrite=overwrite).close()
-    env, eval_env, agent, replay = build(config)
+    env, eval_env, agent, replay = build(config, check)
     make_output_dir(run_dir, "--run-dir")
     lock = take_run_dir(run_dir, overwrite=overwrite)
     remove_leftovers(run_dir)
@@ -237,8 +167,9 @@ def write_config(run_dir: Path, config: TrainConfig) -> None:
     atomic_write(run_dir / CONFIG_NAME, lambda tmp: tmp.write_text(text))
 
 
-def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
-    """Reload a run from its directory; ``overrides`` may only change resumable fields."""
+def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
+    """Reload a run from its directory; ``overrides`` may only change resumable fields;
+    ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
     config_path = run_dir / CONFIG_NAME
     if not config_path.is_file():
         raise SetupError(
@@ -278,7 +209,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any]) -> Run:
             f"{payload['replay_path']} (the replay of the checkpoint) is missing; the run cannot "
             "continue exactly. Start a new run."
         )
-    env, eval_env, agent, _ = build(config)
+    env, eval_env, agent, _ = build(config, check)
     try:
         agent.load_state_dict(payload["agent"])
         replay = FrameReplay.load(payload["replay_path"])
@@ -510,7 +441,7 @@ class Trainer:
             self.evaluate("the final evaluation")
         final = self.logger.last_eval
         self.checkpoint(required="of the run's end")
-        files = {"learning_curve": CURVE_PNG, "checkpoint": "checkpoint.pt"}
+        files = {"learning_curve": CURVE_PNG, "checkpoint": CHECKPOINT_NAME}
         if config.video:
             self.phase = "the final video (it is recorded on resume)"
             _, frames = evaluate(
@@ -522,8 +453,8 @@ class Trainer:
                 stop=run.stop.is_set,
             )
             fps = video_fps(run.eval_env, config.resolved_action_repeat())
-            write_video(run.run_dir / "video.mp4", frames, fps)
-            files["video"] = "video.mp4"
+            write_video(run.run_dir / VIDEO_NAME, frames, fps)
+            files["video"] = VIDEO_NAME
         summary = {
             "env_step": counters.env_step,
             "wall_time_s": counters.wall_time_s,
@@ -557,13 +488,11 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     A stop (a first SIGINT/SIGTERM, a callback's ``stop_requested``) in any phase writes a
     checkpoint and raises :class:`Stopped`; a NaN reward or a full disk raises
     :class:`TrainingError` (see :data:`CHECKPOINT_TRIES`). The callbacks' ``on_start`` and
-    ``on_end`` run whatever happens.
+    ``on_end`` run whatever happens. The loop knows only the callbacks it is given: a config key
+    that a callback carries out (:attr:`TrainCallback.serves`, such as ``eval_distraction``,
+    served by :func:`simoun_agent.generalization.distraction_callbacks`) is refused without one.
     """
-    if run.config.eval_distraction:
-        # Imported here: the callback's module builds on this one's TrainCallback.
-        from simoun_agent.generalization.callback import DistractionEvaluation
-
-        callbacks = [DistractionEvaluation(run.config.eval_distraction), *callbacks]
+    check_served(run.config, callbacks)
     final = None
     # Entered after the envs were built, so a library that took the signals then (SDL) is found
     with deferred_stop(run.stop):
@@ -589,8 +518,34 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
         finally:
             trainer.close()
             release(run)
-            for callback in trainer.callbacks:
-                callback.on_end(run, final)
+            end_callbacks(run, trainer.callbacks, final)
+
+
+def check_served(config: TrainConfig, callbacks: Sequence[TrainCallback]) -> None:
+    """Raise ValueError when ``config`` sets a key that only a callback carries out and none of
+    ``callbacks`` serves it (the setting would be dropped silently)."""
+    served = {key for callback in callbacks for key in callback.serves}
+    if config.eval_distraction and "eval_distraction" not in served:
+        raise ValueError(
+            f"eval_distraction={list(config.eval_distraction)} needs a callback that plays the "
+            "distracted episodes: pass simoun_agent.generalization.distraction_callbacks(config) "
+            "to train()"
+        )
+
+
+def end_callbacks(
+    run: Run, callbacks: Sequence[TrainCallback], final: dict[str, float] | None
+) -> None:
+    """Every callback's ``on_end``, even when an earlier one raises (each closes what it opened);
+    the first error is raised after all have run."""
+    error: BaseException | None = None
+    for callback in callbacks:
+        try:
+            callback.on_end(run, final)
+        except BaseException as err:  # re-raised below, once every callback has closed
+            error = error or err
+    if error is not None:
+        raise error
 
 
 def release(run: Run) -> None:
@@ -602,162 +557,3 @@ def release(run: Run) -> None:
 
 def _next(counters: Counters, every: int) -> int:
     return (counters.env_step // every + 1) * every
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The command line: a few run options and one flag per config key."""
-    presets = "\n".join(f"  {name:18} {preset.description}" for name, preset in PRESETS.items())
-    recipes = "\n".join(f"  {name:18} {recipe.description}" for name, recipe in RECIPES.items())
-    parser = argparse.ArgumentParser(
-        prog="simoun-train",
-        usage="simoun-train [--preset NAME | --resume RUN_DIR] [--KEY VALUE ...] [--set KEY=VALUE]",
-        description="Train the Simoun agent (vision-based SAC) on a Gymnasium environment.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog=f"presets:\n{presets}\n\nagent recipes (--agent.recipe NAME):\n{recipes}\n\n"
-        "examples:\n"
-        "  simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu\n"
-        "  simoun-train --preset cheetah-run --agent.encoder dual --agent.curiosity false\n"
-        "  simoun-train --preset highway --set agent.batch_size=64\n"
-        "  simoun-train --preset cpu --agent.recipe drq --seed 2\n"
-        "  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000\n\n"
-        "Values: booleans true/false, None as none, dicts as JSON (--env-kwargs '{\"a\": 1}').",
-    )
-    parser.add_argument(
-        "--resume",
-        metavar="RUN_DIR",
-        help="continue a run from its last checkpoint (only "
-        f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="start over in a --run-dir whose run stopped before its first checkpoint (a run "
-        "with a checkpoint is never deleted: --resume it)",
-    )
-    add_version(parser)
-    add_config_arguments(parser)
-    return parser
-
-
-def add_config_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--preset``, ``--set KEY=VALUE`` and one flag per config key (read by
-    :func:`overrides_from`); shared by ``simoun-train`` and ``simoun-sweep``."""
-    parser.add_argument("--preset", choices=list(PRESETS), help="start from a named preset")
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a config key, e.g. --set agent.lr=3e-4 (repeatable; like the flags below)",
-    )
-    group = parser.add_argument_group(
-        "config keys (defaults before any preset; each is also KEY for --set)"
-    )
-    for key, (kind, default, doc) in config_fields().items():
-        if key == "preset":
-            continue
-        shown = json.dumps(default) if isinstance(default, dict) else repr(default)
-        flag = "--" + key.replace("_", "-")
-        switch = kind is bool
-        hint = f"; --no-{flag[2:]} for false" if switch else ""
-        group.add_argument(
-            flag,
-            dest=key,
-            # A tuple key's flag is repeatable: --eval-distraction video_hard --eval-distraction ...
-            action="append" if (typing.get_origin(kind) or kind) is tuple else "store",
-            default=argparse.SUPPRESS,
-            metavar=_metavar(kind),
-            # a switch: --progress alone means true, and --progress false still works
-            **({"nargs": "?", "const": "true"} if switch else {}),
-            help=f"{doc} (default: {shown}{hint})".replace("%", "%%"),
-        )
-        if switch:
-            group.add_argument(
-                f"--no-{flag[2:]}",
-                dest=key,
-                action="store_const",
-                const="false",
-                default=argparse.SUPPRESS,
-                help=argparse.SUPPRESS,
-            )
-
-
-def _metavar(kind: Any) -> str:
-    names = {int: "INT", float: "FLOAT", str: "STR", bool: "BOOL", dict: "JSON"}
-    skipped = (type(None), Ellipsis)  # Ellipsis: tuple[str, ...] shows as STR
-    options = [option for option in typing.get_args(kind) or (kind,) if option not in skipped]
-    return "|".join(names.get(typing.get_origin(o) or o, "VALUE") for o in options)
-
-
-def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
-    """``{"agent.lr": 3e-4, ...}`` from the config flags and ``--set`` pairs, typed."""
-    fields = config_fields()
-    given = {k: v for k, v in vars(args).items() if k in fields and k != "preset"}
-    for pair in args.set:
-        key, sep, value = pair.partition("=")
-        key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
-        if not sep:
-            raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
-        check_keys([key])  # an unknown key fails here, with its close matches
-        given[key] = value
-    given = {key: ",".join(v) if isinstance(v, list) else v for key, v in given.items()}
-    return {key: parse_value(key, value, fields[key][0]) for key, value in given.items()}
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``simoun-train``."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        with stop_at_once():  # nothing to save during set-up
-            run = setup(parser, args)
-    except Stopped as stop:
-        print(
-            f"simoun-train: stopped by {signal.Signals(stop.signum).name} during set-up, before "
-            "anything was trained",
-            file=sys.stderr,
-        )
-        return stop.exit_code
-    tqdm.write(f"run directory: {run.run_dir}")
-    try:
-        final = train(run)
-    except KeyboardInterrupt as stop:  # Stopped after a checkpoint, or a second Ctrl-C
-        return getattr(stop, "exit_code", 130)
-    except TrainingError as err:
-        print(f"simoun-train: error: {err}", file=sys.stderr)
-        return err.exit_code
-    finally:
-        run.env.close()
-        run.eval_env.close()
-        release(run)
-    tqdm.write(
-        f"done: evaluation return {final['return_mean']:.1f} +- {final['return_std']:.1f} after "
-        f"{run.counters.env_step} env steps; learning curve, logs, checkpoint"
-        f"{' and video' if run.config.video else ''} in {run.run_dir}"
-    )
-    return 0
-
-
-def setup(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Run:
-    """The run that ``args`` ask for, new or resumed; bad input exits with status 2."""
-    try:
-        overrides = overrides_from(args)
-        if args.resume:
-            if args.preset:
-                raise SetupError("--preset does not combine with --resume: a run keeps its config")
-            if args.overwrite:
-                raise SetupError("--overwrite starts a run over; it does not combine with --resume")
-            run = resume_run(Path(args.resume), overrides)
-        else:
-            config = resolve(args.preset, overrides)
-            warning = check_memory(config)  # before anything is built
-            if warning:
-                print(f"simoun-train: warning: {warning}", file=sys.stderr)
-            run = create_run(config, overwrite=args.overwrite)
-    except SetupError as err:
-        parser.exit(2, f"simoun-train: error: {err}\n")
-    return run
-
-
-if __name__ == "__main__":
-    sys.exit(main())

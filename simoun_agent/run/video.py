@@ -8,7 +8,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 
 MIN_VIDEO_SIDE = 256
 

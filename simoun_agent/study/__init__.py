@@ -12,7 +12,7 @@ Modules, each with one job: :mod:`~simoun_agent.study.spec` (read and check the 
 :mod:`~simoun_agent.study.selection` (the rules) and :mod:`~simoun_agent.study.choice` (the
 chosen settings), :mod:`~simoun_agent.study.archive` (what survives the study),
 :mod:`~simoun_agent.study.provenance` (the commit it ran), :mod:`~simoun_agent.study.report`
-and :mod:`~simoun_agent.study.cli`.
+and :mod:`~simoun_agent.study.runner` (the command: :mod:`simoun_agent.cli.study`).
 
 A study directory holds ``study.json`` (the spec and the commits it ran from),
 ``tuning/<recipe>/<setting>/<task>/s<seed>`` and ``evaluation/<recipe>/<task>/s<seed>`` (run

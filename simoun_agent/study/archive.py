@@ -12,9 +12,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.run.logger import EVAL_CSV, TRAIN_CSV
-from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME, TRAIN_CSV
 from simoun_agent.sweep.trainable import TRIAL_FILE
 
 RUN_FILES = (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, TRIAL_FILE, SUMMARY_NAME)

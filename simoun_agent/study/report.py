@@ -33,9 +33,9 @@ import numpy as np
 
 from simoun_agent import stats
 from simoun_agent.config import RECIPES, resolve, to_dict
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.run.train import SUMMARY_NAME
 from simoun_agent.study.choice import Choice
 from simoun_agent.study.plan import (
     EVALUATION,

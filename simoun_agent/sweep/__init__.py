@@ -2,7 +2,7 @@
 (``simoun-report``).
 
 Ray is an optional extra (``pip install 'simoun[sweep]'``) imported only by
-:mod:`simoun_agent.sweep.trainable` and :mod:`simoun_agent.sweep.cli`; the grid
+:mod:`simoun_agent.sweep.trainable` and :mod:`simoun_agent.sweep.launch`; the grid
 (:mod:`simoun_agent.sweep.grid`) and the report (:mod:`simoun_agent.sweep.report`) work without
 it, and the rest of ``simoun_agent`` never imports this package.
 

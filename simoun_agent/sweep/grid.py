@@ -26,7 +26,7 @@ from typing import Any
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.envs import dmc_task
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 
 SWEEP_FILE = "sweep.json"
 """The sweep's grid and base config, written once in the sweep directory."""

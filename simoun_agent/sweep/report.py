@@ -1,6 +1,7 @@
-"""``simoun-report DIR``: compare the runs of a sweep, or of any directory of ``simoun-train``
-runs, per variant and env, over seeds (the paper's Table 1 and Fig. 6), with the statistics of
-Agarwal et al. 2021 (rliable; :mod:`simoun_agent.stats`). Needs no Ray.
+"""The report behind ``simoun-report DIR`` (:mod:`simoun_agent.cli.report`): compare the runs
+of a sweep, or of any directory of ``simoun-train`` runs, per variant and env, over seeds (the
+paper's Table 1 and Fig. 6), with the statistics of Agarwal et al. 2021 (rliable;
+:mod:`simoun_agent.stats`). Needs no Ray.
 
     simoun-report sweeps/baselines
     simoun-report runs/ --out runs/report
@@ -31,14 +32,12 @@ one evaluation grid (:func:`one_evaluation_grid`). Writes:
 
 from __future__ import annotations
 
-import argparse
 import csv
 import functools
 import io
 import itertools
 import json
 import math
-import sys
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -50,10 +49,10 @@ import numpy as np
 from simoun_agent import stats
 from simoun_agent.config import SetupError, from_dict, to_dict
 from simoun_agent.config.keys import config_sections
-from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.run.logger import EVAL_CSV, read_csv
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
+from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
-from simoun_agent.run.train import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
 from simoun_agent.sweep.report_plots import Band, plot_panels
 
@@ -820,60 +819,3 @@ def write_report(
     names = (REPORT_MD, REPORT_CSV, AGGREGATE_CSV, IMPROVEMENT_CSV)
     names += (CURVES_STEPS_PNG, CURVES_TIME_PNG, IQM_STEPS_PNG, PROFILE_PNG)
     return [out / name for name in names]
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``simoun-report``."""
-    parser = argparse.ArgumentParser(
-        prog="simoun-report",
-        description="Tables (Markdown, CSV) and figures (PNG) of a sweep or of a directory of "
-        "simoun-train runs, per variant and env, over seeds: mean ± std, and on returns "
-        "normalized by the task's maximum the IQM and mean with 95 % stratified-bootstrap "
-        "confidence intervals, probabilities of improvement, performance profiles and IQM "
-        "curves (Agarwal et al. 2021). A row counts each seed once (the run that finished, or "
-        "reached the budget, then the most recent; the others are listed) and runs of one "
-        "evaluation grid (eval_every: runs on another grid than most of their row are listed "
-        "and left out).",
-    )
-    parser.add_argument("root", metavar="DIR", help="a sweep directory or a directory of runs")
-    parser.add_argument(
-        "--out",
-        metavar="DIR",
-        help="where to write the report (default: DIR; for a single run directory, "
-        "report-<name> beside it, so the run directory is left as simoun-train wrote it)",
-    )
-    equal = parser.add_mutually_exclusive_group()
-    equal.add_argument(
-        "--at-step",
-        type=int,
-        metavar="N",
-        help="compare at an equal budget of N env steps: a run counts, finished or not, only "
-        "with an evaluation at exactly N (runs evaluated elsewhere are listed as short)",
-    )
-    equal.add_argument(
-        "--at-wall-time",
-        type=float,
-        metavar="SECONDS",
-        help="compare at an equal wall-time budget: a run counts, finished or not, if it "
-        "trained past SECONDS (an evaluation at or after it), with its last evaluation at or "
-        "before SECONDS (runs that stopped earlier are listed as short)",
-    )
-    args = parser.parse_args(argv)
-    budget = None
-    if args.at_step is not None:
-        budget = ("env_step", args.at_step)
-    elif args.at_wall_time is not None:
-        budget = ("wall_time_s", args.at_wall_time)
-    if budget is not None and budget[1] <= 0:
-        parser.exit(2, "simoun-report: error: --at-step / --at-wall-time must be positive\n")
-    try:
-        written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
-    except SetupError as err:
-        parser.exit(2, f"simoun-report: error: {err}\n")
-    print((Path(written[0])).read_text(), end="")
-    print(f"written: {', '.join(map(str, written))}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

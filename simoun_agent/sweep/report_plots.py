@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.atomic import atomic_write
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

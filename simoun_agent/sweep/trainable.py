@@ -1,5 +1,5 @@
 """Ray Tune's trainable: each trial is one ordinary ``simoun-train`` run in its own run directory,
-reporting every evaluation to Tune through a :class:`~simoun_agent.run.train.TrainCallback`.
+reporting every evaluation to Tune through a :class:`~simoun_agent.run.callback.TrainCallback`.
 
 A trial continues from its run directory's checkpoint when there is one (a resumed sweep), and
 writes ``error.txt`` (the traceback) into its run directory when it fails, so the failure stays
@@ -23,8 +23,10 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import resolve
+from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
 from simoun_agent.run import train
-from simoun_agent.run.checkpoint import CHECKPOINT_NAME, atomic_write
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
 from simoun_agent.run.signals import Stopped
 from simoun_agent.sweep.grid import Trial
 from simoun_agent.sweep.report import ERROR_FILE
@@ -68,10 +70,11 @@ def open_run(trial: Trial) -> train.Run:
     """
     run_dir = Path(trial.run_dir)
     if (run_dir / CHECKPOINT_NAME).is_file():
-        return train.resume_run(run_dir, {})
-    if (run_dir / train.CONFIG_NAME).is_file():
+        return train.resume_run(run_dir, {}, check=check_eval_distractions)
+    if (run_dir / CONFIG_NAME).is_file():
         shutil.rmtree(run_dir)
-    return train.create_run(resolve(trial.preset, trial.overrides))
+    config = resolve(trial.preset, trial.overrides)
+    return train.create_run(config, check=check_eval_distractions)
 
 
 def run_trial(
@@ -88,7 +91,7 @@ def run_trial(
         run = open_run(trial)
         part = start_part(run)
         try:
-            train.train(run, callbacks=callbacks)
+            train.train(run, callbacks=[*distraction_callbacks(run.config), *callbacks])
         except Stopped:
             return
         finally:

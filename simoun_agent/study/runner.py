@@ -1,31 +1,19 @@
-"""``simoun-study``: one protocol for every method, from a spec file, on Ray Tune.
-
-    simoun-study plan docs/studies/dmc100k.toml
-    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
-        --archive docs/studies/dmc100k
-    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
-        --archive docs/studies/dmc100k --resume
-
-``plan`` lists every run of both phases with a CPU-time estimate measured here; ``run`` tunes
-(every recipe x grid setting x tuning seed), selects each recipe's setting by the spec's rule,
-evaluates the selected settings on the held-out seeds and writes the report
-(:mod:`simoun_agent.study.report`). The runs go through ``simoun-sweep``'s code: the same trial
-directories, Tune experiments, STOP file on SIGTERM and failure handling.
+"""Running a study from its spec (the library under ``simoun-study``,
+:mod:`simoun_agent.cli.study`): the study record, both phases on Ray Tune through
+:mod:`simoun_agent.sweep.launch`, the selection between them and the report at the end.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import sys
 from datetime import datetime, timezone
 from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 from simoun_agent.config import SetupError, resolve
-from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.run.flags import add_version
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.study import archive as archiving
 from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_agent.study.plan import (
@@ -33,7 +21,6 @@ from simoun_agent.study.plan import (
     TUNING,
     StudyRun,
     check_layout,
-    describe,
     evaluation_runs,
     setting_label,
     tuning_runs,
@@ -41,7 +28,7 @@ from simoun_agent.study.plan import (
 from simoun_agent.study.provenance import code_version, same_code
 from simoun_agent.study.report import REPORT_DIR, REPORT_MD, write_study_report
 from simoun_agent.study.spec import StudySpec, load_spec
-from simoun_agent.sweep import cli as sweep_cli
+from simoun_agent.sweep import launch
 
 STUDY_FILE = "study.json"
 """The study record, in the study directory and the archive: the spec (its file, text and
@@ -152,18 +139,18 @@ class Phases:
             self.sync(runs)
             return {}
         if self.gpus is None:  # Ray starts only once there is something to run
-            self.started = sweep_cli.connect(self.ray, self.args.address, self.args.num_cpus)
+            self.started = launch.connect(self.ray, self.args.address, self.args.num_cpus)
             device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
             wanted = str(self.spec.gpus_per_trial)
-            self.gpus = sweep_cli.gpus_per_trial(self.ray, wanted, device)
-            sweep_cli.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
+            self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
+            launch.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
         callbacks = []
         if self.archive is not None:
             from simoun_agent.study.tune_callback import ArchiveOnComplete
 
             names = {run.trial(self.spec, self.study_dir).name: run.name for run in todo}
             callbacks.append(ArchiveOnComplete(self.study_dir, self.archive, names))
-        outcome = sweep_cli.run_trials(
+        outcome = launch.run_trials(
             self.todo,
             self.study_dir,
             self.spec.cpus_per_trial,
@@ -186,7 +173,7 @@ def run_study(spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> int
     choices: dict[str, Choice] | None = None
     terminated: list[bool] = []
     try:
-        with sweep_cli.stop_trials_on_sigterm(study_dir) as terminated:
+        with launch.stop_trials_on_sigterm(study_dir) as terminated:
             outcome = phases.run(TUNING, tuning_runs(spec))
             if not (outcome.get("failed") or outcome.get("stopped")):
                 choices = choose(spec, study_dir)
@@ -207,112 +194,9 @@ def run_study(spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> int
         written = [study_dir / REPORT_DIR / REPORT_MD]
         if archive is not None:
             archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
-    return sweep_cli.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
+    return launch.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
 
 
 def say_choices(choices: dict[str, Choice]) -> None:
     for recipe, choice in choices.items():
         print(f"selected for {recipe}: {setting_label(choice.setting)} (score {choice.score:.4g})")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="simoun-study",
-        description="Run a study from its spec file: tune every recipe on one shared grid, "
-        "select each recipe's setting by one rule, evaluate the selected settings on held-out "
-        "seeds, and report IQM with confidence intervals (Agarwal et al. 2021).",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        allow_abbrev=False,
-        epilog="examples:\n"
-        "  simoun-study plan docs/studies/dmc100k.toml\n"
-        "  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k "
-        "--archive docs/studies/dmc100k\n"
-        "  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k "
-        "--archive docs/studies/dmc100k --resume\n\n"
-        "The spec's layout is documented in simoun_agent/study/spec.py; "
-        "docs/studies/dmc100k.toml is a full example.",
-    )
-    add_version(parser)
-    commands = parser.add_subparsers(dest="command", required=True, metavar="{plan,run}")
-    planning = commands.add_parser(
-        "plan",
-        help="list every run of both phases and estimate their CPU time, running nothing",
-        description="List every run of both phases (phase, task, recipe, grid values, seed, "
-        "env steps) and estimate the CPU time of each from a short probe measured here.",
-    )
-    planning.add_argument("spec", metavar="SPEC", help="the study's TOML file")
-    planning.add_argument(
-        "--probe-updates",
-        type=int,
-        default=20,
-        metavar="N",
-        help="agent updates timed per configuration (default: 20; 0: no estimate)",
-    )
-    running = commands.add_parser(
-        "run",
-        help="run the study (tuning, selection, evaluation, report) on Ray Tune",
-        description="Run the tuning phase, select each recipe's setting, run the evaluation "
-        "phase on the held-out seeds and write the report into STUDY_DIR/report.",
-    )
-    running.add_argument("spec", metavar="SPEC", help="the study's TOML file")
-    running.add_argument(
-        "--study-dir",
-        required=True,
-        metavar="DIR",
-        help="where the runs and the report go; on a cluster, a directory every machine sees",
-    )
-    running.add_argument(
-        "--archive",
-        metavar="DIR",
-        help="copy each finished run's CSVs, config.json and summary.json (no checkpoints, "
-        "replays, videos or tb/) here as it completes, with the study record, the selection "
-        "and the report, e.g. docs/studies/NAME; a resumed study counts archived runs as done",
-    )
-    running.add_argument(
-        "--resume",
-        action="store_true",
-        help="continue the study: finished runs (in --study-dir, else in --archive) are kept, "
-        "the others go on from their checkpoints or start",
-    )
-    running.add_argument(
-        "--allow-other-commit",
-        action="store_true",
-        help="resume even though the code is at another commit than the study started from",
-    )
-    running.add_argument(
-        "--address",
-        metavar="auto|HOST:PORT|ray://HOST:PORT",
-        help="run on a Ray cluster (auto: the one `ray start` made here); default: a local "
-        "Ray instance",
-    )
-    running.add_argument(
-        "--num-cpus", type=int, metavar="N", help="CPUs of the local Ray instance (default: all)"
-    )
-    running.add_argument(
-        "--verbose", type=int, default=1, choices=(0, 1, 2), help="Tune's output (default: 1)"
-    )
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``simoun-study``."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        spec = spec_from(args.spec)
-        if args.command == "plan":
-            if args.probe_updates < 0:
-                raise SetupError("--probe-updates must be 0 or more")
-            print(describe(spec, args.spec, args.probe_updates))
-            return 0
-        # absolute: Tune runs each trial in a working directory of its own
-        args.study_dir = Path(args.study_dir).absolute()
-        args.archive = Path(args.archive).absolute() if args.archive else None
-        ray = sweep_cli.load_ray()
-        return run_study(spec, args, ray)
-    except SetupError as err:
-        parser.exit(2, f"simoun-study: error: {err}\n")
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,4 @@
-"""Command-line conventions shared by ``simoun-train`` and ``simoun-eval``.
+"""Command-line conventions shared by the commands of :mod:`simoun_agent.cli`.
 
 Booleans are switches, ``--video`` / ``--no-video`` (``argparse.BooleanOptionalAction``), and the
 older spelling with a value, ``--video false`` or ``--video=false``, still works: :func:`bool_argv`

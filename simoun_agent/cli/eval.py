@@ -1,0 +1,259 @@
+"""``simoun-eval``: evaluate a trained run, deterministic episodes, metrics and a video.
+
+``simoun-eval RUN_DIR_OR_CHECKPOINT`` rebuilds the run's environment and agent from the
+checkpoint (:func:`simoun_agent.run.load.load_run`), plays evaluation episodes
+(:func:`simoun_agent.run.evaluate.evaluate`) and writes ``eval-<step>/metrics.json`` and
+``eval-<step>/video.mp4`` next to the checkpoint (or under ``--out``); an earlier evaluation
+there is kept unless ``--overwrite``. ``--distraction MODES`` evaluates one or several runs under
+distraction instead (:mod:`simoun_agent.generalization`). Ctrl-C or SIGTERM stops it at once
+(exit 130 or 143) without leaving a half-written directory.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import signal
+import sys
+from pathlib import Path
+
+from tqdm import tqdm
+
+from simoun_agent.cli.flags import add_version, bool_argv
+from simoun_agent.config import SetupError
+from simoun_agent.generalization.evaluation import evaluate_runs
+from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
+from simoun_agent.generalization.suite import parse_distractions
+from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
+from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
+from simoun_agent.run.load import load_run
+from simoun_agent.run.make_env import video_fps
+from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.seeds import first_eval_seed
+from simoun_agent.run.signals import Stopped, stop_at_once
+from simoun_agent.run.video import write_video
+
+
+class EpisodeProgress:
+    """Progress of ``simoun-eval``: a bar on a terminal, else one plain line per episode on
+    stderr (logs of nohup or cluster jobs do not fill with bar redraws); nothing when off."""
+
+    def __init__(self, episodes: int, enabled: bool) -> None:
+        self.episodes = episodes
+        self.enabled = enabled
+        self.bar = tqdm(total=episodes, unit="episode") if enabled and sys.stderr.isatty() else None
+
+    def episode(self, index: int, episode_return: float) -> None:
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.set_postfix(episode_return=f"{episode_return:.1f}")
+        elif self.enabled:
+            print(
+                f"episode {index + 1}/{self.episodes}: return {episode_return:.1f}",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    def __enter__(self) -> EpisodeProgress:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-eval",
+        description="Evaluate a simoun-train checkpoint: deterministic episodes, metrics and a "
+        "video.",
+        epilog="example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10",
+    )
+    parser.add_argument(
+        "checkpoint",
+        nargs="+",
+        help="a run directory or its checkpoint.pt (several with --distraction)",
+    )
+    parser.add_argument("--episodes", type=int, default=10, help="episodes to play (default 10)")
+    parser.add_argument(
+        "--seed", type=int, default=None, help="first episode seed (default: the run's eval seeds)"
+    )
+    parser.add_argument(
+        "--out", default=None, help="output directory (default: <run dir>/eval-<step>)"
+    )
+    parser.add_argument(
+        "--video",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="record the first episode to video.mp4 (default: on)",
+    )
+    parser.add_argument(
+        "--progress",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="show a progress bar, or one line per episode when stderr is not a terminal",
+    )
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an earlier evaluation in the output directory",
+    )
+    parser.add_argument(
+        "--random-policy",
+        action="store_true",
+        help="play uniformly random actions on the same episodes instead of the agent "
+        "(the baseline; writes to <run dir>/eval-<step>-random)",
+    )
+    parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
+    parser.add_argument(
+        "--torch-threads",
+        type=int,
+        default=None,
+        metavar="INT",
+        help="torch intra-op threads (default: the run's torch_threads, else torch's default; "
+        "not with --distraction, where each run uses its own)",
+    )
+    parser.add_argument(
+        "--distraction",
+        metavar="MODES",
+        default=None,
+        help="evaluate under distraction modes instead, comma-separated from train, color_easy, "
+        "color_hard, video_easy, video_hard (dm_control runs); writes a mean ± std table and a "
+        "bar chart to <run dir>/generalization, or <common folder>/generalization for several runs",
+    )
+    parser.add_argument(
+        "--videos",
+        metavar="DIR",
+        default=None,
+        help="with --distraction: a folder of video files (or of DAVIS-style folders of frames) "
+        "for the video_* modes (default: a procedural moving background)",
+    )
+    add_version(parser)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-eval``."""
+    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(bool_argv(argv, ("--video", "--progress")))
+    if args.episodes < 1:
+        parser.error("--episodes must be at least 1")
+    if args.seed is not None and not 0 <= args.seed < 2**32:
+        parser.error(f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
+    if args.torch_threads is not None and args.torch_threads < 1:
+        parser.error(f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
+    if args.distraction is not None and args.torch_threads is not None:
+        parser.error(
+            "--torch-threads goes with one run; with --distraction each run's own "
+            "torch_threads (from its config.json) applies: drop --torch-threads"
+        )
+    if args.distraction is not None:
+        return evaluate_distractions(parser, args)
+    if len(args.checkpoint) > 1 or args.videos is not None:
+        parser.error(
+            "several runs and --videos go with --distraction (e.g. --distraction "
+            "train,video_hard); otherwise evaluate one run at a time"
+        )
+    try:
+        # The machine may differ from the training one: --device applies before the checks.
+        run = load_run(Path(args.checkpoint[0]), args.device, args.torch_threads)
+        config, env, step = run.config, run.env, run.env_step
+        suffix = "-random" if args.random_policy else ""
+        default_out = run.run_dir / f"eval-{step}{suffix}"
+        out = Path(args.out) if args.out else default_out
+        if out.is_dir() and any(out.iterdir()) and not args.overwrite:
+            env.close()
+            raise SetupError(
+                f"{out} holds an earlier evaluation; pass --overwrite to replace it, or --out DIR "
+                "to write this one elsewhere"
+            )
+        created = make_output_dir(out)
+        seed = args.seed if args.seed is not None else first_eval_seed(config.seed)
+        agent = RandomPolicy(env.action_space.shape[0], seed) if args.random_policy else run.agent
+    except SetupError as err:
+        parser.exit(2, f"simoun-eval: error: {err}\n")
+    try:
+        with stop_at_once(), EpisodeProgress(args.episodes, args.progress) as progress:
+            metrics, frames = evaluate(
+                agent, env, args.episodes, seed, record=args.video, on_episode=progress.episode
+            )
+    except Stopped as stop:
+        env.close()
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        print(f"simoun-eval: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
+        return stop.exit_code
+    metrics.update(
+        env_step=step, episodes=args.episodes, first_seed=seed, random_policy=args.random_policy
+    )
+    text = metrics_json(metrics)
+    (out / METRICS_NAME).write_text(text)
+    if frames:
+        write_video(out / VIDEO_NAME, frames, video_fps(env, config.resolved_action_repeat()))
+    env.close()
+    print(text, end="")
+    print(f"wrote {out}/{METRICS_NAME}" + (f" and {out}/{VIDEO_NAME}" if args.video else ""))
+    return 0
+
+
+def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """Evaluate ``args.checkpoint`` (one or several runs) on ``args.distraction``'s modes and
+    write the table, CSV and bar chart; bad input exits through ``parser`` without traceback."""
+    if args.random_policy:
+        parser.error("--random-policy does not combine with --distraction")
+    run_dirs = [Path(path) for path in args.checkpoint]
+    created, out = False, None
+    try:
+        modes = parse_distractions(args.distraction)
+        missing = [str(path) for path in run_dirs if not path.exists()]
+        if missing:
+            raise SetupError(
+                f"no such run directory or checkpoint: {', '.join(missing)}; pass directories "
+                "that simoun-train created"
+            )
+        out = Path(args.out) if args.out else default_out(run_dirs)
+        if (out / TABLE_CSV).exists() and not args.overwrite:
+            raise SetupError(
+                f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
+                "or --out DIR to write this one elsewhere"
+            )
+        created = make_output_dir(out)
+        with stop_at_once():
+            results = evaluate_runs(
+                run_dirs,
+                modes,
+                args.episodes,
+                seed=args.seed,
+                device=args.device,
+                videos=args.videos,
+                progress=_status if args.progress else None,
+            )
+    except SetupError as err:
+        # a run or mode refused while loading: leave no empty report directory behind
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        parser.exit(2, f"{parser.prog}: error: {err}\n")
+    except Stopped as stop:
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        print(f"{parser.prog}: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
+        return stop.exit_code
+    envs = sorted({result.env.removeprefix("dm_control/") for result in results})
+    steps = sorted({result.env_step for result in results})
+    title = (
+        f"{', '.join(envs)}: return under distraction after "
+        f"{', '.join(str(step) for step in steps)} env steps"
+    )
+    paths = write_report(results, out, title)
+    print(paths["table"].read_text(), end="")
+    print(f"wrote {paths['table']}, {paths['csv']} and {paths['chart']}")
+    return 0
+
+
+def _status(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,201 @@
+"""``simoun-sweep``: a grid of training runs on Ray Tune, on this machine or a Ray cluster.
+
+    simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl --seeds 0-4 --sweep-dir sw
+    simoun-sweep --resume --sweep-dir sw              # after Ctrl-C: finish what is unfinished
+    simoun-sweep --address auto --preset cheetah-run --grid agent.recipe=simoun,drq --seeds 0-4
+
+The base config is given exactly as to ``simoun-train`` (``--preset``, every config flag,
+``--set KEY=VALUE``). Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``;
+the report (:mod:`simoun_agent.sweep.report`) is written when the sweep ends. The running is
+:mod:`simoun_agent.sweep.launch`'s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+
+from simoun_agent.cli.config_flags import add_config_arguments, overrides_from
+from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_agent.sweep import report
+from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec
+from simoun_agent.sweep.launch import (
+    check_fits,
+    connect,
+    finished,
+    gpus_per_trial,
+    load_ray,
+    run_sweep,
+    stop_trials_on_sigterm,
+    summarize,
+)
+from simoun_agent.sweep.trainable import STOP_FILE
+
+
+def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
+    """The sweep to run: from the flags, or the saved one on ``--resume`` (which the flags, when
+    given, must match)."""
+    base = overrides_from(args)
+    given = bool(args.grid or args.seeds or args.envs or base or args.preset)
+    if not args.resume:
+        if (sweep_dir / SWEEP_FILE).exists():
+            raise SetupError(
+                f"{sweep_dir} already holds a sweep; continue it with --resume, or pass another "
+                "--sweep-dir"
+            )
+        if sweep_dir.exists() and any(sweep_dir.iterdir()):
+            raise SetupError(f"{sweep_dir} is not empty; pass a new --sweep-dir")
+        cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
+        return SweepSpec.create(args.preset, base, args.grid, args.seeds, args.envs, cpus)
+    saved = SweepSpec.load(sweep_dir)
+    if not given and args.cpus_per_trial in (None, saved.cpus_per_trial):
+        return saved
+    spec = SweepSpec.create(
+        args.preset,
+        base,
+        args.grid,
+        args.seeds,
+        args.envs,
+        saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
+    )
+    differences = spec.describe_differences(saved)
+    if differences:
+        raise SetupError(
+            f"the sweep in {sweep_dir} was started with another grid, so --resume cannot continue "
+            f"it ({'; '.join(differences)}); give the flags it was started with (or only "
+            f"--resume --sweep-dir {sweep_dir}), or start a new sweep in another --sweep-dir"
+        )
+    return saved
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="simoun-sweep",
+        usage="simoun-sweep --sweep-dir DIR [--grid KEY=V1,V2 ...] [--seeds 0-4] [--envs A,B] "
+        "[--preset NAME] [--KEY VALUE ...] [--resume] [--address auto|HOST:PORT]",
+        description="Run a grid of simoun-train runs (variants x envs x seeds) on Ray Tune, on "
+        "this machine or a Ray cluster, then write the report (simoun-report).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        allow_abbrev=False,
+        epilog="examples:\n"
+        "  simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 "
+        "--sweep-dir sweeps/baselines\n"
+        "  simoun-sweep --resume --sweep-dir sweeps/baselines\n"
+        "  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq "
+        "--seeds 0-4 --sweep-dir /shared/sweeps/walker\n\n"
+        f"agent recipes (--grid agent.recipe=A,B): {', '.join(RECIPES)}\n"
+        "Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.",
+    )
+    sweep = parser.add_argument_group("sweep")
+    sweep.add_argument(
+        "--sweep-dir",
+        metavar="DIR",
+        help="where the runs and the report go (default: sweeps/<UTC time>; required with "
+        "--resume); on a cluster, a directory every machine sees",
+    )
+    sweep.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="KEY=V1,V2",
+        help="a config key and the values to try (repeatable: the variants are the product), "
+        "e.g. --grid agent.recipe=simoun,drq",
+    )
+    sweep.add_argument(
+        "--seeds",
+        metavar="SEEDS",
+        help="seeds of each variant, e.g. 0-4 or 0,2,5 (default: --seed)",
+    )
+    sweep.add_argument(
+        "--envs", metavar="ID,ID", help="Gymnasium ids to run every variant on (default: --env)"
+    )
+    sweep.add_argument(
+        "--cpus-per-trial",
+        type=int,
+        metavar="N",
+        help="CPUs per trial; the trial uses as many torch threads (default: 1)",
+    )
+    sweep.add_argument(
+        "--gpus-per-trial",
+        default="auto",
+        metavar="N|auto",
+        help="GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device "
+        "is not cpu, else 0",
+    )
+    sweep.add_argument(
+        "--address",
+        metavar="auto|HOST:PORT|ray://HOST:PORT",
+        help="run on a Ray cluster (auto: the one `ray start` made on this machine); default: a "
+        "local Ray instance",
+    )
+    sweep.add_argument(
+        "--num-cpus",
+        type=int,
+        metavar="N",
+        help="CPUs of the local Ray instance (default: this machine's)",
+    )
+    sweep.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue the sweep in --sweep-dir: finished trials are skipped, the others go on "
+        "from their checkpoints",
+    )
+    sweep.add_argument(
+        "--verbose", type=int, default=1, choices=(0, 1, 2), help="Tune's output (default: 1)"
+    )
+    add_config_arguments(parser)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``simoun-sweep``."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.resume and not args.sweep_dir:
+        parser.exit(2, "simoun-sweep: error: --resume needs the --sweep-dir of the sweep\n")
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    # absolute: Tune runs each trial in a working directory of its own
+    sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
+    try:
+        ray = load_ray()
+        spec = sweep_spec(args, sweep_dir)
+    except SetupError as err:
+        parser.exit(2, f"simoun-sweep: error: {err}\n")
+    todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
+    done = len(spec.trials(sweep_dir)) - len(todo)
+    print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
+    terminated: list[bool] = []
+    if todo:
+        started = False
+        try:
+            started = connect(ray, args.address, args.num_cpus)
+            device = spec.base.get("device", resolve(spec.preset, {}).device)
+            gpus = gpus_per_trial(ray, args.gpus_per_trial, device)
+            check_fits(ray, spec.cpus_per_trial, gpus)
+            sweep_dir.mkdir(parents=True, exist_ok=True)
+            if not (sweep_dir / SWEEP_FILE).exists():
+                spec.save(sweep_dir)
+            (sweep_dir / STOP_FILE).unlink(missing_ok=True)
+            with stop_trials_on_sigterm(sweep_dir) as came:
+                terminated = came
+                outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
+        except SetupError as err:
+            parser.exit(2, f"simoun-sweep: error: {err}\n")
+        except KeyboardInterrupt:
+            outcome = {"stopped": todo}
+        finally:
+            if started:
+                ray.shutdown()
+    else:
+        outcome = {}
+    try:
+        written = report.write_report(sweep_dir)
+    except SetupError:  # no trial got as far as writing its config.json
+        written = []
+    return summarize(outcome, sweep_dir, written, bool(terminated))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
