@@ -175,7 +175,7 @@ def intrinsic_return_by_hand(agent: SimounAgent, batch: dict) -> np.ndarray:
     return (GAMMA ** np.arange(len(mask))[:, None] * mask * r_i).sum(0)
 
 
-@pytest.mark.parametrize(("n_step", "curiosity"), [(3, False), (3, True), (2, True)])
+@pytest.mark.parametrize(("n_step", "curiosity"), [(3, False), (3, True), (2, True), (4, True)])
 def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return(n_step, curiosity):
     """The cpu preset's 3-step returns on a hand-built replay: the TD target is
     R + sum_j gamma^j r^i(s_{t+j}) + gamma * discount * V(bootstrap_obs), with FrameReplay.sample's

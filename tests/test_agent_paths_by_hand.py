@@ -5,6 +5,7 @@ schedule, the initial running maxima, the checkpoint counters and the misuse mes
 
 import copy
 import io
+from dataclasses import asdict
 
 import numpy as np
 import pytest
@@ -193,6 +194,7 @@ def test_act_explores_with_the_std_of_its_step_defaulting_to_the_latest_update()
         return agent.act(obs, **kwargs) - mu
 
     z = noise(step=0) / schedule_by_hand(0)
+    np.testing.assert_allclose(noise(), z * schedule_by_hand(0), rtol=1e-5, atol=1e-7)  # step 0
     assert np.abs(z).max() > 0.1 and np.all(np.abs(mu + z * 0.2) < 1)
     np.testing.assert_allclose(noise(step=600), z * schedule_by_hand(600), rtol=1e-4, atol=1e-6)
     trained = copy.deepcopy(agent)
@@ -200,6 +202,10 @@ def test_act_explores_with_the_std_of_its_step_defaulting_to_the_latest_update()
     assert trained.env_step == 600
     agent.env_step = 600  # as the update leaves it, with the weights unchanged
     np.testing.assert_allclose(noise(), z * schedule_by_hand(600), rtol=1e-4, atol=1e-6)
+    state = agent.encoder(torch.from_numpy(obs)[None]).state.detach()
+    for step, std in ((None, schedule_by_hand(600)), (0, 0.2)):  # the actor step's default too
+        metrics = copy.deepcopy(agent).update_actor(state, step)
+        assert float(metrics["exploration_std"]) == pytest.approx(std)
 
 
 def test_gaussian_act_samples_unless_deterministic_and_returns_the_tanh_mean_when_it_is():
@@ -221,6 +227,7 @@ def test_running_maxima_start_at_their_own_initial_values_below_which_eq13_is_sc
     r_e_max_init and r_i_max_init, each its own value."""
     torch.manual_seed(0)
     config = small_config(init_temperature=ALPHA, discount=GAMMA, r_e_max_init=50.0)
+    config.curiosity_scale, config.curiosity_decay = 0.3, 1e-4  # not the defaults
     config.r_i_max_init = 1e4  # above every distance of the batch, and not 50
     agent = SimounAgent(FRAME, ACTIONS, config, "cpu")
     window, action, reward, discount = random_window()
@@ -244,7 +251,13 @@ def test_checkpoint_round_trip_keeps_every_counter_and_resumes_bit_exact(actor):
     torch.save(agent.state_dict(), buffer)
     buffer.seek(0)
     resumed = SimounAgent(FRAME, ACTIONS, config, "cpu")
-    resumed.load_state_dict(torch.load(buffer, weights_only=False))
+    state = torch.load(buffer, weights_only=False)
+    networks = {"encoder", "encoder_target", "critic", "critic_target", "actor", "reward_model"}
+    networks |= {"similarity", "transition", "critic_optimizer", "actor_optimizer"}
+    alpha = {"log_alpha", "alpha_optimizer"} if actor == "gaussian" else set()
+    assert set(state) == networks | alpha | {"running_max", "num_updates", "env_step", "config"}
+    assert state["config"] == asdict(config)  # what a resume compares its config against
+    resumed.load_state_dict(state)
     assert (resumed.env_step, resumed.num_updates) == (1236, 3)
     assert resumed.running_max.state_dict() == agent.running_max.state_dict()
     assert (resumed.log_alpha is None) == (actor == "deterministic")
@@ -303,3 +316,67 @@ def test_bad_observations_are_refused_with_the_problem_and_the_fix():
         assert f"got {got}; pass the 'frames' entry of SimounObservation unchanged" in message
     features = agent.encoder_features(torch.zeros(2, 3, *FRAME, dtype=torch.uint8))
     assert [tuple(f.shape) for f in features] == [(2, 16), (2, 3, 16)]
+
+
+def test_contrastive_shift_view_is_an_independent_shift_of_the_unshifted_frames():
+    """contrastive_view="shift" (CURL): the key is the EMA encoder on an independently shifted
+    copy of frames t-2 .. t; L_con is Eq. 3's cross-entropy with the diagonal as positives."""
+    agent = agent_for_targets(contrastive_view="shift")
+    window, action, reward, discount = random_window()
+    torch.manual_seed(5)  # with augmentation "none" the key's shift is the first random draw
+    key_view = random_shift(window[:, :3], agent.shift_pad)
+    with torch.no_grad():
+        anchor = agent.encoder(window[:, :3]).anchor
+        key = agent.encoder_target.encode_key(agent.encoder.key_frames(key_view))
+        logits = np64(anchor @ agent.similarity.weight @ key.T)
+    logits -= logits.max(1, keepdims=True)
+    expected = -np.mean(np.diag(logits) - np.log(np.exp(logits).sum(1)))
+    torch.manual_seed(5)
+    metrics = agent.update_window(window, action, reward, discount, STEP)
+    assert float(metrics["contrastive_loss"]) == pytest.approx(expected, rel=1e-5)
+
+
+def test_random_conv_kernel_of_the_config_makes_the_contrastive_key():
+    losses = []
+    for kernel in (3, 5):
+        agent = agent_for_targets(random_conv_kernel=kernel)
+        torch.manual_seed(5)
+        losses.append(float(agent.update_window(*random_window(), step=STEP)["contrastive_loss"]))
+    assert losses[0] != pytest.approx(losses[1], rel=1e-4)
+
+
+@pytest.mark.parametrize(("weight", "head"), [("reward", "reward_model"),
+    ("transition", "transition"), ("contrastive", "similarity")])  # fmt: skip
+def test_each_auxiliary_weight_scales_its_heads_gradient(weight, head):
+    """Eq. 14: the head of one auxiliary term gets weight * its loss's gradient (nothing else
+    reads it), with the config's weight passed through."""
+    grads = []
+    for value in (1.0, 0.25):
+        agent = agent_for_targets(curiosity=False, **{f"{weight}_weight": value})
+        agent.num_updates = 1  # no actor step
+        torch.manual_seed(5)
+        agent.update_window(*random_window(), step=STEP)
+        grads.append([p.grad for p in getattr(agent, head).parameters()])
+    for full, quarter in zip(*grads, strict=True):
+        assert full.abs().max() > 0
+        torch.testing.assert_close(quarter, 0.25 * full, rtol=1e-5, atol=1e-9)
+
+
+def test_zero_weight_terms_build_no_head_and_report_no_loss():
+    agent = agent_for_targets(transition_weight=0.0, contrastive_weight=0.0)
+    assert agent.transition is None and agent.similarity is None
+    metrics = agent.update_window(*random_window(), step=STEP)
+    assert "transition_loss" not in metrics and "contrastive_loss" not in metrics
+    assert "reward_loss" in metrics and set(agent.modules()) >= {"reward_model"}
+
+
+def test_construction_reads_the_optimiser_settings_shift_pad_and_shapes_from_the_config():
+    config = small_config(lr=3e-4, alpha_lr=2e-4, alpha_beta=0.6, shift_pad=3)
+    agent = SimounAgent(FRAME, ACTIONS, config, "cpu")
+    assert [g["lr"] for g in agent.critic_optimizer.param_groups] == [3e-4]
+    assert [g["lr"] for g in agent.actor_optimizer.param_groups] == [3e-4]
+    [alpha_group] = agent.alpha_optimizer.param_groups
+    assert (alpha_group["lr"], alpha_group["betas"]) == (2e-4, (0.6, 0.999))
+    assert (agent.shift_pad, agent.action_dim, agent.env_step, agent.num_updates) == (3, 2, 0, 0)
+    wide = SimounAgent((3, 32, 64), ACTIONS, small_config(), "cpu")
+    assert wide.shift_pad == 2  # 4 px per 84 px of the height, 32 px
