@@ -20,7 +20,8 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from simoun_agent.models.encoder import conv_output_size, conv_trunk, weight_init
+from simoun_agent.config.shapes import conv_output_size
+from simoun_agent.models.encoder import conv_trunk, weight_init
 from simoun_agent.models.sac import Actor, Critic
 
 

@@ -19,7 +19,7 @@ CHILD = """
 import json, resource, sys, torch
 from simoun_agent import SimounAgent
 from simoun_agent.run.memory import ACTION_DIM, frame_shape
-from simoun_agent.run.presets import resolve
+from simoun_agent.config import resolve
 
 config = resolve("cpu", {"image_size": int(sys.argv[1])})
 torch.set_num_threads(1)
@@ -40,8 +40,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[64, 96, 128])
     args = parser.parse_args()
+    from simoun_agent.config import resolve
     from simoun_agent.run.memory import update_bytes
-    from simoun_agent.run.presets import resolve
 
     print("size  estimated GB  measured GB (peak RSS growth)  measured / estimated")
     row = "{:4d}  {:12.2f}  {:30.2f}  {:20.2f}"

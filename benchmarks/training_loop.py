@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from simoun_agent.config import resolve
 from simoun_agent.run import train
-from simoun_agent.run.presets import resolve
 
 
 def config(run_dir: Path, env_process: bool, agent_steps: int, warmup: int):

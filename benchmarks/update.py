@@ -72,7 +72,7 @@ def first_step_curiosity(agent: SimounAgent, replay: FrameReplay):
 
 def n_step_curiosity(args: argparse.Namespace) -> None:
     """Per-step against first-step curiosity at the cpu preset's settings."""
-    from simoun_agent.run.presets import resolve
+    from simoun_agent.config import resolve
 
     torch.set_num_threads(1)
     config = resolve("cpu", {}).agent

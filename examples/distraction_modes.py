@@ -14,8 +14,8 @@ import cv2
 import imageio.v2 as imageio
 import numpy as np
 
+from simoun_agent.config import resolve
 from simoun_agent.generalization import DISTRACTIONS, make_distracted_env
-from simoun_agent.run.presets import resolve
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--env", default="dm_control/ball_in_cup-catch-v0")

@@ -1,28 +1,39 @@
-"""The reference Simoun SAC agent."""
+"""The reference Simoun SAC agent.
+
+The torch parts load on first use (``simoun_agent.SimounAgent``, PEP 562), so importing the
+torch-free configuration (:mod:`simoun_agent.config`) or the run directories' readers does not
+import torch.
+"""
+
+import importlib
+from typing import Any
 
 import simoun_wrappers  # noqa: F401  (headless rendering defaults)
-from simoun_agent.agent import SimounAgent
 from simoun_agent.config import AgentConfig
-from simoun_agent.models import encoder as encoders
-from simoun_agent.models.encoder import (
-    DualPathEncoder,
-    FlareEncoder,
-    SingleFrameEncoder,
-    StackedEncoder,
-    make_encoder,
-)
-from simoun_agent.models.interaction import StructuralInteraction
-from simoun_agent.replay import FrameReplay
 
-__all__ = [
-    "AgentConfig",
-    "DualPathEncoder",
-    "FlareEncoder",
-    "FrameReplay",
-    "SimounAgent",
-    "SingleFrameEncoder",
-    "StackedEncoder",
-    "StructuralInteraction",
-    "encoders",
-    "make_encoder",
-]
+_LAZY = {
+    "DualPathEncoder": "simoun_agent.models.encoder",
+    "FlareEncoder": "simoun_agent.models.encoder",
+    "FrameReplay": "simoun_agent.replay",
+    "SimounAgent": "simoun_agent.agent",
+    "SingleFrameEncoder": "simoun_agent.models.encoder",
+    "StackedEncoder": "simoun_agent.models.encoder",
+    "StructuralInteraction": "simoun_agent.models.interaction",
+    "make_encoder": "simoun_agent.models.encoder",
+}
+"""Public name -> the module defining it, imported when the name is first read."""
+
+
+def __getattr__(name: str) -> Any:
+    if name == "encoders":
+        return importlib.import_module("simoun_agent.models.encoder")
+    if name not in _LAZY:
+        raise AttributeError(f"module 'simoun_agent' has no attribute {name!r}")
+    return getattr(importlib.import_module(_LAZY[name]), name)
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *__all__])
+
+
+__all__ = ["AgentConfig", "encoders", *_LAZY]

@@ -12,7 +12,7 @@ import numpy as np
 import torch
 
 from simoun_agent.config import AgentConfig
-from simoun_agent.config_checks import check_agent_inputs
+from simoun_agent.config.shapes import check_agent_inputs
 from simoun_agent.device import default_device
 from simoun_agent.losses import (
     contrastive_loss,

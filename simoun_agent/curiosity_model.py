@@ -20,6 +20,7 @@ import torch
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config.shapes import min_image_size
 from simoun_agent.losses import contrastive_loss, transition_loss
 from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
@@ -145,7 +146,7 @@ class CuriosityModel(OnlineModel):
     The encoder is the agent's ``DualPathEncoder`` and its ``encode_transition`` (each of the
     four frames through each path once); the losses are ``simoun_agent.losses``'. Frames are
     average-pooled to about ``encoder_size`` first (84x84 -> 42x42 by default), and must then
-    be at least 23x23 (15x15 without the interactive module); the action space is Discrete,
+    be at least 19x19 (15x15 without the interactive module); the action space is Discrete,
     MultiDiscrete, MultiBinary or Box.
 
     **Schedule and reproducibility.** The batch of the step due at watch call ``k`` is sampled
@@ -196,14 +197,17 @@ class CuriosityModel(OnlineModel):
     def _smallest_frame(self) -> tuple[int, str, int]:
         interactive = self.config.interactive
         needs = "the conv paths" + (" and the interactive module" if interactive else "")
-        return (23 if interactive else 15), needs, 32
+        return min_image_size(AgentConfig(encoder=self._encoder_name())), needs, 32
+
+    def _encoder_name(self) -> str:
+        return "dual_interactive" if self.config.interactive else "dual"
 
     def _build(self) -> PixelEncoder:
         """The encoder, its momentum copy, G, the bilinear similarity, one Adam for all, and the
         buffer of windows and encoded actions."""
         config = self.config
         encoder_config = AgentConfig(
-            encoder="dual_interactive" if config.interactive else "dual",
+            encoder=self._encoder_name(),
             feature_dim=config.feature_dim,
             num_filters=config.num_filters,
             channels_last=config.channels_last,

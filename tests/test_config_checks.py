@@ -6,11 +6,8 @@ import math
 import pytest
 import torch
 
-from simoun_agent.config import AgentConfig
-from simoun_agent.config_checks import min_image_size
-from simoun_agent.models.encoder import make_encoder
-from simoun_agent.recipes import RECIPES
-from simoun_agent.run.presets import PRESETS, SetupError, config_fields, resolve
+from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, resolve
+from simoun_agent.config.keys import config_fields
 
 BAD = {
     "env": "",
@@ -118,20 +115,6 @@ def test_messages_give_the_value_and_the_fix(overrides, words):
 def test_device_cuda_without_a_gpu_names_the_flag_and_cpu():
     with pytest.raises(SetupError, match=r"--device cuda: .*no CUDA GPU.*--device cpu"):
         resolve(None, {"device": "cuda"})
-
-
-@pytest.mark.filterwarnings("ignore:Initializing zero-element tensors")
-@pytest.mark.parametrize("encoder", ["dual_interactive", "dual", "stacked"])
-def test_min_image_size_is_the_smallest_the_real_encoder_runs_on(encoder):
-    config = AgentConfig(encoder=encoder, curiosity=encoder.startswith("dual"), num_filters=4)
-    size = min_image_size(config, channels=3, cameras=1)
-    frames = torch.zeros(1, 3, 3, size, size, dtype=torch.uint8)
-    make_encoder(config, (3, size, size))(frames)
-    with pytest.raises(RuntimeError):
-        smaller = torch.zeros(1, 3, 3, size - 1, size - 1, dtype=torch.uint8)
-        make_encoder(config, (3, size - 1, size - 1))(smaller)
-    checked = {"image_size": size, "agent.encoder": encoder, "agent.curiosity": config.curiosity}
-    assert resolve(None, checked).image_size == size
 
 
 def test_agent_config_in_python_names_the_field_too():

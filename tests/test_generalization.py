@@ -9,8 +9,8 @@ import pytest
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.generalization import DISTRACTIONS, check_supported, make_distracted_env
-from simoun_agent.run.presets import SetupError, resolve
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

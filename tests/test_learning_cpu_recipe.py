@@ -1,9 +1,9 @@
 """Learning evidence for what we ship: the ``cpu`` preset's agent (the simoun recipe with random
 shift and 3-step returns) trained at a tiny size on simoun/PointReach-v0 beats a random policy."""
 
+from simoun_agent.config import PRESETS, resolve
 from simoun_agent.run import train
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
-from simoun_agent.run.presets import PRESETS, resolve
 
 EPISODES = 20
 EVAL_SEED = 10_000

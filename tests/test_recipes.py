@@ -16,11 +16,11 @@ import torch.nn.functional as F
 from test_train_resume import TINY
 
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+from simoun_agent.config import RECIPES, SetupError, from_dict, resolve, to_dict
+from simoun_agent.config.keys import config_sections
 from simoun_agent.models.actors import DeterministicActor
 from simoun_agent.models.encoder import ENCODERS
-from simoun_agent.recipes import RECIPES
 from simoun_agent.run import train
-from simoun_agent.run.presets import SetupError, config_sections, from_dict, resolve, to_dict
 from simoun_agent.sweep.report import with_defaults
 from simoun_wrappers.augment import random_shift, shift_pad
 

@@ -21,9 +21,9 @@ from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent import stats
 from simoun_agent.cli import report as report_cli
+from simoun_agent.config import resolve, to_dict
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
-from simoun_agent.run.presets import resolve, to_dict
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SweepSpec
 

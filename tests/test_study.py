@@ -12,8 +12,7 @@ import pytest
 import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
 from simoun_agent.cli import study as cli
-from simoun_agent.recipes import RECIPES
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import RECIPES, SetupError
 from simoun_agent.study.plan import evaluation_runs, tuning_runs
 from simoun_agent.study.provenance import code_version
 from simoun_agent.study.spec import load_spec

@@ -4,22 +4,22 @@ import json
 
 import pytest
 
-from simoun_agent.recipes import RECIPES, Recipe
-from simoun_agent.run.presets import (
-    CPU_PRESET_TIME,
-    PAPER_ACTION_REPEAT,
+from simoun_agent.config import (
     PRESETS,
-    RESUMABLE_FIELDS,
+    RECIPES,
     Preset,
+    Recipe,
     SetupError,
     TrainConfig,
-    config_fields,
     from_dict,
-    from_flat,
-    parse_value,
     resolve,
     to_dict,
 )
+from simoun_agent.config.envs import PAPER_ACTION_REPEAT
+from simoun_agent.config.keys import config_fields, parse_value
+from simoun_agent.config.presets import CPU_PRESET_TIME
+from simoun_agent.config.resolve import from_flat
+from simoun_agent.config.train import RESUMABLE_FIELDS
 
 
 @pytest.mark.parametrize("task", sorted(PAPER_ACTION_REPEAT))

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.envs import POINT_REACH_ID
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
 from simoun_agent.run.make_env import make_env, video_fps
-from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.run.video import write_video
 
 

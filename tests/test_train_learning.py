@@ -1,8 +1,8 @@
 """Learning evidence: a short CPU run on the tiny pixel task must beat a random policy."""
 
+from simoun_agent.config import resolve
 from simoun_agent.run import train
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
-from simoun_agent.run.presets import resolve
 from simoun_agent.run.seeds import first_eval_seed
 
 EPISODES = 20

@@ -6,10 +6,10 @@ import pytest
 import torch
 
 from simoun_agent.cli import train as train_cli
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
-from simoun_agent.run.presets import SetupError, resolve
 
 TINY = {
     "env": "simoun/PointReach-v0",

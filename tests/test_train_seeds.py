@@ -7,10 +7,10 @@ import pytest
 import torch
 from test_train_resume import tiny_config
 
+from simoun_agent.config import SetupError
 from simoun_agent.envs import PointReach
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import CHECKPOINT_NAME
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.seeds import HALF, Stream, first_eval_seed, int_seed, train_episode_seed
 
 RESETS: list[int | None] = []

@@ -19,9 +19,9 @@ import pytest
 import torch
 
 from simoun_agent.cli import train as train_cli
+from simoun_agent.config import resolve
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.env_runner import BackgroundEnv
-from simoun_agent.run.presets import resolve
 
 TINY = [
     "--image-size", "32",

@@ -11,6 +11,7 @@ import functools
 
 import torch
 
+from simoun_agent.config import SetupError
 from simoun_agent.models.encoder import (
     DualPathEncoder,
     FlareEncoder,
@@ -18,7 +19,6 @@ from simoun_agent.models.encoder import (
     SingleFrameEncoder,
     StackedEncoder,
 )
-from simoun_agent.run.presets import SetupError
 
 PATH, MOTION, APPEARANCE, STATE = "path", "motion path", "appearance path", "fused state"
 """Layer names: the conv path of a single-path encoder, the two paths of a dual encoder, f_t."""

@@ -15,10 +15,10 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
+from simoun_agent.config import SetupError
 from simoun_agent.models.encoder import PixelEncoder
 from simoun_agent.models.interaction import StructureMasks
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.presets import SetupError
 
 COLORMAP = "magma"
 """Perceptual colour map of the heat maps (uniform in lightness, readable in grey)."""

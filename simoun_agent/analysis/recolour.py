@@ -12,8 +12,8 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
+from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.run.make_env import make_env
-from simoun_agent.run.presets import SetupError, TrainConfig
 
 BLOCK = 3
 """Decisions per colour set: the triplets at t = 2, 5, 8, ... see one colour set each."""

@@ -10,7 +10,7 @@ import numpy as np
 import torch
 
 from simoun_agent.agent import SimounAgent
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import make_output_dir
 
 

@@ -24,10 +24,10 @@ from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
 from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
 from simoun_agent.analysis.report import RunBias, write_report
 from simoun_agent.analysis.runs import play_episode, prepare_output
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.load import LoadedRun, load_run
 from simoun_agent.run.make_env import video_fps
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.video import write_video
 
 MAX_BIAS_EPISODES = 200

@@ -8,7 +8,8 @@ import json
 import typing
 from typing import Any
 
-from simoun_agent.run.presets import PRESETS, SetupError, check_keys, config_fields, parse_value
+from simoun_agent.config import PRESETS, SetupError
+from simoun_agent.config.keys import check_keys, config_fields, parse_value
 
 
 def add_config_arguments(parser: argparse.ArgumentParser) -> None:

@@ -20,6 +20,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from simoun_agent.cli.flags import add_version, bool_argv
+from simoun_agent.config import SetupError
 from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
 from simoun_agent.generalization.suite import parse_distractions
@@ -27,7 +28,6 @@ from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
 from simoun_agent.run.load import load_run
 from simoun_agent.run.make_env import video_fps
-from simoun_agent.run.presets import SetupError
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.signals import Stopped, stop_at_once

@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import SetupError
 from simoun_agent.sweep.report import write_report
 
 

@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 
 from simoun_agent.cli.flags import add_version
-from simoun_agent.run.presets import SetupError
+from simoun_agent.config import SetupError
 from simoun_agent.study.plan import describe
 from simoun_agent.study.runner import run_study, spec_from
 from simoun_agent.sweep.launch import load_ray

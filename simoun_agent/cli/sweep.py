@@ -18,8 +18,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from simoun_agent.cli.config_flags import add_config_arguments, overrides_from
-from simoun_agent.recipes import RECIPES
-from simoun_agent.run.presets import SetupError, resolve
+from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec
 from simoun_agent.sweep.launch import (

@@ -21,11 +21,11 @@ from tqdm import tqdm
 
 from simoun_agent.cli.config_flags import add_config_arguments, overrides_from
 from simoun_agent.cli.flags import add_version
+from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
+from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
-from simoun_agent.recipes import RECIPES
 from simoun_agent.run import train as loop  # called through the module: tests wrap loop.train
 from simoun_agent.run.memory import check_memory
-from simoun_agent.run.presets import PRESETS, RESUMABLE_FIELDS, SetupError, resolve
 from simoun_agent.run.signals import Stopped, stop_at_once
 
 

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import gymnasium as gym
 
+from simoun_agent.config import TrainConfig
 from simoun_agent.generalization.suite import check_eval_distractions, make_distracted_env
 from simoun_agent.run.callback import TrainCallback
 from simoun_agent.run.evaluate import evaluate
-from simoun_agent.run.presets import TrainConfig
 from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.state import Run
 

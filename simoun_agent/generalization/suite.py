@@ -14,7 +14,7 @@ from pathlib import Path
 
 import gymnasium as gym
 
-from simoun_agent.run.presets import SetupError, TrainConfig
+from simoun_agent.config import SetupError, TrainConfig
 from simoun_wrappers import ColorShift, MovingBackground
 
 DISTRACTIONS: dict[str, tuple[type[gym.Wrapper], str] | None] = {

@@ -11,8 +11,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.spec import StudySpec, load_spec
-from simoun_agent.run.presets import SetupError
 
 ARCHIVE = Path("docs/studies/minigrid")
 

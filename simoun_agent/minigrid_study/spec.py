@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.arms import ARMS
-from simoun_agent.run.presets import SetupError
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 

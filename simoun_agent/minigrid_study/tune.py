@@ -14,10 +14,10 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
 from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_agent.run.checkpoint import atomic_write
-from simoun_agent.run.presets import SetupError
 from simoun_agent.study.provenance import code_version
 from simoun_agent.sweep.launch import connect, load_ray
 

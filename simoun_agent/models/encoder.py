@@ -29,7 +29,8 @@ from typing import NamedTuple
 import torch
 from torch import nn
 
-from simoun_agent.config import AgentConfig
+from simoun_agent.config.agent import AgentConfig
+from simoun_agent.config.shapes import ENCODER_SHAPES, TRUNK, EncoderShape, conv_output_size
 from simoun_agent.models.interaction import StructuralInteraction, StructureMasks, resized_linear
 
 
@@ -49,17 +50,14 @@ class Encoding(NamedTuple):
     """attention X and masks X^m, X^a of the interactive module"""
 
 
-def conv_output_size(size: int) -> int:
-    """Side of the last feature map of :func:`conv_trunk` (84 -> 41 -> 39 -> 37 -> 35)."""
-    return (size - 3) // 2 + 1 - 6
-
-
 def conv_trunk(in_channels: int, num_filters: int) -> nn.Sequential:
-    """Four 3x3 convs with ReLU, strides 2, 1, 1, 1 (the paths of Sec. 3.2, CURL's encoder)."""
+    """The convs of :data:`~simoun_agent.config.shapes.TRUNK` with ReLU: four 3x3 convs, strides
+    2, 1, 1, 1 (the paths of Sec. 3.2, CURL's encoder); its last map's side is
+    :func:`~simoun_agent.config.shapes.conv_output_size`."""
     layers: list[nn.Module] = []
-    for i in range(4):
-        conv = nn.Conv2d(num_filters if i else in_channels, num_filters, 3, 1 if i else 2)
-        layers += [conv, nn.ReLU(inplace=True)]
+    for i, conv in enumerate(TRUNK):
+        layer = nn.Conv2d(num_filters if i else in_channels, num_filters, conv.kernel, conv.stride)
+        layers += [layer, nn.ReLU(inplace=True)]
     return nn.Sequential(*layers)
 
 
@@ -376,20 +374,28 @@ class EncoderEntry:
 
     build: Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]
     """(config, frame shape (C, H, W)) -> the encoder"""
-    motion_path: bool
-    """True: separate motion and appearance paths, so L_tran acts on f^m and the consistency
-    curiosity (Eq. 13) can compare them; False: one path, L_tran acts on the state"""
+    shape: EncoderShape
+    """its paths and convs, as the configuration knows them
+    (:data:`simoun_agent.config.shapes.ENCODER_SHAPES`)"""
     description: str
     """one line for help texts"""
 
+    @property
+    def motion_path(self) -> bool:
+        """True: separate motion and appearance paths (L_tran on f^m, curiosity of Eq. 13)."""
+        return self.shape.motion_path
 
-def _dual(interactive: bool) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]:
+
+def _dual(name: str) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]:
+    """The builder of the dual-path encoder ``name``, with the interactive module when its
+    shape has one."""
+
     def build(c: AgentConfig, shape: tuple[int, int, int]) -> PixelEncoder:
         return DualPathEncoder(
             shape,
             c.num_filters,
             c.feature_dim,
-            interactive=interactive,
+            interactive=ENCODER_SHAPES[name].interactive,
             reduce_kernel=c.reduce_kernel,
             reduce_stride=c.reduce_stride,
             detach_past_frames=c.detach_past_frames,
@@ -402,42 +408,43 @@ def _dual(interactive: bool) -> Callable[[AgentConfig, tuple[int, int, int]], Pi
 ENCODERS: dict[str, EncoderEntry] = {
     "single": EncoderEntry(
         lambda c, shape: SingleFrameEncoder(shape, c.num_filters, c.feature_dim, c.channels_last),
-        motion_path=False,
+        shape=ENCODER_SHAPES["single"],
         description="one conv path on frame t only",
     ),
     "stacked": EncoderEntry(
         lambda c, shape: StackedEncoder(
             shape, c.num_frames, c.num_filters, c.feature_dim, c.channels_last
         ),
-        motion_path=False,
+        shape=ENCODER_SHAPES["stacked"],
         description="one conv path on the frames folded into channels (CURL, DrQ)",
     ),
     "stacked_wide": EncoderEntry(
         lambda c, shape: StackedEncoder(
             shape, c.num_frames, 2 * c.num_filters, c.feature_dim, c.channels_last
         ),
-        motion_path=False,
+        shape=ENCODER_SHAPES["stacked_wide"],
         description="stacked with twice the filters (about the dual path's parameter count)",
     ),
     "flare": EncoderEntry(
         lambda c, shape: FlareEncoder(
             shape, c.num_frames, c.num_filters, c.feature_dim, c.channels_last
         ),
-        motion_path=False,
+        shape=ENCODER_SHAPES["flare"],
         description="per-frame convs with latent differences (Flare, Shang et al. 2021)",
     ),
     "dual": EncoderEntry(
-        _dual(interactive=False),
-        motion_path=True,
+        _dual("dual"),
+        shape=ENCODER_SHAPES["dual"],
         description="motion path on residuals + appearance path per frame (Sec. 3.2)",
     ),
     "dual_interactive": EncoderEntry(
-        _dual(interactive=True),
-        motion_path=True,
+        _dual("dual_interactive"),
+        shape=ENCODER_SHAPES["dual_interactive"],
         description="dual with the structural interactive module (Eq. 4-6), the paper's model",
     ),
 }
-"""The encoders of Fig. 6 by ``AgentConfig.encoder`` name; a new encoder is one entry."""
+"""The encoders of Fig. 6 by ``AgentConfig.encoder`` name; a new encoder is one entry here and
+one in :data:`simoun_agent.config.shapes.ENCODER_SHAPES` (its paths and convs)."""
 
 
 def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:

@@ -24,9 +24,11 @@ from typing import Any
 import numpy as np
 import torch
 
+from simoun_agent.config import SetupError
+from simoun_agent.config.keys import config_sections
+from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import atomic_write, dead_temporaries
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
-from simoun_agent.run.presets import RESUMABLE_FIELDS, SetupError, config_sections
 from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
@@ -102,7 +104,7 @@ def save_checkpoint(
 
     Args:
         run_dir: the run directory.
-        config: the run's config as a dict (``presets.to_dict``).
+        config: the run's config as a dict (``simoun_agent.config.to_dict``).
         agent: the SimounAgent (its ``state_dict()`` is saved).
         replay: the FrameReplay (``replay.save(path)``).
         state: the trainer's counters and its own RNG state, restored as given.

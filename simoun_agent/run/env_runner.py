@@ -25,8 +25,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AsyncVectorEnv, AutoresetMode
 
+from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.run.make_env import make_env
-from simoun_agent.run.presets import SetupError, TrainConfig
 
 Transition = tuple[dict[str, np.ndarray], float, bool, bool]
 """(observation, reward, terminated, truncated) of one agent step"""

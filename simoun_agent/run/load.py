@@ -17,9 +17,9 @@ import gymnasium as gym
 import torch
 
 from simoun_agent.agent import SimounAgent
+from simoun_agent.config import TrainConfig, from_dict
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.make_env import make_env
-from simoun_agent.run.presets import TrainConfig, from_dict
 from simoun_agent.run.seeds import first_eval_seed
 
 

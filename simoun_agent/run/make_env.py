@@ -21,7 +21,8 @@ from gymnasium.envs.registration import load_env_creator
 from gymnasium.wrappers import RescaleAction
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
-from simoun_agent.run.presets import SetupError, TrainConfig, is_highway
+from simoun_agent.config import SetupError, TrainConfig
+from simoun_agent.config.envs import is_highway
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import image_layout
 

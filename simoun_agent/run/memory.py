@@ -24,8 +24,8 @@ from typing import Any
 import torch
 from torch.utils._python_dispatch import TorchDispatchMode
 
+from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.device import default_device
-from simoun_agent.run.presets import SetupError, TrainConfig
 
 ACTION_DIM = 2
 """Action size assumed before the env is built; the networks' share of memory barely depends

@@ -18,8 +18,8 @@ import shutil
 from pathlib import Path
 from typing import IO
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.layout import CHECKPOINT_NAME, LOCK_NAME, TENSORBOARD_DIR, TRAINER_FILES
-from simoun_agent.run.presets import SetupError
 
 _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""

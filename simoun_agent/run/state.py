@@ -10,9 +10,9 @@ import gymnasium as gym
 import numpy as np
 
 from simoun_agent.agent import SimounAgent
+from simoun_agent.config import TrainConfig
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.env_runner import EnvRunner
-from simoun_agent.run.presets import TrainConfig
 from simoun_agent.run.signals import StopRequest
 
 

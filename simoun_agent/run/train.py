@@ -44,6 +44,9 @@ import numpy as np
 import torch
 
 from simoun_agent import SimounAgent
+from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
+from simoun_agent.config.envs import dmc_task
+from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.callback import TrainCallback
@@ -68,14 +71,6 @@ from simoun_agent.run.layout import (
 )
 from simoun_agent.run.logger import RunLogger
 from simoun_agent.run.make_env import make_env, video_fps
-from simoun_agent.run.presets import (
-    RESUMABLE_FIELDS,
-    SetupError,
-    TrainConfig,
-    dmc_task,
-    from_dict,
-    to_dict,
-)
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.run.presets import SetupError
 from simoun_agent.study.plan import StudyRun, tuning_runs
 from simoun_agent.study.selection import SELECTION_RULES, TIE_RULE, best_setting
 from simoun_agent.study.spec import StudySpec

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.study import probe
 from simoun_agent.study.spec import StudySpec
 from simoun_agent.sweep.grid import Trial, env_label, path_part, show, typed

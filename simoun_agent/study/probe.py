@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from simoun_agent.run.presets import TrainConfig, to_dict
+from simoun_agent.config import TrainConfig, to_dict
 
 NOT_COST = {"seed", "total_env_steps", "run_dir", "eval_every", "eval_episodes", "video"}
 """Config keys that change how long a run is, not what a step of it costs."""

@@ -32,11 +32,10 @@ from typing import Any
 import numpy as np
 
 from simoun_agent import stats
-from simoun_agent.recipes import RECIPES
+from simoun_agent.config import RECIPES, resolve, to_dict
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.run.presets import resolve, to_dict
 from simoun_agent.study.choice import Choice
 from simoun_agent.study.plan import (
     EVALUATION,
@@ -205,7 +204,7 @@ def protocol(spec: StudySpec, record: dict[str, Any], choices: dict[str, Choice]
         "### What each recipe was given",
         "",
         "Each recipe got the same base config, grid, seeds and budgets; its own values are its "
-        "recipe's (`simoun_agent/recipes.py`) and the grid setting its tuning selected.",
+        "recipe's (`simoun_agent/config/recipes.py`) and the grid setting its tuning selected.",
         "",
         "| recipe | what it is | selected setting | tuning score |",
         "|---|---|---|---:|",

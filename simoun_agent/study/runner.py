@@ -12,8 +12,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.presets import SetupError, resolve
 from simoun_agent.study import archive as archiving
 from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_agent.study.plan import (

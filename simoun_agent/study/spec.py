@@ -5,7 +5,7 @@ grid key that a recipe fixes); an error names the file, the line and the fix (``
 printed without a traceback). The layout (``docs/studies/dmc100k.toml`` is a full example)::
 
     description = "what the study asks"        # optional
-    recipes = ["simoun", "sac"]                # simoun_agent.recipes; the first is the one
+    recipes = ["simoun", "sac"]                # simoun_agent.config.recipes; the first is the one
                                                # compared with each other in the report
     selection = "auc"                          # the rule that picks each recipe's setting
 
@@ -48,14 +48,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.recipes import RECIPES
-from simoun_agent.run.presets import (
-    PRESETS,
-    SetupError,
+from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
+from simoun_agent.config.keys import (
+    HELP_FIX,
+    close_match,
     config_fields,
     config_sections,
     parse_value,
-    resolve,
 )
 from simoun_agent.study.selection import SELECTION_RULES
 from simoun_agent.study.toml_lines import key_line
@@ -335,7 +334,7 @@ class _Reader:
                     where,
                     f"unknown recipe {recipe!r}"
                     + (f" (did you mean {hint[0]!r}?)" if hint else "")
-                    + f"; choose from {', '.join(RECIPES)} (simoun_agent/recipes.py)",
+                    + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
                 )
         repeated = sorted({r for r in value if value.count(r) > 1})
         if repeated:
@@ -369,13 +368,7 @@ class _Reader:
         if key in STUDY_SETS:
             raise self.fail(where, f"the study sets {key} itself; give it as {STUDY_SETS[key]}")
         if key not in self.fields:
-            hint = difflib.get_close_matches(key, self.fields, n=1)
-            raise self.fail(
-                where,
-                f"unknown config key {key!r}"
-                + (f" (did you mean {hint[0]}?)" if hint else "")
-                + "; `simoun-train --help` lists every key",
-            )
+            raise self.fail(where, f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
         for recipe, fixed in fixed_by(key, recipes).items():
             raise self.fail(
                 where,

@@ -15,7 +15,6 @@ Example:
 
 from __future__ import annotations
 
-import difflib
 import itertools
 import json
 import re
@@ -24,8 +23,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError, resolve
+from simoun_agent.config.envs import dmc_task
+from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.presets import SetupError, config_fields, dmc_task, parse_value, resolve
 
 SWEEP_FILE = "sweep.json"
 """The sweep's grid and base config, written once in the sweep directory."""
@@ -89,12 +90,7 @@ def check_key(key: str, flag: str) -> None:
         raise SetupError(f"{flag} cannot set {key}: the sweep sets it; use {DEDICATED[key]}")
     known = config_fields()
     if key not in known:
-        hint = difflib.get_close_matches(key, known, n=1)
-        raise SetupError(
-            f"{flag}: unknown config key {key!r}"
-            + (f" (did you mean {hint[0]}?)" if hint else "")
-            + "; `simoun-train --help` lists every key"
-        )
+        raise SetupError(f"{flag}: unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
 
 
 def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:

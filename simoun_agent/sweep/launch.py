@@ -18,9 +18,9 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.run.presets import SetupError
 from simoun_agent.sweep.grid import SweepSpec, Trial
 from simoun_agent.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table
 

@@ -47,10 +47,11 @@ from typing import Any
 import numpy as np
 
 from simoun_agent import stats
+from simoun_agent.config import SetupError, from_dict, to_dict
+from simoun_agent.config.keys import config_sections
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
-from simoun_agent.run.presets import SetupError, config_sections, from_dict, to_dict
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
 from simoun_agent.sweep.report_plots import Band, plot_panels

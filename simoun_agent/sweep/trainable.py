@@ -22,11 +22,11 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import resolve
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
 from simoun_agent.run import train
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
-from simoun_agent.run.presets import resolve
 from simoun_agent.run.signals import Stopped
 from simoun_agent.sweep.grid import Trial
 from simoun_agent.sweep.report import ERROR_FILE

@@ -1,14 +1,31 @@
-"""Hyperparameters of the Simoun SAC agent (defaults: the paper's, i.e. DrQ's setup, and CURL's)."""
+"""Hyperparameters of the Simoun SAC agent (defaults: the paper's, i.e. DrQ's setup, and CURL's),
+each field checked by its rule when the config is built."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
-from simoun_agent.config_checks import check_agent_config
+from simoun_agent.config.recipes import RECIPES
+from simoun_agent.config.rules import (
+    Rule,
+    boolean,
+    check_fields,
+    fail,
+    finite,
+    integer,
+    is_real,
+    one_of,
+    real,
+)
+from simoun_agent.config.shapes import ENCODER_SHAPES
 
 AUGMENTATIONS = ("none", "shift")
 CONTRASTIVE_VIEWS = ("random_conv", "shift")
 NEXT_STATE_ENCODERS = ("online", "target")
+ACTOR_NAMES = ("gaussian", "deterministic")
+"""The actors of :data:`simoun_agent.models.actors.ACTORS` (the same names: a test holds them
+equal)."""
 
 
 @dataclass
@@ -16,12 +33,13 @@ class AgentConfig:
     """Everything the agent needs besides the frame shape and the action size."""
 
     recipe: str | None = None
-    """name of the agent recipe these values started from (simoun_agent.recipes: simoun, drq,
+    """name of the agent recipe these values started from (simoun_agent.config.recipes: simoun, drq,
     drqv2, rad, curl, sac and the Fig. 6 encoders); applied before the user's overrides. None:
     these dataclass defaults"""
     encoder: str = "dual_interactive"
     """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6;
-    the registry simoun_agent.models.encoder.ENCODERS)"""
+    the registry simoun_agent.models.encoder.ENCODERS, whose geometry is
+    simoun_agent.config.shapes.ENCODER_SHAPES)"""
     augmentation: str = "none"
     """augmentation of the frames the critic and actor see: "none", or "shift" (DrQ's random
     shift: replicate-pad, random crop back, one offset per sample for its whole window)"""
@@ -128,3 +146,99 @@ class AgentConfig:
 
     def __post_init__(self) -> None:
         check_agent_config(self)  # every field, then cross-field
+
+
+AGENT = "agent."
+"""Flag prefix of AgentConfig's fields (``--agent.batch-size``)."""
+
+_POSITIVE = integer(1)
+_RATE = real(0.0, 1.0, open_low=True)
+_WEIGHT = real(0.0)
+
+AGENT_RULES: dict[str, Rule] = {
+    "recipe": Rule(f"none or one of {', '.join(RECIPES)}", lambda v: v is None or v in RECIPES),
+    "encoder": one_of(list(ENCODER_SHAPES)),
+    "augmentation": one_of(AUGMENTATIONS),
+    "shift_pad": integer(0, optional=True),
+    "critic_augmentations": _POSITIVE,
+    "target_augmentations": _POSITIVE,
+    "next_state_encoder": one_of(NEXT_STATE_ENCODERS),
+    "contrastive_view": one_of(CONTRASTIVE_VIEWS),
+    "feature_dim": _POSITIVE,
+    "num_filters": _POSITIVE,
+    "hidden_dim": _POSITIVE,
+    "aux_hidden_dim": _POSITIVE,
+    "batch_size": _POSITIVE,
+    "lr": real(0.0, open_low=True),
+    "alpha_lr": real(0.0, open_low=True),
+    "alpha_beta": Rule("a number in [0, 1) (Adam's beta1)", lambda v: is_real(v) and 0 <= v < 1),
+    "discount": real(0.0, 1.0),
+    "n_step": _POSITIVE,
+    "critic_tau": _RATE,
+    "encoder_tau": _RATE,
+    "actor_update_every": _POSITIVE,
+    "target_update_every": _POSITIVE,
+    "actor": one_of(ACTOR_NAMES),
+    "exploration_std_start": real(0.0),
+    "exploration_std_end": real(0.0),
+    "exploration_steps": _POSITIVE,
+    "noise_clip": real(0.0),
+    "init_temperature": real(0.0, open_low=True),
+    "log_std_min": finite(),
+    "log_std_max": finite(),
+    "curiosity": boolean(),
+    "curiosity_scale": _WEIGHT,
+    "curiosity_decay": _WEIGHT,
+    "r_e_max_init": real(0.0, open_low=True),
+    "r_i_max_init": real(0.0, open_low=True),
+    "transition_weight": _WEIGHT,
+    "contrastive_weight": _WEIGHT,
+    "reward_weight": _WEIGHT,
+    "num_frames": _POSITIVE,
+    "reduce_kernel": _POSITIVE,
+    "reduce_stride": _POSITIVE,
+    "random_conv_kernel": integer(1, odd=True, fix="an odd kernel keeps the image size: 3"),
+    "detach_past_frames": boolean(),
+    "channels_last": boolean(),
+}
+"""The rule of every ``AgentConfig`` field."""
+
+
+def check_agent_config(config: Any) -> None:
+    """Every field of an ``AgentConfig``, then the constraints between fields."""
+    check_fields(config, AGENT_RULES, AGENT)
+    if config.log_std_min >= config.log_std_max:
+        raise fail(
+            AGENT,
+            "log_std_min",
+            config.log_std_min,
+            f"must be below --agent.log-std-max {config.log_std_max:g}; e.g. -10 and 2",
+        )
+    for name in ("critic_augmentations", "target_augmentations"):
+        if getattr(config, name) > 1 and config.augmentation == "none":
+            raise fail(
+                AGENT,
+                name,
+                getattr(config, name),
+                "several views of one sample need a random augmentation, and augmentation is "
+                f"'none' (every view would be the same); set --agent.augmentation shift or "
+                f"--agent.{name.replace('_', '-')} 1",
+            )
+    motion_path = ENCODER_SHAPES[config.encoder].motion_path
+    if config.num_frames != 3 and motion_path:
+        raise fail(
+            AGENT,
+            "num_frames",
+            config.num_frames,
+            f"the dual-path encoder {config.encoder!r} needs 3 frames (o_t-2, o_t-1, o_t); "
+            "set --agent.num-frames 3 (AgentConfig(num_frames=3))",
+        )
+    if config.curiosity and not motion_path:
+        raise fail(
+            AGENT,
+            "curiosity",
+            True,
+            f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
+            f"{config.encoder!r} does not have; set --agent.curiosity false "
+            "(AgentConfig(curiosity=False)) or use a dual encoder",
+        )

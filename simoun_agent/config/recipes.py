@@ -13,7 +13,7 @@ temperature 0.1, temperature lr 1e-4 with Adam beta1 0.5, critic tau 0.01, encod
 actor and targets updated every 2 steps), which the paper's agent follows too.
 
 Example:
-    >>> from simoun_agent.recipes import RECIPES
+    >>> from simoun_agent.config.recipes import RECIPES
     >>> drq = RECIPES["drq"].values
     >>> drq["critic_augmentations"], drq["target_augmentations"], drq["next_state_encoder"]
     (2, 2, 'target')

@@ -1,0 +1,137 @@
+"""The keys of the configuration: every field by its flat key (``agent.lr``), its type, default
+and docstring; typing a command-line value for it; refusing keys no field has, with the close
+match (:mod:`simoun_agent.config.key_match`), wherever they come from."""
+
+from __future__ import annotations
+
+import ast
+import dataclasses
+import inspect
+import itertools
+import json
+import textwrap
+import types
+import typing
+from typing import Any
+
+from simoun_agent.config.errors import SetupError
+from simoun_agent.config.key_match import did_you_mean
+from simoun_agent.config.train import TrainConfig
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """The docstring under each field of a dataclass (cleanrl style), read from its source."""
+    try:
+        tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
+    except (OSError, TypeError):
+        return {}
+    body = tree.body[0].body
+    docs = {}
+    for node, following in itertools.pairwise(body):
+        if (
+            isinstance(node, ast.AnnAssign)
+            and isinstance(node.target, ast.Name)
+            and isinstance(following, ast.Expr)
+            and isinstance(following.value, ast.Constant)
+            and isinstance(following.value.value, str)
+        ):
+            docs[node.target.id] = " ".join(following.value.value.split())
+    return docs
+
+
+def config_sections(cls: type | None = None) -> dict[str, type]:
+    """Nested config sections by key prefix: ``{"": TrainConfig, "agent.": AgentConfig, ...}``.
+
+    A field whose type is a dataclass is a section; a new section is one such field.
+    """
+    cls = cls or TrainConfig
+    sections = {"": cls}
+    for name, kind in typing.get_type_hints(cls).items():
+        if dataclasses.is_dataclass(kind):
+            sections.update(
+                {name + "." + sub: inner for sub, inner in config_sections(kind).items()}
+            )
+    return sections
+
+
+def config_fields() -> dict[str, tuple[type, Any, str]]:
+    """Every overridable key (``"seed"``, ``"agent.lr"``, ...) -> (type, default, doc)."""
+    keys = {}
+    for prefix, cls in config_sections().items():
+        hints = typing.get_type_hints(cls)
+        docs = field_docs(cls)
+        for f in dataclasses.fields(cls):
+            if dataclasses.is_dataclass(hints[f.name]):
+                continue
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            keys[prefix + f.name] = (hints[f.name], default, docs.get(f.name, ""))
+    return keys
+
+
+def parse_value(key: str, text: str, kind: Any) -> Any:
+    """Convert a command-line string to the field's type, or raise SetupError naming the key."""
+    options = typing.get_args(kind) if _is_union(kind) else (kind,)
+    if type(None) in options and text.lower() in ("none", "null"):
+        return None
+    errors = []
+    for option in options:
+        if option is type(None):
+            continue
+        try:
+            return _parse_one(text, option)
+        except ValueError as error:
+            errors.append(str(error))
+    raise SetupError(f"cannot read {key}={text!r}: {'; '.join(errors)}")
+
+
+def _is_union(kind: Any) -> bool:
+    return typing.get_origin(kind) in (typing.Union, types.UnionType)
+
+
+def _parse_one(text: str, kind: Any) -> Any:
+    origin = typing.get_origin(kind) or kind
+    if origin is bool:
+        lowered = text.lower()
+        if lowered in ("1", "true", "yes", "on"):
+            return True
+        if lowered in ("0", "false", "no", "off"):
+            return False
+        raise ValueError("expected true or false")
+    if origin in (int, float, str):
+        try:
+            return origin(text)
+        except ValueError:
+            raise ValueError(f"expected {origin.__name__}") from None
+    words = origin in (list, tuple) and set(typing.get_args(kind)) in ({str}, {str, Ellipsis})
+    if words and not text.lstrip().startswith("["):
+        # A list of words may be given plainly: --set eval_distraction=video_hard,color_hard
+        value = [item.strip() for item in text.split(",") if item.strip()]
+        return tuple(value) if origin is tuple else value
+    if origin in (dict, list, tuple):
+        try:
+            value = json.loads(text)
+        except json.JSONDecodeError:
+            raise ValueError(f"expected JSON for a {origin.__name__}") from None
+        return tuple(value) if origin is tuple else value
+    raise ValueError(f"unsupported type {kind}")
+
+
+HELP_FIX = "`simoun-train --help` lists every key"
+
+
+def close_match(key: str) -> str:
+    """``" (did you mean agent.lr?)"`` for an unknown ``key``, or an empty string when no config
+    key is close (:func:`simoun_agent.config.key_match.did_you_mean` over every field)."""
+    return did_you_mean(key, {known: doc for known, (_, _, doc) in config_fields().items()})
+
+
+def check_keys(keys: Any, source: str = "", fix: str = HELP_FIX) -> None:
+    """Raise SetupError naming every key of ``keys`` that no config field has, each with its
+    close matches (:func:`close_match`); ``source`` says where the keys came from (none: the
+    user) and ``fix`` how to correct them. The user's overrides, presets, recipes and saved
+    configs all pass here."""
+    unknown = [key for key in keys if key not in config_fields()]
+    if unknown:
+        named = ", ".join(key + close_match(key) for key in unknown)
+        where = f"{source}: " if source else ""
+        raise SetupError(f"{where}unknown config key {named}; {fix}")

@@ -1,0 +1,141 @@
+"""A run's configuration resolved in four layers, each checked the same way.
+
+The dataclass defaults (the paper's DrQ-style setup), then a named preset
+(:mod:`simoun_agent.config.presets`), then a named agent recipe (``--agent.recipe drq``,
+:mod:`simoun_agent.config.recipes`), then the user's overrides (``--agent.batch-size 64`` or
+``--set agent.batch_size=64``). Every layer's keys pass :func:`~simoun_agent.config.keys.
+check_keys`, so a misspelled key is refused with its close match wherever it comes from. The
+resolved config is saved as ``config.json`` in the run directory and checked again when the run
+is resumed.
+
+Example:
+    >>> config = resolve("cpu", {"agent.recipe": "drq", "seed": 3})
+    >>> config.agent.encoder, config.agent.batch_size, config.seed
+    ('stacked', 64, 3)
+    >>> from_dict(to_dict(config)) == config
+    True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import json
+import typing
+from typing import Any
+
+from simoun_agent.config.envs import split_env_id
+from simoun_agent.config.errors import SetupError
+from simoun_agent.config.keys import check_keys, config_fields, config_sections
+from simoun_agent.config.presets import PRESETS
+from simoun_agent.config.recipes import RECIPES
+from simoun_agent.config.train import TrainConfig
+
+
+def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
+    """Build a TrainConfig from the defaults, a preset and ``{"agent.lr": 3e-4, ...}`` overrides.
+
+    Every layer (the preset, the recipe, the overrides) is checked for unknown keys the same
+    way. Raises SetupError for an unknown preset or key, or a preset meant for another
+    environment.
+    """
+    check_keys(overrides)
+    values: dict[str, Any] = {}
+    if preset is not None:
+        values.update(preset_values(preset))
+        chosen = PRESETS[preset]
+        env_id = split_env_id(overrides.get("env", values.get("env", TrainConfig.env)))[1]
+        if not chosen.accepts(env_id):
+            meant = "highway-env ids" if chosen.envs == "highway" else chosen.envs
+            fitting = [name for name, other in PRESETS.items() if other.envs != "any"]
+            fitting = [name for name in fitting if PRESETS[name].accepts(env_id)] + ["cpu"]
+            raise SetupError(
+                f"preset {preset!r} is meant for {meant}, not {env_id!r}; drop --env to train "
+                f"on {meant}, or use a preset for {env_id!r}: {' or '.join(fitting)} (or no "
+                "preset for the paper defaults)"
+            )
+    recipe = overrides.get("agent.recipe", values.get("agent.recipe"))
+    if recipe is not None:
+        values.update(recipe_values(recipe))
+    values.update(overrides)
+    return from_flat(values)
+
+
+def preset_values(name: str) -> dict[str, Any]:
+    """The flat overrides of the preset ``name`` with ``"preset": name``; SetupError for an
+    unknown preset or a preset entry with an unknown key."""
+    if name not in PRESETS:
+        raise SetupError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
+    values = flatten(PRESETS[name].overrides)
+    check_keys(values, f"preset {name!r}", "fix its entry in simoun_agent.config.presets.PRESETS")
+    return {**values, "preset": name}
+
+
+def recipe_values(name: str) -> dict[str, Any]:
+    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name``;
+    SetupError for an unknown recipe or a recipe entry with an unknown key."""
+    if name not in RECIPES:
+        hint = difflib.get_close_matches(name, RECIPES, n=1)
+        raise SetupError(
+            f"unknown recipe --agent.recipe {name!r}"
+            + (f" (did you mean {hint[0]!r}?)" if hint else "")
+            + f"; choose one of {', '.join(RECIPES)}"
+        )
+    values = {"agent." + key: value for key, value in RECIPES[name].values.items()}
+    check_keys(values, f"recipe {name!r}", "fix its entry in simoun_agent.config.recipes.RECIPES")
+    return values
+
+
+def flatten(nested: dict, prefix: str = "") -> dict[str, Any]:
+    """``{"agent": {"lr": 1e-3}, "seed": 1}`` -> ``{"agent.lr": 1e-3, "seed": 1}``: the dicts
+    of config sections are walked, any other dict (``env_kwargs``) is a value."""
+    sections = config_sections()
+    flat = {}
+    for key, value in nested.items():
+        if isinstance(value, dict) and prefix + key + "." in sections:
+            flat.update(flatten(value, prefix + key + "."))
+        else:
+            flat[prefix + key] = value
+    return flat
+
+
+def from_flat(values: dict[str, Any]) -> TrainConfig:
+    """TrainConfig from flat keys (``"agent.lr"``) over the dataclass defaults; SetupError for a
+    key no field has (nothing is dropped silently)."""
+    check_keys(values)
+    try:
+        return _build(TrainConfig, "", values)
+    except ValueError as err:
+        raise SetupError(str(err)) from None
+
+
+def _build(cls: type, prefix: str, values: dict[str, Any]) -> Any:
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if dataclasses.is_dataclass(hints[f.name]):
+            kwargs[f.name] = _build(hints[f.name], prefix + f.name + ".", values)
+        elif prefix + f.name in values:
+            kwargs[f.name] = values[prefix + f.name]
+    return cls(**kwargs)
+
+
+def to_dict(config: TrainConfig) -> dict[str, Any]:
+    """JSON-ready nested dict of a config (tuples become lists)."""
+    return json.loads(json.dumps(dataclasses.asdict(config)))
+
+
+def from_dict(data: dict[str, Any]) -> TrainConfig:
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know."""
+    flat = flatten(data)
+    check_keys(
+        flat,
+        "saved config",
+        "it was written by another version of simoun; use that version, or train it again",
+    )
+    known = config_fields()
+    for key, value in flat.items():
+        kind = known[key][0]
+        if isinstance(value, list) and (typing.get_origin(kind) or kind) is tuple:
+            flat[key] = tuple(value)
+    return from_flat(flat)

@@ -1,0 +1,134 @@
+"""What a config field accepts (:class:`Rule`) and the check every config runs with its table.
+
+``AgentConfig`` and ``TrainConfig`` call :func:`check_fields` from ``__post_init__`` with a
+table of :class:`Rule` per field, then their cross-field checks, so a bad value fails when the
+config is built (command line, preset, recipe, Python or a saved ``config.json``), not deep
+inside torch later. Errors are ``ValueError``; the command-line tools print them without a
+traceback.
+
+Example:
+    >>> from simoun_agent.config import AgentConfig
+    >>> AgentConfig(batch_size=0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: --agent.batch-size 0 (AgentConfig.batch_size) must be an int >= 1; e.g. ...
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import numbers
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Rule:
+    """What one field accepts: ``ok(value)``, described as ``need`` (``"an int >= 1"``)."""
+
+    need: str
+    """the accepted values in words, completing "must be ..." """
+    ok: Callable[[Any], bool]
+    """True for an accepted value"""
+    fix: str = ""
+    """advice after the error; empty: suggest the field's default"""
+
+
+def is_int(value: Any) -> bool:
+    """An integer that is not a bool."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+
+
+def is_real(value: Any) -> bool:
+    """A finite real number that is not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def integer(low: int, optional: bool = False, fix: str = "", odd: bool = False) -> Rule:
+    """An int ``>= low`` (odd when ``odd``), or None when ``optional``."""
+    need = f"an {'odd ' if odd else ''}int >= {low}" + (" or none" if optional else "")
+    return Rule(
+        need,
+        lambda v: (optional and v is None) or (is_int(v) and v >= low and (not odd or v % 2)),
+        fix,
+    )
+
+
+def real(low: float, high: float | None = None, open_low: bool = False, fix: str = "") -> Rule:
+    """A finite number in ``[low, high]`` (``(low, ...`` when ``open_low``)."""
+    bounds = f"> {low:g}" if open_low else f">= {low:g}"
+    need = f"a number {bounds}" + (f" and <= {high:g}" if high is not None else "")
+    return Rule(
+        need,
+        lambda v: (
+            is_real(v) and (v > low if open_low else v >= low) and (high is None or v <= high)
+        ),
+        fix,
+    )
+
+
+def finite() -> Rule:
+    return Rule("a finite number", is_real)
+
+
+def boolean() -> Rule:
+    return Rule("true or false", lambda v: isinstance(v, bool))
+
+
+def one_of(options: Sequence[str]) -> Rule:
+    return Rule("a known name", lambda v: v in options, f"choose one of {', '.join(options)}")
+
+
+def text(optional: bool = False, fix: str = "") -> Rule:
+    need = "a non-empty string" + (" or none" if optional else "")
+    return Rule(need, lambda v: (optional and v is None) or (isinstance(v, str) and v != ""), fix)
+
+
+def json_object(fix: str = "") -> Rule:
+    return Rule("a JSON object (a dict)", lambda v: isinstance(v, dict), fix)
+
+
+def flag_name(prefix: str, name: str) -> str:
+    """``("agent.", "batch_size")`` -> ``"--agent.batch-size"``, the command-line flag."""
+    return "--" + prefix + name.replace("_", "-")
+
+
+def shown(value: Any) -> str:
+    """``value`` as typed on the command line: true/false, none, JSON dicts."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if value is None:
+        return "none"
+    if isinstance(value, dict):
+        return json.dumps(value)
+    return str(value)
+
+
+def check_fields(config: Any, rules: dict[str, Rule], prefix: str) -> None:
+    """Raise ValueError for the first field of ``config`` that breaks its rule.
+
+    Every field must have a rule (a new field without one is a programming error), so nothing
+    reaches the agent unchecked.
+    """
+    cls = type(config).__name__
+    unruled = [f.name for f in dataclasses.fields(config) if f.name not in rules]
+    if unruled:
+        raise TypeError(f"{cls} fields without a rule: {', '.join(unruled)}")
+    for f in dataclasses.fields(config):
+        value = getattr(config, f.name)
+        if dataclasses.is_dataclass(value):
+            continue
+        rule = rules[f.name]
+        if not rule.ok(value):
+            flag = flag_name(prefix, f.name)
+            default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+            fix = rule.fix or f"e.g. {flag} {shown(default)} (the default)"
+            raise ValueError(f"{flag} {shown(value)} ({cls}.{f.name}) must be {rule.need}; {fix}")
+
+
+def fail(prefix: str, name: str, value: Any, problem: str) -> ValueError:
+    """A ValueError for a cross-field problem: ``--flag value: problem``."""
+    return ValueError(f"{flag_name(prefix, name)} {shown(value)}: {problem}")

@@ -1,0 +1,55 @@
+"""Every layer of a run's configuration refuses an unknown key with its close match: the user's
+overrides, a preset (top level or section), a recipe, and a saved config.json."""
+
+import pytest
+
+from simoun_agent.config import (
+    PRESETS,
+    RECIPES,
+    Preset,
+    Recipe,
+    SetupError,
+    from_dict,
+    resolve,
+    to_dict,
+)
+
+
+def test_a_misspelled_top_level_key_in_a_preset_is_refused_with_the_close_match(monkeypatch):
+    cpu = PRESETS["cpu"]
+    broken = {**cpu.overrides, "total_env_step": 1000}
+    monkeypatch.setitem(PRESETS, "cpu", Preset(cpu.description, broken, cpu.envs))
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {"agent.recipe": "drq"})
+    assert str(error.value).startswith(
+        "preset 'cpu': unknown config key total_env_step (did you mean total_env_steps?); "
+        "fix its entry in simoun_agent.config.presets.PRESETS"
+    )
+
+
+def test_a_train_key_in_a_recipe_is_refused_pointing_at_the_train_key(monkeypatch):
+    sac = RECIPES["sac"]
+    monkeypatch.setitem(RECIPES, "sac", Recipe(sac.description, {**sac.values, "seed": 3}))
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {"agent.recipe": "sac"})
+    assert str(error.value).startswith(
+        "recipe 'sac': unknown config key agent.seed (did you mean seed?); "
+        "fix its entry in simoun_agent.config.recipes.RECIPES"
+    )
+
+
+def test_a_saved_config_with_a_misspelled_key_is_refused_with_the_close_match():
+    saved = to_dict(resolve("cpu", {}))
+    saved["agent"]["bach_size"] = saved["agent"].pop("batch_size")
+    with pytest.raises(SetupError) as error:
+        from_dict(saved)
+    assert str(error.value).startswith(
+        "saved config: unknown config key agent.bach_size (did you mean agent.batch_size?)"
+    )
+
+
+def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
+    with pytest.raises(SetupError, match=r"unknown recipe --agent.recipe 'drqv3' \(did you mean "):
+        resolve(None, {"agent.recipe": "drqv3"})
+    with pytest.raises(SetupError, match=r"unknown preset 'gpu'; choose one of .*cpu"):
+        resolve("gpu", {})
