@@ -175,13 +175,21 @@ def intrinsic_return_by_hand(agent: SimounAgent, batch: dict) -> np.ndarray:
     return (GAMMA ** np.arange(len(mask))[:, None] * mask * r_i).sum(0)
 
 
-@pytest.mark.parametrize(("n_step", "curiosity"), [(3, False), (3, True), (2, True), (4, True)])
-def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return(n_step, curiosity):
+@pytest.mark.parametrize(
+    ("n_step", "curiosity", "transition_weight"),
+    [(3, False, 1.0), (3, True, 1.0), (2, True, 1.0), (4, True, 1.0), (3, False, 0.0)],
+)
+def test_n_step_target_bootstraps_from_the_frame_reached_with_the_summed_return(
+    n_step, curiosity, transition_weight
+):
     """The cpu preset's 3-step returns on a hand-built replay: the TD target is
     R + sum_j gamma^j r^i(s_{t+j}) + gamma * discount * V(bootstrap_obs), with FrameReplay.sample's
     R, mask and discount (checked by hand in test_n_step_return_discount_and_bootstrap_by_hand)
-    and V read on the frame reached."""
-    agent = agent_for_targets(n_step=n_step, curiosity=curiosity)
+    and V read on the frame reached. Without L_tran and curiosity (as DrQ's n-step recipe) the
+    update encodes no t+1 states at all, a path of its own."""
+    agent = agent_for_targets(
+        n_step=n_step, curiosity=curiosity, transition_weight=transition_weight
+    )
     replay = hand_built_replay(FRAME, random_frames=True)
     batch = copy.deepcopy(replay).sample(agent.config.batch_size, n_step, GAMMA)  # the same draw
     assert (batch["return"] != batch["reward"]).any()
