@@ -89,16 +89,20 @@ def config_switches() -> list[str]:
 
 def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
     """``{"agent.lr": 3e-4, ...}``: the config keys whose flag ``argv`` names, with the values
-    tyro read into ``flags``, then the ``--set`` pairs, typed."""
+    tyro read into ``flags`` (a list key's values also split at commas, as ``--set`` does), then
+    the ``--set`` pairs, typed."""
     known = config_flags()
+    fields = config_fields()
     given = {}
     for arg in argv:
         if arg == "--":
             break
         key = known.get(arg.partition("=")[0])
         if key is not None:
-            given[key] = functools.reduce(getattr, key.split("."), flags.config)
-    fields = config_fields()
+            value = functools.reduce(getattr, key.split("."), flags.config)
+            if isinstance(value, tuple):  # a repeated flag may list several: --eval-distraction a,b
+                value = parse_value(key, ",".join(value), fields[key][0])
+            given[key] = value
     for pair in flags.set:
         key, sep, value = pair.partition("=")
         key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64

@@ -79,11 +79,7 @@ class TrainCommand:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    try:
-        default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
-    except SetupError as err:
-        fail(PROG, err)
-    command = parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
+    command = parse_command(argv)
     try:
         with stop_at_once():  # nothing to save during set-up
             run = setup(command, argv)
@@ -112,6 +108,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{' and video' if run.config.video else ''} in {run.run_dir}"
     )
     return 0
+
+
+def parse_command(argv: Sequence[str]) -> TrainCommand:
+    """``argv`` read with tyro over the defaults of the preset it names; bad input exits with
+    status 2."""
+    try:
+        default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
+    except SetupError as err:
+        fail(PROG, err)
+    return parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
 
 
 def setup(command: TrainCommand, argv: Sequence[str]) -> loop.Run:
