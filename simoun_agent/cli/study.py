@@ -20,6 +20,7 @@ import dataclasses
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, Union
 
 import tyro
@@ -58,15 +59,20 @@ class Plan:
     """agent updates timed per configuration (0: no estimate)"""
 
 
-@dataclass
-class Run:
+@dataclass(kw_only=True)
+class Run(StudyOptions):
     """Run the tuning phase, select each recipe's setting, run the evaluation phase on the
     held-out seeds and write the report into STUDY_DIR/report (on Ray Tune)."""
 
     spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
-    options: Annotated[StudyOptions, tyro.conf.arg(name="")]
-    """where and how the study runs"""
+    # the library's options, with the command line's metavars (their docs are StudyOptions')
+    study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
+    archive: Annotated[Path | None, tyro.conf.arg(metavar="DIR")] = None
+    resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    allow_other_commit: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    address: Annotated[str | None, tyro.conf.arg(metavar="auto|HOST:PORT|ray://HOST:PORT")] = None
+    num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
 
 
 Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
@@ -87,9 +93,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 0
         # absolute: Tune runs each trial in a working directory of its own
         options = dataclasses.replace(
-            args.options,
-            study_dir=args.options.study_dir.absolute(),
-            archive=args.options.archive.absolute() if args.options.archive else None,
+            args,
+            study_dir=args.study_dir.absolute(),
+            archive=args.archive.absolute() if args.archive else None,
         )
         ray = load_ray()
         return run_study(spec, args.spec, options, ray)
