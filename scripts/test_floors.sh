@@ -3,7 +3,8 @@
 # dependency allows (uv's --resolution lowest-direct) into .venv-floors and runs tests there.
 #   1. the package and its dev extra at their floors: a fast subset that uses each floor's
 #      feature (fused CPU Adam: torch; np.trapezoid: numpy; AutoresetMode and spec rebuilds:
-#      gymnasium; a short training run: matplotlib, opencv, tensorboard, imageio, tqdm);
+#      gymnasium; a short training run: matplotlib, opencv, tensorboard, imageio, tqdm,
+#      tyro);
 #   2. the optional extras added at their floors (stable-baselines3's floor raises torch past
 #      its own), with the tests of dm_control, highway-env, PettingZoo and the vector wrappers.
 # Needs .venv (scripts/setup.sh) and about 4 GB of disk (PyPI's torch with its CUDA libraries).
@@ -35,7 +36,7 @@ install() {
     "$uv" pip list --python "$python" 2>/dev/null | grep -iE "^($2) " | tr -s " " | \
         sed "s/^/floor ($1): /"
 }
-install dev "gymnasium|numpy|torch|opencv-python-headless|tqdm|matplotlib|imageio|imageio-ffmpeg|tensorboard|pytest"
+install dev "gymnasium|numpy|torch|opencv-python-headless|tqdm|matplotlib|imageio|imageio-ffmpeg|tensorboard|tyro|pytest"
 SIMOUN_FLOORS=core "$python" -m pytest -q -p no:cacheprovider -W ignore::DeprecationWarning \
     tests/test_dependency_floors.py \
     tests/test_losses_by_hand.py \

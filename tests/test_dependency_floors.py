@@ -65,7 +65,7 @@ def test_numpy_trapezoid_and_gymnasium_autoreset_modes():
 
 def test_a_tiny_training_run_draws_resizes_logs_and_records(tmp_path):
     """opencv resizes the frames, matplotlib draws the curve, tensorboard logs, imageio and
-    imageio-ffmpeg write the video, tqdm is imported by the loop."""
+    imageio-ffmpeg write the video, tqdm is imported by the loop, tyro parses the command line."""
     run_dir = tmp_path / "run"
     argv = [
         "--env", "simoun/PointReach-v0", "--image-size", "24", "--total-env-steps", "16",

@@ -10,12 +10,16 @@ evaluation episodes; ``bias`` counts static, dynamic, joint and residual units p
 
 from __future__ import annotations
 
-import argparse
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated, Literal, Union
 
 import numpy as np
 import torch
+import tyro
+from tyro.constructors import PrimitiveConstructorSpec
 
 from simoun_agent.analysis import masks as mask_pictures
 from simoun_agent.analysis.bias import information_bias
@@ -24,6 +28,7 @@ from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
 from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
 from simoun_agent.analysis.report import RunBias, write_report
 from simoun_agent.analysis.runs import play_episode, prepare_output
+from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.load import LoadedRun, load_run
@@ -39,7 +44,7 @@ def parse_pair(text: str) -> tuple[int, int]:
     try:
         row, col = (int(part) for part in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected ROW,COL (two integers), got {text!r}") from None
+        raise SetupError(f"--query expects ROW,COL (two integers), got {text!r}") from None
     return row, col
 
 
@@ -48,16 +53,97 @@ def parse_steps(text: str) -> list[int]:
     try:
         steps = sorted({int(part) for part in text.split(",")})
     except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"expected comma-separated step numbers, e.g. 2,20,40, got {text!r}"
+        raise SetupError(
+            f"--steps expects comma-separated step numbers, e.g. 2,20,40, got {text!r}"
         ) from None
     if steps[0] < 0:
-        raise argparse.ArgumentTypeError(f"steps count agent decisions from 0, got {steps[0]}")
+        raise SetupError(f"--steps count agent decisions from 0, got {steps[0]}")
     return steps
 
 
-def masks_command(args: argparse.Namespace) -> list[Path]:
+def _animation_format(args: list[str]) -> str:
+    if len(args) > 1 or (args and args[0] not in ("gif", "mp4")):
+        raise ValueError(f"expected gif or mp4 (or nothing: gif), got {' '.join(args)!r}")
+    return args[0] if args else "gif"
+
+
+VIDEO_FORMAT = PrimitiveConstructorSpec(
+    nargs="*",  # --video alone means gif
+    metavar="[gif|mp4]",
+    instance_from_str=_animation_format,
+    is_instance=lambda value: value in (None, "gif", "mp4"),
+    str_from_instance=lambda value: [] if value is None else [value],
+)
+"""``--video`` takes an optional format: gif without one."""
+
+
+@dataclass
+class Output:
+    """The options both analyses take."""
+
+    out: str | None = None
+    """output directory (none: <run dir>/analysis/<analysis>; required by bias with several
+    runs)"""
+    overwrite: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """replace results already in --out"""
+    device: str | None = None
+    """torch device (none: the run's)"""
+
+
+@dataclass(kw_only=True)
+class Masks(Output):
+    """Play deterministic evaluation episodes of a dual_interactive run and write, for each
+    chosen step, a PNG of frame o_t beside the heat maps of X^m and X^a (and the attention row
+    of --query), plus the heat maps as .npz. Example: simoun-analyze masks
+    runs/highway-highway-s1-... --steps 2,40 --query 42,126 --video"""
+
+    run: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    """a run directory or its checkpoint.pt"""
+    episodes: int = 1
+    """episodes to play"""
+    steps: Annotated[str | None, tyro.conf.arg(metavar="STEPS")] = None
+    """agent decisions after which to draw, comma-separated, e.g. 2,20,40 (step 0 is the reset
+    observation; none: 4 steps spread over each episode from step 2)"""
+    query: Annotated[str | None, tyro.conf.arg(metavar="ROW,COL")] = None
+    """also draw the attention row X[q, :] (Eq. 4) of the reduced-map position q under this
+    pixel; the queries of Eq. 4 come from frame t-1"""
+    video: Annotated[Literal["gif", "mp4"] | None, VIDEO_FORMAT] = None
+    """also write the first episode as an animation (gif without a format): o_t, X^m, X^a and
+    the query's row, left to right (top to bottom for wide frames), each heat map scaled to its
+    own range"""
+
+
+@dataclass(kw_only=True)
+class Bias(Output):
+    """For each run: play deterministic evaluation episodes, build dynamic pairs (same frames
+    under a random convolution) and static pairs (same frames in shuffled order), and estimate
+    each layer with the estimator of Kowal et al. (CVPR 2022). Writes bias.png (one grouped bar
+    chart), bias.json and bias.md. Example: simoun-analyze bias runs/stacked-... runs/flare-...
+    runs/simoun-... --out docs/bias"""
+
+    runs: Annotated[tuple[str, ...], tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    """run directories (or checkpoint.pt files)"""
+    pairs: int = 256
+    """pairs per factor"""
+    seed: int = 0
+    """seed of the pairs"""
+    recolour: Literal["conv", "model"] = "conv"
+    """how dynamic pairs change appearance: conv, a random convolution of the frames (any env);
+    model, the episode replayed in a twin env under new colours of the skybox, materials and
+    bodies (dm_control tasks)"""
+
+
+# typing.Union: tyro 1.0 does not read the `|` of two Annotated types as a union
+Command = Union[  # noqa: UP007
+    Annotated[Masks, tyro.conf.subcommand("masks")], Annotated[Bias, tyro.conf.subcommand("bias")]
+]
+"""The command line: one of the two analyses."""
+
+
+def masks_command(args: Masks) -> list[Path]:
     """Play the episodes, then write one PNG (+ its heat maps as .npz) per chosen step."""
+    chosen = parse_steps(args.steps) if args.steps is not None else None
+    query = parse_pair(args.query) if args.query is not None else None
     run = load_run(Path(args.run), args.device)
     mask_pictures.require_masks(run.agent.encoder, run.config.agent.encoder)
     episodes = [
@@ -65,23 +151,23 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
         for e in range(args.episodes)
     ]
     lengths = [len(episode) - 1 for episode in episodes]
-    if args.steps is not None and args.steps[-1] > min(lengths):
+    if chosen is not None and chosen[-1] > min(lengths):
         raise SetupError(
-            f"--steps {args.steps[-1]} is beyond the episode: the episodes played lasted "
+            f"--steps {chosen[-1]} is beyond the episode: the episodes played lasted "
             f"{', '.join(map(str, lengths))} agent decisions (steps 0..length); pick steps up to "
             f"{min(lengths)}"
         )
     size = tuple(episodes[0].shape[-2:])
-    if args.query is not None:
-        mask_pictures.query_index(args.query, size, (1, 1))
+    if query is not None:
+        mask_pictures.query_index(query, size, (1, 1))
     out = Path(args.out) if args.out else run.run_dir / "analysis" / f"masks-{run.env_step}"
     prepare_output(out, ["ep*-step*.png", "ep*-step*.npz", "masks-ep0.*"], args.overwrite)
     written = []
     for e, episode in enumerate(episodes):
-        steps = args.steps if args.steps is not None else mask_pictures.default_steps(lengths[e])
+        steps = chosen if chosen is not None else mask_pictures.default_steps(lengths[e])
         every = list(range(len(episode))) if args.video and e == 0 else steps
         heats = mask_pictures.heat_maps(
-            mask_pictures.structure_masks(run.agent.encoder, episode[every]), size, args.query
+            mask_pictures.structure_masks(run.agent.encoder, episode[every]), size, query
         )
         position = {step: i for i, step in enumerate(every)}
         for step in steps:
@@ -93,7 +179,7 @@ def masks_command(args: argparse.Namespace) -> list[Path]:
                 f"episode {e}, decision {step}"
             )
             written.append(
-                mask_pictures.draw_figure(stem.with_suffix(".png"), frame, one, title, args.query)
+                mask_pictures.draw_figure(stem.with_suffix(".png"), frame, one, title, query)
             )
             npz = stem.with_suffix(".npz")
             atomic_write(npz, lambda tmp, one=one, frame=frame: np.savez(tmp, frame=frame, **one))
@@ -160,8 +246,10 @@ def bias_of_run(run: LoadedRun, count: int, seed: int, recolour: str = "conv") -
     )
 
 
-def bias_command(args: argparse.Namespace) -> list[Path]:
+def bias_command(args: Bias) -> list[Path]:
     """The estimates of every run, then one chart, JSON and Markdown for all of them."""
+    if not args.runs:  # tyro accepts no value for a variable number of them
+        raise SetupError("give the runs to compare: run directories (or checkpoint.pt files)")
     if args.out is None and len(args.runs) > 1:
         raise SetupError("several runs need one output directory: pass --out DIR")
     runs = [load_run(Path(path), args.device) for path in args.runs]
@@ -174,95 +262,26 @@ def bias_command(args: argparse.Namespace) -> list[Path]:
     return write_report(out, results, args.seed)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="simoun-analyze",
-        description="The paper's analyses for a trained run: structure masks (Fig. 7) and the "
-        "information-bias analysis (Fig. 5).",
-    )
-    commands = parser.add_subparsers(dest="command", required=True)
-    masks = commands.add_parser(
-        "masks",
-        help="draw X^m and X^a (Eq. 5) over the frames of deterministic episodes",
-        description="Play deterministic evaluation episodes of a dual_interactive run and write, "
-        "for each chosen step, a PNG of frame o_t beside the heat maps of X^m and X^a (and the "
-        "attention row of --query), plus the heat maps as .npz.",
-        epilog="example: simoun-analyze masks runs/highway-highway-s1-... --steps 2,40 "
-        "--query 42,126 --video",
-    )
-    masks.add_argument("run", help="a run directory or its checkpoint.pt")
-    masks.add_argument("--episodes", type=int, default=1, help="episodes to play (default 1)")
-    masks.add_argument(
-        "--steps",
-        type=parse_steps,
-        default=None,
-        help="agent decisions after which to draw, comma-separated, e.g. 2,20,40 (step 0 is the "
-        "reset observation; default: 4 steps spread over each episode from step 2)",
-    )
-    masks.add_argument(
-        "--query",
-        type=parse_pair,
-        default=None,
-        metavar="ROW,COL",
-        help="also draw the attention row X[q, :] (Eq. 4) of the reduced-map position q under "
-        "this pixel; the queries of Eq. 4 come from frame t-1",
-    )
-    masks.add_argument(
-        "--video",
-        nargs="?",
-        const="gif",
-        choices=("gif", "mp4"),
-        default=None,
-        help="also write the first episode as an animation (default format gif): o_t, X^m, X^a "
-        "and the query's row, left to right (top to bottom for wide frames), each heat map "
-        "scaled to its own range",
-    )
-    bias = commands.add_parser(
-        "bias",
-        help="count static / dynamic / joint / residual units per layer (Kowal et al.)",
-        description="For each run: play deterministic evaluation episodes, build dynamic pairs "
-        "(same frames under a random convolution) and static pairs (same frames in shuffled "
-        "order), and estimate each layer with the estimator of Kowal et al. (CVPR 2022). Writes "
-        "bias.png (one grouped bar chart), bias.json and bias.md.",
-        epilog="example: simoun-analyze bias runs/stacked-... runs/flare-... runs/simoun-... "
-        "--out docs/bias",
-    )
-    bias.add_argument("runs", nargs="+", help="run directories (or checkpoint.pt files)")
-    bias.add_argument("--pairs", type=int, default=256, help="pairs per factor (default 256)")
-    bias.add_argument("--seed", type=int, default=0, help="seed of the pairs (default 0)")
-    bias.add_argument(
-        "--recolour",
-        choices=("conv", "model"),
-        default="conv",
-        help="how dynamic pairs change appearance: conv, a random convolution of the frames "
-        "(any env, default); model, the episode replayed in a twin env under new colours of the "
-        "skybox, materials and bodies (dm_control tasks)",
-    )
-    defaults = {
-        masks: "<run dir>/analysis/masks-<env step>",
-        bias: "<run dir>/analysis/bias, required with several runs",
-    }
-    for sub, default in defaults.items():
-        sub.add_argument("--out", default=None, help=f"output directory (default: {default})")
-        sub.add_argument(
-            "--overwrite", action="store_true", help="replace results already in --out"
-        )
-        sub.add_argument("--device", default=None, help="torch device (default: the run's)")
-    return parser
+PROG = "simoun-analyze"
+
+DESCRIPTION = (
+    "The paper's analyses for a trained run: structure masks (Fig. 7) and the "
+    "information-bias analysis (Fig. 5)."
+)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-analyze``."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if getattr(args, "episodes", 1) < 1:
-        parser.error("--episodes must be at least 1")
-    if getattr(args, "pairs", 2) < 2:
-        parser.error("--pairs must be at least 2")
+    args = parse(Command, argv, PROG, DESCRIPTION)
+    name = "masks" if isinstance(args, Masks) else "bias"
+    if isinstance(args, Masks) and args.episodes < 1:
+        fail(PROG, "--episodes must be at least 1")
+    if isinstance(args, Bias) and args.pairs < 2:
+        fail(PROG, "--pairs must be at least 2")
     try:
-        written = masks_command(args) if args.command == "masks" else bias_command(args)
+        written = masks_command(args) if isinstance(args, Masks) else bias_command(args)
     except SetupError as err:
-        parser.exit(2, f"simoun-analyze {args.command}: error: {err}\n")
+        fail(f"{PROG} {name}", err)
     for path in written:
         print(f"wrote {path}")
     return 0

@@ -1,77 +1,113 @@
-"""The config flags of ``simoun-train`` and ``simoun-sweep``: ``--preset``, ``--set KEY=VALUE``
-and one flag per config key, read back as typed overrides."""
+"""The config flags of ``simoun-train`` and ``simoun-sweep``: ``--preset NAME``, one flag per
+config key (tyro, from the fields of ``TrainConfig`` and ``AgentConfig``) and ``--set
+KEY=VALUE``, read back as the overrides the user gave.
+
+The preset is read from the command line before parsing, so the flags' defaults in ``--help``
+are the preset's (``simoun-train --preset cpu --help``). The overrides are the keys whose flag
+the command line names, not the values that differ from the defaults: a value equal to the
+preset's must still win over a recipe (``--preset cpu --agent.recipe sac
+--agent.augmentation shift``), and a resumed run must refuse a fixed key even when it is given
+its saved value.
+"""
 
 from __future__ import annotations
 
-import argparse
-import json
-import typing
-from typing import Any
+import functools
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Annotated, Any
 
-from simoun_agent.config import PRESETS, SetupError
+import tyro
+
+from simoun_agent.cli.flags import negated
+from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import check_keys, config_fields, parse_value
 
-
-def add_config_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--preset``, ``--set KEY=VALUE`` and one flag per config key (read by
-    :func:`overrides_from`); shared by ``simoun-train`` and ``simoun-sweep``."""
-    parser.add_argument("--preset", choices=list(PRESETS), help="start from a named preset")
-    parser.add_argument(
-        "--set",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a config key, e.g. --set agent.lr=3e-4 (repeatable; like the flags below)",
-    )
-    group = parser.add_argument_group(
-        "config keys (defaults before any preset; each is also KEY for --set)"
-    )
-    for key, (kind, default, doc) in config_fields().items():
-        if key == "preset":
-            continue
-        shown = json.dumps(default) if isinstance(default, dict) else repr(default)
-        flag = "--" + key.replace("_", "-")
-        switch = kind is bool
-        hint = f"; --no-{flag[2:]} for false" if switch else ""
-        group.add_argument(
-            flag,
-            dest=key,
-            # A tuple key's flag is repeatable: --eval-distraction video_hard --eval-distraction ...
-            action="append" if (typing.get_origin(kind) or kind) is tuple else "store",
-            default=argparse.SUPPRESS,
-            metavar=_metavar(kind),
-            # a switch: --progress alone means true, and --progress false still works
-            **({"nargs": "?", "const": "true"} if switch else {}),
-            help=f"{doc} (default: {shown}{hint})".replace("%", "%%"),
-        )
-        if switch:
-            group.add_argument(
-                f"--no-{flag[2:]}",
-                dest=key,
-                action="store_const",
-                const="false",
-                default=argparse.SUPPRESS,
-                help=argparse.SUPPRESS,
-            )
+PRESETS_HELP = "start from a named preset: " + ", ".join(PRESETS)
+RECIPES_HELP = "agent recipes (--agent.recipe NAME):\n" + "\n".join(
+    f"  {name:18} {recipe.description}" for name, recipe in RECIPES.items()
+)
+PRESETS_LIST = "presets (--preset NAME):\n" + "\n".join(
+    f"  {name:18} {preset.description}" for name, preset in PRESETS.items()
+)
 
 
-def _metavar(kind: Any) -> str:
-    names = {int: "INT", float: "FLOAT", str: "STR", bool: "BOOL", dict: "JSON"}
-    skipped = (type(None), Ellipsis)  # Ellipsis: tuple[str, ...] shows as STR
-    options = [option for option in typing.get_args(kind) or (kind,) if option not in skipped]
-    return "|".join(names.get(typing.get_origin(o) or o, "VALUE") for o in options)
+@dataclass
+class ConfigFlags:
+    """The run config as the command line gives it."""
+
+    preset: Annotated[str | None, tyro.conf.arg(metavar="NAME", help=PRESETS_HELP)] = None
+    set: Annotated[
+        tuple[str, ...], tyro.conf.UseAppendAction, tyro.conf.arg(metavar="KEY=VALUE")
+    ] = ()
+    """override a config key, e.g. --set agent.lr=3e-4 (like the flags below)"""
+    config: Annotated[TrainConfig, tyro.conf.arg(name="")] = field(default_factory=TrainConfig)
+    """the config keys (defaults: the preset's; each is also KEY for --set)"""
 
 
-def overrides_from(args: argparse.Namespace) -> dict[str, Any]:
-    """``{"agent.lr": 3e-4, ...}`` from the config flags and ``--set`` pairs, typed."""
+def config_default(argv: Sequence[str]) -> TrainConfig:
+    """The defaults the flags start from: the preset that ``argv`` names, else the dataclass
+    defaults; SetupError for an unknown preset."""
+    return resolve(preset_in(argv), {})
+
+
+def preset_in(argv: Sequence[str]) -> str | None:
+    """The value of ``--preset NAME`` / ``--preset=NAME`` in ``argv``, else None."""
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        if arg == "--preset" and i + 1 < len(argv):
+            return argv[i + 1]
+        if arg.startswith("--preset="):
+            return arg.partition("=")[2]
+    return None
+
+
+@functools.cache
+def config_flags() -> dict[str, str]:
+    """Every spelling of a config key's flag -> the key: ``--agent.batch-size``, and for a
+    switch its negation (``--agent.no-curiosity``) and the former ``--no-agent.curiosity``."""
+    flags = {}
+    for key, (kind, _, _) in config_fields().items():
+        flag = key_flag(key)
+        flags[flag] = key
+        if kind is bool:
+            flags[negated(flag)] = flags["--no-" + flag[2:]] = key
+    flags.pop("--preset")  # the command's own --preset, not the informational config key
+    return flags
+
+
+def key_flag(key: str) -> str:
+    """``agent.batch_size`` -> ``--agent.batch-size``, the flag tyro makes for a config key."""
+    return "--" + key.replace("_", "-")
+
+
+def config_switches() -> list[str]:
+    """The flags of the boolean config keys (``--video``, ``--agent.curiosity``, ...)."""
+    return [key_flag(key) for key, (kind, _, _) in config_fields().items() if kind is bool]
+
+
+def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
+    """``{"agent.lr": 3e-4, ...}``: the config keys whose flag ``argv`` names, with the values
+    tyro read into ``flags`` (a list key's values also split at commas, as ``--set`` does), then
+    the ``--set`` pairs, typed."""
+    known = config_flags()
     fields = config_fields()
-    given = {k: v for k, v in vars(args).items() if k in fields and k != "preset"}
-    for pair in args.set:
+    given = {}
+    for arg in argv:
+        if arg == "--":
+            break
+        key = known.get(arg.partition("=")[0])
+        if key is not None:
+            value = functools.reduce(getattr, key.split("."), flags.config)
+            if isinstance(value, tuple):  # a repeated flag may list several: --eval-distraction a,b
+                value = parse_value(key, ",".join(value), fields[key][0])
+            given[key] = value
+    for pair in flags.set:
         key, sep, value = pair.partition("=")
         key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
         if not sep:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
         check_keys([key])  # an unknown key fails here, with its close matches
-        given[key] = value
-    given = {key: ",".join(v) if isinstance(v, list) else v for key, v in given.items()}
-    return {key: parse_value(key, value, fields[key][0]) for key, value in given.items()}
+        given[key] = parse_value(key, value, fields[key][0])
+    return given

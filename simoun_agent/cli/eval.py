@@ -11,15 +11,18 @@ distraction instead (:mod:`simoun_agent.generalization`). Ctrl-C or SIGTERM stop
 
 from __future__ import annotations
 
-import argparse
 import shutil
 import signal
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
+import tyro
 from tqdm import tqdm
 
-from simoun_agent.cli.flags import add_version, bool_argv
+from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import SetupError
 from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
@@ -62,98 +65,72 @@ class EpisodeProgress:
             self.bar.close()
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="simoun-eval",
-        description="Evaluate a simoun-train checkpoint: deterministic episodes, metrics and a "
-        "video.",
-        epilog="example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10",
-    )
-    parser.add_argument(
-        "checkpoint",
-        nargs="+",
-        help="a run directory or its checkpoint.pt (several with --distraction)",
-    )
-    parser.add_argument("--episodes", type=int, default=10, help="episodes to play (default 10)")
-    parser.add_argument(
-        "--seed", type=int, default=None, help="first episode seed (default: the run's eval seeds)"
-    )
-    parser.add_argument(
-        "--out", default=None, help="output directory (default: <run dir>/eval-<step>)"
-    )
-    parser.add_argument(
-        "--video",
-        action=argparse.BooleanOptionalAction,
-        default=True,
-        help="record the first episode to video.mp4 (default: on)",
-    )
-    parser.add_argument(
-        "--progress",
-        action=argparse.BooleanOptionalAction,
-        default=True,
-        help="show a progress bar, or one line per episode when stderr is not a terminal",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace an earlier evaluation in the output directory",
-    )
-    parser.add_argument(
-        "--random-policy",
-        action="store_true",
-        help="play uniformly random actions on the same episodes instead of the agent "
-        "(the baseline; writes to <run dir>/eval-<step>-random)",
-    )
-    parser.add_argument("--device", default=None, help="torch device (default: cuda if available)")
-    parser.add_argument(
-        "--torch-threads",
-        type=int,
-        default=None,
-        metavar="INT",
-        help="torch intra-op threads (default: the run's torch_threads, else torch's default; "
-        "not with --distraction, where each run uses its own)",
-    )
-    parser.add_argument(
-        "--distraction",
-        metavar="MODES",
-        default=None,
-        help="evaluate under distraction modes instead, comma-separated from train, color_easy, "
-        "color_hard, video_easy, video_hard (dm_control runs); writes a mean ± std table and a "
-        "bar chart to <run dir>/generalization, or <common folder>/generalization for several runs",
-    )
-    parser.add_argument(
-        "--videos",
-        metavar="DIR",
-        default=None,
-        help="with --distraction: a folder of video files (or of DAVIS-style folders of frames) "
-        "for the video_* modes (default: a procedural moving background)",
-    )
-    add_version(parser)
-    return parser
+PROG = "simoun-eval"
+
+DESCRIPTION = """Evaluate a simoun-train checkpoint: deterministic episodes, metrics and a video.
+
+example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10"""
 
 
-def main(argv: list[str] | None = None) -> int:
+@dataclass
+class EvalCommand:
+    """What ``simoun-eval`` is asked."""
+
+    checkpoint: Annotated[tuple[str, ...], tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    """a run directory or its checkpoint.pt (several with --distraction)"""
+    episodes: int = 10
+    """episodes to play"""
+    seed: int | None = None
+    """first episode seed (none: the run's eval seeds)"""
+    out: str | None = None
+    """output directory (none: <run dir>/eval-<step>)"""
+    video: bool = True
+    """record the first episode to video.mp4"""
+    progress: bool = True
+    """show a progress bar, or one line per episode when stderr is not a terminal"""
+    overwrite: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """replace an earlier evaluation in the output directory"""
+    random_policy: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """play uniformly random actions on the same episodes instead of the agent (the baseline;
+    writes to <run dir>/eval-<step>-random)"""
+    device: str | None = None
+    """torch device (none: cuda if available)"""
+    torch_threads: int | None = None
+    """torch intra-op threads (none: the run's torch_threads, else torch's default; not with
+    --distraction, where each run uses its own)"""
+    distraction: Annotated[str | None, tyro.conf.arg(metavar="MODES")] = None
+    """evaluate under distraction modes instead, comma-separated from train, color_easy,
+    color_hard, video_easy, video_hard (dm_control runs); writes a mean ± std table and a bar
+    chart to <run dir>/generalization, or <common folder>/generalization for several runs"""
+    videos: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    """with --distraction: a folder of video files (or of DAVIS-style folders of frames) for the
+    video_* modes (none: a procedural moving background)"""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
-    parser = build_parser()
-    argv = sys.argv[1:] if argv is None else argv
-    args = parser.parse_args(bool_argv(argv, ("--video", "--progress")))
+    args = parse(EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"))
+    if not args.checkpoint:  # tyro accepts no value for a variable number of them
+        fail(PROG, "give the run to evaluate: a run directory or its checkpoint.pt")
     if args.episodes < 1:
-        parser.error("--episodes must be at least 1")
+        fail(PROG, "--episodes must be at least 1")
     if args.seed is not None and not 0 <= args.seed < 2**32:
-        parser.error(f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
+        fail(PROG, f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
     if args.torch_threads is not None and args.torch_threads < 1:
-        parser.error(f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
+        fail(PROG, f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
     if args.distraction is not None and args.torch_threads is not None:
-        parser.error(
+        fail(
+            PROG,
             "--torch-threads goes with one run; with --distraction each run's own "
-            "torch_threads (from its config.json) applies: drop --torch-threads"
+            "torch_threads (from its config.json) applies: drop --torch-threads",
         )
     if args.distraction is not None:
-        return evaluate_distractions(parser, args)
+        return evaluate_distractions(args)
     if len(args.checkpoint) > 1 or args.videos is not None:
-        parser.error(
+        fail(
+            PROG,
             "several runs and --videos go with --distraction (e.g. --distraction "
-            "train,video_hard); otherwise evaluate one run at a time"
+            "train,video_hard); otherwise evaluate one run at a time",
         )
     try:
         # The machine may differ from the training one: --device applies before the checks.
@@ -172,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
         seed = args.seed if args.seed is not None else first_eval_seed(config.seed)
         agent = RandomPolicy(env.action_space.shape[0], seed) if args.random_policy else run.agent
     except SetupError as err:
-        parser.exit(2, f"simoun-eval: error: {err}\n")
+        fail(PROG, err)
     try:
         with stop_at_once(), EpisodeProgress(args.episodes, args.progress) as progress:
             metrics, frames = evaluate(
@@ -197,11 +174,11 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+def evaluate_distractions(args: EvalCommand) -> int:
     """Evaluate ``args.checkpoint`` (one or several runs) on ``args.distraction``'s modes and
-    write the table, CSV and bar chart; bad input exits through ``parser`` without traceback."""
+    write the table, CSV and bar chart; bad input exits with status 2, without traceback."""
     if args.random_policy:
-        parser.error("--random-policy does not combine with --distraction")
+        fail(PROG, "--random-policy does not combine with --distraction")
     run_dirs = [Path(path) for path in args.checkpoint]
     created, out = False, None
     try:
@@ -233,11 +210,11 @@ def evaluate_distractions(parser: argparse.ArgumentParser, args: argparse.Namesp
         # a run or mode refused while loading: leave no empty report directory behind
         if created:
             shutil.rmtree(out, ignore_errors=True)
-        parser.exit(2, f"{parser.prog}: error: {err}\n")
+        fail(PROG, err)
     except Stopped as stop:
         if created:
             shutil.rmtree(out, ignore_errors=True)
-        print(f"{parser.prog}: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
+        print(f"{PROG}: stopped by {signal.Signals(stop.signum).name}", file=sys.stderr)
         return stop.exit_code
     envs = sorted({result.env.removeprefix("dm_control/") for result in results})
     steps = sorted({result.env_step for result in results})

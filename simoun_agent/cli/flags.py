@@ -1,29 +1,172 @@
-"""Command-line conventions shared by the commands of :mod:`simoun_agent.cli`.
+"""Command-line conventions shared by the commands of :mod:`simoun_agent.cli`, parsed with tyro.
 
-Booleans are switches, ``--video`` / ``--no-video`` (``argparse.BooleanOptionalAction``), and the
-older spelling with a value, ``--video false`` or ``--video=false``, still works: :func:`bool_argv`
-rewrites it to the switch before parsing. Both tools answer ``--version``.
+Every command is a dataclass whose field docstrings are its help text; :func:`parse` hands it
+to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not have:
+
+* help is each field's docstring on one line (tyro keeps the docstring's line breaks); a
+  tuple key of the config is given by repeating its flag (``--eval-distraction video_hard
+  --eval-distraction color_hard``); and a section of the run config (``TrainConfig``,
+  ``AgentConfig``) is filled with the values read but not checked (:func:`_unchecked`): a
+  value that is only valid once the preset and recipe layers are under it must not be
+  refused, so the commands hand the values the user gave to
+  :func:`simoun_agent.config.resolve`, which builds and checks the config once;
+* dicts are JSON (``--env-kwargs '{"a": 1}'``), and an optional value takes ``none``;
+* booleans are switches, ``--video`` / ``--no-video`` (``--agent.no-curiosity`` in a section),
+  and the older spelling with a value, ``--video false`` or ``--video=false``, still works:
+  :func:`bool_argv` rewrites it to the switch before parsing;
+* every command answers ``--version``; help printed to a pipe is not wrapped at 80 columns.
 """
 
 from __future__ import annotations
 
-import argparse
-from collections.abc import Iterable, Sequence
+import contextlib
+import dataclasses
+import json
+import os
+import sys
+import typing
+from collections.abc import Iterable, Iterator, Sequence
 from importlib.metadata import PackageNotFoundError, version
+from typing import Annotated, Any, NoReturn, TypeVar
 
-TRUE_WORDS = ("1", "true", "yes", "on")
-FALSE_WORDS = ("0", "false", "no", "off")
+import tyro
+from tyro.constructors import (
+    MISSING_NONPROP,
+    ConstructorRegistry,
+    PrimitiveConstructorSpec,
+    PrimitiveTypeInfo,
+    StructConstructorSpec,
+    StructFieldSpec,
+    StructTypeInfo,
+    UnsupportedTypeAnnotationError,
+)
+
+from simoun_agent.config import AgentConfig, TrainConfig
+from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs
+
+T = TypeVar("T")
+
+REGISTRY = ConstructorRegistry()
+"""The conventions above, for every ``tyro.cli`` call of the commands."""
+
+CONFIG_SECTIONS = (TrainConfig, AgentConfig)
+"""Dataclasses filled without their checks (those run once, in ``resolve``)."""
+
+PIPED_HELP_COLUMNS = "160"
+"""Width of help written to a pipe (grep, less, a log): a field's doc stays on one line."""
+
+
+@REGISTRY.struct_rule
+def _dataclass(info: StructTypeInfo) -> StructConstructorSpec | None:
+    cls = info.type
+    # ours only: tyro wraps a union of commands in a generic dataclass of its own
+    if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+        return None
+    if not cls.__module__.startswith("simoun_agent."):
+        return None
+    hints = typing.get_type_hints(cls, include_extras=True)
+    if cls in CONFIG_SECTIONS:  # a list of the config is given by repeating its flag
+        hints = {
+            name: Annotated[hint, tyro.conf.UseAppendAction]
+            if typing.get_origin(hint) is tuple
+            else hint
+            for name, hint in hints.items()
+        }
+    docs = field_docs(cls)
+    given = info.default if isinstance(info.default, cls) else None
+    fields = tuple(
+        StructFieldSpec(f.name, hints[f.name], _default(f, given), docs.get(f.name))
+        for f in dataclasses.fields(cls)
+        # a preset is chosen with the commands' own --preset, which resolves it
+        if f.init and not (cls is TrainConfig and f.name == "preset")
+    )
+    build = _unchecked(cls) if cls in CONFIG_SECTIONS else cls
+    return StructConstructorSpec(instantiate=build, fields=fields)
+
+
+def _unchecked(cls: type[T]) -> Any:
+    """``cls(**values)`` without ``__post_init__``: the values as typed, checked later by
+    :func:`simoun_agent.config.resolve` once the preset and recipe layers are applied."""
+
+    def build(**values: Any) -> T:
+        section = object.__new__(cls)
+        section.__dict__.update(values)
+        return section
+
+    return build
+
+
+def _default(field: dataclasses.Field, given: Any) -> Any:
+    if given is not None:
+        return getattr(given, field.name)
+    if field.default is not dataclasses.MISSING:
+        return field.default
+    if field.default_factory is not dataclasses.MISSING:
+        return field.default_factory()
+    return MISSING_NONPROP
+
+
+@REGISTRY.primitive_rule
+def _json_dict(info: PrimitiveTypeInfo) -> PrimitiveConstructorSpec | None:
+    if (info.type_origin or info.type) is not dict:
+        return None
+
+    def read(args: list[str]) -> dict:
+        try:
+            value = json.loads(args[0])
+        except json.JSONDecodeError:
+            value = None
+        if not isinstance(value, dict):
+            raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {args[0]!r}")
+        return value
+
+    return PrimitiveConstructorSpec(
+        nargs=1,
+        metavar="JSON",
+        instance_from_str=read,
+        is_instance=lambda value: isinstance(value, dict),
+        str_from_instance=lambda value: [json.dumps(value)],
+    )
+
+
+@REGISTRY.primitive_rule
+def _optional(info: PrimitiveTypeInfo) -> PrimitiveConstructorSpec | None:
+    options = typing.get_args(info.type)
+    if type(None) not in options or len(options) != 2 or typing.get_origin(info.type) is None:
+        return None
+    inner_type = next(option for option in options if option is not type(None))
+    inner = ConstructorRegistry.get_primitive_spec(PrimitiveTypeInfo.make(inner_type, info.markers))
+    if isinstance(inner, UnsupportedTypeAnnotationError) or inner.nargs != 1:
+        return None
+
+    def read(args: list[str]) -> Any:
+        return None if args[0].lower() in NONE_WORDS else inner.instance_from_str(args)
+
+    return PrimitiveConstructorSpec(
+        nargs=1,
+        metavar=f"{inner.metavar}|none",
+        instance_from_str=read,
+        is_instance=lambda value: value is None or inner.is_instance(value),
+        str_from_instance=lambda value: (
+            ["none"] if value is None else inner.str_from_instance(value)
+        ),
+    )
 
 
 def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
     """``argv`` with ``--flag WORD`` / ``--flag=WORD`` (WORD true/false, yes/no, on/off, 1/0)
-    rewritten to ``--flag`` / ``--no-flag`` for each boolean ``flags`` entry (``"--video"``).
+    rewritten to ``--flag`` / its negation (:func:`negated`) for each boolean ``flags`` entry
+    (``"--video"``), and argparse's former negation ``--no-agent.curiosity`` to tyro's.
 
     Example:
         >>> bool_argv(["--video", "false", "--progress=yes", "run"], ["--video", "--progress"])
         ['--no-video', '--progress', 'run']
+        >>> bool_argv(["--agent.curiosity", "off", "--no-agent.channels-last"],
+        ...           ["--agent.curiosity", "--agent.channels-last"])
+        ['--agent.no-curiosity', '--agent.no-channels-last']
     """
     flags = set(flags)
+    former = {"--no-" + flag[2:]: negated(flag) for flag in flags}
     words = TRUE_WORDS + FALSE_WORDS
     out: list[str] = []
     i = 0
@@ -34,18 +177,69 @@ def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
         elif name in flags and eq and word.lower() in words:
             step = 1
         else:
-            out.append(argv[i])
+            out.append(former.get(argv[i], argv[i]))
             i += 1
             continue
-        out.append(name if word.lower() in TRUE_WORDS else "--no-" + name[2:])
+        out.append(name if word.lower() in TRUE_WORDS else negated(name))
         i += step
     return out
 
 
-def add_version(parser: argparse.ArgumentParser) -> None:
-    """``--version``: the installed simoun version."""
+def negated(flag: str) -> str:
+    """tyro's negation of a switch: ``--video`` -> ``--no-video``, ``--agent.curiosity`` ->
+    ``--agent.no-curiosity``."""
+    section, dot, name = flag[2:].rpartition(".")
+    return f"--{section}{dot}no-{name}"
+
+
+def installed_version() -> str:
+    """The installed simoun version."""
     try:
-        installed = version("simoun")
+        return version("simoun")
     except PackageNotFoundError:  # run from a source tree that was never installed
-        installed = "unknown (not installed)"
-    parser.add_argument("--version", action="version", version=f"%(prog)s {installed}")
+        return "unknown (not installed)"
+
+
+def parse(
+    cls: type[T],
+    argv: Sequence[str] | None,
+    prog: str,
+    description: str,
+    default: T | None = None,
+    switches: Iterable[str] = (),
+) -> T:
+    """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
+    ``switches`` are the boolean flags that also take the older ``--flag false``. Exits 0
+    after ``--version`` or ``--help``, 2 with tyro's message for input it cannot read."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if "--version" in argv:
+        print(f"{prog} {installed_version()}")
+        sys.exit(0)
+    with _help_unwrapped_in_pipes():
+        return tyro.cli(
+            cls,
+            prog=prog,
+            description=description,
+            args=bool_argv(argv, switches),
+            default=MISSING_NONPROP if default is None else default,
+            registry=REGISTRY,
+        )
+
+
+@contextlib.contextmanager
+def _help_unwrapped_in_pipes() -> Iterator[None]:
+    # tyro lays help out at the terminal's width, 80 columns without one (shutil reads COLUMNS)
+    if sys.stdout.isatty() or "COLUMNS" in os.environ:
+        yield
+        return
+    os.environ["COLUMNS"] = PIPED_HELP_COLUMNS
+    try:
+        yield
+    finally:
+        del os.environ["COLUMNS"]
+
+
+def fail(prog: str, message: object) -> NoReturn:
+    """``PROG: error: MESSAGE`` on stderr, then exit status 2 (bad input)."""
+    print(f"{prog}: error: {message}", file=sys.stderr)
+    sys.exit(2)

@@ -12,12 +12,22 @@ the report (:mod:`simoun_agent.sweep.report`) is written when the sweep ends. Th
 
 from __future__ import annotations
 
-import argparse
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Annotated, Any, Literal
 
-from simoun_agent.cli.config_flags import add_config_arguments, overrides_from
+import tyro
+
+from simoun_agent.cli.config_flags import (
+    ConfigFlags,
+    config_default,
+    config_switches,
+    overrides_from,
+)
+from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec
@@ -33,12 +43,64 @@ from simoun_agent.sweep.launch import (
 )
 from simoun_agent.sweep.trainable import STOP_FILE
 
+PROG = "simoun-sweep"
 
-def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
-    """The sweep to run: from the flags, or the saved one on ``--resume`` (which the flags, when
-    given, must match)."""
-    base = overrides_from(args)
-    given = bool(args.grid or args.seeds or args.envs or base or args.preset)
+DESCRIPTION = f"""Run a grid of simoun-train runs (variants x envs x seeds) on Ray Tune, on this
+machine or a Ray cluster, then write the report (simoun-report). The base config is given
+exactly as to simoun-train (--preset, every config flag, --set KEY=VALUE).
+
+examples:
+  simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 \\
+      --sweep-dir sweeps/baselines
+  simoun-sweep --resume --sweep-dir sweeps/baselines
+  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq \\
+      --seeds 0-4 --sweep-dir /shared/sweeps/walker
+
+agent recipes (--grid agent.recipe=A,B): {", ".join(RECIPES)}
+
+Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory."""
+
+
+@dataclass
+class SweepCommand:
+    """What ``simoun-sweep`` is asked: the grid, where and how to run it, and the base config."""
+
+    sweep_dir: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    """where the runs and the report go (none: sweeps/<UTC time>; required with --resume); on a
+    cluster, a directory every machine sees"""
+    grid: Annotated[
+        tuple[str, ...], tyro.conf.UseAppendAction, tyro.conf.arg(metavar="KEY=V1,V2")
+    ] = ()
+    """a config key and the values to try (the variants are the product), e.g. --grid
+    agent.recipe=simoun,drq"""
+    seeds: Annotated[str | None, tyro.conf.arg(metavar="SEEDS")] = None
+    """seeds of each variant, e.g. 0-4 or 0,2,5 (none: --seed)"""
+    envs: Annotated[str | None, tyro.conf.arg(metavar="ID,ID")] = None
+    """Gymnasium ids to run every variant on (none: --env)"""
+    cpus_per_trial: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
+    """CPUs per trial; the trial uses as many torch threads (none: 1)"""
+    gpus_per_trial: Annotated[str, tyro.conf.arg(metavar="N|auto")] = "auto"
+    """GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device is not
+    cpu, else 0"""
+    address: Annotated[str | None, tyro.conf.arg(metavar="auto|HOST:PORT|ray://HOST:PORT")] = None
+    """run on a Ray cluster (auto: the one `ray start` made on this machine); none: a local Ray
+    instance"""
+    num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
+    """CPUs of the local Ray instance (none: this machine's)"""
+    resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """continue the sweep in --sweep-dir: finished trials are skipped, the others go on from
+    their checkpoints"""
+    verbose: Literal[0, 1, 2] = 1
+    """Tune's output"""
+    flags: Annotated[ConfigFlags, tyro.conf.arg(name="")] = field(default_factory=ConfigFlags)
+    """the base config of every trial"""
+
+
+def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> SweepSpec:
+    """The sweep to run: from the flags (``base``: the config overrides they give), or the saved
+    one on ``--resume`` (which the flags, when given, must match)."""
+    preset = args.flags.preset
+    given = bool(args.grid or args.seeds or args.envs or base or preset)
     if not args.resume:
         if (sweep_dir / SWEEP_FILE).exists():
             raise SetupError(
@@ -48,14 +110,14 @@ def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
         if sweep_dir.exists() and any(sweep_dir.iterdir()):
             raise SetupError(f"{sweep_dir} is not empty; pass a new --sweep-dir")
         cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
-        return SweepSpec.create(args.preset, base, args.grid, args.seeds, args.envs, cpus)
+        return SweepSpec.create(preset, base, list(args.grid), args.seeds, args.envs, cpus)
     saved = SweepSpec.load(sweep_dir)
     if not given and args.cpus_per_trial in (None, saved.cpus_per_trial):
         return saved
     spec = SweepSpec.create(
-        args.preset,
+        preset,
         base,
-        args.grid,
+        list(args.grid),
         args.seeds,
         args.envs,
         saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
@@ -70,99 +132,24 @@ def sweep_spec(args: argparse.Namespace, sweep_dir: Path) -> SweepSpec:
     return saved
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="simoun-sweep",
-        usage="simoun-sweep --sweep-dir DIR [--grid KEY=V1,V2 ...] [--seeds 0-4] [--envs A,B] "
-        "[--preset NAME] [--KEY VALUE ...] [--resume] [--address auto|HOST:PORT]",
-        description="Run a grid of simoun-train runs (variants x envs x seeds) on Ray Tune, on "
-        "this machine or a Ray cluster, then write the report (simoun-report).",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        allow_abbrev=False,
-        epilog="examples:\n"
-        "  simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 "
-        "--sweep-dir sweeps/baselines\n"
-        "  simoun-sweep --resume --sweep-dir sweeps/baselines\n"
-        "  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq "
-        "--seeds 0-4 --sweep-dir /shared/sweeps/walker\n\n"
-        f"agent recipes (--grid agent.recipe=A,B): {', '.join(RECIPES)}\n"
-        "Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.",
-    )
-    sweep = parser.add_argument_group("sweep")
-    sweep.add_argument(
-        "--sweep-dir",
-        metavar="DIR",
-        help="where the runs and the report go (default: sweeps/<UTC time>; required with "
-        "--resume); on a cluster, a directory every machine sees",
-    )
-    sweep.add_argument(
-        "--grid",
-        action="append",
-        default=[],
-        metavar="KEY=V1,V2",
-        help="a config key and the values to try (repeatable: the variants are the product), "
-        "e.g. --grid agent.recipe=simoun,drq",
-    )
-    sweep.add_argument(
-        "--seeds",
-        metavar="SEEDS",
-        help="seeds of each variant, e.g. 0-4 or 0,2,5 (default: --seed)",
-    )
-    sweep.add_argument(
-        "--envs", metavar="ID,ID", help="Gymnasium ids to run every variant on (default: --env)"
-    )
-    sweep.add_argument(
-        "--cpus-per-trial",
-        type=int,
-        metavar="N",
-        help="CPUs per trial; the trial uses as many torch threads (default: 1)",
-    )
-    sweep.add_argument(
-        "--gpus-per-trial",
-        default="auto",
-        metavar="N|auto",
-        help="GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device "
-        "is not cpu, else 0",
-    )
-    sweep.add_argument(
-        "--address",
-        metavar="auto|HOST:PORT|ray://HOST:PORT",
-        help="run on a Ray cluster (auto: the one `ray start` made on this machine); default: a "
-        "local Ray instance",
-    )
-    sweep.add_argument(
-        "--num-cpus",
-        type=int,
-        metavar="N",
-        help="CPUs of the local Ray instance (default: this machine's)",
-    )
-    sweep.add_argument(
-        "--resume",
-        action="store_true",
-        help="continue the sweep in --sweep-dir: finished trials are skipped, the others go on "
-        "from their checkpoints",
-    )
-    sweep.add_argument(
-        "--verbose", type=int, default=1, choices=(0, 1, 2), help="Tune's output (default: 1)"
-    )
-    add_config_arguments(parser)
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-sweep``."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        default = SweepCommand(flags=ConfigFlags(config=config_default(argv)))
+    except SetupError as err:
+        fail(PROG, err)
+    args = parse(SweepCommand, argv, PROG, DESCRIPTION, default, config_switches())
     if args.resume and not args.sweep_dir:
-        parser.exit(2, "simoun-sweep: error: --resume needs the --sweep-dir of the sweep\n")
+        fail(PROG, "--resume needs the --sweep-dir of the sweep")
     stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
     # absolute: Tune runs each trial in a working directory of its own
     sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
     try:
         ray = load_ray()
-        spec = sweep_spec(args, sweep_dir)
+        spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
     except SetupError as err:
-        parser.exit(2, f"simoun-sweep: error: {err}\n")
+        fail(PROG, err)
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
     print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
@@ -182,7 +169,7 @@ def main(argv: list[str] | None = None) -> int:
                 terminated = came
                 outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
         except SetupError as err:
-            parser.exit(2, f"simoun-sweep: error: {err}\n")
+            fail(PROG, err)
         except KeyboardInterrupt:
             outcome = {"stopped": todo}
         finally:

@@ -1,7 +1,7 @@
 """``simoun-train``: train the Simoun agent on any pixel or renderable Gymnasium env.
 
     simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu
-    simoun-train --preset walker-walk --agent.encoder dual --agent.curiosity false
+    simoun-train --preset walker-walk --agent.encoder dual --agent.no-curiosity
     simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000
 
 The command line over the training loop (:mod:`simoun_agent.run.train`, where the run
@@ -12,65 +12,77 @@ directory, the stops and the exit statuses are described). A run whose config na
 
 from __future__ import annotations
 
-import argparse
 import signal
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
+import tyro
 from tqdm import tqdm
 
-from simoun_agent.cli.config_flags import add_config_arguments, overrides_from
-from simoun_agent.cli.flags import add_version
-from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
+from simoun_agent.cli.config_flags import (
+    PRESETS_LIST,
+    RECIPES_HELP,
+    ConfigFlags,
+    config_default,
+    config_switches,
+    overrides_from,
+)
+from simoun_agent.cli.flags import fail, parse
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
 from simoun_agent.run import train as loop  # called through the module: tests wrap loop.train
 from simoun_agent.run.memory import check_memory
 from simoun_agent.run.signals import Stopped, stop_at_once
 
+PROG = "simoun-train"
 
-def build_parser() -> argparse.ArgumentParser:
-    """The command line: a few run options and one flag per config key."""
-    presets = "\n".join(f"  {name:18} {preset.description}" for name, preset in PRESETS.items())
-    recipes = "\n".join(f"  {name:18} {recipe.description}" for name, recipe in RECIPES.items())
-    parser = argparse.ArgumentParser(
-        prog="simoun-train",
-        usage="simoun-train [--preset NAME | --resume RUN_DIR] [--KEY VALUE ...] [--set KEY=VALUE]",
-        description="Train the Simoun agent (vision-based SAC) on a Gymnasium environment.",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        epilog=f"presets:\n{presets}\n\nagent recipes (--agent.recipe NAME):\n{recipes}\n\n"
-        "examples:\n"
-        "  simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu\n"
-        "  simoun-train --preset cheetah-run --agent.encoder dual --agent.curiosity false\n"
-        "  simoun-train --preset highway --set agent.batch_size=64\n"
-        "  simoun-train --preset cpu --agent.recipe drq --seed 2\n"
-        "  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000\n\n"
-        "Values: booleans true/false, None as none, dicts as JSON (--env-kwargs '{\"a\": 1}').",
-    )
-    parser.add_argument(
-        "--resume",
-        metavar="RUN_DIR",
-        help="continue a run from its last checkpoint (only "
-        f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="start over in a --run-dir whose run stopped before its first checkpoint (a run "
-        "with a checkpoint is never deleted: --resume it)",
-    )
-    add_version(parser)
-    add_config_arguments(parser)
-    return parser
+DESCRIPTION = f"""Train the Simoun agent (vision-based SAC) on a Gymnasium environment.
+
+{PRESETS_LIST}
+
+{RECIPES_HELP}
+
+examples:
+  simoun-train --env dm_control/cartpole-swingup-v0 --preset cpu
+  simoun-train --preset cheetah-run --agent.encoder dual --agent.no-curiosity
+  simoun-train --preset highway --set agent.batch_size=64
+  simoun-train --preset cpu --agent.recipe drq --seed 2
+  simoun-train --resume runs/cartpole-swingup-cpu-s1-20260101-120000
+
+Values: booleans as switches (--no-video; --video false works too), None as none, dicts as
+JSON (--env-kwargs '{{"a": 1}}')."""
 
 
-def main(argv: list[str] | None = None) -> int:
+@dataclass
+class TrainCommand:
+    """What ``simoun-train`` is asked: a new run (its config flags) or one to resume."""
+
+    resume: Annotated[
+        str | None,
+        tyro.conf.arg(
+            metavar="RUN_DIR",
+            help="continue a run from its last checkpoint (only "
+            f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
+        ),
+    ] = None
+    overwrite: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """start over in a --run-dir whose run stopped before its first checkpoint (a run with a
+    checkpoint is never deleted: --resume it)"""
+    flags: Annotated[ConfigFlags, tyro.conf.arg(name="")] = field(default_factory=ConfigFlags)
+    """the run config"""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    command = parse_command(argv)
     try:
         with stop_at_once():  # nothing to save during set-up
-            run = setup(parser, args)
+            run = setup(command, argv)
     except Stopped as stop:
         print(
             f"simoun-train: stopped by {signal.Signals(stop.signum).name} during set-up, before "
@@ -98,24 +110,37 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def setup(parser: argparse.ArgumentParser, args: argparse.Namespace) -> loop.Run:
-    """The run that ``args`` ask for, new or resumed; bad input exits with status 2."""
+def parse_command(argv: Sequence[str]) -> TrainCommand:
+    """``argv`` read with tyro over the defaults of the preset it names; bad input exits with
+    status 2."""
     try:
-        overrides = overrides_from(args)
-        if args.resume:
-            if args.preset:
+        default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
+    except SetupError as err:
+        fail(PROG, err)
+    return parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
+
+
+def setup(command: TrainCommand, argv: Sequence[str]) -> loop.Run:
+    """The run that ``command`` (parsed from ``argv``) asks for, new or resumed; bad input
+    exits with status 2."""
+    try:
+        overrides = overrides_from(command.flags, argv)
+        if command.resume:
+            if command.flags.preset:
                 raise SetupError("--preset does not combine with --resume: a run keeps its config")
-            if args.overwrite:
+            if command.overwrite:
                 raise SetupError("--overwrite starts a run over; it does not combine with --resume")
-            run = loop.resume_run(Path(args.resume), overrides, check=check_eval_distractions)
+            run = loop.resume_run(Path(command.resume), overrides, check=check_eval_distractions)
         else:
-            config = resolve(args.preset, overrides)
+            config = resolve(command.flags.preset, overrides)
             warning = check_memory(config)  # before anything is built
             if warning:
                 print(f"simoun-train: warning: {warning}", file=sys.stderr)
-            run = loop.create_run(config, overwrite=args.overwrite, check=check_eval_distractions)
+            run = loop.create_run(
+                config, overwrite=command.overwrite, check=check_eval_distractions
+            )
     except SetupError as err:
-        parser.exit(2, f"simoun-train: error: {err}\n")
+        fail(PROG, err)
     return run
 
 

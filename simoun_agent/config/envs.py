@@ -31,6 +31,12 @@ def dmc_task(env_id: str) -> str | None:
     return env_id.removeprefix("dm_control/").rsplit("-v", 1)[0]
 
 
+def env_label(env_id: str) -> str:
+    """The task's name in run and trial directories and in reports:
+    ``dm_control/cartpole-swingup-v0`` -> ``cartpole-swingup``; others with ``/`` as ``-``."""
+    return dmc_task(env_id) or env_id.replace("/", "-")
+
+
 def is_highway(env_id: str) -> bool:
     """True for ids registered by highway-env (``highway-v0``, ``merge-v0``, ...)."""
     spec = gym.registry.get(env_id)

@@ -18,9 +18,23 @@ from simoun_agent.config.errors import SetupError
 from simoun_agent.config.key_match import did_you_mean
 from simoun_agent.config.train import TrainConfig
 
+TRUE_WORDS = ("1", "true", "yes", "on")
+FALSE_WORDS = ("0", "false", "no", "off")
+NONE_WORDS = ("none", "null")
+"""How a command line writes true, false and None (any case)."""
+
 
 def field_docs(cls: type) -> dict[str, str]:
-    """The docstring under each field of a dataclass (cleanrl style), read from its source."""
+    """The docstring under each field of a dataclass and of the dataclasses it extends
+    (cleanrl style), each on one line, read from their source."""
+    docs: dict[str, str] = {}
+    for owner in reversed(cls.__mro__):
+        if dataclasses.is_dataclass(owner):
+            docs.update(_own_field_docs(owner))
+    return docs
+
+
+def _own_field_docs(cls: type) -> dict[str, str]:
     try:
         tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
     except (OSError, TypeError):
@@ -71,7 +85,7 @@ def config_fields() -> dict[str, tuple[type, Any, str]]:
 def parse_value(key: str, text: str, kind: Any) -> Any:
     """Convert a command-line string to the field's type, or raise SetupError naming the key."""
     options = typing.get_args(kind) if _is_union(kind) else (kind,)
-    if type(None) in options and text.lower() in ("none", "null"):
+    if type(None) in options and text.lower() in NONE_WORDS:
         return None
     errors = []
     for option in options:
@@ -92,9 +106,9 @@ def _parse_one(text: str, kind: Any) -> Any:
     origin = typing.get_origin(kind) or kind
     if origin is bool:
         lowered = text.lower()
-        if lowered in ("1", "true", "yes", "on"):
+        if lowered in TRUE_WORDS:
             return True
-        if lowered in ("0", "false", "no", "off"):
+        if lowered in FALSE_WORDS:
             return False
         raise ValueError("expected true or false")
     if origin in (int, float, str):

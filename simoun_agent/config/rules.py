@@ -96,14 +96,19 @@ def flag_name(prefix: str, name: str) -> str:
     return "--" + prefix + name.replace("_", "-")
 
 
-def shown(value: Any) -> str:
-    """``value`` as typed on the command line: true/false, none, JSON dicts."""
-    if isinstance(value, bool):
-        return str(value).lower()
-    if value is None:
-        return "none"
-    if isinstance(value, dict):
-        return json.dumps(value)
+def show(value: Any) -> str:
+    """A value as written on the command line: true/false, none, compact JSON for dicts and
+    lists, numbers and strings as they are. Error messages, sweep variant names (and so their
+    directories) and study settings all write values this way.
+
+    Example:
+        >>> show(None), show(True), show({"lanes": 4}), show(("video_hard",)), show(3e-4)
+        ('none', 'true', '{"lanes":4}', '["video_hard"]', '0.0003')
+    """
+    if isinstance(value, bool) or value is None:
+        return json.dumps(value).replace("null", "none")
+    if isinstance(value, (dict, list, tuple)):
+        return json.dumps(value, separators=(",", ":"))
     return str(value)
 
 
@@ -125,10 +130,10 @@ def check_fields(config: Any, rules: dict[str, Rule], prefix: str) -> None:
         if not rule.ok(value):
             flag = flag_name(prefix, f.name)
             default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
-            fix = rule.fix or f"e.g. {flag} {shown(default)} (the default)"
-            raise ValueError(f"{flag} {shown(value)} ({cls}.{f.name}) must be {rule.need}; {fix}")
+            fix = rule.fix or f"e.g. {flag} {show(default)} (the default)"
+            raise ValueError(f"{flag} {show(value)} ({cls}.{f.name}) must be {rule.need}; {fix}")
 
 
 def fail(prefix: str, name: str, value: Any, problem: str) -> ValueError:
     """A ValueError for a cross-field problem: ``--flag value: problem``."""
-    return ValueError(f"{flag_name(prefix, name)} {shown(value)}: {problem}")
+    return ValueError(f"{flag_name(prefix, name)} {show(value)}: {problem}")

@@ -7,61 +7,71 @@ python -m simoun_agent.minigrid_study report               # docs/studies/minigr
 
 from __future__ import annotations
 
-import argparse
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated, Union
+
+import tyro
 
 from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.spec import StudySpec, load_spec
 
 ARCHIVE = Path("docs/studies/minigrid")
 
+PROG = "python -m simoun_agent.minigrid_study"
 
-def spec_for(args: argparse.Namespace) -> StudySpec:
-    """``--spec``, else the archive's spec, else the defaults (the study as designed)."""
+
+def spec_for(spec: Path | None, archive: Path) -> StudySpec:
+    """``spec``, else the archive's spec, else the defaults (the study as designed)."""
     from simoun_agent.minigrid_study.tune import SPEC_FILE
 
-    if args.spec is not None:
-        return load_spec(args.spec)
-    if (args.archive / SPEC_FILE).is_file():
-        return load_spec(args.archive / SPEC_FILE)
+    if spec is not None:
+        return load_spec(spec)
+    if (archive / SPEC_FILE).is_file():
+        return load_spec(archive / SPEC_FILE)
     return StudySpec()
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="python -m simoun_agent.minigrid_study",
+@dataclass
+class Report:
+    """Write the report."""
+
+    archive: Path = ARCHIVE
+    """the study's records"""
+    spec: Path | None = None
+    """a JSON spec (None: the archive's spec.json)"""
+
+
+@dataclass
+class Run(Report):
+    """Train every unfinished run."""
+
+    work_dir: Path = Path("runs/minigrid_study")
+    """Ray Tune's records and the runs in progress"""
+    address: str | None = None
+    """a Ray cluster (auto, HOST:PORT); None: local"""
+    concurrent: int = 2
+    """runs at a time"""
+
+
+Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
+    Annotated[Run, tyro.conf.subcommand("run")], Annotated[Report, tyro.conf.subcommand("report")]
+]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = tyro.cli(
+        Command,
+        prog=PROG,
         description="SB3 PPO on MiniGrid pixels with no intrinsic reward, consistency curiosity "
         "or RND: train the runs on Ray Tune (resumable), then report.",
+        args=argv,
     )
-    commands = parser.add_subparsers(dest="command", required=True)
-    for name, text in (("run", "train every unfinished run"), ("report", "write the report")):
-        command = commands.add_parser(name, help=text)
-        command.add_argument(
-            "--archive", type=Path, default=ARCHIVE, help=f"the study's records (default {ARCHIVE})"
-        )
-        command.add_argument(
-            "--spec", type=Path, default=None, help="a JSON spec (default: the archive's spec.json)"
-        )
-    run = commands.choices["run"]
-    run.add_argument(
-        "--work-dir",
-        type=Path,
-        default=Path("runs/minigrid_study"),
-        help="Ray Tune's records and the runs in progress (default runs/minigrid_study)",
-    )
-    run.add_argument(
-        "--address", default=None, help="a Ray cluster (auto, HOST:PORT); default local"
-    )
-    run.add_argument("--concurrent", type=int, default=2, help="runs at a time (default 2)")
-    return parser
-
-
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
     try:
-        spec = spec_for(args)
-        if args.command == "run":
+        spec = spec_for(args.spec, args.archive)
+        if isinstance(args, Run):
             from simoun_agent.minigrid_study.tune import run_study
 
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)

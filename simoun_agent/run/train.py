@@ -45,7 +45,7 @@ import torch
 
 from simoun_agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
-from simoun_agent.config.envs import dmc_task
+from simoun_agent.config.envs import env_label
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.atomic import atomic_write
@@ -104,9 +104,11 @@ class TrainingError(RuntimeError):
 
 def default_run_dir(config: TrainConfig) -> Path:
     """``runs/<task>-<preset>-s<seed>-<UTC time>``, e.g. ``runs/cartpole-swingup-cpu-s1-...``."""
-    task = dmc_task(config.env) or config.env.replace("/", "-")
     stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
-    return Path("runs") / f"{task}-{config.preset or 'default'}-s{config.seed}-{stamp}"
+    return (
+        Path("runs")
+        / f"{env_label(config.env)}-{config.preset or 'default'}-s{config.seed}-{stamp}"
+    )
 
 
 def build(

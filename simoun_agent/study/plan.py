@@ -16,10 +16,12 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, resolve
+from simoun_agent.config.envs import env_label
+from simoun_agent.config.rules import show
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.study import probe
 from simoun_agent.study.spec import StudySpec
-from simoun_agent.sweep.grid import Trial, env_label, path_part, show, typed
+from simoun_agent.sweep.grid import Trial, path_part, typed
 
 TUNING, EVALUATION = "tuning", "evaluation"
 

@@ -33,6 +33,9 @@ import numpy as np
 
 from simoun_agent import stats
 from simoun_agent.config import RECIPES, resolve, to_dict
+from simoun_agent.config.envs import env_label
+from simoun_agent.config.resolve import flatten
+from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
@@ -48,7 +51,6 @@ from simoun_agent.study.plan import (
 from simoun_agent.study.selection import SELECTION_RULES, TIE_RULE
 from simoun_agent.study.spec import StudySpec, fixed_by
 from simoun_agent.sweep import report as sweep_report
-from simoun_agent.sweep.grid import env_label, show
 from simoun_agent.sweep.trainable import read_trial_parts
 
 REPORT_DIR = "report"
@@ -113,7 +115,7 @@ def recipe_differences(spec: StudySpec, choices: dict[str, Choice]) -> tuple[lis
     flat = {}
     for recipe in spec.recipes:
         overrides = spec.overrides(recipe, task, choices[recipe].setting, 0, 1)
-        flat[recipe] = sweep_report.flatten(to_dict(resolve(spec.preset, overrides)))
+        flat[recipe] = flatten(to_dict(resolve(spec.preset, overrides)))
     keys = [
         key
         for key in flat[spec.recipes[0]]

@@ -5,12 +5,12 @@
 
 from __future__ import annotations
 
-import argparse
 import json
+from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, Literal
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
@@ -35,6 +35,30 @@ STUDY_FILE = "study.json"
 parsed form) and each part's code version."""
 
 
+@dataclass
+class StudyOptions:
+    """Where and how :func:`run_study` runs a study (the options of ``simoun-study run``)."""
+
+    study_dir: Path
+    """where the runs and the report go; on a cluster, a directory every machine sees"""
+    archive: Path | None = None
+    """copy each finished run's CSVs, config.json and summary.json (no checkpoints, replays,
+    videos or tb/) here as it completes, with the study record, the selection and the report,
+    e.g. docs/studies/NAME; a resumed study counts archived runs as done"""
+    resume: bool = False
+    """continue the study: finished runs (in --study-dir, else in --archive) are kept, the
+    others go on from their checkpoints or start"""
+    allow_other_commit: bool = False
+    """resume even though the code is at another commit than the study started from"""
+    address: str | None = None
+    """run on a Ray cluster: auto (the one `ray start` made here), HOST:PORT or
+    ray://HOST:PORT; none: a local Ray instance"""
+    num_cpus: int | None = None
+    """CPUs of the local Ray instance (none: all)"""
+    verbose: Literal[0, 1, 2] = 1
+    """Tune's output"""
+
+
 def spec_from(path: str) -> StudySpec:
     spec = load_spec(path)
     check_layout(spec)
@@ -53,12 +77,12 @@ def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
     )
 
 
-def open_study(spec: StudySpec, spec_path: str, args: argparse.Namespace) -> dict[str, Any]:
+def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[str, Any]:
     """The study record, new or resumed (same spec and, unless allowed, same commit)."""
-    study_dir, archive = args.study_dir, args.archive
+    study_dir, archive = options.study_dir, options.archive
     code = code_version()
     part = {"started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"), **code}
-    if not args.resume:
+    if not options.resume:
         for where, flag in ((study_dir, "--study-dir"), (archive, "--archive")):
             if where is not None and (where / STUDY_FILE).is_file():
                 raise SetupError(
@@ -78,7 +102,7 @@ def open_study(spec: StudySpec, spec_path: str, args: argparse.Namespace) -> dic
             f"{STUDY_FILE}, spec_text), or start a new study in another --study-dir"
         )
     first = record["parts"][0]
-    if not same_code(first, code) and not args.allow_other_commit:
+    if not same_code(first, code) and not options.allow_other_commit:
         raise SetupError(
             f"this study ran from commit {first['commit'] or first['version']}, and the code is "
             f"now at {code['commit'] or code['version']}: the code under study must not change "
@@ -101,16 +125,18 @@ def save_record(record: dict[str, Any], places: list[Path]) -> None:
 class Phases:
     """Runs the study's phases on Ray Tune through simoun-sweep's trial code."""
 
-    def __init__(self, spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> None:
-        self.spec, self.args, self.ray = spec, args, ray
-        self.study_dir, self.archive = args.study_dir, args.archive
+    def __init__(
+        self, spec: StudySpec, spec_path: str, options: StudyOptions, ray: ModuleType
+    ) -> None:
+        self.spec, self.options, self.ray = spec, options, ray
+        self.study_dir, self.archive = options.study_dir, options.archive
         self.gpus: float | None = None
         self.started = False
         """whether Ray was started here (then the study shuts it down)"""
         self.todo: list = []
         """the trials of the phase running now"""
-        self.resume = f"simoun-study run {args.spec} --study-dir {args.study_dir} --resume" + (
-            f" --archive {args.archive}" if args.archive else ""
+        self.resume = f"simoun-study run {spec_path} --study-dir {options.study_dir} --resume" + (
+            f" --archive {options.archive}" if options.archive else ""
         )
 
     def restore(self, runs: list[StudyRun]) -> int:
@@ -139,7 +165,7 @@ class Phases:
             self.sync(runs)
             return {}
         if self.gpus is None:  # Ray starts only once there is something to run
-            self.started = launch.connect(self.ray, self.args.address, self.args.num_cpus)
+            self.started = launch.connect(self.ray, self.options.address, self.options.num_cpus)
             device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
             wanted = str(self.spec.gpus_per_trial)
             self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
@@ -155,7 +181,7 @@ class Phases:
             self.study_dir,
             self.spec.cpus_per_trial,
             self.gpus,
-            self.args.verbose,
+            self.options.verbose,
             callbacks,
             self.spec.max_concurrent_trials,
             name=f"{phase}-",
@@ -164,12 +190,13 @@ class Phases:
         return outcome
 
 
-def run_study(spec: StudySpec, args: argparse.Namespace, ray: ModuleType) -> int:
-    """Tune, select, evaluate, report; the exit status (the sweep's: 130/143 stopped, 1 failed)."""
-    study_dir, archive = args.study_dir, args.archive
-    record = open_study(spec, args.spec, args)
+def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: ModuleType) -> int:
+    """Tune, select, evaluate, report the study of ``spec`` (read from ``spec_path``); the exit
+    status (the sweep's: 130/143 stopped, 1 failed)."""
+    study_dir, archive = options.study_dir, options.archive
+    record = open_study(spec, spec_path, options)
     save_record(record, [study_dir] + ([archive] if archive is not None else []))
-    phases = Phases(spec, args, ray)
+    phases = Phases(spec, spec_path, options, ray)
     choices: dict[str, Choice] | None = None
     terminated: list[bool] = []
     try:

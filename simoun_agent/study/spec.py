@@ -56,9 +56,10 @@ from simoun_agent.config.keys import (
     config_sections,
     parse_value,
 )
+from simoun_agent.config.rules import show
 from simoun_agent.study.selection import SELECTION_RULES
 from simoun_agent.study.toml_lines import key_line
-from simoun_agent.sweep.grid import parse_seeds, show
+from simoun_agent.sweep.grid import parse_seeds
 
 try:
     import tomllib

@@ -24,8 +24,9 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, resolve
-from simoun_agent.config.envs import dmc_task
+from simoun_agent.config.envs import env_label
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
+from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 
 SWEEP_FILE = "sweep.json"
@@ -120,23 +121,9 @@ def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
     return grid
 
 
-def show(value: Any) -> str:
-    """A value as written on the command line: true/false, none, compact JSON, numbers as is."""
-    if isinstance(value, bool) or value is None:
-        return json.dumps(value).replace("null", "none")
-    if isinstance(value, (dict, list, tuple)):
-        return json.dumps(value, separators=(",", ":"))
-    return str(value)
-
-
 def path_part(text: str) -> str:
     """A safe directory name: env ids and values keep letters, digits and ``.=,+-_``."""
     return re.sub(r"[^A-Za-z0-9.=,+_-]", "-", text)
-
-
-def env_label(env_id: str) -> str:
-    """``dm_control/cartpole-swingup-v0`` -> ``cartpole-swingup``; others with ``/`` as ``-``."""
-    return dmc_task(env_id) or env_id.replace("/", "-")
 
 
 @dataclass(frozen=True)

@@ -48,12 +48,14 @@ import numpy as np
 
 from simoun_agent import stats
 from simoun_agent.config import SetupError, from_dict, to_dict
-from simoun_agent.config.keys import config_sections
+from simoun_agent.config.envs import env_label
+from simoun_agent.config.resolve import flatten
+from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
-from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE, env_label, show
+from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE
 from simoun_agent.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
@@ -127,19 +129,6 @@ class RunRecord:
         """The run directory relative to the report's root (its name when it is the root)."""
         relative = self.run_dir.relative_to(root).as_posix()
         return self.run_dir.name if relative == "." else relative
-
-
-def flatten(nested: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """``{"agent": {"lr": 1}}`` -> ``{"agent.lr": 1}``: config sections are walked, any other
-    dict (``env_kwargs``) stays one value, as on the command line."""
-    sections = config_sections()
-    flat: dict[str, Any] = {}
-    for key, value in nested.items():
-        if isinstance(value, dict) and f"{prefix}{key}." in sections:
-            flat.update(flatten(value, f"{prefix}{key}."))
-        else:
-            flat[prefix + key] = value
-    return flat
 
 
 def with_defaults(saved: dict[str, Any]) -> dict[str, Any]:

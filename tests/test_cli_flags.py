@@ -1,0 +1,71 @@
+"""The config flags as tyro reads them (issue 18): the overrides are the keys the command line
+names, whatever their value; switches, lists, dicts and none in every spelling; help shows the
+named preset's values as defaults."""
+
+import pytest
+
+from simoun_agent.cli import train as train_cli
+from simoun_agent.cli.config_flags import overrides_from
+from simoun_agent.config import SetupError, resolve
+
+
+def overrides(argv: list[str]) -> dict:
+    return overrides_from(train_cli.parse_command(argv).flags, argv)
+
+
+def test_a_value_equal_to_the_presets_still_beats_the_recipe():
+    # cpu's augmentation is shift and sac's is none: the flag names it, so it wins
+    argv = ["--preset", "cpu", "--agent.recipe", "sac", "--agent.augmentation", "shift"]
+    given = overrides(argv)
+    assert given == {"agent.recipe": "sac", "agent.augmentation": "shift"}
+    assert resolve("cpu", given).agent.augmentation == "shift"
+    assert resolve("cpu", {"agent.recipe": "sac"}).agent.augmentation == "none"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--agent.no-curiosity"],
+        ["--no-agent.curiosity"],
+        ["--agent.curiosity", "false"],
+        ["--agent.curiosity=off"],
+        ["--set", "agent.curiosity=no"],
+    ],
+)
+def test_every_spelling_of_a_false_switch(argv):
+    assert overrides(argv) == {"agent.curiosity": False}
+
+
+def test_lists_dicts_and_none():
+    argv = ["--eval-distraction", "video_hard,color_hard", "--eval-distraction", "color_easy"]
+    argv += ["--env-kwargs", '{"a": {"b": 1}}', "--action-repeat", "none", "--seed", "1"]
+    assert overrides(argv) == {
+        "eval_distraction": ("video_hard", "color_hard", "color_easy"),
+        "env_kwargs": {"a": {"b": 1}},
+        "action_repeat": None,
+        "seed": 1,  # the default's value, given: an override
+    }
+
+
+def test_nothing_given_is_no_override():
+    assert overrides(["--preset", "cpu"]) == {}
+
+
+def test_help_shows_the_named_presets_values(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(["--preset", "cpu", "--help"])
+    assert exit_info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "transitions per gradient step (default: 64)" in text  # the dataclass default is 512
+
+
+def test_an_unknown_preset_is_refused_before_parsing(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(["--preset", "cpuu"])
+    assert exit_info.value.code == 2
+    assert "simoun-train: error: unknown preset 'cpuu'; choose one of" in capsys.readouterr().err
+
+
+def test_an_unknown_set_key_is_refused_with_the_close_match():
+    with pytest.raises(SetupError, match=r"unknown config key gamma \(did you mean agent.discount"):
+        overrides(["--set", "gamma=0.9"])
