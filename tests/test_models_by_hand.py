@@ -17,6 +17,7 @@ from torch import nn
 
 from simoun_agent import AgentConfig, DualPathEncoder, StructuralInteraction, make_encoder
 from simoun_agent.models.actors import DeterministicActor
+from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.models.interaction import resize_bilinear, resized_linear, structure_mask
 from simoun_agent.models.networks import RewardModel, TransitionModel
 from simoun_agent.models.sac import Actor, Critic
@@ -133,6 +134,17 @@ def test_make_encoder_builds_the_dual_encoders_from_every_config_value():
         else:
             for conv in (encoder.interaction.reduce_appearance, encoder.interaction.reduce_motion):
                 assert conv.kernel_size == (2, 2) and conv.stride == (2, 2)
+
+
+def test_every_encoder_takes_its_conv_memory_format_from_the_config():
+    for name in ENCODERS:
+        for channels_last in (True, False):
+            config = AgentConfig(
+                encoder=name, curiosity=False, channels_last=channels_last, num_filters=4
+            )
+            encoder = make_encoder(config, FRAME)
+            layout = torch.channels_last if channels_last else torch.contiguous_format
+            assert encoder.memory_format == layout, (name, channels_last)
 
 
 @pytest.mark.parametrize("detach", [True, False, None])  # None: the default
