@@ -41,10 +41,11 @@ class FrameReplay:
     reset padding of ``simoun_wrappers.FrameTriplet`` (the first frame of an episode repeated),
     so nothing is stored twice: about one frame per transition instead of CURL's two stacks.
 
-    The ring holds ``capacity + capacity // 50 + num_frames`` frames so that ``capacity``
-    transitions fit along with the reset frames of episodes of 50 steps or more. Sampling
-    (uniform, with replacement) uses the buffer's own ``numpy.random.Generator``, which
-    :meth:`save` stores, so a reloaded buffer samples exactly what the original would have.
+    The ring holds ``capacity + ceil((capacity - 1) / 50) + num_frames`` frames so that
+    ``capacity`` transitions fit along with the reset frames of episodes of 50 steps or more
+    (for ``num_frames`` < 50). Sampling (uniform, with replacement) uses the buffer's own
+    ``numpy.random.Generator``, which :meth:`save` stores, so a reloaded buffer samples exactly
+    what the original would have.
 
     Example:
         >>> import numpy as np
@@ -71,14 +72,10 @@ class FrameReplay:
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
         self.num_frames = int(num_frames)
-        self.slots = self.capacity + self.capacity // 50 + self.num_frames
-        self.frames = np.zeros((self.slots, *self.frame_shape), np.uint8)
-        self.actions = np.zeros((self.slots, self.action_dim), np.float32)
-        self.rewards = np.zeros(self.slots, np.float32)
-        self.terminated = np.zeros(self.slots, bool)
-        self.truncated = np.zeros(self.slots, bool)
-        self.steps = np.zeros(self.slots, np.uint8)
-        """position of each frame in its episode (0 = reset frame), saturating at 255"""
+        # episodes of 50 steps put one reset frame in every 51 frames: (capacity + 48) // 50
+        # slots for them leave capacity transitions with whole windows, beside the num_frames
+        # oldest frames whose windows lost their first frames
+        self._allocate(self.capacity + (self.capacity + 48) // 50 + self.num_frames)
         self.written = 0
         """frames written since creation; absolute index of the next frame"""
         self.transitions = 0
@@ -87,6 +84,17 @@ class FrameReplay:
         self.episode_step: int | None = None
         """step of the open episode, None between an episode's end and the next start_episode"""
         self.rng = np.random.default_rng(seed)
+
+    def _allocate(self, slots: int) -> None:
+        """Empty arrays for a ring of ``slots`` frames."""
+        self.slots = slots
+        self.frames = np.zeros((slots, *self.frame_shape), np.uint8)
+        self.actions = np.zeros((slots, self.action_dim), np.float32)
+        self.rewards = np.zeros(slots, np.float32)
+        self.terminated = np.zeros(slots, bool)
+        self.truncated = np.zeros(slots, bool)
+        self.steps = np.zeros(slots, np.uint8)
+        """position of each frame in its episode (0 = reset frame), saturating at 255"""
 
     # -- writing -------------------------------------------------------------------------------
 
@@ -278,6 +286,7 @@ class FrameReplay:
             "frame_shape": self.frame_shape,
             "action_dim": self.action_dim,
             "num_frames": self.num_frames,
+            "slots": self.slots,
             "written": self.written,
             "transitions": self.transitions,
             "episode_step": self.episode_step,
@@ -327,6 +336,13 @@ class FrameReplay:
                         f"this one with {wanted}"
                     )
             replay = cls(**built)
+            # absolute frame i sits in slot i % slots: keep the ring size the file was written
+            # with (files without "slots" predate the ceil((capacity - 1) / 50) reset frames)
+            slots = meta.get(
+                "slots", built["capacity"] + built["capacity"] // 50 + built["num_frames"]
+            )
+            if slots != replay.slots:
+                replay._allocate(slots)
             used = data["frames"].shape[0]
             for name in ("frames", "actions", "rewards", "terminated", "truncated", "steps"):
                 getattr(replay, name)[:used] = data[name]
