@@ -120,22 +120,27 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
 
 
 def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path, capsys):
-    # A replay of 8 slots passes the config checks (it is one batch) but holds 7 whole windows
-    # when the updates start: that trial raises at its first update, inside Ray.
+    # A replay of 50 transitions passes the config checks (it is one batch of 50) but, room
+    # kept for the reset frames of 50-step episodes, holds 49 whole windows of PointReach's
+    # 20-step ones at agent step 52: that trial raises there, inside Ray.
     sweep_dir = tmp_path / "failing"
-    argv = [*tiny_without("--replay-capacity"), "--grid", "replay_capacity=8,1000"]
+    tiny = [
+        "agent.batch_size=50" if a == "agent.batch_size=8" else a
+        for a in tiny_without("--replay-capacity")
+    ]
+    argv = [*tiny, "--grid", "replay_capacity=50,1000"]
     argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir)]
     assert cli.main([*argv, "--verbose", "0"]) == 1
-    bad, good = sweep_dir / "replay_capacity=8", sweep_dir / "replay_capacity=1000"
+    bad, good = sweep_dir / "replay_capacity=50", sweep_dir / "replay_capacity=1000"
     assert (good / "simoun-PointReach-v0/s0/summary.json").is_file()
     assert not (bad / "simoun-PointReach-v0/s0/summary.json").exists()
     error = (bad / "simoun-PointReach-v0/s0/error.txt").read_text()
-    assert "cannot sample 8 transitions" in error
+    assert "cannot sample 50 transitions: the replay holds 49" in error
     err = capsys.readouterr().err
-    assert "FAILED replay_capacity=8/simoun-PointReach-v0/s0" in err
+    assert "FAILED replay_capacity=50/simoun-PointReach-v0/s0" in err
     assert "--resume" in err
     assert [(row["variant"], row["n"]) for row in report_rows(sweep_dir)] == [
-        ("replay_capacity=8", "0"),
+        ("replay_capacity=50", "0"),
         ("replay_capacity=1000", "1"),
     ]
     assert "## Failed runs" in (sweep_dir / "report.md").read_text()
