@@ -388,6 +388,26 @@ def test_recipe_is_saved_and_reloaded_with_the_run(tmp_path):
     run.eval_env.close()
 
 
+@pytest.mark.parametrize(
+    ("name", "changed"),
+    [
+        ("simoun_no_curiosity", {"curiosity": False}),
+        ("simoun_no_interaction", {"encoder": "dual"}),
+        (
+            "simoun_no_aux",
+            {"transition_weight": 0.0, "contrastive_weight": 0.0, "reward_weight": 0.0},
+        ),
+    ],
+)
+def test_each_simoun_ablation_differs_from_simoun_in_its_part_alone(name, changed):
+    simoun = to_dict(resolve("cpu", {"agent.recipe": "simoun"}))["agent"]
+    ablation = to_dict(resolve("cpu", {"agent.recipe": name}))["agent"]
+    differing = {key for key in simoun if simoun[key] != ablation[key]}
+    assert differing == set(changed) | {"recipe"}
+    assert {key: ablation[key] for key in changed} == changed
+    assert simoun["n_step"] == ablation["n_step"] == 3 and ablation["augmentation"] == "shift"
+
+
 def test_unknown_recipe_suggests_the_close_one():
     with pytest.raises(SetupError, match=r"--agent.recipe 'dqr' \(did you mean 'drq'\?\)"):
         resolve(None, {"agent.recipe": "dqr"})

@@ -74,11 +74,33 @@ def _encoder_ablation(encoder: str, what: str) -> Recipe:
     )
 
 
+SIMOUN = {"encoder": "dual_interactive", **SIMOUN_LOSSES, "curiosity": True}
+"""The paper's model."""
+
+SIMOUN_PARTS = {
+    "curiosity": {"curiosity": False},
+    "interaction": {"encoder": "dual"},
+    "aux": {"transition_weight": 0.0, "contrastive_weight": 0.0, "reward_weight": 0.0},
+}
+"""Each part of Simoun that the ``simoun_no_<part>`` ablations remove, as the values that
+remove it: the intrinsic reward (Eq. 13), the interactive module (Eq. 5-8), the auxiliary
+losses L_tran, L_con and L_re (Eq. 2, 3, 7)."""
+
+
+def _simoun_without(part: str) -> Recipe:
+    return Recipe(
+        f"Simoun with one part removed, the rest as 'simoun': no {part} "
+        f"({', '.join(f'{key}={value}' for key, value in SIMOUN_PARTS[part].items())})",
+        {**SIMOUN, **SIMOUN_PARTS[part]},
+    )
+
+
 RECIPES: dict[str, Recipe] = {
     "simoun": Recipe(
         "the paper's model: dual path + interactive module, L_tran + L_con + L_re, curiosity",
-        {"encoder": "dual_interactive", **SIMOUN_LOSSES, "curiosity": True},
+        SIMOUN,
     ),
+    **{f"simoun_no_{part}": _simoun_without(part) for part in SIMOUN_PARTS},
     "drq": Recipe(
         "DrQ (Kostrikov, Yarats & Fergus 2021): SAC on stacked frames with random shift, the TD "
         "target averaged over K=2 and the critic loss over M=2 augmented views, the next state "
