@@ -75,12 +75,13 @@ PRESETS["highway"] = Preset(
     envs="highway",
 )
 CPU_PRESET_TIME = (
-    "about 30 min alone on 2 cores, 40-55 min beside a second run (measured 2026-11-29/30, "
-    "before per-step n-step curiosity made an update 1.31x slower)"
+    "about 33 CPU-minutes of one thread, 52-81 min wall beside a second run on 2 loaded cores "
+    "(measured 2026-12-02)"
 )
-"""Wall time of one cpu-preset run (a reviewer's seed-1 run alone: 1,804 s; the README's three
-main-job runs: 39, 39 and 56 min, two side by side): the one figure the help text and the README
-quote; update both together."""
+"""Time of one cpu-preset run: the dmc100k study's 5 evaluation seeds on cartpole-swingup
+(docs/main-job), 1,916-1,997 s of CPU time each where a run went in one part, 3,101-4,858 s
+wall at a load average of 5-8: the one figure the help text and the README quote; update both
+together."""
 
 PRESETS["cpu"] = Preset(
     description=f"sized for 2 CPU cores (the main job, {CPU_PRESET_TIME}): "
