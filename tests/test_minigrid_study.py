@@ -5,15 +5,19 @@ import csv
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 from gymnasium.vector import AutoresetMode
 
+from simoun_agent.minigrid_study.checkpoint import CHECKPOINT, restore
 from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
-from simoun_agent.minigrid_study.spec import StudySpec, load_spec
+from simoun_agent.minigrid_study.run import set_up, train_run
+from simoun_agent.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
 
 TINY = {
     "tasks": [{"env_id": "MiniGrid-DoorKey-5x5-v0", "steps": 2048, "seeds": [0]}],
@@ -108,3 +112,57 @@ def test_sb3_vec_env_gives_the_ending_step_its_own_info():
     venv.close()
     with pytest.raises(ValueError, match=r"AutoresetMode\.SAME_STEP"):
         SB3VecEnv(gym.vector.SyncVectorEnv([lambda: minigrid_pixels("MiniGrid-Empty-5x5-v0")]))
+
+
+def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
+    """A run killed after its first checkpoint is resumed from it: the learner, the RNGs and the
+    intrinsic model come back as saved, and the records go on without a gap or a repeat."""
+    spec = spec_from_dict(
+        {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 4096}], "evaluations": 4}, "test"
+    )
+    (run,) = [r for r in spec.runs() if r.arm == "consistency"]
+    run_dir = tmp_path / "run"
+    code = (
+        "import sys, json; from pathlib import Path\n"
+        "from simoun_agent.minigrid_study.spec import spec_from_dict\n"
+        "from simoun_agent.minigrid_study.run import train_run\n"
+        "spec = spec_from_dict(json.loads(sys.argv[1]), 'test')\n"
+        "run = [r for r in spec.runs() if r.arm == 'consistency'][0]\n"
+        "train_run(spec, run, Path(sys.argv[2]))\n"
+    )
+    process = subprocess.Popen([sys.executable, "-c", code, json.dumps(spec.to_json()), run_dir])
+    deadline = time.monotonic() + 600  # generous: the suite may share a loaded machine
+    while not (run_dir / CHECKPOINT).is_file():
+        assert process.poll() is None and time.monotonic() < deadline
+        time.sleep(0.02)
+    process.kill()
+    process.wait()
+    assert not (run_dir / "summary.json").exists()
+    saved = torch.load(run_dir / CHECKPOINT, weights_only=False)
+    assert saved["env_step"] == 1024  # the first rollout after the evaluation at 1024
+
+    training = set_up(spec, run, tmp_path / "probe")
+    fresh = {k: v.clone() for k, v in training.ppo.policy.state_dict().items()}
+    assert restore(run_dir / CHECKPOINT, training) == 1024
+    policy = training.ppo.policy.state_dict()
+    assert any(not torch.equal(fresh[k], policy[k]) for k in fresh)  # trained weights came back
+    assert all(torch.equal(policy[k], saved["policy"][k]) for k in policy)
+    assert training.ppo.num_timesteps == 1024 and training.ppo._n_updates == 1
+    assert torch.equal(torch.get_rng_state(), saved["rng"]["torch"])
+    env_rng = [g.bit_generator.state for g in training.timed.get_attr("np_random")]
+    assert env_rng == saved["env_rng"]
+    model = training.envs.curiosity.source
+    assert model.updates == saved["intrinsic"]["model"]["updates"] > 0
+    assert [r["env_step"] for r in training.log.eval_rows] == [0, 1024]
+    training.close()
+
+    summary = train_run(spec, run, run_dir)
+    assert summary["env_steps"] == 4096
+    assert [p["env_step_start"] for p in summary["parts"]] == [0, 1024]
+    evals = rows(run_dir / "eval.csv")
+    assert [int(r["env_step"]) for r in evals] == [0, 1024, 2048, 3072, 4096]
+    walls = [float(r["wall_s"]) for r in evals]
+    assert walls == sorted(walls)  # training time counts on from the saved seconds
+    train = rows(run_dir / "train.csv")
+    assert [int(float(r["env_step"])) for r in train] == [1024, 2048, 3072, 4096]
+    assert not (run_dir / CHECKPOINT).exists()

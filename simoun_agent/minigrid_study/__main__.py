@@ -49,7 +49,8 @@ class Run(Report):
     """Train every unfinished run."""
 
     work_dir: Path = Path("runs/minigrid_study")
-    """Ray Tune's records and the runs in progress"""
+    """Ray Tune's records and the run directories (a run in progress keeps its checkpoint
+    there, and a rerun goes on from it)"""
     address: str | None = None
     """a Ray cluster (auto, HOST:PORT); None: local"""
     concurrent: int = 2

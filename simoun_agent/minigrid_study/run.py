@@ -13,6 +13,8 @@ import csv
 import json
 import time
 from collections import Counter
+from dataclasses import dataclass
+from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
@@ -22,12 +24,22 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback, CallbackList
 
 from simoun_agent.minigrid_study.arms import ARMS
+from simoun_agent.minigrid_study.checkpoint import CHECKPOINT, RunCheckpoint, restore
 from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
 from simoun_agent.minigrid_study.spec import Run, StudySpec
 from simoun_agent.minigrid_study.timing import RolloutClock, TimedVecEnv
 from simoun_agent.run.checkpoint import atomic_write
 
-__all__ = ["EVAL_CSV", "RUN_FILES", "SUMMARY", "TRAIN_CSV", "evaluate", "train_run"]
+__all__ = [
+    "EVAL_CSV",
+    "RUN_FILES",
+    "SUMMARY",
+    "TRAIN_CSV",
+    "Training",
+    "evaluate",
+    "set_up",
+    "train_run",
+]
 
 EVAL_CSV, TRAIN_CSV, CONFIG, SUMMARY = "eval.csv", "train.csv", "config.json", "summary.json"
 RUN_FILES = (CONFIG, EVAL_CSV, TRAIN_CSV, SUMMARY)
@@ -73,6 +85,10 @@ class StudyLog(BaseCallback):
         self.eval_s = 0.0
         """seconds spent evaluating, left out of the training wall time"""
         self._rollout_eval_s = 0.0
+        self._resumed_wall_s: float | None = None
+        """training seconds of the earlier parts of a resumed run (None: a fresh start)"""
+        self.parts: list[dict[str, Any]] = []
+        """when each part of the run started and from which env step (more than one: resumed)"""
         self.visits: Counter[tuple[int, ...]] = Counter()
         self.eval_rows: list[dict[str, float]] = []
         self.rollout_rows: list[dict[str, float]] = []
@@ -87,8 +103,32 @@ class StudyLog(BaseCallback):
         self._episodes: list[tuple[float, float, bool]] = []
 
     def training_wall_s(self) -> float:
-        """Seconds since training started, evaluations left out."""
+        """Seconds since training started, evaluations left out (earlier parts of a resumed run
+        included)."""
         return time.perf_counter() - self.start - self.eval_s
+
+    def state(self) -> dict[str, Any]:
+        """The records so far, for a checkpoint taken between rollouts."""
+        return {
+            "eval_rows": self.eval_rows,
+            "rollout_rows": self.rollout_rows,
+            "clock_rows": self.clock.rows,
+            "visits": list(self.visits.items()),
+            "next_eval": self.next_eval,
+            "eval_s": self.eval_s,
+            "training_wall_s": self.training_wall_s(),
+            "parts": self.parts,
+        }
+
+    def load(self, state: dict[str, Any]) -> None:
+        """Go on from :meth:`state`: training time counts on from the saved seconds, and
+        training starts without the evaluation at step 0."""
+        self.eval_rows, self.rollout_rows = state["eval_rows"], state["rollout_rows"]
+        self.clock.rows = state["clock_rows"]
+        self.visits = Counter({tuple(key): count for key, count in state["visits"]})
+        self.next_eval, self.eval_s = state["next_eval"], state["eval_s"]
+        self._resumed_wall_s = state["training_wall_s"]
+        self.parts = state["parts"]
 
     def evaluate_now(self) -> None:
         """Evaluate the policy now and add a row to ``eval_rows``."""
@@ -100,6 +140,9 @@ class StudyLog(BaseCallback):
         self._rollout_eval_s += spent
 
     def _on_training_start(self) -> None:
+        if self._resumed_wall_s is not None:
+            self.start = time.perf_counter() - self._resumed_wall_s - self.eval_s
+            return
         self.start = time.perf_counter()
         self.evaluate_now()
         self.next_eval = self.interval
@@ -170,15 +213,32 @@ def write_json(path: Path, value: Any) -> None:
     atomic_write(path, lambda tmp: tmp.write_text(json.dumps(value, indent=2) + "\n"))
 
 
-def train_run(
-    spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None
-) -> dict[str, Any]:
-    """Train and evaluate ``run``, writing its files into ``run_dir``; returns the summary.
+@dataclass
+class Training:
+    """A run set up to train: its envs, PPO learner and callbacks."""
 
-    One ``SeedSequence(seed)`` spawns the training envs', PPO's and the intrinsic model's seeds,
-    so two seeds share no stream; the evaluation episodes use the spec's fixed env seeds.
-    ``commit`` (the code's git commit) is recorded in ``config.json``.
-    """
+    envs: Any
+    """the training vector env, with the arm's intrinsic-reward wrapper (if any)"""
+    timed: TimedVecEnv
+    """the SB3 view of ``envs`` PPO steps, timing its steps"""
+    eval_envs: SB3VecEnv
+    """one sub-env per evaluation episode"""
+    ppo: PPO
+    clock: RolloutClock
+    log: StudyLog
+    env_seed: int
+    """seeds the training envs on a fresh start"""
+
+    def close(self) -> None:
+        self.timed.close()
+        self.eval_envs.close()
+
+
+def set_up(spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None) -> Training:
+    """Build ``run``'s envs and learner and write its ``config.json``. One
+    ``SeedSequence(seed)`` spawns the training envs', PPO's and the intrinsic model's seeds, so
+    two seeds share no stream; the evaluation episodes use the spec's fixed env seeds.
+    ``commit`` (the code's git commit) is recorded in ``config.json``."""
     run_dir.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)
     env_seed, ppo_seed, model_seed = (
@@ -190,20 +250,42 @@ def train_run(
     write_json(run_dir / CONFIG, config)
     envs = ARMS[run.arm](pixel_vector_env(run.task.env_id, spec.ppo.n_envs), model_seed, device)
     timed = TimedVecEnv(SB3VecEnv(envs))
-    timed.seed(env_seed)
     eval_envs = SB3VecEnv(pixel_vector_env(run.task.env_id, spec.eval_episodes))
     ppo = PPO("CnnPolicy", timed, seed=ppo_seed, device=device, **spec.ppo.kwargs())
     clock = RolloutClock(timed)
     log = StudyLog(spec, run, eval_envs, clock)
-    start = time.perf_counter()
+    return Training(envs, timed, eval_envs, ppo, clock, log, env_seed)
+
+
+def train_run(
+    spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None
+) -> dict[str, Any]:
+    """Train and evaluate ``run`` (set up by :func:`set_up`), writing its files into
+    ``run_dir``; returns the summary. A ``checkpoint.pt`` left in ``run_dir`` by an ended
+    process is gone on from (:mod:`~simoun_agent.minigrid_study.checkpoint`); the finished run
+    removes it."""
+    training = set_up(spec, run, run_dir, commit)
+    ppo, clock, log = training.ppo, training.clock, training.log
+    checkpoint_path = run_dir / CHECKPOINT
+    part = {"started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+    if checkpoint_path.is_file():
+        part["env_step_start"] = restore(checkpoint_path, training)
+    else:
+        training.timed.seed(training.env_seed)
+        part["env_step_start"] = 0
+    log.parts.append(part)
+    checkpoint = RunCheckpoint(checkpoint_path, training)
     try:
-        ppo.learn(run.task.steps, callback=CallbackList([clock, log]))
+        ppo.learn(
+            run.task.steps - ppo.num_timesteps,
+            callback=CallbackList([clock, log, checkpoint]),
+            reset_num_timesteps=False,
+        )
         if log.eval_rows[-1]["env_step"] < ppo.num_timesteps:
             log.evaluate_now()  # after the last update
     finally:
-        timed.close()
-        eval_envs.close()
-    wall = time.perf_counter() - start
+        training.close()
+    training_wall = log.training_wall_s()
     rows = [
         {**rollout, **times} for rollout, times in zip(log.rollout_rows, clock.rows, strict=True)
     ]
@@ -213,13 +295,15 @@ def train_run(
     summary = {
         "run": run.name,
         "env_steps": ppo.num_timesteps,
-        "wall_s": wall,
-        "training_wall_s": wall - log.eval_s,
-        "steps_per_s": ppo.num_timesteps / (wall - log.eval_s),
+        "wall_s": training_wall + log.eval_s,
+        "training_wall_s": training_wall,
+        "steps_per_s": ppo.num_timesteps / training_wall,
         "env_s": sum(r["env_s"] for r in clock.rows),
         "update_s": sum(r.get("update_s", 0.0) for r in clock.rows),
         "final_success_rate": final["success_rate"],
         "final_return_mean": final["return_mean"],
+        "parts": log.parts,
     }
     write_json(run_dir / SUMMARY, summary)
+    checkpoint_path.unlink(missing_ok=True)
     return summary

@@ -1,10 +1,12 @@
 """The study on Ray Tune: every unfinished run as a trial, two at a time, one torch thread each,
 each finished run's files copied into the archive as its trial reports them.
 
-Resuming is by run: a run whose ``summary.json`` is in the archive is finished and skipped; one
-interrupted mid-way starts again from scratch. The files travel in the trial's result (not
-through a shared disk), so trials on the machines of a Ray cluster (``--address``) archive on
-the machine that runs the study.
+Resuming: a run whose ``summary.json`` is in the archive is finished and skipped; one ended
+mid-way goes on from its last checkpoint (:mod:`~simoun_agent.minigrid_study.checkpoint`) when
+its run directory, ``<work_dir>/runs/<task>/<arm>/s<seed>``, is still there, and starts again
+from scratch when it is not. The files travel in the trial's result (not through a shared
+disk), so trials on the machines of a Ray cluster (``--address``) archive on the machine that
+runs the study (a run resumes there only on a node that holds its run directory).
 """
 
 from __future__ import annotations
@@ -25,6 +27,9 @@ __all__ = ["SPEC_FILE", "finished_runs", "run_study"]
 
 SPEC_FILE = "spec.json"
 """the spec the archive's runs were trained with"""
+
+RUNS_DIR = "runs"
+"""the run directories under the work directory, kept across invocations for resuming"""
 
 
 def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
@@ -50,14 +55,19 @@ def record_spec(spec: StudySpec, archive: Path) -> None:
     atomic_write(path, lambda tmp: tmp.write_text(json.dumps(wanted, indent=2) + "\n"))
 
 
-def trainable(config: dict[str, Any], spec: dict[str, Any], commit: str | None) -> None:
-    """One Tune trial: train the run ``config["run"]`` and report its files."""
+def trainable(
+    config: dict[str, Any], spec: dict[str, Any], commit: str | None, work_dir: str
+) -> None:
+    """One Tune trial: train the run ``config["run"]`` in its run directory under ``work_dir``
+    (from its checkpoint, if an earlier trial left one; not again if it finished there) and
+    report its files."""
     from ray import tune
 
     study = spec_from_dict(spec, "the study's spec")
     run = {r.name: r for r in study.runs()}[config["run"]]
-    run_dir = Path(tune.get_context().get_trial_dir()) / "run"
-    train_run(study, run, run_dir, commit=commit)
+    run_dir = Path(work_dir) / RUNS_DIR / run.name
+    if not (run_dir / SUMMARY).is_file():
+        train_run(study, run, run_dir, commit=commit)
     files = {name: (run_dir / name).read_text() for name in RUN_FILES}
     tune.report({"finished": 1, "files_json": json.dumps(files)})
 
@@ -111,7 +121,10 @@ def run_study(
         tuner = tune.Tuner(
             tune.with_resources(
                 tune.with_parameters(
-                    trainable, spec=spec.to_json(), commit=code_version()["commit"]
+                    trainable,
+                    spec=spec.to_json(),
+                    commit=code_version()["commit"],
+                    work_dir=str(work_dir.resolve()),
                 ),
                 {"cpu": 1},
             ),

@@ -1,0 +1,109 @@
+"""Mid-run checkpoints of a study run, so that a run whose process was ended (a session's end, a
+preempted cluster node) goes on from its last checkpoint instead of from scratch.
+
+A checkpoint is written atomically at the first rollout after each evaluation (after PPO's
+update, with an empty rollout buffer). It holds PPO's policy and optimizer and its step and
+update counters; the global torch, numpy and Python RNG states (PPO samples its actions from
+torch's, its minibatches from numpy's); each training sub-env's RNG (the layouts of its next
+episodes); the intrinsic reward's running statistics and its model's weights, optimizer,
+counters and RNG; and the run's records so far. What a resume changes, said in the run's
+``summary.json`` (``parts``): the episodes in progress at the checkpoint start again from a
+reset, and the intrinsic model's buffer (not kept: 1,000 transitions) refills from new
+transitions before its next gradient step.
+"""
+
+from __future__ import annotations
+
+import random
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import torch
+from stable_baselines3.common.callbacks import BaseCallback
+
+from simoun_agent.run.atomic import atomic_write
+
+if TYPE_CHECKING:  # run.py imports this module to build its callbacks
+    from simoun_agent.minigrid_study.run import Training
+
+__all__ = ["CHECKPOINT", "RunCheckpoint", "intrinsic_state", "load_intrinsic_state", "restore"]
+
+CHECKPOINT = "checkpoint.pt"
+"""a run's checkpoint, in its run directory until the run has finished"""
+
+
+def intrinsic_state(envs: Any) -> dict[str, Any] | None:
+    """The intrinsic-reward wrapper's statistics and its model's state (None: no wrapper)."""
+    if not hasattr(envs, "curiosity"):
+        return None
+    return {"signal": envs.state_dict(), "model": envs.curiosity.source.state_dict()}
+
+
+def load_intrinsic_state(envs: Any, state: dict[str, Any] | None) -> None:
+    """Restore what :func:`intrinsic_state` returned into the wrapper ``envs``."""
+    if state is not None:
+        envs.load_state_dict(state["signal"])
+        envs.curiosity.source.load_state_dict(state["model"])
+
+
+class RunCheckpoint(BaseCallback):
+    """Writes ``path`` at the first rollout after each evaluation of the run ``training``
+    (a :class:`~simoun_agent.minigrid_study.run.Training`)."""
+
+    def __init__(self, path: Path, training: Training) -> None:
+        super().__init__()
+        self.path, self.training = path, training
+        self.saved_evaluations = 0
+
+    def _on_training_start(self) -> None:
+        # after the log's evaluation at step 0, which is no reason to save
+        self.saved_evaluations = len(self.training.log.eval_rows)
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_start(self) -> None:
+        if len(self.training.log.eval_rows) > self.saved_evaluations:
+            self.save()
+
+    def save(self) -> None:
+        """Write the checkpoint now (atomically: an interrupted write keeps the previous one)."""
+        training, ppo = self.training, self.training.ppo
+        state = {
+            "env_step": ppo.num_timesteps,
+            "n_updates": ppo._n_updates,
+            "policy": ppo.policy.state_dict(),
+            "optimizer": ppo.policy.optimizer.state_dict(),
+            "rng": {
+                "torch": torch.get_rng_state(),
+                # SB3 draws its minibatches from numpy's legacy global RNG
+                "numpy": np.random.get_state(),  # noqa: NPY002
+                "python": random.getstate(),
+            },
+            "env_rng": [g.bit_generator.state for g in training.timed.get_attr("np_random")],
+            "intrinsic": intrinsic_state(training.envs),
+            "log": training.log.state(),
+        }
+        atomic_write(self.path, lambda tmp: torch.save(state, tmp))
+        self.saved_evaluations = len(training.log.eval_rows)
+
+
+def restore(path: Path, training: Training) -> int:
+    """Load the checkpoint at ``path`` into ``training``, set up afresh (PPO built, envs not
+    reset); returns its env step."""
+    state = torch.load(path, weights_only=False)
+    ppo = training.ppo
+    ppo.policy.load_state_dict(state["policy"])
+    ppo.policy.optimizer.load_state_dict(state["optimizer"])
+    ppo.num_timesteps = state["env_step"]
+    ppo._n_updates = state["n_updates"]
+    torch.set_rng_state(state["rng"]["torch"])
+    np.random.set_state(state["rng"]["numpy"])  # noqa: NPY002
+    random.setstate(state["rng"]["python"])
+    generators = training.timed.get_attr("np_random")
+    for generator, saved in zip(generators, state["env_rng"], strict=True):
+        generator.bit_generator.state = saved
+    load_intrinsic_state(training.envs, state["intrinsic"])
+    training.log.load(state["log"])
+    return int(state["env_step"])
