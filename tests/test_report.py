@@ -247,8 +247,7 @@ def test_dm_control_returns_are_normalized_by_their_maximum_of_1000(tmp_path):
     """The committed main job: the dmc100k study's 5 evaluation seeds of the cpu preset on
     cartpole-swingup, real run directories."""
     main_job = (
-        Path(__file__).parent.parent
-        / "docs/studies/dmc100k/evaluation/simoun/cartpole-swingup"
+        Path(__file__).parent.parent / "docs/studies/dmc100k/evaluation/simoun/cartpole-swingup"
     )
     report.write_report(main_job, tmp_path)
     (row,) = rows_of(tmp_path)

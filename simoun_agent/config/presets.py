@@ -74,14 +74,11 @@ PRESETS["highway"] = Preset(
     },
     envs="highway",
 )
-CPU_PRESET_TIME = (
-    "about 33 CPU-minutes of one thread, 52-81 min wall beside a second run on 2 loaded cores "
-    "(measured 2026-12-02)"
-)
+CPU_PRESET_TIME = "52-81 min wall beside a second run on 2 loaded cores (measured 2026-12-02)"
 """Time of one cpu-preset run: the dmc100k study's 5 evaluation seeds on cartpole-swingup
-(docs/main-job), 1,916-1,997 s of CPU time each where a run went in one part, 3,101-4,858 s
-wall at a load average of 5-8: the one figure the help text and the README quote; update both
-together."""
+(docs/main-job), 3,101-4,858 s wall at a load average of 5-8 (1,916-1,997 s of process CPU
+time where a run went in one part): the one figure the help text and the README quote; update
+both together."""
 
 PRESETS["cpu"] = Preset(
     description=f"sized for 2 CPU cores (the main job, {CPU_PRESET_TIME}): "
