@@ -16,8 +16,9 @@ from gymnasium.vector import AutoresetMode
 
 from simoun_agent.minigrid_study.checkpoint import CHECKPOINT, restore
 from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
-from simoun_agent.minigrid_study.run import set_up, train_run
+from simoun_agent.minigrid_study.run import train_run
 from simoun_agent.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
+from simoun_agent.minigrid_study.training import set_up
 
 TINY = {
     "tasks": [{"env_id": "MiniGrid-DoorKey-5x5-v0", "steps": 2048, "seeds": [0]}],

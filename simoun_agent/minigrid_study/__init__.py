@@ -10,6 +10,9 @@ Modules, each with one job: :mod:`~simoun_agent.minigrid_study.spec` (the design
 :mod:`~simoun_agent.minigrid_study.envs` (pixels, symbolic state, SB3 over a Gymnasium vector
 env), :mod:`~simoun_agent.minigrid_study.arms` (the arms' registry),
 :mod:`~simoun_agent.minigrid_study.timing` (env vs update time),
+:mod:`~simoun_agent.minigrid_study.study_log` (evaluations and per-rollout records),
+:mod:`~simoun_agent.minigrid_study.training` (a run set up to train),
+:mod:`~simoun_agent.minigrid_study.checkpoint` (mid-run resume),
 :mod:`~simoun_agent.minigrid_study.run` (one run), :mod:`~simoun_agent.minigrid_study.tune`
 (the runs on Ray Tune) and :mod:`~simoun_agent.minigrid_study.report`. Run it with
 ``python -m simoun_agent.minigrid_study run`` (needs the ``sb3``, ``minigrid`` and ``sweep``

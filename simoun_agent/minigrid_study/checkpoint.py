@@ -16,16 +16,14 @@ from __future__ import annotations
 
 import random
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
+from simoun_agent.minigrid_study.training import Training
 from simoun_agent.run.atomic import atomic_write
-
-if TYPE_CHECKING:  # run.py imports this module to build its callbacks
-    from simoun_agent.minigrid_study.run import Training
 
 __all__ = ["CHECKPOINT", "RunCheckpoint", "intrinsic_state", "load_intrinsic_state", "restore"]
 
@@ -49,7 +47,7 @@ def load_intrinsic_state(envs: Any, state: dict[str, Any] | None) -> None:
 
 class RunCheckpoint(BaseCallback):
     """Writes ``path`` at the first rollout after each evaluation of the run ``training``
-    (a :class:`~simoun_agent.minigrid_study.run.Training`)."""
+    (a :class:`~simoun_agent.minigrid_study.training.Training`)."""
 
     def __init__(self, path: Path, training: Training) -> None:
         super().__init__()
