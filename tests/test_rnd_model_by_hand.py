@@ -21,7 +21,7 @@ def model_of(**overrides) -> RNDModel:
         learning_starts=4,
         update_every=10_000,
         background=False,
-        lr=1e-3,
+        lr=5e-4,
         seed=0,
     )
     return RNDModel(SHAPE, config=RNDConfig(**{**config, **overrides}), device="cpu")
@@ -74,6 +74,21 @@ def test_the_networks_are_the_papers():
     assert target(torch.zeros(2, 3, 36, 36)).shape == predictor(torch.zeros(2, 3, 36, 36)).shape
 
 
+def test_the_model_builds_a_fixed_target_and_a_deeper_trained_predictor():
+    model = model_of()
+    linear_layers = [
+        sum(isinstance(m, nn.Linear) for m in net.modules())
+        for net in (model.target, model.predictor)
+    ]
+    assert linear_layers == [1, 3]
+    assert not any(p.requires_grad for p in model.target.parameters())
+    assert all(p.requires_grad for p in model.predictor.parameters())
+    group = model.optimizer.param_groups[0]
+    assert group["lr"] == 5e-4  # the config's rate (Adam's default is 1e-3)
+    assert {id(p) for p in group["params"]} == {id(p) for p in model.predictor.parameters()}
+    assert model._frames.dtype == np.uint8 and model._frames.shape == (8, *SHAPE)
+
+
 def test_the_error_is_the_squared_distance_on_the_newest_normalized_frame():
     rng = np.random.default_rng(0)
     model = model_of()
@@ -124,7 +139,7 @@ def test_the_loss_is_the_mean_squared_error_against_the_fixed_target():
 
 def test_updates_train_the_predictor_on_the_frames_reached_and_leave_the_target():
     rng = np.random.default_rng(2)
-    model = model_of(capacity=4)
+    model = model_of(capacity=4, lr=1e-3)
     reached = triplets_of(rng, 4)
     watch(model, triplets_of(rng, 4), reached)
     np.testing.assert_array_equal(model._frames, reached[:, -1])  # the reached, newest
@@ -143,6 +158,27 @@ def test_updates_train_the_predictor_on_the_frames_reached_and_leave_the_target(
     with torch.no_grad():
         expected = ((model.predictor(x) - model.target(x)) ** 2).mean(-1).numpy()
     np.testing.assert_allclose(model(reached), expected, rtol=1e-5)
+
+
+def test_a_loaded_state_goes_on_as_the_saved_model_does():
+    rng = np.random.default_rng(4)
+    model = model_of()
+    watch(model, triplets_of(rng, 4), triplets_of(rng, 4))
+    model.update()
+    clone = model_of(seed=1)
+    clone.load_state_dict(model.state_dict())
+    more, scored = triplets_of(rng, 3), triplets_of(rng, 2)
+    for each in (model, clone):  # both watch the same frames after the load
+        watch(each, more, more)
+    np.testing.assert_array_equal(clone.observations.mean, model.observations.mean)
+    np.testing.assert_array_equal(clone.observations.var, model.observations.var)
+    assert clone.observations.count == model.observations.count == 7
+    np.testing.assert_array_equal(clone(scored), model(scored))
+
+
+def test_bad_feature_dim_is_refused():
+    with pytest.raises(ValueError, match="feature_dim"):
+        RNDConfig(feature_dim=0)
 
 
 def test_frames_are_pooled_to_the_encoder_size_before_both_networks():

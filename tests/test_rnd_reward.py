@@ -62,7 +62,7 @@ def test_predictor_error_falls_on_seen_frames_and_stays_high_on_unseen_ones():
 
 def test_reward_is_the_error_over_its_running_std_after_the_warm_up():
     source = Brightness()
-    env = RNDReward(pixels(), source, scale=0.3, warmup=6)
+    env = RNDReward(pixels(), source, scale=0.3, warmup=7)
     env.reset(seed=0)
     errors, intrinsic = [], []
     for t in range(14):
@@ -70,14 +70,45 @@ def test_reward_is_the_error_over_its_running_std_after_the_warm_up():
         errors.append(source(obs["frames"][None])[0])
         intrinsic.append(info["reward_intrinsic"])
         assert reward == pytest.approx(info["reward_extrinsic"] + info["reward_intrinsic"])
-    assert intrinsic[:6] == [0.0] * 6  # the warm-up gives no reward
-    for t in range(6, 14):
-        counted = np.array(errors[3 : t + 1])  # the second half of the warm-up on
+    assert intrinsic[:7] == [0.0] * 7  # the warm-up gives no reward
+    for t in range(7, 14):
+        counted = np.array(errors[3 : t + 1])  # from warmup // 2 = 3 on
         expected = 0.3 * errors[t] / np.sqrt(counted.var() + 1e-8)
         assert intrinsic[t] == pytest.approx(expected, rel=1e-6)
     assert env.state_dict()["scored"] == 14
     assert env.state_dict()["error_mean"] == pytest.approx(np.mean(errors[3:]), rel=1e-9)
     assert len(source.watched) == 14
+
+
+def test_each_sub_env_counts_towards_the_warm_up_in_order():
+    envs = RNDVectorReward(make_vec(2, AutoresetMode.NEXT_STEP), Brightness(), warmup=3)
+    envs.reset(seed=[0, 1])
+    first = envs.step(np.array([0, 1]))[4]["reward_intrinsic"]  # transitions 0, 1
+    second = envs.step(np.array([0, 1]))[4]["reward_intrinsic"]  # transitions 2, 3
+    assert np.all(first == 0.0)
+    assert second[0] == 0.0 and second[1] > 0
+    envs.close()
+
+
+def test_the_error_statistics_load_into_a_new_wrapper():
+    source = Brightness()
+    env = RNDReward(pixels(), source, scale=0.3, warmup=2)
+    env.reset(seed=0)
+    for t in range(6):
+        env.step(t % 3)
+    clone = RNDReward(pixels(), source, scale=0.3, warmup=2)
+    clone.load_state_dict(env.state_dict())
+    assert clone.state_dict() == env.state_dict()
+    for each in (env, clone):
+        each.reset(seed=1)
+    for t in range(4):  # the same steps from the same statistics: the same rewards
+        assert clone.step(t % 3)[4]["reward_intrinsic"] == env.step(t % 3)[4]["reward_intrinsic"]
+    assert clone.state_dict() == env.state_dict()
+
+
+def test_the_defaults_are_the_studys():
+    env = RNDReward(pixels(), Brightness())
+    assert env.scale == 0.05 and env.curiosity.warmup == 1024
 
 
 def make_vec(num_envs: int, mode: AutoresetMode) -> gym.vector.VectorEnv:
@@ -178,18 +209,30 @@ def test_passes_check_env_and_rebuilds_from_its_spec():
 def test_bad_arguments_are_refused_with_the_fix():
     with pytest.raises(TypeError, match="SimounObservation"):
         RNDReward(gym.make("MiniGrid-Empty-5x5-v0"), Brightness())
-    with pytest.raises(TypeError, match="NoveltySource"):
+    with pytest.raises(TypeError, match=r"NoveltySource.*got str"):
         RNDReward(pixels(), novelty="rnd")
     with pytest.raises(ValueError, match=r"scale must be a finite number >= 0"):
         RNDReward(pixels(), Brightness(), scale=-1.0)
     with pytest.raises(ValueError, match=r"warmup must be an int >= 0.*warmup=1024"):
         RNDVectorReward(make_vec(1, AutoresetMode.NEXT_STEP), Brightness(), warmup=-1)
-    with pytest.raises(ValueError, match=r"RND's convolutions need H, W >= 36"):
+    with pytest.raises(ValueError, match=r"RND's convolutions need H, W >= 36.*size=42"):
         RNDModel((3, 32, 32), config=RNDConfig(encoder_size=None))
     with pytest.raises(ValueError, match=r"batch_size <= learning_starts <= capacity"):
         RNDConfig(batch_size=64, learning_starts=32)
     # a FeatureSource is callable too; its (f_m, f_a) output is named as the mistake
     env = RNDReward(pixels(), lambda triplets: (np.zeros((1, 4)), np.zeros((1, 3, 4))))
     env.reset(seed=0)
-    with pytest.raises(ValueError, match="goes with ConsistencyCuriosityReward"):
+    with pytest.raises(ValueError, match=r"function returned a tuple for 1 triplets.*goes with"):
         env.step(0)
+    for errors, problem in (
+        ([0.1, 0.2], r"returned shape \(2,\) for 1 triplets"),
+        ([-0.1], "must be finite and >= 0"),
+        ([np.nan], "must be finite and >= 0"),
+    ):
+        env = RNDReward(pixels(), lambda triplets, errors=errors: np.array(errors))
+        env.reset(seed=0)
+        with pytest.raises(ValueError, match=problem):
+            env.step(0)
+    env = RNDReward(pixels(), lambda triplets: np.zeros(len(triplets)), warmup=0)
+    env.reset(seed=0)
+    assert env.step(0)[4]["reward_intrinsic"] == 0.0  # a zero error is an error like any
