@@ -226,7 +226,7 @@ def test_bad_arguments_are_refused_with_the_fix():
         env.step(0)
     for errors, problem in (
         ([0.1, 0.2], r"returned shape \(2,\) for 1 triplets"),
-        ([-0.1], "must be finite and >= 0"),
+        ([-0.1], r"source function returned \[-0.1\]: errors must be finite and >= 0"),
         ([np.nan], "must be finite and >= 0"),
     ):
         env = RNDReward(pixels(), lambda triplets, errors=errors: np.array(errors))
