@@ -1,0 +1,167 @@
+"""The reward-wrapper mechanism both intrinsic signals share (simoun_wrappers.intrinsic_reward):
+the reward's sum, what a learning source is handed, resets with options and masks, the errors
+before a reset, close, and the triplet layouts it reads. Real envs (CartPole's pixels)."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+
+from simoun_wrappers import SimounObservation
+from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+from simoun_wrappers.intrinsic_reward import triplet_shape
+from simoun_wrappers.rnd import RNDReward, RNDVectorReward
+
+
+class Recorder:
+    """A novelty source by hand (0.5 + the newest frame's mean pixel value / 255) that records
+    every transition it is handed and whether it was closed."""
+
+    def __init__(self):
+        self.watched = []
+        self.closed = 0
+
+    def __call__(self, triplets):
+        return 0.5 + triplets[:, -1].reshape(len(triplets), -1).mean(axis=1) / 255.0
+
+    def watch(self, triplets, actions, next_triplets, terminated, truncated):
+        names = ("start", "actions", "end", "terminated", "truncated")
+        values = (triplets, actions, next_triplets, terminated, truncated)
+        self.watched.append({name: np.array(v) for name, v in zip(names, values, strict=True)})
+
+    def close(self):
+        self.closed += 1
+
+
+def cartpole() -> gym.Env:
+    return SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=16)
+
+
+def vector(mode: AutoresetMode, n: int = 2) -> SyncVectorEnv:
+    return SyncVectorEnv([cartpole for _ in range(n)], autoreset_mode=mode)
+
+
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+def test_the_vector_reward_is_the_extrinsic_plus_the_scaled_intrinsic(mode):
+    envs = RNDVectorReward(vector(mode), Recorder(), scale=0.5, warmup=0)
+    envs.reset(seed=[0, 1])
+    for t in range(4):
+        _, rewards, _, _, info = envs.step(np.array([t % 2, 1 - t % 2]))
+        np.testing.assert_array_equal(info["reward_extrinsic"], [1.0, 1.0])  # CartPole's
+        assert np.all(info["reward_intrinsic"] > 0)
+        np.testing.assert_array_equal(rewards, info["reward_extrinsic"] + info["reward_intrinsic"])
+        for key in ("_reward_extrinsic", "_reward_intrinsic"):  # Gymnasium's vector-info masks
+            assert info[key].dtype == np.bool_ and info[key].all()
+    envs.close()
+
+
+def test_the_single_reward_is_the_extrinsic_plus_the_scaled_intrinsic():
+    env = RNDReward(cartpole(), Recorder(), scale=0.5, warmup=0)
+    env.reset(seed=0)
+    _, reward, *_, info = env.step(0)
+    assert info["reward_extrinsic"] == 1.0 and info["reward_intrinsic"] > 0
+    assert reward == info["reward_extrinsic"] + info["reward_intrinsic"]
+
+
+def test_the_source_is_handed_each_transition_with_its_flags():
+    source = Recorder()
+    env = RNDReward(cartpole(), source, warmup=0)
+    obs, _ = env.reset(seed=0)
+    terminated, steps = False, 0
+    while not terminated:  # always pushing left ends the episode in a few steps
+        start = obs["frames"]
+        obs, _, terminated, truncated, _ = env.step(0)
+        steps += 1
+        watched = source.watched[-1]
+        np.testing.assert_array_equal(watched["start"], start[None])
+        np.testing.assert_array_equal(watched["end"], obs["frames"][None])
+        np.testing.assert_array_equal(watched["actions"], [0])
+        np.testing.assert_array_equal(watched["terminated"], [terminated])
+        np.testing.assert_array_equal(watched["truncated"], [truncated])
+    assert len(source.watched) == steps > 1
+
+
+def test_the_vector_source_gets_the_flags_of_the_sub_envs_it_scores():
+    source = Recorder()
+    envs = RNDVectorReward(vector(AutoresetMode.NEXT_STEP), source, warmup=0)
+    envs.reset(seed=[0, 1])
+    active, ends = np.ones(2, dtype=bool), 0
+    for t in range(40):
+        calls = len(source.watched)
+        actions = np.array([0, t % 2])  # sub-env 0 falls first, then both again and again
+        _, _, terminated, truncated, _ = envs.step(actions)
+        assert len(source.watched) == calls + active.any()
+        if active.any():  # the sub-envs not resetting this step, and their flags
+            watched = source.watched[-1]
+            np.testing.assert_array_equal(watched["actions"], actions[active])
+            np.testing.assert_array_equal(watched["terminated"], terminated[active])
+            np.testing.assert_array_equal(watched["truncated"], truncated[active])
+        ends += int(terminated.sum())
+        active = ~(terminated | truncated)
+    assert ends >= 2
+    envs.close()
+
+
+def test_reset_hands_its_options_to_the_env():
+    env = RNDReward(cartpole(), Recorder(), warmup=0)
+    env.reset(seed=0, options={"low": 0.04, "high": 0.04})
+    np.testing.assert_allclose(env.unwrapped.state, 0.04)
+
+
+def test_a_masked_reset_renews_only_the_masked_sub_envs_triplets():
+    source = Recorder()
+    envs = RNDVectorReward(vector(AutoresetMode.DISABLED), source, warmup=0)
+    envs.reset(seed=[0, 1])
+    before, *_ = envs.step(np.array([0, 1]))
+    after, _ = envs.reset(options={"reset_mask": np.array([True, False])})
+    envs.step(np.array([1, 0]))
+    start = source.watched[-1]["start"]
+    np.testing.assert_array_equal(start[0], after["frames"][0])  # sub-env 0 starts afresh
+    np.testing.assert_array_equal(start[1], before["frames"][1])  # sub-env 1 goes on
+    assert not np.array_equal(after["frames"][0], before["frames"][0])
+    envs.close()
+
+
+def test_a_step_before_reset_is_refused_and_close_closes_the_source():
+    for wrapped in (
+        RNDReward(cartpole(), Recorder()),
+        RNDVectorReward(vector(AutoresetMode.NEXT_STEP), Recorder()),
+    ):
+        action = wrapped.action_space.sample()
+        with pytest.raises(gym.error.ResetNeeded, match="Call reset"):
+            wrapped.step(action)
+        source = wrapped.curiosity.source
+        wrapped.close()
+        assert source.closed == 1
+
+
+def box(*shape: int) -> spaces.Box:
+    return spaces.Box(0, 255, shape, np.uint8)
+
+
+def test_the_triplet_layouts_read():
+    assert triplet_shape(box(3, 1, 8, 8)) == (3, 1, 8, 8)  # grayscale, one frame a row
+    assert triplet_shape(box(3, 3, 8, 8)) == (3, 3, 8, 8)
+    assert triplet_shape(box(3, 8, 8)) == (3, 1, 8, 8)  # grayscale folded
+    assert triplet_shape(box(9, 8, 8)) == (3, 3, 8, 8)  # RGB folded
+    assert triplet_shape(spaces.Dict({"frames": box(3, 3, 8, 8)})) == (3, 3, 8, 8)
+    for shape in ((6, 1, 8, 8), (4, 8, 8), (3, 8)):
+        with pytest.raises(ValueError, match="triplet of frames"):
+            triplet_shape(box(*shape))
+
+
+class Features:
+    """A feature source by hand: f_m the newest frame's mean, f_a zeros."""
+
+    def __call__(self, triplets):
+        newest = triplets[:, -1].reshape(len(triplets), -1).mean(axis=1, keepdims=True) / 255
+        return newest.astype(np.float32), np.zeros((len(triplets), 3, 1), np.float32)
+
+
+def test_the_consistency_wrapper_starts_from_its_maxima_and_defaults():
+    env = ConsistencyCuriosityReward(cartpole(), Features(), r_e_max_init=3.0, r_i_max_init=2.0)
+    assert env.state_dict() == {"step": 0, "r_e_max": 3.0, "r_i_max": 2.0}
+    env = ConsistencyCuriosityReward(cartpole(), Features())
+    assert env.scale == 0.2 and env.curiosity.decay == 2e-5
+    assert env.state_dict() == {"step": 0, "r_e_max": 1.0, "r_i_max": 1.0}
