@@ -271,15 +271,13 @@ class IntrinsicVectorReward(IntrinsicState, VectorWrapper, gym.utils.RecordConst
     def reset(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(seed=seed, options=options)
-        triplets = self._read(obs)
+        # read before the reset: Gymnasium's vector envs pop "reset_mask" from the options
         mask = None if options is None else options.get("reset_mask")
-        if mask is None or self._last_triplets is None:
-            self._last_triplets = triplets
-            self._prev_dones[:] = False
-        else:
-            self._last_triplets[mask] = triplets[mask]
-            self._prev_dones[mask] = False
+        obs, info = self.env.reset(seed=seed, options=options)
+        # a masked reset returns the other sub-envs' observations unchanged
+        self._last_triplets = self._read(obs)
+        # a sub-env left out of the mask that has just ended still autoresets on its next step
+        self._prev_dones[slice(None) if mask is None else np.asarray(mask)] = False
         return obs, info
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:

@@ -113,13 +113,28 @@ def test_a_masked_reset_renews_only_the_masked_sub_envs_triplets():
     source = Recorder()
     envs = RNDVectorReward(vector(AutoresetMode.DISABLED), source, warmup=0)
     envs.reset(seed=[0, 1])
-    before, *_ = envs.step(np.array([0, 1]))
+    for _ in range(4):  # the poles lean visibly
+        before, *_ = envs.step(np.array([0, 1]))
     after, _ = envs.reset(options={"reset_mask": np.array([True, False])})
+    assert not np.array_equal(after["frames"][0], before["frames"][0])  # sub-env 0 starts afresh
+    np.testing.assert_array_equal(after["frames"][1], before["frames"][1])  # sub-env 1 goes on
     envs.step(np.array([1, 0]))
-    start = source.watched[-1]["start"]
-    np.testing.assert_array_equal(start[0], after["frames"][0])  # sub-env 0 starts afresh
-    np.testing.assert_array_equal(start[1], before["frames"][1])  # sub-env 1 goes on
-    assert not np.array_equal(after["frames"][0], before["frames"][0])
+    np.testing.assert_array_equal(source.watched[-1]["start"], after["frames"])
+    envs.close()
+
+
+def test_a_masked_reset_leaves_the_other_sub_envs_autoreset_step_unscored():
+    source = Recorder()
+    envs = RNDVectorReward(vector(AutoresetMode.NEXT_STEP), source, warmup=0)
+    envs.reset(seed=[0, 1])
+    terminated = np.zeros(2, dtype=bool)
+    while not terminated[0]:  # sub-env 0 falls; sub-env 1, balanced by turns, does not yet
+        _, _, terminated, _, _ = envs.step(np.array([0, int(len(source.watched) % 2)]))
+    assert not terminated[1]
+    envs.reset(options={"reset_mask": np.array([False, True])})
+    _, _, _, _, info = envs.step(np.array([1, 1]))  # sub-env 0's autoreset step
+    assert info["reward_intrinsic"][0] == 0.0 and info["reward_intrinsic"][1] > 0
+    assert len(source.watched[-1]["actions"]) == 1  # only sub-env 1 was handed on
     envs.close()
 
 
