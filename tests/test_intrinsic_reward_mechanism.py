@@ -180,3 +180,30 @@ def test_the_consistency_wrapper_starts_from_its_maxima_and_defaults():
     env = ConsistencyCuriosityReward(cartpole(), Features())
     assert env.scale == 0.2 and env.curiosity.decay == 2e-5
     assert env.state_dict() == {"step": 0, "r_e_max": 1.0, "r_i_max": 1.0}
+
+
+def test_scale_zero_logs_the_intrinsic_reward_without_adding_it():
+    env = RNDReward(cartpole(), Recorder(), scale=0, warmup=0)
+    env.reset(seed=0)
+    _, reward, *_, info = env.step(0)
+    assert reward == info["reward_extrinsic"] == 1.0 and info["reward_intrinsic"] == 0.0
+    assert env.curiosity.scored == 1  # the signal still ran
+
+
+def test_the_errors_name_the_wrapper_and_the_source():
+    with pytest.raises(TypeError, match=r"RNDReward wraps a single env.*put RNDReward in each"):
+        RNDReward(vector(AutoresetMode.NEXT_STEP), Recorder())
+    with pytest.raises(gym.error.ResetNeeded, match=r"before step\(\) on RNDVectorReward"):
+        RNDVectorReward(vector(AutoresetMode.NEXT_STEP), Recorder()).step(np.array([0, 0]))
+    with pytest.raises(TypeError, match=r"FeatureSource.*got int"):
+        ConsistencyCuriosityReward(cartpole(), 42)
+
+    class Diverged(Features):
+        def __call__(self, triplets):
+            f_m, f_a = super().__call__(triplets)
+            return f_m * np.nan, f_a
+
+    env = ConsistencyCuriosityReward(cartpole(), Diverged())
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="feature source Diverged returned NaN"):
+        env.step(0)
