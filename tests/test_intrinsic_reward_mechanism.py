@@ -207,3 +207,20 @@ def test_the_errors_name_the_wrapper_and_the_source():
     env.reset(seed=0)
     with pytest.raises(ValueError, match="feature source Diverged returned NaN"):
         env.step(0)
+
+
+def test_reset_hands_its_seeds_to_the_env():
+    env = RNDReward(cartpole(), Recorder())
+    with pytest.raises(gym.error.ResetNeeded, match=r"before step\(\) on RNDReward"):
+        env.step(0)
+    envs = RNDVectorReward(vector(AutoresetMode.NEXT_STEP), Recorder())
+    plain = vector(AutoresetMode.NEXT_STEP)
+    for seed in ([3, 4], [5, 6]):
+        envs.reset(seed=seed)
+        plain.reset(seed=seed)
+        for wrapped, unwrapped in zip(envs.env.envs, plain.envs, strict=True):
+            np.testing.assert_array_equal(wrapped.unwrapped.state, unwrapped.unwrapped.state)
+    env.reset(seed=7)
+    single = cartpole()
+    single.reset(seed=7)
+    np.testing.assert_array_equal(env.unwrapped.state, single.unwrapped.state)
