@@ -25,6 +25,7 @@ CONFIG = "config.json"
 
 
 def write_json(path: Path, value: Any) -> None:
+    """Write ``value`` to ``path`` as indented JSON, atomically (the study's one JSON writer)."""
     atomic_write(path, lambda tmp: tmp.write_text(json.dumps(value, indent=2) + "\n"))
 
 

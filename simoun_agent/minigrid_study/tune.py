@@ -19,7 +19,8 @@ from typing import Any
 from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
 from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
-from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.minigrid_study.training import write_json
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.study.provenance import code_version
 from simoun_agent.sweep.launch import connect, load_ray
 
@@ -52,7 +53,7 @@ def record_spec(spec: StudySpec, archive: Path) -> None:
             )
         return
     archive.mkdir(parents=True, exist_ok=True)
-    atomic_write(path, lambda tmp: tmp.write_text(json.dumps(wanted, indent=2) + "\n"))
+    write_json(path, wanted)
 
 
 def trainable(
