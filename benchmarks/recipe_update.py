@@ -1,0 +1,136 @@
+"""Cost of one gradient update of each recipe of the DMC 100k study, against DrQ's, in one run.
+
+Issue 20's diagnostic of Simoun's equal-wall-time result: the study's runs spread over sessions
+whose machines ran at different speeds, so their wall times compare only within a session. This
+times the updates themselves, every recipe in the same process on the same replay contents:
+
+- each recipe is built as the study ran it (the ``cpu`` preset, the recipe, its setting selected
+  by the study, read from ``docs/studies/dmc100k/selection.json``) on the chosen task, and its
+  replay is filled with the same ``--fill`` random-action transitions;
+- each repeat times ``--updates`` updates of every recipe (an even count, so the actor and target
+  updates that run every second step are averaged in), the recipes in a rotated order; medians
+  over ``--repeats`` are reported, so a machine shared with other work slows all alike;
+- the table gives milliseconds per update, the ratio to DrQ (the named baseline) and the update
+  time of a whole 100k-env-step run of the task (``100_000 / action_repeat`` updates);
+- ``--ablations`` adds the ``simoun_no_<part>`` recipes at Simoun's selected setting, so the table
+  also says which part of Simoun (curiosity, the interactive module, the auxiliary losses) costs
+  the time.
+
+    python benchmarks/recipe_update.py                                   # cheetah-run
+    python benchmarks/recipe_update.py --task dm_control/cartpole-swingup-v0 --action-repeat 8
+    python benchmarks/recipe_update.py --ablations
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from simoun_agent.config import resolve
+from simoun_agent.config.recipes import SIMOUN_PARTS
+from simoun_agent.run.train import build
+
+SELECTION = Path(__file__).resolve().parent.parent / "docs/studies/dmc100k/selection.json"
+BASELINE = "drq"
+ENV_STEPS = 100_000
+
+
+def selected_settings(path: Path, ablations: bool) -> dict[str, dict]:
+    """Each recipe's setting selected by the study, as config overrides; with ``ablations``,
+    also each ``simoun_no_<part>`` recipe at Simoun's setting (the study tuned no ablation)."""
+    recipes = json.loads(path.read_text())["recipes"]
+    settings = {name: dict(entry["setting"]) for name, entry in recipes.items()}
+    if ablations:
+        settings.update({f"simoun_no_{part}": settings["simoun"] for part in SIMOUN_PARTS})
+    return settings
+
+
+def filled(recipe: str, setting: dict, task: str, action_repeat: int, fill: int):
+    """The recipe's agent and a replay holding ``fill`` random-action transitions of the task."""
+    config = resolve(
+        "cpu",
+        {"env": task, "action_repeat": action_repeat, "agent.recipe": recipe, **setting},
+    )
+    env, eval_env, agent, replay = build(config)
+    try:
+        rng = np.random.default_rng(0)
+        low, high = env.action_space.low, env.action_space.high
+        obs = env.reset(seed=0)
+        replay.start_episode(obs["frames"][-1])
+        for _ in range(fill):
+            action = rng.uniform(low, high).astype(np.float32)
+            env.step_async(action)
+            obs, reward, terminated, truncated = env.step_wait()
+            replay.add(action, reward, obs["frames"][-1], terminated, truncated)
+            if terminated or truncated:
+                obs = env.reset(seed=1)
+                replay.start_episode(obs["frames"][-1])
+    finally:
+        env.close()
+        eval_env.close()
+    return agent, replay
+
+
+def time_updates(agent, replay, updates: int, step: int) -> float:
+    """Milliseconds per update over ``updates`` consecutive updates."""
+    start = time.perf_counter()
+    for _ in range(updates):
+        agent.update(replay, step)
+    return 1000 * (time.perf_counter() - start) / updates
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--task", default="dm_control/cheetah-run-v0")
+    parser.add_argument("--action-repeat", type=int, default=4)
+    parser.add_argument("--fill", type=int, default=1000, help="transitions in each replay")
+    parser.add_argument("--updates", type=int, default=20, help="updates per timing (even)")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--selection", type=Path, default=SELECTION)
+    parser.add_argument(
+        "--ablations", action="store_true", help="also time each simoun_no_<part> recipe"
+    )
+    args = parser.parse_args()
+    if args.updates < 2 or args.updates % 2:
+        parser.error(f"--updates must be even and at least 2, got {args.updates}")
+    torch.set_num_threads(1)
+    settings = selected_settings(args.selection, args.ablations)
+    if BASELINE not in settings:
+        parser.error(f"{args.selection} selects no setting for the baseline {BASELINE!r}")
+    built = {
+        name: filled(name, setting, args.task, args.action_repeat, args.fill)
+        for name, setting in settings.items()
+    }
+    step = args.fill * args.action_repeat
+    for agent, replay in built.values():
+        time_updates(agent, replay, 2, step)
+    names = list(built)
+    times: dict[str, list[float]] = {name: [] for name in names}
+    for repeat in range(args.repeats):
+        shift = repeat % len(names)
+        for name in names[shift:] + names[:shift]:
+            times[name].append(time_updates(*built[name], args.updates, step))
+    medians = {name: statistics.median(values) for name, values in times.items()}
+    updates_per_run = ENV_STEPS // args.action_repeat
+    print(
+        f"one update of each recipe at the cpu preset (48x48, batch 64, 1 torch thread) on "
+        f"{args.task}, action repeat {args.action_repeat}: median of {args.repeats} repeats of "
+        f"{args.updates} updates"
+    )
+    print(f"| recipe | setting | ms / update | x {BASELINE} | update time of a 100k run (s) |")
+    print("|---|---|---:|---:|---:|")
+    for name in names:
+        setting = ", ".join(f"{key}={value}" for key, value in settings[name].items())
+        ratio = medians[name] / medians[BASELINE]
+        run_s = medians[name] * updates_per_run / 1000
+        print(f"| {name} | {setting} | {medians[name]:.1f} | {ratio:.2f} | {run_s:.0f} |")
+
+
+if __name__ == "__main__":
+    main()
