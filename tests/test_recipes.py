@@ -245,6 +245,16 @@ def test_drqv2_noise_std_follows_the_linear_schedule_of_the_env_step():
     assert samples.std() > 0.5
 
 
+def test_drqv2_easy_is_drqv2_with_the_schedule_of_drqv2s_easy_tasks_alone():
+    drqv2 = to_dict(resolve("cpu", {"agent.recipe": "drqv2"}))["agent"]
+    easy = to_dict(resolve("cpu", {"agent.recipe": "drqv2_easy"}))["agent"]
+    assert {key for key in drqv2 if drqv2[key] != easy[key]} == {"recipe", "exploration_steps"}
+    agent = recipe_agent("drqv2_easy")
+    schedule = {0: 1.0, 100_000: 0.55, 200_000: 0.1, 1_000_000: 0.1}
+    for step, std in schedule.items():
+        assert agent.actor.std(step) == pytest.approx(std)
+
+
 def test_drqv2_target_and_actor_loss_read_min_q_at_the_clipped_noisy_action():
     """TD target r + gamma d min(Qbar)(s', clamp(mu(s') + clip(std eps, +-0.3))) through the
     online encoder, no entropy term; actor loss -min Q(s, clamp(mu(s) + clip(std eps)))."""

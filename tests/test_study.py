@@ -386,6 +386,21 @@ def test_the_dmc100k_spec_of_issue_20_plans_its_runs():
     assert spec.cpus_per_trial == 1 and spec.max_concurrent_trials == 2
 
 
+def test_the_drqv2_easy_supplement_runs_the_dmc100k_protocol_on_its_cartpole_runs():
+    study = cli.spec_from("docs/studies/dmc100k.toml")
+    supplement = cli.spec_from("docs/studies/dmc100k-drqv2-easy.toml")
+    assert supplement.recipes == ["drqv2_easy"]
+    for key in ("selection", "preset", "base", "grid", "grid_overrides", "tuning"):
+        assert getattr(supplement, key) == getattr(study, key), key
+    cartpole = "dm_control/cartpole-swingup-v0"
+    assert supplement.task_config == {cartpole: study.task_config[cartpole]}
+    runs = {(r.task, r.seed, r.env_steps) for r in evaluation_runs(supplement)}
+    assert runs == {(r.task, r.seed, r.env_steps) for r in evaluation_runs(study)} & {
+        (cartpole, seed, 100_000) for seed in range(1, 6)
+    }
+    assert len(runs) == 5
+
+
 def test_without_ray_a_study_plans_and_says_how_to_install_ray_to_run(
     monkeypatch, tmp_path, capsys
 ):

@@ -95,6 +95,45 @@ def _simoun_without(part: str) -> Recipe:
     )
 
 
+DRQV2 = {
+    "encoder": "stacked",
+    "augmentation": "shift",
+    **NO_AUXILIARY,
+    "actor": "deterministic",
+    "exploration_std_start": 1.0,
+    "exploration_std_end": 0.1,
+    "exploration_steps": 1_000_000,
+    "noise_clip": 0.3,
+    "n_step": 3,
+    "next_state_encoder": "online",
+    "lr": 1e-4,
+    "critic_tau": 0.01,
+    "actor_update_every": 1,
+    "target_update_every": 2,
+}
+"""DrQ-v2 with the exploration schedule of its medium tasks: 500k agent steps at action repeat
+2, 'linear(1.0,0.1,500000)' in its cfgs/task/medium.yaml, counted here in env steps."""
+
+
+DRQV2_DEVIATIONS = (
+    "one gradient step per agent step (simoun-train's updates_per_step 1), the actor "
+    "every step and the targets every 2: the targets move at DrQ-v2's rate per env "
+    "step, the critic and actor take twice its updates (DrQ-v2 updates all three once "
+    "every 2 agent steps)",
+    "the schedule counts env steps, twice DrQ-v2's agent steps at its action repeat 2; at "
+    "another action repeat it decays per env step, not per agent step",
+    "the encoder ends in FC + LayerNorm (no tanh) shared by actor and critic, the actor "
+    "reading it detached; DrQ-v2's encoder is the convs alone and actor and critic each "
+    "put their own FC + LayerNorm + tanh on the flat conv features; pixels are x/255 "
+    "(DrQ-v2: x/255 - 0.5)",
+    SHARED_OFFSET,
+    "actions clamped to [-1, 1] with the identity as gradient (DrQ-v2: to [-1 + 1e-6, 1 - 1e-6])",
+    FROM_PRESET + "; DrQ-v2 uses batch 256, a 1M replay and 4000 random frames",
+    STACK,
+)
+"""How both DrQ-v2 recipes differ from DrQ-v2, whatever their schedule."""
+
+
 RECIPES: dict[str, Recipe] = {
     "simoun": Recipe(
         "the paper's model: dual path + interactive module, L_tran + L_con + L_re, curiosity",
@@ -132,41 +171,26 @@ RECIPES: dict[str, Recipe] = {
     ),
     "drqv2": Recipe(
         "DrQ-v2 (Yarats, Fergus, Lazaric & Pinto 2022): deterministic actor explored with noise "
-        "of std 1.0 -> 0.1 (linear over 1M env steps), noise clipped at 0.3 in the TD target and "
-        "the actor loss (-min Q), no entropy term, 3-step returns, random shift, the online "
-        "encoder for the next state, lr 1e-4, actor every update, targets every 2 with tau 0.01",
-        {
-            "encoder": "stacked",
-            "augmentation": "shift",
-            **NO_AUXILIARY,
-            "actor": "deterministic",
-            "exploration_std_start": 1.0,
-            "exploration_std_end": 0.1,
-            "exploration_steps": 1_000_000,
-            "noise_clip": 0.3,
-            "n_step": 3,
-            "next_state_encoder": "online",
-            "lr": 1e-4,
-            "critic_tau": 0.01,
-            "actor_update_every": 1,
-            "target_update_every": 2,
-        },
+        "of std 1.0 -> 0.1 (linear over 1M env steps: its medium tasks' schedule), noise clipped "
+        "at 0.3 in the TD target and the actor loss (-min Q), no entropy term, 3-step returns, "
+        "random shift, the online encoder for the next state, lr 1e-4, actor every update, "
+        "targets every 2 with tau 0.01",
+        DRQV2,
         (
-            "one gradient step per agent step (simoun-train's updates_per_step 1), the actor "
-            "every step and the targets every 2: the targets move at DrQ-v2's rate per env "
-            "step, the critic and actor take twice its updates (DrQ-v2 updates all three once "
-            "every 2 agent steps)",
-            "the schedule counts env steps: 1M is DrQ-v2's 500k agent steps at its action "
-            "repeat 2; at another action repeat it decays per env step, not per agent step",
-            "the encoder ends in FC + LayerNorm (no tanh) shared by actor and critic, the actor "
-            "reading it detached; DrQ-v2's encoder is the convs alone and actor and critic each "
-            "put their own FC + LayerNorm + tanh on the flat conv features; pixels are x/255 "
-            "(DrQ-v2: x/255 - 0.5)",
-            SHARED_OFFSET,
-            "actions clamped to [-1, 1] with the identity as gradient (DrQ-v2: to "
-            "[-1 + 1e-6, 1 - 1e-6])",
-            FROM_PRESET + "; DrQ-v2 uses batch 256, a 1M replay and 4000 random frames",
-            STACK,
+            "the exploration schedule is DrQ-v2's for its medium tasks (cheetah_run, "
+            "reacher_hard, ...: cfgs/task/medium.yaml); its easy tasks (cartpole_swingup, "
+            "cup_catch, finger_spin, walker_walk, ...) decay 5x faster: recipe 'drqv2_easy'",
+            *DRQV2_DEVIATIONS,
+        ),
+    ),
+    "drqv2_easy": Recipe(
+        "DrQ-v2 with its easy tasks' exploration schedule (std 1.0 -> 0.1 over 200k env steps: "
+        "cartpole_swingup, cup_catch, finger_spin, walker_walk, ...), otherwise 'drqv2'",
+        {**DRQV2, "exploration_steps": 200_000},
+        (
+            "the schedule is DrQ-v2's for its easy tasks, 'linear(1.0,0.1,100000)' in agent "
+            "steps at action repeat 2 (cfgs/task/easy.yaml), counted here in env steps",
+            *DRQV2_DEVIATIONS,
         ),
     ),
     "rad": Recipe(
