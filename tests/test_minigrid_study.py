@@ -89,6 +89,10 @@ def test_the_default_spec_is_the_issue_s_design():
         ("MiniGrid-DoorKey-8x8-v0", 1_000_000, 3),
     ]
     assert spec.arms == ("ppo", "consistency", "rnd") and len(spec.runs()) == 24
+    first = [(run.task.env_id, run.seed, run.arm) for run in spec.runs()[:4]]
+    assert first == [("MiniGrid-DoorKey-6x6-v0", 0, arm) for arm in spec.arms] + [
+        ("MiniGrid-DoorKey-6x6-v0", 1, "ppo")
+    ]
     committed = Path(__file__).resolve().parents[1] / "docs/studies/minigrid/spec.json"
     assert load_spec(committed) == spec
 

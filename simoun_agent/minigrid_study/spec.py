@@ -113,9 +113,10 @@ class StudySpec:
             )
 
     def runs(self) -> list[Run]:
-        """Every run of the study, tasks outermost, then arms, then seeds."""
+        """Every run of the study in the order they run: tasks outermost, then seeds, then arms,
+        so a study stopped part way has every arm on the same seeds (a balanced comparison)."""
         return [
-            Run(task, arm, seed) for task in self.tasks for arm in self.arms for seed in task.seeds
+            Run(task, arm, seed) for task in self.tasks for seed in task.seeds for arm in self.arms
         ]
 
     def to_json(self) -> dict[str, Any]:
