@@ -11,7 +11,8 @@ times the updates themselves, every recipe in the same process on the same repla
   updates that run every second step are averaged in), the recipes in a rotated order; medians
   over ``--repeats`` are reported, so a machine shared with other work slows all alike;
 - the table gives milliseconds per update, the ratio to DrQ (the named baseline) and the update
-  time of a whole 100k-env-step run of the task (``100_000 / action_repeat`` updates);
+  time of a whole run of the preset's budget (one update per agent step after the warm-up:
+  12,250 updates in 100k env steps at action repeat 8, 24,750 at 4);
 - ``--ablations`` adds the ``simoun_no_<part>`` recipes at Simoun's selected setting, so the table
   also says which part of Simoun (curiosity, the interactive module, the auxiliary losses) costs
   the time.
@@ -38,7 +39,6 @@ from simoun_agent.run.train import build
 
 SELECTION = Path(__file__).resolve().parent.parent / "docs/studies/dmc100k/selection.json"
 BASELINE = "drq"
-ENV_STEPS = 100_000
 
 
 def selected_settings(path: Path, ablations: bool) -> dict[str, dict]:
@@ -52,12 +52,15 @@ def selected_settings(path: Path, ablations: bool) -> dict[str, dict]:
 
 
 def filled(recipe: str, setting: dict, task: str, action_repeat: int, fill: int):
-    """The recipe's agent and a replay holding ``fill`` random-action transitions of the task."""
+    """The recipe's agent, a replay holding ``fill`` random-action transitions of the task and
+    the number of updates of a whole run of the preset's budget."""
     config = resolve(
         "cpu",
         {"env": task, "action_repeat": action_repeat, "agent.recipe": recipe, **setting},
     )
     env, eval_env, agent, replay = build(config)
+    learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
+    updates = (config.total_env_steps // action_repeat - learning_starts) * config.updates_per_step
     try:
         rng = np.random.default_rng(0)
         low, high = env.action_space.low, env.action_space.high
@@ -74,7 +77,7 @@ def filled(recipe: str, setting: dict, task: str, action_repeat: int, fill: int)
     finally:
         env.close()
         eval_env.close()
-    return agent, replay
+    return agent, replay, updates
 
 
 def time_updates(agent, replay, updates: int, step: int) -> float:
@@ -108,27 +111,27 @@ def main() -> None:
         for name, setting in settings.items()
     }
     step = args.fill * args.action_repeat
-    for agent, replay in built.values():
+    for agent, replay, _ in built.values():
         time_updates(agent, replay, 2, step)
     names = list(built)
     times: dict[str, list[float]] = {name: [] for name in names}
     for repeat in range(args.repeats):
         shift = repeat % len(names)
         for name in names[shift:] + names[:shift]:
-            times[name].append(time_updates(*built[name], args.updates, step))
+            agent, replay, _ = built[name]
+            times[name].append(time_updates(agent, replay, args.updates, step))
     medians = {name: statistics.median(values) for name, values in times.items()}
-    updates_per_run = ENV_STEPS // args.action_repeat
     print(
         f"one update of each recipe at the cpu preset (48x48, batch 64, 1 torch thread) on "
         f"{args.task}, action repeat {args.action_repeat}: median of {args.repeats} repeats of "
         f"{args.updates} updates"
     )
-    print(f"| recipe | setting | ms / update | x {BASELINE} | update time of a 100k run (s) |")
+    print(f"| recipe | setting | ms / update | x {BASELINE} | update time of a run (s) |")
     print("|---|---|---:|---:|---:|")
     for name in names:
         setting = ", ".join(f"{key}={value}" for key, value in settings[name].items())
         ratio = medians[name] / medians[BASELINE]
-        run_s = medians[name] * updates_per_run / 1000
+        run_s = medians[name] * built[name][2] / 1000
         print(f"| {name} | {setting} | {medians[name]:.1f} | {ratio:.2f} | {run_s:.0f} |")
 
 
