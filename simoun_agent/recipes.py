@@ -198,3 +198,17 @@ RECIPES: dict[str, Recipe] = {
     "dual_interactive": _encoder_ablation("dual_interactive", "dual path + interactive module"),
 }
 """Every recipe by name (``--agent.recipe NAME``); a new method or ablation is one entry."""
+
+RECIPES["drqv2_easy"] = Recipe(
+    "DrQ-v2 with its easy tasks' exploration schedule (std 1.0 -> 0.1 over 200k env steps: "
+    "cartpole_swingup, cup_catch, finger_spin, walker_walk, ...), otherwise 'drqv2'",
+    {**RECIPES["drqv2"].values, "exploration_steps": 200_000},
+    (
+        "the schedule is DrQ-v2's for its easy tasks, 'linear(1.0,0.1,100000)' in agent steps "
+        "at action repeat 2 (cfgs/task/easy.yaml), counted here in env steps",
+        RECIPES["drqv2"].deviations[0],
+        *RECIPES["drqv2"].deviations[2:],
+    ),
+)
+"""The dmc100k study's supplement (issue 20): DrQ-v2 with the schedule its config gives
+cartpole_swingup; 'drqv2' has its medium tasks' (1M env steps)."""
