@@ -3,6 +3,7 @@
 check, and the bad specs it refuses before Ray starts, each naming its line."""
 
 import json
+import math
 import re
 import shutil
 import sys
@@ -15,6 +16,7 @@ from simoun_agent.cli import study as cli
 from simoun_agent.config import RECIPES, SetupError
 from simoun_agent.study.plan import evaluation_runs, tuning_runs
 from simoun_agent.study.provenance import code_version
+from simoun_agent.study.report import RunResult, mean_cpu
 from simoun_agent.study.spec import load_spec
 from simoun_agent.study.toml_lines import key_line
 
@@ -121,6 +123,32 @@ def test_study_tunes_selects_evaluates_and_reports(study):
     trial = json.loads((study_dir / names[0] / "trial.json").read_text())["parts"]
     assert len(trial) == 1 and trial[0]["cpu_s"] > 0 and len(trial[0]["loadavg"]) == 3
     assert trial[0]["env_step_start"] == 0 and trial[0]["env_step_end"] == 80
+
+
+def test_report_writes_the_report_again_from_the_archive_alone(study, tmp_path):
+    spec_path, study_dir, archive = study
+    copy = tmp_path / "archive"
+    shutil.copytree(archive, copy)
+    shutil.rmtree(copy / "report")
+    assert cli.main(["report", str(spec_path), "--study-dir", str(copy)]) == 0
+    again = (copy / "report/report.md").read_text()
+    assert "written again from the finished runs by the code at commit" in again
+    first = (study_dir / "report/report.md").read_text()
+    results = first[first.index("## Results") : first.index("## Time")]
+    assert results in again  # the same runs give the same statistics
+    assert (copy / "report/iqm_curves.png").stat().st_size > 1000
+    other = write_spec(tmp_path / "other.toml", SPEC.replace("[101, 102]", "[103, 104]"))
+    with pytest.raises(SystemExit):
+        cli.main(["report", str(other), "--study-dir", str(copy)])
+
+
+def test_cpu_time_of_a_group_leaves_out_runs_with_an_unrecorded_part():
+    def result(cpu_s: float) -> RunResult:
+        return RunResult(None, 0.0, 0.0, {}, 10.0, cpu_s, 0.5)
+
+    assert mean_cpu([result(100.0), result(300.0)]) == "200"
+    assert mean_cpu([result(100.0), result(math.nan)]) == "100 (1 of 2 runs)"
+    assert mean_cpu([result(math.nan)]) == "–"
 
 
 def test_archive_holds_the_finished_runs_without_checkpoints(study):

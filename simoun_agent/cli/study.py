@@ -9,9 +9,10 @@
 ``plan`` lists every run of both phases with a CPU-time estimate measured here; ``run`` tunes
 (every recipe x grid setting x tuning seed), selects each recipe's setting by the spec's rule,
 evaluates the selected settings on the held-out seeds and writes the report
-(:mod:`simoun_agent.study.report`). The study is run by :mod:`simoun_agent.study.runner`; the
-runs go through ``simoun-sweep``'s code: the same trial directories, Tune experiments, STOP file
-on SIGTERM and failure handling.
+(:mod:`simoun_agent.study.report`); ``report`` writes it again from the finished runs of a study
+directory or its archive (``simoun-study report SPEC --study-dir docs/studies/NAME``). The
+study is run by :mod:`simoun_agent.study.runner`; the runs go through ``simoun-sweep``'s code:
+the same trial directories, Tune experiments, STOP file on SIGTERM and failure handling.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import tyro
 from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import SetupError
 from simoun_agent.study.plan import describe
-from simoun_agent.study.runner import StudyOptions, run_study, spec_from
+from simoun_agent.study.runner import StudyOptions, report_study, run_study, spec_from
 from simoun_agent.sweep.launch import load_ray
 
 PROG = "simoun-study"
@@ -75,10 +76,23 @@ class Run(StudyOptions):
     num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
 
 
+@dataclass(kw_only=True)
+class Report:
+    """Write the report of a study's finished runs again, with this code, from its study
+    directory or its archive (no Ray, nothing trained): into DIR/report."""
+
+    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    """the study's TOML file"""
+    study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
+    """the study directory or its archive (e.g. docs/studies/NAME)"""
+
+
 Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
-    Annotated[Plan, tyro.conf.subcommand("plan")], Annotated[Run, tyro.conf.subcommand("run")]
+    Annotated[Plan, tyro.conf.subcommand("plan")],
+    Annotated[Run, tyro.conf.subcommand("run")],
+    Annotated[Report, tyro.conf.subcommand("report")],
 ]
-"""The command line: plan a study, or run it."""
+"""The command line: plan a study, run it, or write its report again."""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -90,6 +104,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             if args.probe_updates < 0:
                 raise SetupError("--probe-updates must be 0 or more")
             print(describe(spec, args.spec, args.probe_updates))
+            return 0
+        if isinstance(args, Report):
+            print(f"report: {report_study(spec, args.study_dir)}")
             return 0
         # absolute: Tune runs each trial in a working directory of its own
         options = dataclasses.replace(

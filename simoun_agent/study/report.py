@@ -371,8 +371,10 @@ def time_section(results: list[RunResult]) -> list[str]:
         "",
         "Wall time: seconds in the training loop (`summary.json`, evaluations included). CPU "
         "time: user + system seconds of the trial's process (`trial.json`, summed over its "
-        "parts). Load: the 1-minute load average per CPU when the trial started (above 1, runs "
-        "waited for a CPU and their wall times are inflated).",
+        "parts); a part whose process was ended (a session's end) recorded none, so a run with "
+        "such a part is left out of the mean, which then says over how many runs it is. Load: "
+        "the 1-minute load average per CPU when the trial started (above 1, runs waited for a "
+        "CPU and their wall times are inflated).",
         "",
         "| phase | recipe | runs | env steps | wall time per run (s) | CPU time per run (s) | "
         "env steps per wall second | load at start (max) |",
@@ -384,21 +386,32 @@ def time_section(results: list[RunResult]) -> list[str]:
     for (phase, recipe), group in groups.items():
         steps = np.mean([r.run.env_steps for r in group])
         wall = np.mean([r.wall_s for r in group])
-        cpu = np.mean([r.cpu_s for r in group])
         loads = [r.load for r in group if not math.isnan(r.load)]
         load = f"{max(loads):.2f}" if loads else "–"
         lines.append(
             f"| {phase} | {recipe} | {len(group)} | {steps:.0f} | {wall:.0f} | "
-            f"{'–' if math.isnan(cpu) else f'{cpu:.0f}'} | {steps / wall:.1f} | {load} |"
+            f"{mean_cpu(group)} | {steps / wall:.1f} | {load} |"
         )
     total_cpu = np.nansum([r.cpu_s for r in results])
+    unrecorded = sum(math.isnan(r.cpu_s) for r in results)
     lines += [
         "",
         f"Total over {len(results)} runs: {sum(r.wall_s for r in results) / 3600:.2f} h of "
-        f"wall time, {total_cpu / 3600:.2f} h of CPU time. Every run's times are in "
-        f"`{SCORES_CSV}`.",
+        f"wall time, {total_cpu / 3600:.2f} h of CPU time"
+        + (f" (without {unrecorded} runs' unrecorded parts)" if unrecorded else "")
+        + f". Every run's times are in `{SCORES_CSV}`.",
     ]
     return lines
+
+
+def mean_cpu(group: list[RunResult]) -> str:
+    """The mean CPU time of the runs whose every part recorded one, with their count when some
+    did not; '–' when none did."""
+    known = [r.cpu_s for r in group if not math.isnan(r.cpu_s)]
+    if not known:
+        return "–"
+    count = "" if len(known) == len(group) else f" ({len(known)} of {len(group)} runs)"
+    return f"{np.mean(known):.0f}{count}"
 
 
 def curve_scores(
@@ -486,10 +499,16 @@ def score_rows(results: list[RunResult]) -> list[dict[str, Any]]:
 
 
 def write_study_report(
-    spec: StudySpec, study_dir: Path, record: dict[str, Any], choices: dict[str, Choice]
+    spec: StudySpec,
+    study_dir: Path,
+    record: dict[str, Any],
+    choices: dict[str, Choice],
+    rewritten_by: str | None = None,
 ) -> list[Path]:
     """Write the report of the study in ``study_dir`` into its ``report/``; returns its files.
-    Counts the finished evaluation runs (the missing ones are listed)."""
+    Counts the finished evaluation runs (the missing ones are listed). ``rewritten_by``: the
+    commit of the code writing the report again after the study (``simoun-study report``),
+    named under the protocol."""
     out = study_dir / REPORT_DIR
     out.mkdir(parents=True, exist_ok=True)
     for phase in (TUNING, EVALUATION):
@@ -500,6 +519,11 @@ def write_study_report(
     tuned = [r for run in tuning_runs(spec) if (r := read_result(study_dir, run)) is not None]
     missing = [run.name for run in runs if not run.finished(study_dir)]
     lines = protocol(spec, record, choices)
+    if rewritten_by is not None:
+        lines.append(
+            f"- This report was written again from the finished runs by the code at commit "
+            f"{rewritten_by} (`simoun-study report`); the runs are the study's."
+        )
     if results:
         recipes = recipe_variants(study_dir / EVALUATION)
         lines += results_section(spec, out / EVALUATION, recipes)

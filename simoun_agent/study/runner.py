@@ -77,6 +77,12 @@ def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
     )
 
 
+def changed_keys(record: dict[str, Any], spec: StudySpec) -> list[str]:
+    """The keys in which ``spec`` differs from the one the study ``record`` was started with."""
+    saved, wanted = record["spec"], spec.to_json()
+    return [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
+
+
 def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[str, Any]:
     """The study record, new or resumed (same spec and, unless allowed, same commit)."""
     study_dir, archive = options.study_dir, options.archive
@@ -94,8 +100,8 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
         text = Path(spec_path).read_text()
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
-    if record["spec"] != spec.to_json():
-        changed = [k for k in record["spec"] if record["spec"][k] != spec.to_json().get(k)]
+    changed = changed_keys(record, spec)
+    if changed:
         raise SetupError(
             f"{spec_path} is not the spec this study was started with ({', '.join(changed)} "
             f"differ from the saved {STUDY_FILE}); resume with that spec (its text is in "
@@ -222,6 +228,22 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
         if archive is not None:
             archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
     return launch.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
+
+
+def report_study(spec: StudySpec, study_dir: Path) -> Path:
+    """Write the report of the finished runs in ``study_dir`` (a study directory or its
+    archive) again, with this code, into ``study_dir/report``; returns its ``report.md``."""
+    record = load_record(study_dir, None)
+    changed = changed_keys(record, spec)
+    if changed:
+        raise SetupError(
+            f"{study_dir} holds a study of another spec ({', '.join(changed)} differ); pass the "
+            f"spec it was run with ({record['spec_file']})"
+        )
+    code = code_version()
+    commit = f"{code['commit']}{' with uncommitted changes' if code['dirty'] else ''}"
+    write_study_report(spec, study_dir, record, choose(spec, study_dir), rewritten_by=commit)
+    return study_dir / REPORT_DIR / REPORT_MD
 
 
 def say_choices(choices: dict[str, Choice]) -> None:
