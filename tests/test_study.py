@@ -385,12 +385,13 @@ def test_key_lines_follow_tables_dotted_keys_and_inline_tables():
 
 
 def test_help_runs_for_the_command_and_each_subcommand(capsys):
-    for argv in (["--help"], ["plan", "--help"], ["run", "--help"]):
+    for argv in (["--help"], ["plan", "--help"], ["run", "--help"], ["report", "--help"]):
         with pytest.raises(SystemExit) as exit_info:
             cli.main(argv)
         assert exit_info.value.code == 0
     out = capsys.readouterr().out
     assert "simoun-study plan docs/studies/dmc100k.toml" in out
+    assert "simoun-study report docs/studies/dmc100k.toml --study-dir docs/studies/dmc100k" in out
     assert "--probe-updates N" in out and "--allow-other-commit" in out and "--archive DIR" in out
 
 

@@ -44,6 +44,7 @@ examples:
       --archive docs/studies/dmc100k
   simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
       --archive docs/studies/dmc100k --resume
+  simoun-study report docs/studies/dmc100k.toml --study-dir docs/studies/dmc100k
 
 The spec's layout is documented in simoun_agent/study/spec.py; docs/studies/dmc100k.toml is a
 full example."""
