@@ -77,10 +77,15 @@ def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
     )
 
 
-def changed_keys(record: dict[str, Any], spec: StudySpec) -> list[str]:
-    """The keys in which ``spec`` differs from the one the study ``record`` was started with."""
+def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: str) -> None:
+    """Refuse ``spec`` when it is not the one the study ``record`` was started with: the error
+    says ``problem``, the keys that differ and ``fix``."""
     saved, wanted = record["spec"], spec.to_json()
-    return [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
+    changed = [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
+    if changed:
+        raise SetupError(
+            f"{problem} ({', '.join(changed)} differ from the saved {STUDY_FILE}); {fix}"
+        )
 
 
 def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[str, Any]:
@@ -100,13 +105,13 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
         text = Path(spec_path).read_text()
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
-    changed = changed_keys(record, spec)
-    if changed:
-        raise SetupError(
-            f"{spec_path} is not the spec this study was started with ({', '.join(changed)} "
-            f"differ from the saved {STUDY_FILE}); resume with that spec (its text is in "
-            f"{STUDY_FILE}, spec_text), or start a new study in another --study-dir"
-        )
+    check_same_spec(
+        record,
+        spec,
+        f"{spec_path} is not the spec this study was started with",
+        f"resume with that spec (its text is in {STUDY_FILE}, spec_text), or start a new study "
+        "in another --study-dir",
+    )
     first = record["parts"][0]
     if not same_code(first, code) and not options.allow_other_commit:
         raise SetupError(
@@ -234,12 +239,12 @@ def report_study(spec: StudySpec, study_dir: Path) -> Path:
     """Write the report of the finished runs in ``study_dir`` (a study directory or its
     archive) again, with this code, into ``study_dir/report``; returns its ``report.md``."""
     record = load_record(study_dir, None)
-    changed = changed_keys(record, spec)
-    if changed:
-        raise SetupError(
-            f"{study_dir} holds a study of another spec ({', '.join(changed)} differ); pass the "
-            f"spec it was run with ({record['spec_file']})"
-        )
+    check_same_spec(
+        record,
+        spec,
+        f"{study_dir} holds a study of another spec",
+        f"pass the spec it was run with ({record['spec_file']})",
+    )
     code = code_version()
     commit = f"{code['commit']}{' with uncommitted changes' if code['dirty'] else ''}"
     write_study_report(spec, study_dir, record, choose(spec, study_dir), rewritten_by=commit)
