@@ -261,7 +261,7 @@ class OnlineModel(ABC):
         loss, metrics = self._loss(*batch)
         if not torch.isfinite(loss):
             raise FloatingPointError(
-                f"the {type(self).__name__} loss is {float(loss)} before this step"
+                f"the {type(self).__name__} loss is {float(loss.detach())} before this step"
             )
         self.optimizer.zero_grad(set_to_none=True)
         loss.backward()
