@@ -3,19 +3,21 @@
 python -m simoun_agent.minigrid_study run                  # every unfinished run, locally
 python -m simoun_agent.minigrid_study run --address auto   # on a running Ray cluster
 python -m simoun_agent.minigrid_study report               # docs/studies/minigrid/report/
+python -m simoun_agent.minigrid_study probe                # docs/studies/minigrid/probe/
 """
 
 from __future__ import annotations
 
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Union
 
 import tyro
 
 from simoun_agent.config import SetupError
+from simoun_agent.minigrid_study.probe import PROBED, ProbeSettings
 from simoun_agent.minigrid_study.spec import StudySpec, load_spec
 
 ARCHIVE = Path("docs/studies/minigrid")
@@ -57,8 +59,21 @@ class Run(Report):
     """runs at a time"""
 
 
+@dataclass
+class Probe:
+    """Correlate each probed intrinsic reward with novelty under a random policy (no PPO)."""
+
+    settings: ProbeSettings = field(default_factory=ProbeSettings)
+    probes: list[str] = field(default_factory=lambda: list(PROBED))
+    """probes of ``simoun_agent.minigrid_study.probe.PROBED``"""
+    out: Path = ARCHIVE / "probe"
+    """where probe.csv and probe.md go"""
+
+
 Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
-    Annotated[Run, tyro.conf.subcommand("run")], Annotated[Report, tyro.conf.subcommand("report")]
+    Annotated[Run, tyro.conf.subcommand("run")],
+    Annotated[Report, tyro.conf.subcommand("report")],
+    Annotated[Probe, tyro.conf.subcommand("probe")],
 ]
 
 
@@ -67,9 +82,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         Command,
         prog=PROG,
         description="SB3 PPO on MiniGrid pixels with no intrinsic reward, consistency curiosity "
-        "or RND: train the runs on Ray Tune (resumable), then report.",
+        "or RND: train the runs on Ray Tune (resumable), then report; probe an intrinsic reward's "
+        "link to novelty without PPO.",
         args=argv,
     )
+    if isinstance(args, Probe):
+        from simoun_agent.minigrid_study.probe import write_probe
+
+        try:
+            print(write_probe(args.settings, args.probes, args.out))
+        except ValueError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 2
+        return 0
     try:
         spec = spec_for(args.spec, args.archive)
         if isinstance(args, Run):

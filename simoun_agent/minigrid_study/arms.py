@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import Any
 
 import torch
 from gymnasium.vector import VectorEnv
@@ -20,9 +21,12 @@ def no_intrinsic(envs: VectorEnv, seed: int, device: torch.device) -> VectorEnv:
     return envs
 
 
-def consistency(envs: VectorEnv, seed: int, device: torch.device) -> VectorEnv:
-    """+ Simoun's consistency curiosity (Eq. 13), CuriosityModel and wrapper at their defaults."""
-    model = CuriosityModel.for_env(envs, CuriosityConfig(seed=seed), device=device)
+def consistency(
+    envs: VectorEnv, seed: int, device: torch.device, **changes: Any
+) -> VectorEnv:
+    """+ Simoun's consistency curiosity (Eq. 13), the wrapper at its defaults and CuriosityModel
+    at its defaults but for ``changes`` (``CuriosityConfig`` fields: none in the study's arm)."""
+    model = CuriosityModel.for_env(envs, CuriosityConfig(seed=seed, **changes), device=device)
     return ConsistencyCuriosityVectorReward(envs, model)
 
 
