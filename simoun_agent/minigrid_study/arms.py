@@ -21,9 +21,7 @@ def no_intrinsic(envs: VectorEnv, seed: int, device: torch.device) -> VectorEnv:
     return envs
 
 
-def consistency(
-    envs: VectorEnv, seed: int, device: torch.device, **changes: Any
-) -> VectorEnv:
+def consistency(envs: VectorEnv, seed: int, device: torch.device, **changes: Any) -> VectorEnv:
     """+ Simoun's consistency curiosity (Eq. 13), the wrapper at its defaults and CuriosityModel
     at its defaults but for ``changes`` (``CuriosityConfig`` fields: none in the study's arm)."""
     model = CuriosityModel.for_env(envs, CuriosityConfig(seed=seed, **changes), device=device)

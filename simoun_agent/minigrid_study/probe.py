@@ -46,8 +46,15 @@ model with one default changed each: RND's learning rate (1e-4 against 1e-3: fea
 slower than the policy's visits), a buffer of 10k transitions (10 rollouts of memory against
 one), no structural interactive module (Eq. 4-6)"""
 
-COLUMNS = ("probe", "seed", "env_step", "intrinsic_mean", "intrinsic_std", "novelty_corr",
-           "states_visited")
+COLUMNS = (
+    "probe",
+    "seed",
+    "env_step",
+    "intrinsic_mean",
+    "intrinsic_std",
+    "novelty_corr",
+    "states_visited",
+)
 
 
 @dataclass(frozen=True)
@@ -87,22 +94,26 @@ def probe(name: str, settings: ProbeSettings) -> list[dict[str, float | str]]:
         for block in range(settings.steps // (settings.n_envs * settings.n_steps)):
             intrinsic, novelty = [], []
             for _ in range(settings.n_steps):
-                _, _, _, infos = envs.step(actions.integers(envs.action_space.n, size=envs.num_envs))
+                _, _, _, infos = envs.step(
+                    actions.integers(envs.action_space.n, size=envs.num_envs)
+                )
                 for info in infos:
                     state = tuple(int(v) for v in info[STATE_KEY])
                     visits[state] += 1
                     intrinsic.append(float(info["reward_intrinsic"]))
                     novelty.append(visits[state] ** -0.5)
             reward = np.array(intrinsic)
-            rows.append({
-                "probe": name,
-                "seed": settings.seed,
-                "env_step": (block + 1) * settings.n_envs * settings.n_steps,
-                "intrinsic_mean": float(reward.mean()),
-                "intrinsic_std": float(reward.std()),
-                "novelty_corr": pearson(reward, np.array(novelty)),
-                "states_visited": len(visits),
-            })
+            rows.append(
+                {
+                    "probe": name,
+                    "seed": settings.seed,
+                    "env_step": (block + 1) * settings.n_envs * settings.n_steps,
+                    "intrinsic_mean": float(reward.mean()),
+                    "intrinsic_std": float(reward.std()),
+                    "novelty_corr": pearson(reward, np.array(novelty)),
+                    "states_visited": len(visits),
+                }
+            )
     finally:
         envs.close()
     return rows
@@ -137,8 +148,10 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     for name in names:
         blocks = [r for r in rows if r["probe"] == name][1:]
         corr = np.array([b["novelty_corr"] for b in blocks], dtype=float)
-        cv = np.array([b["intrinsic_std"] / b["intrinsic_mean"] for b in blocks
-                       if b["intrinsic_mean"] > 0], dtype=float)
+        cv = np.array(
+            [b["intrinsic_std"] / b["intrinsic_mean"] for b in blocks if b["intrinsic_mean"] > 0],
+            dtype=float,
+        )
         lines.append(
             f"| {name} | {np.nanmean(corr):+.3f} | {int(np.sum(corr > 0))} of {len(corr)} | "
             f"{np.mean(cv):.3f} |"

@@ -1,0 +1,89 @@
+"""The novelty probe of the MiniGrid study: its correlation by hand, a reward that is the novelty
+itself (r = 1) or its negation (r = -1), and the command line on the real consistency model."""
+
+import csv
+import subprocess
+import sys
+from collections import Counter
+
+import numpy as np
+import pytest
+from gymnasium.vector import VectorWrapper
+
+from simoun_agent.minigrid_study.envs import STATE_KEY
+from simoun_agent.minigrid_study.probe import PROBED, ProbeSettings, pearson, probe, write_probe
+
+
+def test_pearson_by_hand():
+    # x - mean = (-1, 0, 1), y - mean = (-7/3, -1/3, 8/3): r = 5 / sqrt(2 * 38/3)
+    assert pearson(np.array([1.0, 2.0, 3.0]), np.array([2.0, 4.0, 7.0])) == pytest.approx(
+        5 / np.sqrt(2 * 38 / 3)
+    )
+    assert np.isnan(pearson(np.array([1.0, 1.0]), np.array([0.0, 1.0])))
+
+
+class NoveltyReward(VectorWrapper):
+    """info["reward_intrinsic"] = sign / sqrt(N(s)) of the state each sub-env reached (the
+    ending state of an episode that ended, not the next episode's first)."""
+
+    def __init__(self, envs, sign):
+        super().__init__(envs)
+        self.sign, self.visits = sign, Counter()
+
+    def step(self, actions):
+        obs, rewards, terminated, truncated, info = self.env.step(actions)
+        states = info[STATE_KEY].copy()
+        for i in np.flatnonzero(terminated | truncated):
+            states[i] = info["final_info"][STATE_KEY][i]
+        novelty = []
+        for state in map(tuple, states):
+            self.visits[state] += 1
+            novelty.append(self.sign * self.visits[state] ** -0.5)
+        info = {
+            **info,
+            "reward_intrinsic": np.array(novelty),
+            "_reward_intrinsic": ~np.isnan(novelty),
+        }
+        return obs, rewards, terminated, truncated, info
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_a_reward_that_is_the_novelty_correlates_one(monkeypatch, sign):
+    monkeypatch.setitem(PROBED, "novelty", lambda envs, seed, device: NoveltyReward(envs, sign))
+    # 5x5 episodes time out at 250 steps: blocks of 2 x 200 transitions cross episode ends
+    settings = ProbeSettings("MiniGrid-DoorKey-5x5-v0", steps=1600, n_envs=2, n_steps=200, seed=3)
+    rows = probe("novelty", settings)
+    assert [r["env_step"] for r in rows] == [400, 800, 1200, 1600]
+    assert [r["novelty_corr"] for r in rows] == pytest.approx([sign] * 4)
+    visited = [r["states_visited"] for r in rows]
+    assert visited == sorted(visited) and visited[0] > 1
+
+
+def test_an_unknown_probe_is_refused_with_the_choices(tmp_path):
+    with pytest.raises(ValueError, match=r"--probes \['nope'\].*consistency"):
+        write_probe(ProbeSettings(), ["nope"], tmp_path)
+
+
+def test_the_command_line_probes_the_consistency_model(tmp_path):
+    command = [
+        sys.executable,
+        "-m",
+        "simoun_agent.minigrid_study",
+        "probe",
+        "--probes",
+        "consistency",
+        "--settings.steps",
+        "1024",
+        "--settings.n-steps",
+        "32",
+        "--out",
+        str(tmp_path),
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    with (tmp_path / "probe.csv").open() as file:
+        rows = list(csv.DictReader(file))
+    assert [int(r["env_step"]) for r in rows] == [256, 512, 768, 1024]
+    assert all(float(r["intrinsic_mean"]) > 0 for r in rows)  # Eq. 13 is positive
+    table = (tmp_path / "probe.md").read_text()
+    assert "| consistency | " in table and "of 3 |" in table
