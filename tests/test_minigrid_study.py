@@ -79,6 +79,8 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
     assert report.returncode == 0, report.stderr[-4000:]
     text = (archive / "report" / "report.md").read_text()
     assert "3 of 3 runs finished" in text and "| consistency |" in text and "P(rnd > ppo)" in text
+    assert "## Is it a survival bonus?" in text
+    assert "| MiniGrid-DoorKey-5x5-v0 | consistency | 10-30 % | " in text
     assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_success.png").is_file()
 
 
@@ -171,3 +173,17 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     train = rows(run_dir / "train.csv")
     assert [int(float(r["env_step"])) for r in train] == [1024, 2048, 3072, 4096]
     assert not (run_dir / CHECKPOINT).exists()
+
+
+def test_survival_row_by_hand():
+    from simoun_agent.minigrid_study.report import survival_row
+
+    row = {"intrinsic_mean": 0.3, "intrinsic_std": 0.4, "novelty_corr": -0.1}
+    # 0.09 / (0.09 + 0.16); 0.3 / (1 - 0.9); a negative correlation
+    assert survival_row(row, gamma=0.9) == pytest.approx([0.36, 3.0, 1.0])
+    row = {"intrinsic_mean": -0.2, "intrinsic_std": 0.0, "novelty_corr": 0.5}
+    assert survival_row(row, gamma=0.5) == pytest.approx([1.0, -0.4, 0.0])
+    share, value, negative = survival_row(
+        {"intrinsic_mean": 0.0, "intrinsic_std": 0.0, "novelty_corr": float("nan")}, gamma=0.99
+    )
+    assert np.isnan(share) and value == 0.0 and np.isnan(negative)

@@ -14,6 +14,7 @@ import csv
 import json
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure  # no pyplot: no backend or global figure state
@@ -141,34 +142,87 @@ INTRINSIC_KEYS = (
 )
 
 
-PARTS = {"early": (0.0, 0.1), "middle": (0.45, 0.55), "late": (0.9, 1.0)}
-"""brackets of training, as fractions of a run's rollouts"""
+PARTS = {
+    "0-10 %": (0.0, 0.1),
+    "10-30 %": (0.1, 0.3),
+    "45-55 %": (0.45, 0.55),
+    "90-100 %": (0.9, 1.0),
+}
+"""brackets of training, as fractions of a run's rollouts (10-30 %: where a policy has turned
+towards what the intrinsic reward pays for while that reward is still large)"""
+
+
+def bracket_means(
+    records: Records, runs: list[Run], part: tuple[float, float], values: Any
+) -> np.ndarray:
+    """``values(row)`` (a list of numbers) averaged over the rollouts of the bracket ``part`` of
+    each run, then over runs; NaN-free means where some rollout has no value (no still triplet,
+    a constant reward)."""
+    lo, hi = part
+    per_run = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for run in runs:
+            rows = records.train[run.name]
+            n = len(rows)
+            chosen = rows[int(lo * n) : max(int(hi * n), int(lo * n) + 1)]
+            per_run.append(np.nanmean([values(r) for r in chosen], axis=0))
+        return np.nanmean(per_run, axis=0)
 
 
 def intrinsic_table(records: Records) -> list[str]:
     """The intrinsic reward per rollout, averaged over each tenth-of-training bracket's rollouts
-    and over seeds: early (first tenth), middle, late (last tenth)."""
+    and over seeds, in the brackets of :data:`PARTS`. Plain PPO's rows (no
+    intrinsic reward) give the share of still triplets its policy makes, for comparison."""
     lines = [
         "| task | arm | part | " + " | ".join(INTRINSIC_KEYS) + " |",
         "|---" * (len(INTRINSIC_KEYS) + 3) + "|",
     ]
     for task in records.spec.tasks:
-        for arm in [a for a in records.spec.arms if a != "ppo"]:
+        for arm in records.spec.arms:
             runs = records.runs(task.env_id, arm)
-            if not runs:
-                continue
-            for part, (lo, hi) in PARTS.items():
-                values = []
-                with warnings.catch_warnings():  # a column with no value (no still triplet,
-                    warnings.simplefilter("ignore", RuntimeWarning)  # a constant reward): nan
-                    for run in runs:
-                        rows = records.train[run.name]
-                        n = len(rows)
-                        chosen = rows[int(lo * n) : max(int(hi * n), int(lo * n) + 1)]
-                        values.append([np.nanmean([r[k] for r in chosen]) for k in INTRINSIC_KEYS])
-                    means = np.nanmean(values, axis=0)
+            for part, bracket in PARTS.items() if runs else ():
+                means = bracket_means(
+                    records, runs, bracket, lambda r: [r[k] for k in INTRINSIC_KEYS]
+                )
                 cells = " | ".join(f"{v:.3f}" for v in means)
                 lines.append(f"| {task.env_id} | {arm} | {part} | {cells} |")
+    return lines
+
+
+def survival_row(row: dict[str, float], gamma: float) -> list[float]:
+    """What makes a positive per-step reward a survival bonus, from one rollout's row: the share
+    of the reward's second moment its mean carries (``mean^2 / (mean^2 + std^2)``: 1 for a
+    constant), the discounted value of that mean to a policy that never ends its episode
+    (``mean / (1 - gamma)``, against DoorKey's success reward of at most 1), and whether the
+    reward correlated negatively with novelty (1.0) or not (0.0)."""
+    mean, std, corr = row["intrinsic_mean"], row["intrinsic_std"], row["novelty_corr"]
+    moment = mean**2 + std**2
+    return [
+        mean**2 / moment if moment > 0 else np.nan,
+        mean / (1 - gamma),
+        float(corr < 0) if np.isfinite(corr) else np.nan,
+    ]
+
+
+def survival_table(records: Records) -> list[str]:
+    """:func:`survival_row` averaged over each bracket of training and over seeds."""
+    gamma = records.spec.ppo.gamma
+    lines = [
+        "| task | arm | part | constant share | bonus value mean/(1-gamma) | rollouts corr < 0 |",
+        "|---|---|---|---|---|---|",
+    ]
+    for task in records.spec.tasks:
+        for arm in [a for a in records.spec.arms if a != "ppo"]:
+            runs = records.runs(task.env_id, arm)
+            for part, bracket in PARTS.items() if runs else ():
+                share, value, negative = bracket_means(
+                    records, runs, bracket, lambda r: survival_row(r, gamma)
+                )
+                lines.append(
+                    f"| {task.env_id} | {arm} | {part} | {share:.3f} | {value:.3f} | "
+                    f"{negative:.2f} |"
+                )
     return lines
 
 
@@ -243,6 +297,19 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "still triplets.",
         "",
         *intrinsic_table(records),
+        "",
+        "## Is it a survival bonus?",
+        "",
+        "A positive reward that is nearly the same at every step pays the agent for staying in "
+        "its episode: in DoorKey, reaching the goal (a reward of at most 1) ends that income. "
+        "Per rollout: the share of the reward's second moment its mean carries "
+        "(mean^2 / (mean^2 + std^2), 1 for a constant), the discounted value of the mean reward "
+        f"to a policy that never ends its episode (mean / (1 - gamma), gamma {spec.ppo.gamma}), "
+        "and the share of rollouts whose reward correlated negatively with novelty. "
+        "`python -m simoun_agent.minigrid_study probe` measures the correlation without PPO "
+        "(`probe/`).",
+        "",
+        *survival_table(records),
         "",
         "## Curves",
         "",
