@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import functools
+import warnings
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -53,6 +54,10 @@ COLUMNS = (
     "intrinsic_mean",
     "intrinsic_std",
     "novelty_corr",
+    "still_fraction",
+    "still_mean",
+    "moving_mean",
+    "novelty_corr_moving",
     "states_visited",
 )
 
@@ -92,17 +97,20 @@ def probe(name: str, settings: ProbeSettings) -> list[dict[str, float | str]]:
     rows: list[dict[str, float | str]] = []
     try:
         for block in range(settings.steps // (settings.n_envs * settings.n_steps)):
-            intrinsic, novelty = [], []
+            intrinsic, novelty, still = [], [], []
             for _ in range(settings.n_steps):
-                _, _, _, infos = envs.step(
+                obs, _, _, infos = envs.step(
                     actions.integers(envs.action_space.n, size=envs.num_envs)
                 )
-                for info in infos:
+                for i, info in enumerate(infos):
                     state = tuple(int(v) for v in info[STATE_KEY])
                     visits[state] += 1
                     intrinsic.append(float(info["reward_intrinsic"]))
                     novelty.append(visits[state] ** -0.5)
-            reward = np.array(intrinsic)
+                    frames = info.get("terminal_observation", obs[i]).reshape(3, -1)
+                    still.append(bool(np.all(frames == frames[:1])))
+            reward, novel, stood = np.array(intrinsic), np.array(novelty), np.array(still)
+            moved = ~stood
             rows.append(
                 {
                     "probe": name,
@@ -110,7 +118,11 @@ def probe(name: str, settings: ProbeSettings) -> list[dict[str, float | str]]:
                     "env_step": (block + 1) * settings.n_envs * settings.n_steps,
                     "intrinsic_mean": float(reward.mean()),
                     "intrinsic_std": float(reward.std()),
-                    "novelty_corr": pearson(reward, np.array(novelty)),
+                    "novelty_corr": pearson(reward, novel),
+                    "still_fraction": float(stood.mean()),
+                    "still_mean": float(reward[stood].mean()) if stood.any() else np.nan,
+                    "moving_mean": float(reward[moved].mean()) if moved.any() else np.nan,
+                    "novelty_corr_moving": pearson(reward[moved], novel[moved]),
                     "states_visited": len(visits),
                 }
             )
@@ -121,8 +133,8 @@ def probe(name: str, settings: ProbeSettings) -> list[dict[str, float | str]]:
 
 def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     """Probe each of ``names`` and write ``out/probe.csv`` (every block) and ``out/probe.md``
-    (per probe: the mean over blocks, the first left out, of the reward's correlation with
-    novelty and of its std / mean)."""
+    (per probe, means over blocks, the first left out: the reward's correlation with novelty
+    over all and over moving transitions, its std / mean, its still / moving mean)."""
     unknown = [n for n in names if n not in PROBED]
     if unknown:
         raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBED)}")
@@ -142,19 +154,30 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
         f"{settings.steps} env steps a probe, {settings.n_envs} envs, seed {settings.seed}; "
         f"blocks of {settings.n_envs * settings.n_steps} transitions, the first left out.",
         "",
-        "| probe | corr(r_i, 1/sqrt(N)) mean | blocks with corr > 0 | std / mean |",
-        "|---|---|---|---|",
+        "corr: Pearson's r of the reward with the novelty 1/sqrt(N(s)) of the state reached, "
+        "over every transition of a block and over its moving ones (a still triplet, three "
+        "equal frames, re-visits the state it stands in, so a reward that pays still triplets "
+        "more correlates negatively with novelty for that reason alone); block means.",
+        "",
+        "| probe | corr | blocks with corr > 0 | corr, moving only | std / mean | "
+        "still / moving mean | still share |",
+        "|---|---|---|---|---|---|---|",
     ]
     for name in names:
         blocks = [r for r in rows if r["probe"] == name][1:]
-        corr = np.array([b["novelty_corr"] for b in blocks], dtype=float)
-        cv = np.array(
-            [b["intrinsic_std"] / b["intrinsic_mean"] for b in blocks if b["intrinsic_mean"] > 0],
-            dtype=float,
-        )
+
+        def column(key: str, blocks: list[dict[str, float | str]] = blocks) -> np.ndarray:
+            return np.array([b[key] for b in blocks], dtype=float)
+
+        corr, mean = column("novelty_corr"), column("intrinsic_mean")
+        with warnings.catch_warnings():  # a zero reward (RND's warm-up): no ratio
+            warnings.simplefilter("ignore", RuntimeWarning)
+            cv = np.nanmean(np.where(mean > 0, column("intrinsic_std") / mean, np.nan))
+            ratio = np.nanmean(column("still_mean") / column("moving_mean"))
         lines.append(
             f"| {name} | {np.nanmean(corr):+.3f} | {int(np.sum(corr > 0))} of {len(corr)} | "
-            f"{np.mean(cv):.3f} |"
+            f"{np.nanmean(column('novelty_corr_moving')):+.3f} | {cv:.3f} | {ratio:.2f} | "
+            f"{np.mean(column('still_fraction')):.2f} |"
         )
     atomic_write(out / "probe.md", lambda tmp: tmp.write_text("\n".join(lines) + "\n"))
     return out / "probe.md"
