@@ -55,6 +55,7 @@ def test_a_reward_that_is_the_novelty_correlates_one(monkeypatch, sign):
     rows = probe("novelty", settings)
     assert [r["env_step"] for r in rows] == [400, 800, 1200, 1600]
     assert [r["novelty_corr"] for r in rows] == pytest.approx([sign] * 4)
+    assert [r["novelty_corr_moving"] for r in rows] == pytest.approx([sign] * 4)
     visited = [r["states_visited"] for r in rows]
     assert visited == sorted(visited) and visited[0] > 1
 
@@ -87,3 +88,30 @@ def test_the_command_line_probes_the_consistency_model(tmp_path):
     assert all(float(r["intrinsic_mean"]) > 0 for r in rows)  # Eq. 13 is positive
     table = (tmp_path / "probe.md").read_text()
     assert "| consistency | " in table and "of 3 |" in table
+
+
+class StillReward(VectorWrapper):
+    """info["reward_intrinsic"] = 1 for a still triplet (three equal frames) and 0 otherwise,
+    judged on the ending observation of an episode that ended."""
+
+    def step(self, actions):
+        obs, rewards, terminated, truncated, info = self.env.step(actions)
+        frames = np.array(obs)
+        for i in np.flatnonzero(terminated | truncated):
+            frames[i] = info["final_obs"][i]
+        frames = frames.reshape(len(frames), 3, -1)
+        still = np.all(frames == frames[:, :1], axis=(1, 2)).astype(float)
+        info = {**info, "reward_intrinsic": still, "_reward_intrinsic": np.ones(len(still), bool)}
+        return obs, rewards, terminated, truncated, info
+
+
+def test_the_probe_tells_still_triplets_from_moving_ones(monkeypatch):
+    monkeypatch.setitem(PROBED, "still", lambda envs, seed, device: StillReward(envs))
+    settings = ProbeSettings("MiniGrid-DoorKey-5x5-v0", steps=1600, n_envs=2, n_steps=200, seed=3)
+    rows = probe("still", settings)
+    # a random policy's no-ops and moves into walls: 4 of MiniGrid's 7 actions change nothing
+    assert all(0.2 < r["still_fraction"] < 0.9 for r in rows)
+    assert [r["still_mean"] for r in rows] == [1.0] * 4
+    assert [r["moving_mean"] for r in rows] == [0.0] * 4
+    assert [r["intrinsic_mean"] for r in rows] == pytest.approx([r["still_fraction"] for r in rows])
+    assert all(np.isnan(r["novelty_corr_moving"]) for r in rows)  # constant 0 when moving
