@@ -187,3 +187,20 @@ def test_survival_row_by_hand():
         {"intrinsic_mean": 0.0, "intrinsic_std": 0.0, "novelty_corr": float("nan")}, gamma=0.99
     )
     assert np.isnan(share) and value == 0.0 and np.isnan(negative)
+
+
+def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path):
+    import shutil
+
+    from simoun_agent.minigrid_study.report import Records
+
+    study_dir = Path(__file__).parent.parent / "docs" / "studies" / "minigrid"
+    task = "MiniGrid-DoorKey-6x6-v0"
+    for name in ("ppo/s0", "consistency/s0", "rnd/s0", "ppo/s1"):
+        shutil.copytree(study_dir / task / name, tmp_path / task / name)
+    records = Records(load_spec(study_dir / "spec.json"), tmp_path)
+    assert len(records.finished) == 4
+    assert sorted(r.name for r in records.used) == [
+        f"{task}/{a}/s0" for a in ("consistency", "ppo", "rnd")
+    ]
+    assert len(records.final(task, "ppo", "success_rate")) == 1

@@ -5,7 +5,8 @@ each arm's step-time cost, and what the intrinsic rewards look like during train
 
 Scores are the last evaluation of each run (32 episodes on fixed held-out env seeds by default).
 DoorKey's return lies in [0, 1] (1 - 0.9 x steps / max_steps on success), so success rate and
-return need no normalization. Runs not finished yet are left out and counted.
+return need no normalization. Only seeds on which every arm has finished are used, so a study
+stopped part way compares the arms on the same seeds; the runs left out are counted.
 """
 
 from __future__ import annotations
@@ -40,19 +41,26 @@ def read_rows(path: Path) -> list[dict[str, float]]:
 
 
 class Records:
-    """The finished runs of the archive: ``eval``, ``train`` rows and ``summary`` by run."""
+    """The archive's runs of the seeds every arm has finished (``finished``: all finished
+    runs): ``eval``, ``train`` rows and ``summary`` by run."""
 
     def __init__(self, spec: StudySpec, archive: Path) -> None:
         self.spec, self.archive = spec, archive
         self.finished = [r for r in spec.runs() if (archive / r.name / SUMMARY).is_file()]
-        self.eval = {r.name: read_rows(archive / r.name / EVAL_CSV) for r in self.finished}
-        self.train = {r.name: read_rows(archive / r.name / TRAIN_CSV) for r in self.finished}
+        done = {(r.task.env_id, r.seed, r.arm) for r in self.finished}
+        self.used = [
+            r
+            for r in self.finished
+            if all((r.task.env_id, r.seed, arm) in done for arm in spec.arms)
+        ]
+        self.eval = {r.name: read_rows(archive / r.name / EVAL_CSV) for r in self.used}
+        self.train = {r.name: read_rows(archive / r.name / TRAIN_CSV) for r in self.used}
         self.summary = {
-            r.name: json.loads((archive / r.name / SUMMARY).read_text()) for r in self.finished
+            r.name: json.loads((archive / r.name / SUMMARY).read_text()) for r in self.used
         }
 
     def runs(self, env_id: str, arm: str) -> list[Run]:
-        return [r for r in self.finished if r.task.env_id == env_id and r.arm == arm]
+        return [r for r in self.used if r.task.env_id == env_id and r.arm == arm]
 
     def final(self, env_id: str, arm: str, key: str) -> np.ndarray:
         """The last evaluation's ``key`` of each finished run of ``arm`` on ``env_id``."""
@@ -269,7 +277,8 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
     lines = [
         "# MiniGrid PPO study: does an intrinsic reward help PPO from pixels?",
         "",
-        f"{len(records.finished)} of {total} runs finished. Scores: the last evaluation of each "
+        f"{len(records.finished)} of {total} runs finished; {len(records.used)} used (the seeds "
+        f"on which every arm has finished). Scores: the last evaluation of each "
         f"run ({spec.eval_episodes} episodes on env seeds {spec.eval_seed}+), IQM over seeds "
         "with a 95 % stratified bootstrap CI, n = runs. For scale (another setting: symbolic "
         "observations, 256 envs), RLeXplore reports PPO's success on DoorKey-8x8 at 1M steps as "
