@@ -14,7 +14,8 @@ env), :mod:`~simoun_agent.minigrid_study.arms` (the arms' registry),
 :mod:`~simoun_agent.minigrid_study.training` (a run set up to train),
 :mod:`~simoun_agent.minigrid_study.checkpoint` (mid-run resume),
 :mod:`~simoun_agent.minigrid_study.run` (one run), :mod:`~simoun_agent.minigrid_study.tune`
-(the runs on Ray Tune) and :mod:`~simoun_agent.minigrid_study.report`. Run it with
+(the runs on Ray Tune), :mod:`~simoun_agent.minigrid_study.report` and
+:mod:`~simoun_agent.minigrid_study.probe` (an intrinsic reward against novelty, no PPO). Run it with
 ``python -m simoun_agent.minigrid_study run`` (needs the ``sb3``, ``minigrid`` and ``sweep``
 extras).
 """
