@@ -82,6 +82,7 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
     assert "## Is it a survival bonus?" in text
     assert "| MiniGrid-DoorKey-5x5-v0 | consistency | 10-30 % | " in text
     assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_success.png").is_file()
+    assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_intrinsic.png").is_file()
 
 
 def test_the_default_spec_is_the_issue_s_design():

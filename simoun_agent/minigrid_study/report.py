@@ -268,6 +268,54 @@ def plot_curves(records: Records, out: Path) -> list[str]:
     return names
 
 
+TRAINING_PANELS = (
+    ("intrinsic_mean", "intrinsic reward, rollout mean (log)"),
+    ("novelty_corr", "corr(intrinsic, 1/sqrt(N(s)))"),
+    ("still_fraction", "share of still triplets"),
+)
+
+
+def plot_training(records: Records, out: Path) -> list[str]:
+    """Per task, against env steps, each arm's per-rollout intrinsic-reward mean, its novelty
+    correlation and its policy's share of still triplets (means over seeds, each curve a rolling
+    mean over 10 rollouts; one colour per arm in every panel); returns the image file names."""
+    names = []
+    for task in records.spec.tasks:
+        fig = Figure(figsize=(15, 4))
+        axes = fig.subplots(1, len(TRAINING_PANELS))
+        drawn = False
+        for index, arm in enumerate(records.spec.arms):
+            runs = records.runs(task.env_id, arm)
+            if not runs:
+                continue
+            length = min(len(records.train[r.name]) for r in runs)
+            steps = np.array([row["env_step"] for row in records.train[runs[0].name][:length]])
+            for ax, (key, label) in zip(axes, TRAINING_PANELS, strict=True):
+                if key != "still_fraction" and arm == "ppo":
+                    continue  # plain PPO has no intrinsic reward
+                values = np.array(
+                    [[row[key] for row in records.train[r.name][:length]] for r in runs]
+                )
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    mean = np.nanmean(values, axis=0)
+                smooth = np.convolve(np.nan_to_num(mean), np.ones(10) / 10, mode="valid")
+                ax.plot(steps[9:], smooth, color=f"C{index}", label=f"{arm} (n={len(runs)})")
+                ax.set_title(label)
+                ax.set_xlabel("env steps")
+                if key == "intrinsic_mean":
+                    ax.set_yscale("log")
+            drawn = True
+        if not drawn:
+            continue
+        axes[-1].legend()
+        fig.suptitle(f"{task.env_id}: the intrinsic rewards during training")
+        name = f"{task.env_id}_intrinsic.png"
+        atomic_write(out / name, lambda tmp, fig=fig: fig.savefig(tmp, format="png", dpi=90))
+        names.append(name)
+    return names
+
+
 def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
     records = Records(spec, archive)
@@ -319,6 +367,8 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "(`probe/`).",
         "",
         *survival_table(records),
+        "",
+        *[f"![{name}]({name})" for name in plot_training(records, out)],
         "",
         "## Curves",
         "",
