@@ -278,7 +278,7 @@ TRAINING_PANELS = (
 def plot_training(records: Records, out: Path) -> list[str]:
     """Per task, against env steps, each arm's per-rollout intrinsic-reward mean, its novelty
     correlation and its policy's share of still triplets (means over seeds, each curve a rolling
-    mean over up to 10 rollouts; one colour per arm in every panel); returns the image file names."""
+    mean over up to 10 rollouts; one colour per arm in every panel); returns the image names."""
     names = []
     for task in records.spec.tasks:
         fig = Figure(figsize=(15, 4))
@@ -301,7 +301,8 @@ def plot_training(records: Records, out: Path) -> list[str]:
                     warnings.simplefilter("ignore", RuntimeWarning)
                     mean = np.nanmean(values, axis=0)
                 smooth = np.convolve(np.nan_to_num(mean), np.ones(window) / window, mode="valid")
-                ax.plot(steps[window - 1 :], smooth, color=f"C{index}", label=f"{arm} (n={len(runs)})")
+                label_arm = f"{arm} (n={len(runs)})"
+                ax.plot(steps[window - 1 :], smooth, color=f"C{index}", label=label_arm)
                 ax.set_title(label)
                 ax.set_xlabel("env steps")
                 if key == "intrinsic_mean":
