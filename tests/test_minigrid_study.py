@@ -205,3 +205,11 @@ def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path
         f"{task}/{a}/s0" for a in ("consistency", "ppo", "rnd")
     ]
     assert len(records.final(task, "ppo", "success_rate")) == 1
+    # the exploration column: distinct states reached, averaged over the bracket's rollouts
+    from simoun_agent.minigrid_study.report import intrinsic_table
+
+    rows = records.train[f"{task}/ppo/s0"]
+    last_tenth = rows[int(0.9 * len(rows)) :]
+    visited = np.mean([row["states_visited"] for row in last_tenth])
+    line = next(x for x in intrinsic_table(records) if x.startswith(f"| {task} | ppo | 90-100 % |"))
+    assert line.endswith(f"| {visited:.0f} |") and 100 < visited < 400

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure  # no pyplot: no backend or global figure state
+from matplotlib.ticker import EngFormatter
 
 from simoun_agent import stats
 from simoun_agent.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
@@ -147,6 +148,7 @@ INTRINSIC_KEYS = (
     "intrinsic_still_mean",
     "intrinsic_moving_mean",
     "still_fraction",
+    "states_visited",
 )
 
 
@@ -193,7 +195,10 @@ def intrinsic_table(records: Records) -> list[str]:
                 means = bracket_means(
                     records, runs, bracket, lambda r: [r[k] for k in INTRINSIC_KEYS]
                 )
-                cells = " | ".join(f"{v:.3f}" for v in means)
+                cells = " | ".join(
+                    f"{v:.0f}" if key == "states_visited" else f"{v:.3f}"
+                    for key, v in zip(INTRINSIC_KEYS, means, strict=True)
+                )
                 lines.append(f"| {task.env_id} | {arm} | {part} | {cells} |")
     return lines
 
@@ -258,6 +263,7 @@ def plot_curves(records: Records, out: Path) -> list[str]:
         if not drawn:
             continue
         axes[0].set_xlabel("env steps")
+        axes[0].xaxis.set_major_formatter(EngFormatter())  # 400 k, not overlapping 400000s
         axes[1].set_xlabel("training wall time (h, mean over seeds)")
         axes[0].set_ylabel("success rate (IQM, 95 % CI)")
         axes[0].legend()
@@ -305,6 +311,7 @@ def plot_training(records: Records, out: Path) -> list[str]:
                 ax.plot(steps[window - 1 :], smooth, color=f"C{index}", label=label_arm)
                 ax.set_title(label)
                 ax.set_xlabel("env steps")
+                ax.xaxis.set_major_formatter(EngFormatter())
                 if key == "intrinsic_mean":
                     ax.set_yscale("log")
             drawn = True
@@ -352,8 +359,9 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "",
         "Per rollout: mean and std of the intrinsic reward, its correlation with the novelty "
         "1/sqrt(N(s)) of the symbolic state reached (position, direction, carrying, door open), "
-        "its mean on still triplets (three equal frames) and on the others, and the share of "
-        "still triplets.",
+        "its mean on still triplets (three equal frames) and on the others, the share of "
+        "still triplets, and the number of distinct symbolic states reached since the run began "
+        "(the exploration each arm's policy achieved; plain PPO's rows for comparison).",
         "",
         *intrinsic_table(records),
         "",
