@@ -3,6 +3,9 @@ line, archived, skipped on a rerun, reported; and the SB3 adapter over a Gymnasi
 
 import csv
 import json
+import os
+import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -174,6 +177,40 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     train = rows(run_dir / "train.csv")
     assert [int(float(r["env_step"])) for r in train] == [1024, 2048, 3072, 4096]
     assert not (run_dir / CHECKPOINT).exists()
+
+
+def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_gone(tmp_path):
+    """The study is killed (driver, Ray and the trial) once the archive holds a run's
+    checkpoint; with the work directory deleted (a fresh machine), a rerun goes on from the
+    archived checkpoint and, finished, removes it from the archive."""
+    spec_file = tmp_path / "spec.json"
+    tiny = {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 8192}], "arms": ["ppo"]}
+    spec_file.write_text(json.dumps({**tiny, "evaluations": 8}))
+    archive, work = tmp_path / "archive", tmp_path / "work"
+    paths = ["--archive", str(archive), "--spec", str(spec_file), "--work-dir", str(work)]
+    archived = archive / "MiniGrid-DoorKey-5x5-v0" / "ppo" / "s0" / CHECKPOINT
+    command = [sys.executable, "-m", "simoun_agent.minigrid_study", "run", *paths]
+    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL)
+    deadline = time.monotonic() + 600  # generous: the suite may share a loaded machine
+    while not archived.is_file():
+        assert process.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    assert not archived.with_name("summary.json").exists()
+    saved_step = torch.load(archived, weights_only=False)["env_step"]
+    assert saved_step >= 1024
+    shutil.rmtree(work)
+
+    again = study("run", *paths)
+    assert again.returncode == 0, again.stderr[-4000:]
+    assert "from the archive's checkpoints: MiniGrid-DoorKey-5x5-v0/ppo/s0" in again.stdout
+    summary = json.loads(archived.with_name("summary.json").read_text())
+    assert summary["env_steps"] == 8192
+    assert [p["env_step_start"] for p in summary["parts"]] == [0, saved_step]
+    evals = rows(archived.with_name("eval.csv"))
+    assert [int(r["env_step"]) for r in evals] == list(range(0, 8193, 1024))
+    assert not archived.exists()
 
 
 def test_survival_row_by_hand():

@@ -15,6 +15,7 @@ transitions before its next gradient step.
 from __future__ import annotations
 
 import random
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -47,11 +48,14 @@ def load_intrinsic_state(envs: Any, state: dict[str, Any] | None) -> None:
 
 class RunCheckpoint(BaseCallback):
     """Writes ``path`` at the first rollout after each evaluation of the run ``training``
-    (a :class:`~simoun_agent.minigrid_study.training.Training`)."""
+    (a :class:`~simoun_agent.minigrid_study.training.Training`), then calls ``on_save`` with
+    it (the study hands it to Ray Tune, which keeps it beyond the run directory)."""
 
-    def __init__(self, path: Path, training: Training) -> None:
+    def __init__(
+        self, path: Path, training: Training, on_save: Callable[[Path], None] | None = None
+    ) -> None:
         super().__init__()
-        self.path, self.training = path, training
+        self.path, self.training, self.on_save = path, training, on_save
         self.saved_evaluations = 0
 
     def _on_training_start(self) -> None:
@@ -85,6 +89,8 @@ class RunCheckpoint(BaseCallback):
         }
         atomic_write(self.path, lambda tmp: torch.save(state, tmp))
         self.saved_evaluations = len(training.log.eval_rows)
+        if self.on_save is not None:
+            self.on_save(self.path)
 
 
 def restore(path: Path, training: Training) -> int:

@@ -10,6 +10,7 @@ state novelty), ``config.json`` and ``summary.json``.
 from __future__ import annotations
 
 import csv
+from collections.abc import Callable
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -41,12 +42,16 @@ def write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
 
 
 def train_run(
-    spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None
+    spec: StudySpec,
+    run: Run,
+    run_dir: Path,
+    commit: str | None = None,
+    on_checkpoint: Callable[[Path], None] | None = None,
 ) -> dict[str, Any]:
     """Train and evaluate ``run`` (set up by :func:`set_up`), writing its files into
     ``run_dir``; returns the summary. A ``checkpoint.pt`` left in ``run_dir`` by an ended
-    process is gone on from (:mod:`~simoun_agent.minigrid_study.checkpoint`); the finished run
-    removes it."""
+    process is gone on from (:mod:`~simoun_agent.minigrid_study.checkpoint`); each new one is
+    passed to ``on_checkpoint``; the finished run removes it."""
     training = set_up(spec, run, run_dir, commit)
     ppo, clock, log = training.ppo, training.clock, training.log
     checkpoint_path = run_dir / CHECKPOINT
@@ -57,7 +62,7 @@ def train_run(
         training.timed.seed(training.env_seed)
         part["env_step_start"] = 0
     log.parts.append(part)
-    checkpoint = RunCheckpoint(checkpoint_path, training)
+    checkpoint = RunCheckpoint(checkpoint_path, training, on_checkpoint)
     try:
         ppo.learn(
             run.task.steps - ppo.num_timesteps,

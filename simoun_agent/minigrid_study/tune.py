@@ -1,22 +1,30 @@
 """The study on Ray Tune: every unfinished run as a trial, two at a time, one torch thread each,
 each finished run's files copied into the archive as its trial reports them.
 
-Resuming: a run whose ``summary.json`` is in the archive is finished and skipped; one ended
-mid-way goes on from its last checkpoint (:mod:`~simoun_agent.minigrid_study.checkpoint`) when
-its run directory, ``<work_dir>/runs/<task>/<arm>/s<seed>``, is still there, and starts again
-from scratch when it is not. The files travel in the trial's result (not through a shared
-disk), so trials on the machines of a Ray cluster (``--address``) archive on the machine that
-runs the study (a run resumes there only on a node that holds its run directory).
+Resuming: a run whose ``summary.json`` is in the archive is finished and skipped. A run in
+progress reports each checkpoint it writes to Tune (kept in Tune's storage, the latest only),
+and the study copies it into the archive as ``<run>/checkpoint.pt``, where it stays until the
+run finishes: committed with the archive, it outlives the machine. A run ended mid-way goes on
+from the checkpoint in its run directory, ``<work_dir>/runs/<task>/<arm>/s<seed>``, when that
+is still there, else from the archive's, else from scratch. The files travel in the trial's
+result and the archived checkpoints in Ray's object store (not through a shared disk), so
+trials on the machines of a Ray cluster (``--address``) archive on the machine that runs the
+study; Tune's own checkpoint storage there needs the cluster's shared ``storage_path``, as Ray
+documents.
 """
 
 from __future__ import annotations
 
 import json
+import os
+import shutil
+import tempfile
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.minigrid_study.checkpoint import CHECKPOINT
 from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
 from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_agent.minigrid_study.training import write_json
@@ -56,40 +64,79 @@ def record_spec(spec: StudySpec, archive: Path) -> None:
     write_json(path, wanted)
 
 
+def archived_checkpoints(archive: Path, names: list[str]) -> dict[str, bytes]:
+    """The archived checkpoints of the runs ``names`` that have one, by run name."""
+    paths = {name: archive / name / CHECKPOINT for name in names}
+    return {name: path.read_bytes() for name, path in paths.items() if path.is_file()}
+
+
+def report_checkpoint(path: Path) -> None:
+    """Hand the run's checkpoint file ``path`` to Tune, which persists it in its storage."""
+    from ray import tune
+
+    # a hard link (so on path's file system): Tune copies the file, and we need not
+    with tempfile.TemporaryDirectory(dir=path.parent) as folder:
+        os.link(path, Path(folder) / CHECKPOINT)
+        tune.report({"finished": 0}, checkpoint=tune.Checkpoint.from_directory(folder))
+
+
 def trainable(
-    config: dict[str, Any], spec: dict[str, Any], commit: str | None, work_dir: str
+    config: dict[str, Any],
+    spec: dict[str, Any],
+    commit: str | None,
+    work_dir: str,
+    resume: dict[str, bytes],
 ) -> None:
     """One Tune trial: train the run ``config["run"]`` in its run directory under ``work_dir``
-    (from its checkpoint, if an earlier trial left one; not again if it finished there) and
-    report its files."""
+    (from the checkpoint an earlier trial left there, else from its archived one in ``resume``;
+    not again if it finished there), reporting each checkpoint, then report its files."""
     from ray import tune
 
     study = spec_from_dict(spec, "the study's spec")
     run = {r.name: r for r in study.runs()}[config["run"]]
     run_dir = Path(work_dir) / RUNS_DIR / run.name
     if not (run_dir / SUMMARY).is_file():
-        train_run(study, run, run_dir, commit=commit)
+        if not (run_dir / CHECKPOINT).is_file() and run.name in resume:
+            run_dir.mkdir(parents=True, exist_ok=True)
+            saved = resume[run.name]
+            atomic_write(run_dir / CHECKPOINT, lambda tmp: tmp.write_bytes(saved))
+        train_run(study, run, run_dir, commit=commit, on_checkpoint=report_checkpoint)
     files = {name: (run_dir / name).read_text() for name in RUN_FILES}
     tune.report({"finished": 1, "files_json": json.dumps(files)})
 
 
 def archive_files(archive: Path, name: str, files: dict[str, str]) -> None:
-    """Write a finished run's files under ``archive/name``, each atomically, the summary last."""
+    """Write a finished run's files under ``archive/name``, each atomically, the summary last,
+    then remove the run's archived checkpoint."""
     run_dir = archive / name
     run_dir.mkdir(parents=True, exist_ok=True)
     for file in sorted(files, key=lambda f: f == SUMMARY):
         text = files[file]
         atomic_write(run_dir / file, lambda tmp, text=text: tmp.write_text(text))
+    (run_dir / CHECKPOINT).unlink(missing_ok=True)
+
+
+def archive_checkpoint(archive: Path, name: str, folder: str) -> None:
+    """Copy the checkpoint in a Tune checkpoint's ``folder`` to ``archive/name``, atomically
+    (an interrupted copy keeps the previous one)."""
+    target = archive / name / CHECKPOINT
+    target.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(target, lambda tmp: shutil.copyfile(Path(folder) / CHECKPOINT, tmp))
 
 
 def archive_callback(archive: Path) -> Any:
-    """A Tune callback that archives each run as its trial reports its files."""
+    """A Tune callback that archives each run's checkpoints as its trial saves them, and its
+    files as it reports them."""
     from ray import tune
 
     class ArchiveOnResult(tune.Callback):
         def on_trial_result(self, iteration: int, trials: list, trial: Any, result: dict, **info):
             if "files_json" in result:
                 archive_files(archive, trial.config["run"], json.loads(result["files_json"]))
+
+        def on_checkpoint(self, iteration: int, trials: list, trial: Any, checkpoint, **info):
+            with checkpoint.as_directory() as folder:
+                archive_checkpoint(archive, trial.config["run"], folder)
 
     return ArchiveOnResult()
 
@@ -111,6 +158,9 @@ def run_study(
     done = set(finished_runs(spec, archive))
     todo = [run.name for run in spec.runs() if run.name not in done]
     print(f"{len(done)} of {len(spec.runs())} runs finished in {archive}; {len(todo)} to run")
+    resume = archived_checkpoints(archive, todo)
+    if resume:
+        print(f"from the archive's checkpoints: {', '.join(sorted(resume))}")
     outcome = {"skipped": sorted(done), "finished": [], "failed": []}
     if not todo:
         return outcome
@@ -126,6 +176,7 @@ def run_study(
                     spec=spec.to_json(),
                     commit=code_version()["commit"],
                     work_dir=str(work_dir.resolve()),
+                    resume=resume,
                 ),
                 {"cpu": 1},
             ),
@@ -140,6 +191,7 @@ def run_study(
                 storage_path=str(work_dir.resolve()),
                 failure_config=tune.FailureConfig(max_failures=0, fail_fast=False),
                 verbose=verbose,
+                checkpoint_config=tune.CheckpointConfig(num_to_keep=1),
                 callbacks=[archive_callback(archive)],
             ),
         )
