@@ -88,6 +88,34 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
     assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_intrinsic.png").is_file()
 
 
+def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_pooled_score(tmp_path):
+    from simoun_agent.minigrid_study.report import Records, improvement_lines, score_table
+
+    study_dir = Path(__file__).parent.parent / "docs" / "studies" / "minigrid"
+    small, large = "MiniGrid-DoorKey-6x6-v0", "MiniGrid-DoorKey-8x8-v0"
+    for arm in ("ppo", "consistency", "rnd"):
+        for name in (f"{small}/{arm}/s0", f"{small}/{arm}/s1", f"{small}/{arm}/s2"):
+            shutil.copytree(study_dir / name, tmp_path / name)
+        shutil.copytree(study_dir / large / arm / "s0", tmp_path / large / arm / "s0")
+    records = Records(load_spec(study_dir / "spec.json"), tmp_path)
+    row = next(x for x in score_table(records, "success_rate") if x.startswith("| rnd |"))
+    small_cell, large_cell, pooled = row.strip("| ").split(" | ")[1:]
+    assert small_cell.endswith("(n=3)") and "[" in small_cell
+    large_score = records.final(large, "rnd", "success_rate")[0]
+    assert large_cell == f"{large_score:.2f} (n=1, no CI)"
+    assert small_cell.startswith(pooled)  # the pooled score is the 6x6 score alone
+    [_, rnd_line] = improvement_lines(records)
+    assert rnd_line.endswith(f"({small})")
+
+    for name in (f"{small}/{arm}/s{seed}" for arm in ("ppo", "rnd") for seed in (1, 2)):
+        shutil.rmtree(tmp_path / name)
+    records = Records(load_spec(study_dir / "spec.json"), tmp_path)
+    [_, rnd_line] = improvement_lines(records)
+    assert rnd_line == "- P(rnd > ppo) on success rate: no task has 3 seeds yet"
+    rnd_row = next(x for x in score_table(records, "success_rate") if x.startswith("| rnd |"))
+    assert rnd_row.endswith("| — |")
+
+
 def test_the_default_spec_is_the_issue_s_design():
     spec = StudySpec()
     assert [(t.env_id, t.steps, len(t.seeds)) for t in spec.tasks] == [

@@ -31,6 +31,9 @@ __all__ = ["REPORT", "write_report"]
 REPORT = "report.md"
 REPS = 2000
 """bootstrap resamples of every interval"""
+MIN_SEEDS = 3
+"""fewest seeds a task needs for an interval, and to enter a pooled score or a comparison: a
+bootstrap over one or two runs gives an interval that looks precise and is not"""
 
 
 def read_rows(path: Path) -> list[dict[str, float]]:
@@ -80,20 +83,24 @@ def ci_text(point: float, low: float, high: float) -> str:
 
 def score_table(records: Records, key: str) -> list[str]:
     """Markdown rows: IQM of the final ``key`` with its 95 % CI, per task and arm, and over
-    all tasks."""
+    the tasks with ``MIN_SEEDS`` seeds; a task with fewer shows its runs' values alone."""
     spec = records.spec
     tasks = [t.env_id for t in spec.tasks]
-    lines = ["| arm | " + " | ".join(tasks) + " | all tasks |", "|---" * (len(tasks) + 2) + "|"]
+    head = "| arm | " + " | ".join(tasks) + f" | tasks with {MIN_SEEDS}+ seeds |"
+    lines = [head, "|---" * (len(tasks) + 2) + "|"]
     for arm in spec.arms:
         cells, pooled = [], {}
         for env_id in tasks:
             scores = records.final(env_id, arm, key)
             if len(scores) == 0:
                 cells.append("—")
-                continue
-            pooled[env_id] = scores
-            ci = stats.stratified_bootstrap_ci({env_id: scores}, stats.aggregate_iqm, REPS)
-            cells.append(f"{ci_text(*ci)} (n={len(scores)})")
+            elif len(scores) < MIN_SEEDS:
+                values = ", ".join(f"{s:.2f}" for s in scores)
+                cells.append(f"{values} (n={len(scores)}, no CI)")
+            else:
+                pooled[env_id] = scores
+                ci = stats.stratified_bootstrap_ci({env_id: scores}, stats.aggregate_iqm, REPS)
+                cells.append(f"{ci_text(*ci)} (n={len(scores)})")
         whole = stats.stratified_bootstrap_ci(pooled, stats.aggregate_iqm, REPS) if pooled else None
         cells.append(ci_text(*whole) if whole else "—")
         lines.append(f"| {arm} | " + " | ".join(cells) + " |")
@@ -101,18 +108,21 @@ def score_table(records: Records, key: str) -> list[str]:
 
 
 def improvement_lines(records: Records) -> list[str]:
-    """P(arm > ppo) on the final success rate, per intrinsic arm, over the tasks both ran."""
+    """P(arm > ppo) on the final success rate, per intrinsic arm, over the tasks both ran on
+    ``MIN_SEEDS`` seeds."""
     lines = []
     for arm in [a for a in records.spec.arms if a != "ppo"]:
         x, y = {}, {}
         for task in records.spec.tasks:
             mine = records.final(task.env_id, arm, "success_rate")
             base = records.final(task.env_id, "ppo", "success_rate")
-            if len(mine) and len(base):
+            if min(len(mine), len(base)) >= MIN_SEEDS:
                 x[task.env_id], y[task.env_id] = mine, base
         if x:
             ci = stats.probability_of_improvement_ci(x, y, REPS)
-            lines.append(f"- P({arm} > ppo) on success rate: {ci_text(*ci)}")
+            lines.append(f"- P({arm} > ppo) on success rate: {ci_text(*ci)} ({', '.join(x)})")
+        else:
+            lines.append(f"- P({arm} > ppo) on success rate: no task has {MIN_SEEDS} seeds yet")
     return lines
 
 
@@ -337,7 +347,9 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         f"{len(records.finished)} of {total} runs finished; {len(records.used)} used (the seeds "
         f"on which every arm has finished). Scores: the last evaluation of each "
         f"run ({spec.eval_episodes} episodes on env seeds {spec.eval_seed}+), IQM over seeds "
-        "with a 95 % stratified bootstrap CI, n = runs. For scale (another setting: symbolic "
+        f"with a 95 % stratified bootstrap CI, n = runs (a task with fewer than {MIN_SEEDS} seeds "
+        "shows its runs' values, without an interval, and enters no pooled score or "
+        "comparison). For scale (another setting: symbolic "
         "observations, 256 envs), RLeXplore reports PPO's success on DoorKey-8x8 at 1M steps as "
         "0.22 alone, 0.83 with ICM, 0.95 with RE3.",
         "",
