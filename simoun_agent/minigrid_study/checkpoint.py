@@ -1,5 +1,5 @@
-"""Mid-run checkpoints of a study run, so that a run whose process was ended (a session's end, a
-preempted cluster node) goes on from its last checkpoint instead of from scratch.
+"""Mid-run checkpoints of a study run, so that a run whose process was ended (a machine
+handed back, a preempted cluster node) goes on from its last checkpoint instead of from scratch.
 
 A checkpoint is written atomically at the first rollout after each evaluation (after PPO's
 update, with an empty rollout buffer). It holds PPO's policy and optimizer and its step and
