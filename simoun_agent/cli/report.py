@@ -15,7 +15,7 @@ from typing import Annotated
 
 import tyro
 
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.sweep.report import write_report
 
@@ -53,6 +53,7 @@ class ReportCommand:
     that stopped earlier are listed as short)"""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""
     args = parse(ReportCommand, argv, PROG, DESCRIPTION)

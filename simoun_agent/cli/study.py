@@ -26,7 +26,7 @@ from typing import Annotated, Union
 
 import tyro
 
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.study.plan import describe
 from simoun_agent.study.runner import StudyOptions, report_study, run_study, spec_from
@@ -96,6 +96,7 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 """The command line: plan a study, run it, or write its report again."""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""
     args = parse(Command, argv, PROG, DESCRIPTION)

@@ -27,7 +27,7 @@ from simoun_agent.cli.config_flags import (
     config_switches,
     overrides_from,
 )
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_agent.sweep import report
 from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec
@@ -132,6 +132,7 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
     return saved
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-sweep``."""
     argv = list(sys.argv[1:] if argv is None else argv)
