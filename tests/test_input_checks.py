@@ -3,6 +3,8 @@ works: paths that do not exist, keys given twice, misspelled names and values, s
 word that is not true/false, wrong types and vector envs given to the wrappers; and the
 command-line conventions (--version, a pipe closed early, --no-progress still reporting)."""
 
+import csv
+import json
 import pickle
 import subprocess
 import sys
@@ -18,8 +20,10 @@ from test_cli_conventions import TINY
 from simoun_agent.cli import report as report_cli
 from simoun_agent.cli import train as train_cli
 from simoun_agent.cli.config_flags import check_given_once
+from simoun_agent.config import resolve, to_dict
 from simoun_agent.minigrid_study import __main__ as minigrid_cli
 from simoun_agent.run.logger import read_csv
+from simoun_agent.sweep.report import write_report
 from simoun_wrappers import (
     ActionRepeat,
     FrameTriplet,
@@ -211,3 +215,82 @@ def test_action_repeat_never_turns_finite_rewards_into_inf():
     env.reset(seed=0)
     reward = env.step(0)[1]
     assert np.isfinite(reward) and reward == sys.float_info.max
+
+
+# reports never pool unlike things; damaged files are named
+
+
+def write_run(root: Path, name: str, env: str, seed: int, final: float, lr: float = 1e-3) -> Path:
+    """A finished run's files as simoun-train writes them (evaluations at 0 and 100)."""
+    run_dir = root / name
+    run_dir.mkdir(parents=True)
+    config = to_dict(resolve(None, {"env": env, "seed": seed, "agent.lr": lr}))
+    (run_dir / "config.json").write_text(json.dumps(config))
+    (run_dir / "eval.csv").write_text(
+        f"env_step,return_mean,wall_time_s\n0,0.0,1.0\n100,{final},2.0\n"
+    )
+    summary = {"env_step": 100, "wall_time_s": 2.0, "final_eval": {"return_mean": final}}
+    (run_dir / "summary.json").write_text(json.dumps(summary))
+    return run_dir
+
+
+CARTPOLE, WALKER, POINT = (
+    "dm_control/cartpole-swingup-v0",
+    "dm_control/walker-walk-v0",
+    "simoun/PointReach-v0",
+)
+
+
+def test_runs_configured_differently_on_two_tasks_are_two_variants(tmp_path):
+    for seed in range(3):
+        write_run(tmp_path, f"cartpole-s{seed}", CARTPOLE, seed, 500.0 + seed)
+        write_run(tmp_path, f"walker-s{seed}", WALKER, seed, 100.0 + seed, lr=2e-4)
+    write_report(tmp_path)
+    with (tmp_path / "aggregate.csv").open() as f:
+        rows = {row["variant"]: row for row in csv.DictReader(f)}
+    assert set(rows) == {"agent.lr=0.001", "agent.lr=0.0002"}
+    assert float(rows["agent.lr=0.001"]["iqm"]) == pytest.approx(0.501)
+    assert rows["agent.lr=0.0002"]["tasks"] == "walker-walk"
+
+
+def test_raw_returns_enter_no_statistic_across_tasks(tmp_path):
+    for seed in range(3):
+        write_run(tmp_path, f"cartpole-s{seed}", CARTPOLE, seed, 500.0)
+        write_run(tmp_path, f"point-s{seed}", POINT, seed, -485.0)
+    write_report(tmp_path)
+    with (tmp_path / "aggregate.csv").open() as f:
+        (row,) = csv.DictReader(f)
+    assert row["tasks"] == "cartpole-swingup" and float(row["iqm"]) == pytest.approx(0.5)
+    text = (tmp_path / "report.md").read_text()
+    assert "simoun-PointReach-v0 (no known maximum) enter no statistic across tasks" in text
+
+
+DAMAGES = {
+    "config.json": ('{"env": ', "config.json cannot be read"),
+    "config.json ": ("", "config.json cannot be read"),
+    "config.json  ": ("[1]", "config.json holds list, not a JSON object"),
+    "eval.csv": ("", "eval.csv holds no evaluation, but the run finished"),
+    "eval.csv ": ("env_step,return_mean,wall_time_s\nx,1,2\n", "eval.csv cannot be read"),
+    "eval.csv  ": (
+        "env_step,return_mean,wall_time_s\n0,nan,1\n",
+        "eval.csv line 2 has an empty, NaN or infinite value",
+    ),
+    "eval.csv   ": ("step,score\n0,1\n", "eval.csv has no column env_step, return_mean"),
+    "summary.json": ("{}", "summary.json has no finite final_eval.return_mean"),
+}
+"""file (padded to be unique) -> what it is overwritten with, and what the report says"""
+
+
+def test_a_damaged_run_is_named_and_left_out(tmp_path):
+    for seed in range(2):
+        write_run(tmp_path, f"s{seed}", CARTPOLE, seed, 500.0 + seed)
+    for seed, (file, (text, _)) in enumerate(DAMAGES.items(), start=2):
+        (write_run(tmp_path, f"s{seed}", CARTPOLE, seed, 0.0) / file.strip()).write_text(text)
+    write_report(tmp_path)
+    text = (tmp_path / "report.md").read_text()
+    assert "## Damaged runs (not counted)" in text
+    for seed, (_, named) in enumerate(DAMAGES.values(), start=2):
+        assert f"- s{seed}: {named}" in text
+    with (tmp_path / "report.csv").open() as f:
+        (row,) = csv.DictReader(f)
+    assert row["n"] == "2" and float(row["final_return_mean"]) == pytest.approx(500.5)
