@@ -294,3 +294,12 @@ def test_a_damaged_run_is_named_and_left_out(tmp_path):
     with (tmp_path / "report.csv").open() as f:
         (row,) = csv.DictReader(f)
     assert row["n"] == "2" and float(row["final_return_mean"]) == pytest.approx(500.5)
+
+
+def test_a_study_report_of_a_missing_directory_gives_the_report_advice(tmp_path, capsys):
+    from simoun_agent.cli import study as study_cli
+
+    spec = str(ROOT / "docs" / "studies" / "dmc100k.toml")
+    err = refused(capsys, study_cli.main, ["report", spec, "--study-dir", str(tmp_path / "x")])
+    assert "no study to report" in err and "(no such directory)" in err
+    assert "--resume" not in err

@@ -220,6 +220,6 @@ def test_a_nan_reward_in_an_evaluation_stops_with_a_checkpoint_naming_step_and_v
     assert "Traceback" not in err
     assert "returned the reward nan at step 5 of evaluation episode 0" in err
     assert "Stopped at env step 0 with a checkpoint" in err and "--resume" in err
-    state = load_checkpoint(run_dir)["state"]
-    assert state["env_step"] == 0 and state["eval_pending"]
+    counters = load_checkpoint(run_dir)["state"]["counters"]
+    assert counters["env_step"] == 0 and counters["eval_pending"]
     assert not (run_dir / "eval.csv").is_file() or read_csv(run_dir / "eval.csv") == []

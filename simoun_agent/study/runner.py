@@ -65,15 +65,23 @@ def spec_from(path: str) -> StudySpec:
     return spec
 
 
-def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
-    """The saved study record, from the study directory, else from the archive."""
+def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) -> dict[str, Any]:
+    """The saved study record, from the study directory, else from the archive; SetupError
+    with the advice of the command asked (``run --resume``, or ``report``: ``resuming``
+    False) when neither holds one."""
     for where in (study_dir, archive):
         if where is not None and (where / STUDY_FILE).is_file():
             return json.loads((where / STUDY_FILE).read_text())
     places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
+    missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
+    if not resuming:
+        raise SetupError(
+            f"no study to report: {places} holds no {STUDY_FILE}{missing}; pass the "
+            "--study-dir of a study that ran (or its archive, e.g. docs/studies/NAME)"
+        )
     raise SetupError(
-        f"no study to resume: {places} holds no {STUDY_FILE}; drop --resume to start the study, "
-        "or pass the --study-dir (or --archive) of the study to continue"
+        f"no study to resume: {places} holds no {STUDY_FILE}{missing}; drop --resume to start "
+        "the study, or pass the --study-dir (or --archive) of the study to continue"
     )
 
 
@@ -238,7 +246,7 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
 def report_study(spec: StudySpec, study_dir: Path) -> Path:
     """Write the report of the finished runs in ``study_dir`` (a study directory or its
     archive) again, with this code, into ``study_dir/report``; returns its ``report.md``."""
-    record = load_record(study_dir, None)
+    record = load_record(study_dir, None, resuming=False)
     check_same_spec(
         record,
         spec,
