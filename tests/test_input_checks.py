@@ -8,6 +8,7 @@ import json
 import pickle
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import gymnasium as gym
@@ -19,9 +20,10 @@ from test_cli_conventions import TINY
 
 from simoun_agent.cli import report as report_cli
 from simoun_agent.cli import train as train_cli
-from simoun_agent.cli.config_flags import check_given_once
+from simoun_agent.cli.config_flags import check_given_once, overrides_from
 from simoun_agent.config import resolve, to_dict
 from simoun_agent.minigrid_study import __main__ as minigrid_cli
+from simoun_agent.run import memory
 from simoun_agent.run.logger import read_csv
 from simoun_agent.sweep.report import write_report
 from simoun_wrappers import (
@@ -303,3 +305,37 @@ def test_a_study_report_of_a_missing_directory_gives_the_report_advice(tmp_path,
     err = refused(capsys, study_cli.main, ["report", spec, "--study-dir", str(tmp_path / "x")])
     assert "no study to report" in err and "(no such directory)" in err
     assert "--resume" not in err
+
+
+# advice that works: every setting that must change, in the interface the user is in
+
+
+def advised(err: str) -> dict[str, int]:
+    """The ``--key N`` settings a refusal's ``Set ...`` sentence asks for, as config keys."""
+    sentence = err[err.index("Set ") :].split(" (or", 1)[0]
+    pairs = [part.split() for part in sentence.removeprefix("Set ").split(" and ")]
+    return {flag[2:].replace("-", "_"): int(value) for flag, value in pairs}
+
+
+def test_a_memory_refusal_names_both_settings_when_both_must_change_and_they_fit(
+    tmp_path, capsys
+):
+    base = resolve(None, overrides_from(train_cli.parse_command(TINY).flags, TINY))
+    host = memory.device_memory("cpu")[1]
+    per_frame = memory.replay_bytes(base) / base.replay_capacity
+    two, one = (replace(base, agent=replace(base.agent, batch_size=b)) for b in (2, 1))
+    per_window = memory.update_bytes(two) - memory.update_bytes(one)
+    # the replay and the update each fill 80% of this machine: lowering one alone cannot fit
+    capacity, batch = int(0.8 * host / per_frame), int(0.8 * host / per_window)
+    argv = [*TINY, "--replay-capacity", str(capacity), "--run-dir", str(tmp_path / "run")]
+    argv[argv.index("--agent.batch-size") + 1] = str(batch)
+    err = refused(capsys, train_cli.main, argv)
+    settings = advised(err)
+    assert set(settings) == {"replay_capacity", "agent.batch_size"}, err
+    fixed = replace(
+        base,
+        replay_capacity=settings["replay_capacity"],
+        agent=replace(base.agent, batch_size=settings["agent.batch_size"]),
+    )
+    assert memory.check_memory(fixed) is None  # it fits, without even a warning
+    assert not (tmp_path / "run").exists()

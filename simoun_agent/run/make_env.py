@@ -227,6 +227,21 @@ def _check_env(env: gym.Env, env_id: str) -> None:
         )
 
 
+def check_task(config: TrainConfig) -> int | None:
+    """Make ``config``'s env and close it: SetupError when the agent cannot train on it (an
+    unknown id, actions that are not a bounded 1-D Box, no pixels), before a run is spent;
+    returns its episodes' step limit (None: it has none)."""
+    env = _make_base(config)
+    try:
+        _check_env(env, config.env)
+        limit = env.spec.max_episode_steps if env.spec is not None else None
+        # envs that truncate their own episodes (MiniGrid, PointReach) say so in max_steps
+        own = getattr(env.unwrapped, "max_steps", None)
+        return limit or (own if isinstance(own, int) and own > 0 else None)
+    finally:
+        env.close()
+
+
 def make_env(
     config: TrainConfig, distractor: Callable[[gym.Env], gym.Env] | None = None
 ) -> gym.Env:

@@ -103,6 +103,10 @@ class TrainingError(RuntimeError):
         super().__init__(message)
         self.exit_code = exit_code
 
+    def __reduce__(self) -> tuple:
+        # Ray copies a trial's exception to report it: rebuild it with its exit code
+        return type(self), (str(self), self.exit_code)
+
 
 def default_run_dir(config: TrainConfig) -> Path:
     """``runs/<task>-<preset>-s<seed>-<UTC time>``, e.g. ``runs/cartpole-swingup-cpu-s1-...``."""

@@ -15,6 +15,7 @@ from typing import Any, Literal
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.study import archive as archiving
+from simoun_agent.study.checks import check_fixed_spec, check_study
 from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_agent.study.plan import (
     EVALUATION,
@@ -113,13 +114,11 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
         text = Path(spec_path).read_text()
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
-    check_same_spec(
-        record,
-        spec,
-        f"{spec_path} is not the spec this study was started with",
-        f"resume with that spec (its text is in {STUDY_FILE}, spec_text), or start a new study "
-        "in another --study-dir",
-    )
+    changed = check_fixed_spec(record, spec, spec_path, [p for p in (study_dir, archive) if p])
+    if changed:  # a fix that leaves every finished run as it ran: the study goes on under it
+        part["spec_changed"] = {"keys": changed, "before": record["spec_text"]}
+        record.update(spec_file=spec_path, spec_text=Path(spec_path).read_text())
+        record["spec"] = spec.to_json()
     first = record["parts"][0]
     if not same_code(first, code) and not options.allow_other_commit:
         raise SetupError(
@@ -213,6 +212,7 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
     """Tune, select, evaluate, report the study of ``spec`` (read from ``spec_path``); the exit
     status (the sweep's: 130/143 stopped, 1 failed)."""
     study_dir, archive = options.study_dir, options.archive
+    check_study(spec, spec_path)
     record = open_study(spec, spec_path, options)
     save_record(record, [study_dir] + ([archive] if archive is not None else []))
     phases = Phases(spec, spec_path, options, ray)
