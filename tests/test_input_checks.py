@@ -317,9 +317,7 @@ def advised(err: str) -> dict[str, int]:
     return {flag[2:].replace("-", "_"): int(value) for flag, value in pairs}
 
 
-def test_a_memory_refusal_names_both_settings_when_both_must_change_and_they_fit(
-    tmp_path, capsys
-):
+def test_a_memory_refusal_names_both_settings_when_both_must_change_and_they_fit(tmp_path, capsys):
     base = resolve(None, overrides_from(train_cli.parse_command(TINY).flags, TINY))
     host = memory.device_memory("cpu")[1]
     per_frame = memory.replay_bytes(base) / base.replay_capacity
@@ -339,3 +337,28 @@ def test_a_memory_refusal_names_both_settings_when_both_must_change_and_they_fit
     )
     assert memory.check_memory(fixed) is None  # it fits, without even a warning
     assert not (tmp_path / "run").exists()
+
+
+# interruptions keep the evaluation grid
+
+
+def test_at_step_counts_a_resumed_run_at_its_nearest_evaluation_and_says_so(tmp_path):
+    def run(seed: int, last: int) -> None:
+        run_dir = write_run(tmp_path, f"s{seed}", CARTPOLE, seed, 500.0)
+        config = json.loads((run_dir / "config.json").read_text())
+        (run_dir / "config.json").write_text(json.dumps({**config, "eval_every": 100}))
+        csv_text = f"env_step,return_mean,wall_time_s\n0,0.0,1.0\n{last},500,2.0\n"
+        (run_dir / "eval.csv").write_text(csv_text)
+
+    for seed in range(3):
+        run(seed, 100)
+    run(3, 103)  # stopped mid-episode and resumed: 3 steps off the grid
+    run(4, 160)  # more than half an eval_every off: short of the budget
+    write_report(tmp_path, budget=("env_step", 100))
+    text = (tmp_path / "report.md").read_text()
+    assert "## Runs counted at the evaluation nearest to 100 env steps" in text
+    assert "- s3: its evaluation at 103 env steps (eval_every 100)" in text
+    assert "- s4: no evaluation at 100 env steps" in text
+    with (tmp_path / "report.csv").open() as f:
+        (row,) = csv.DictReader(f)
+    assert row["n"] == "4"

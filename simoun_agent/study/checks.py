@@ -61,12 +61,14 @@ def memory_line(spec: StudySpec, task: str) -> tuple[str, ...]:
 
 
 def check_study(spec: StudySpec, spec_path: str) -> None:
-    """Make each task once and estimate each configuration's memory; SetupError naming the
-    spec's line, the task and the fix for the first that cannot run."""
+    """Make each task once, check that the replay holds a batch of its episodes and estimate
+    each configuration's memory; SetupError naming the spec's line, the task and the fix for
+    the first that cannot run (the tasks first: they take a second each, a memory estimate
+    several)."""
     source = Source(Path(spec_path), Path(spec_path).read_text())
     made: dict[str, int | None] = {}
-    measured: set[str] = set()
-    for phase, recipe, setting, config in configs(spec):
+    found = configs(spec)
+    for phase, recipe, _, config in found:
         env = json.dumps([config.env, config.env_kwargs, config.env_module], sort_keys=True)
         if env not in made:
             try:
@@ -77,18 +79,20 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
                     f"{config.env} cannot be trained by the recipes: {err} Replace it in "
                     f"[{phase}] tasks (the spec is read before anything runs).",
                 ) from None
-        shown = ", ".join(f"{k} = {v!r}" for k, v in setting.items())
         try:
             check_replay(config, made[env], SPEC_KEYS)
         except SetupError as err:
             raise source.error(
-                memory_line(spec, config.env), f"{recipe} on {config.env} with {shown}: {err}"
+                memory_line(spec, config.env), f"{recipe} on {config.env}: {err}"
             ) from None
+    measured: set[str] = set()
+    for _, recipe, setting, config in found:
         memory = {**to_dict(config), "env": None, "seed": None, "total_env_steps": None}
         key = json.dumps(memory, sort_keys=True)
         if key in measured:
             continue
         measured.add(key)
+        shown = ", ".join(f"{k} = {v!r}" for k, v in setting.items())
         try:
             warning = check_memory(config, SPEC_KEYS)
         except SetupError as err:

@@ -380,8 +380,10 @@ BUDGETS = {"env_step": "env steps", "wall_time_s": "seconds of wall time"}
 """What ``--at-step`` and ``--at-wall-time`` cut the runs at (an eval.csv column)."""
 
 BUDGET_RULE = (
-    "--at-step N counts a run only if it has an evaluation at exactly N env steps (so every "
-    "row compares evaluations at N, never at 20k beside 30k); --at-wall-time S counts a run "
+    "--at-step N counts a run only if it has an evaluation at N env steps, or within half its "
+    "eval_every of N (a run stopped mid-episode and resumed evaluates a few steps off its "
+    "grid; such runs are listed with the step used), so every row compares evaluations at N, "
+    "never at 20k beside 30k; --at-wall-time S counts a run "
     "only if it trained past S (an evaluation at or after S seconds) and uses its last "
     "evaluation at or before S. Runs that fall short are listed. Each row holds runs of one "
     "evaluation grid (eval_every): runs on another grid than most of their row are listed and "
@@ -401,7 +403,8 @@ def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None
     """
     if shortfall(record, column, budget) is not None:
         return None
-    keep = record.curve[column] <= budget
+    end = nearest_evaluation(record, budget) if column == "env_step" else budget
+    keep = record.curve[column] <= end
     curve = {key: values[keep] for key, values in record.curve.items()}
     summary = {
         "env_step": float(curve["env_step"][-1]),
@@ -411,13 +414,29 @@ def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None
     return RunRecord(record.run_dir, record.config, curve, summary, None, record.modified)
 
 
+def nearest_evaluation(record: RunRecord, step: float) -> float | None:
+    """The env step of ``record``'s evaluation at ``step``, else, for a step on its grid (a
+    multiple of its ``eval_every``), of its nearest one within half an ``eval_every`` (a run
+    stopped mid-episode and resumed evaluates off its grid by less than an episode), else
+    None."""
+    x = record.curve["env_step"]
+    if not len(x):
+        return None
+    near = x[np.argmin(np.abs(x - step))]
+    every = record.config.get("eval_every")
+    on_grid = isinstance(every, (int, float)) and every > 0 and step % every == 0
+    if near == step or (on_grid and abs(near - step) <= every / 2):
+        return float(near)
+    return None
+
+
 def shortfall(record: RunRecord, column: str, budget: float) -> str | None:
     """Why ``record`` does not count at ``budget`` of ``column`` (None when it does)."""
     x = record.curve[column]
     if not len(x):
         return "no evaluation yet"
     if column == "env_step":
-        if np.any(x == budget):
+        if nearest_evaluation(record, budget) is not None:
             return None
         if x.max() < budget:
             return f"reached only {x.max():g} env steps"
@@ -477,6 +496,8 @@ class Comparison:
     """runs left out for another evaluation grid than their row's"""
     damaged: list[str] = field(default_factory=list)
     """runs left out for a file that cannot be read, with the file and the problem"""
+    nearby: list[str] = field(default_factory=list)
+    """runs counted at an ``--at-step`` budget with their evaluation nearest to it"""
 
 
 def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Comparison:
@@ -495,11 +516,17 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
             "simoun-train runs"
         )
     reasons: dict[Path, str] = {}
+    comparison_nearby: list[str] = []
     if budget is not None:
         column, value = budget
         cut_records = []
         for record in records:
             cut = at_budget(record, column, value)
+            if cut is not None and cut.summary["env_step"] != value and column == "env_step":
+                comparison_nearby.append(
+                    f"{record.label(root)}: its evaluation at {cut.summary['env_step']:g} env "
+                    f"steps (eval_every {show(record.config.get('eval_every'))})"
+                )
             if cut is None and record.error is None:
                 reasons[record.run_dir] = shortfall(record, column, value) or ""
                 record.summary = None
@@ -507,6 +534,7 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
         records = cut_records
     comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
     comparison.damaged = damaged
+    comparison.nearby = comparison_nearby
     for group in comparison.groups:
         # the grid first, so that a copy of a seed on another grid cannot displace its peer
         group.runs, others = one_evaluation_grid(group.runs)
@@ -785,6 +813,16 @@ def markdown(
     if comparison.unfinished:
         title = "Unfinished runs" if budget is None else "Runs short of the budget"
         lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in comparison.unfinished]
+    if comparison.nearby:
+        lines += [
+            "",
+            f"## Runs counted at the evaluation nearest to {budget[1]:g} env steps",
+            "",
+            "No evaluation at exactly the budget (a stop mid-episode and a resume move the "
+            "later evaluations off the grid by less than an episode); the nearest one within "
+            "half its eval_every counts.",
+            "",
+        ] + [f"- {n}" for n in comparison.nearby]
     if comparison.duplicates:
         lines += [
             "",
