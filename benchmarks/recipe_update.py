@@ -60,7 +60,8 @@ def filled(recipe: str, setting: dict, task: str, action_repeat: int, fill: int)
     )
     env, eval_env, agent, replay = build(config)
     learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
-    updates = (config.total_env_steps // action_repeat - learning_starts) * config.updates_per_step
+    updating = config.total_env_steps // action_repeat - learning_starts
+    updates = -(-updating // config.agent.update_every_steps) * config.updates_per_step
     try:
         rng = np.random.default_rng(0)
         low, high = env.action_space.low, env.action_space.high
