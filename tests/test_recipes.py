@@ -100,42 +100,43 @@ class Spy:
         agent.encoder_target.encode_key = spy_key
 
 
-def test_sac_sees_unshifted_frames_and_rad_shifted_ones():
-    frames, *rest = window()
+def test_sac_sees_unshifted_frames_and_rad_shifted_ones_with_the_next_obs_shifted_apart():
+    frames, *_ = window()
     sac, rad = recipe_agent("sac"), recipe_agent("rad")
-    seen = {}
-    for name, agent in (("sac", sac), ("rad", rad)):
-        spy = Spy(agent)
-        agent.update_window(frames, *rest, step=0)
-        seen[name] = spy.windows[0]
-    assert torch.equal(seen["sac"], frames)
-    assert not torch.equal(seen["rad"], frames)
+    plain, shifted = sac.augment(frames, None), rad.augment(frames, None)
+    assert torch.equal(plain.windows[0], frames)
+    assert torch.equal(plain.next_obs[0], frames[:, 1:4]) and plain.shared == 1
+    assert not torch.equal(shifted.windows[0], frames)
     assert rad.shift_pad == shift_pad(FRAME[1]) == 1
-    # one view of the critic and one of the target, the online encoder for the next state
-    assert len(spy.windows) == 1 and spy.windows[0].shape == frames.shape
+    # RAD's curl_sac.py crops obs and next_obs by separate calls: the next triplet has its own
+    # offset, so the critic's encoder pass cannot give it (shared 0)
+    assert shifted.shared == 0 and shifted.next_obs[0].shape == frames[:, 1:4].shape
+    assert not torch.equal(shifted.next_obs[0], shifted.windows[0][:, 1:4])
+    assert torch.equal(random_shift(frames[:, 1:4], 0), frames[:, 1:4])
 
 
-def test_rad_is_what_drq_meant_before_it_followed_drq_s_k_m_averaging():
-    """The values the 'drq' recipe had until it followed DrQ as published."""
-    before = {"encoder": "stacked", "augmentation": "shift", "transition_weight": 0.0}
-    before.update(contrastive_weight=0.0, reward_weight=0.0, curiosity=False)
-    before.update(alpha_lr=1e-3, alpha_beta=0.9)
-    assert RECIPES["rad"].values == before
+def test_rad_is_rad_s_published_sac():
+    """RadSacAgent of RAD's curl_sac.py with train.py's values: the defaults' SAC (temperature
+    init 0.1, lr 1e-4, beta1 0.5; critic tau 0.01, EMA target encoder 0.05 read by the TD
+    target), delta-orthogonal conv init, obs and next_obs augmented independently."""
+    expected = {"encoder": "stacked", "augmentation": "shift", "transition_weight": 0.0}
+    expected.update(contrastive_weight=0.0, reward_weight=0.0, curiosity=False)
+    expected.update(conv_init="delta_orthogonal", independent_next_shift=True)
+    assert RECIPES["rad"].values == expected
     rad = resolve(None, {"agent.recipe": "rad"}).agent
-    defaults = AgentConfig()
     assert (rad.critic_augmentations, rad.target_augmentations) == (1, 1)
-    assert (rad.next_state_encoder, rad.actor, rad.n_step) == ("online", "gaussian", 1)
-    assert (rad.init_temperature, rad.critic_tau, rad.encoder_tau, rad.lr) == (
-        defaults.init_temperature, defaults.critic_tau, defaults.encoder_tau, defaults.lr,
-    )  # fmt: skip
+    assert (rad.next_state_encoder, rad.actor, rad.n_step) == ("target", "gaussian", 1)
+    assert (rad.init_temperature, rad.alpha_lr, rad.alpha_beta) == (0.1, 1e-4, 0.5)
+    assert (rad.critic_tau, rad.encoder_tau) == (0.01, 0.05)
 
 
 @pytest.mark.parametrize("name", ["drq", "drqv2", "rad", "curl", "sac"])
 def test_each_baseline_cites_its_paper_and_names_its_deviations(name):
     recipe = RECIPES[name]
     assert re.search(r"\([A-Z][^()]* (et al\. |& [A-Z]\w+ )?(19|20)\d\d\)", recipe.description)
-    if name != "sac":
-        assert recipe.deviations and all(len(item) > 20 for item in recipe.deviations)
+    assert recipe.deviations and all(len(item) > 20 for item in recipe.deviations)
+    # the published file and function it follows
+    assert re.search(r"\w+\.py", recipe.description) and "hidden" in " ".join(recipe.deviations)
     if name in ("rad", "curl"):  # the crop of 100x100 renders the papers use
         assert any("random crop of 100x100" in item for item in recipe.deviations)
 
@@ -148,15 +149,17 @@ def perturb(module: torch.nn.Module, seed: int) -> None:
 
 
 def drq_critic_loss_by_hand(agent, frames, action, reward, discount, seed, value_encoder):
-    """DrQ's critic loss written out: K = 2 shifted next states, each through ``value_encoder``
-    for the target Q heads and the online encoder for the actor, their targets averaged; M = 2
-    shifted current states, each against that target, the losses averaged."""
+    """DrQ's critic loss written out: K = 2 next states, each shifted by an offset of its own
+    (drq.py's next_obs and next_obs_aug), each through ``value_encoder`` for the target Q heads
+    and the online encoder for the actor, their targets averaged; M = 2 shifted current states,
+    each against that target, the losses averaged."""
     agent = copy.deepcopy(agent)
     torch.manual_seed(seed)
     views = [random_shift(frames, agent.shift_pad) for _ in range(2)]  # the update's draws
+    next_views = [random_shift(frames[:, 1:], agent.shift_pad) for _ in range(2)]
     gamma, alpha = agent.config.discount, float(agent.alpha.detach())
     with torch.no_grad():
-        next_obs = torch.cat([v[:, 1:] for v in views])
+        next_obs = torch.cat(next_views)
         next_action, log_prob = agent.actor(agent.encoder(next_obs).state)
         q1_bar, q2_bar = agent.critic_target(value_encoder(agent)(next_obs).state, next_action)
         value = (torch.min(q1_bar, q2_bar) - alpha * log_prob)[:, 0].view(2, -1)
