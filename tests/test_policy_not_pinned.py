@@ -9,6 +9,8 @@ drqv2 runs: the same evaluation return to 8 digits for 40k env steps). A plateau
 leaves is no failure: only actions that are all at the bounds and no longer move are.
 """
 
+import itertools
+
 import numpy as np
 import pytest
 import torch
@@ -76,7 +78,7 @@ def test_the_policy_is_not_pinned_at_the_action_bounds(recipe, tmp_path):
     trained = [(step, actions) for step, actions in probe.actions if step > warmup]
     assert len(trained) >= 3, [step for step, _ in probe.actions]
     shown = {step: np.round(actions[:4, 0], 6).tolist() for step, actions in trained}
-    for (_, before), (step, after) in zip(trained, trained[1:]):
+    for (_, before), (step, after) in itertools.pairwise(trained):
         assert np.abs(after - before).max() > MOVED, f"no action moved by env step {step}: {shown}"
     _, last = trained[-1]
     assert (np.abs(last) < BOUND).any(), f"every action at the bounds at the end: {shown}"
