@@ -1,7 +1,7 @@
 """Cost of one gradient update of each recipe of the DMC 100k study, against DrQ's, in one run.
 
-Issue 20's diagnostic of Simoun's equal-wall-time result: the study's runs spread over sessions
-whose machines ran at different speeds, so their wall times compare only within a session. This
+A diagnostic of Simoun's equal-wall-time result: the study's runs spread over machines that
+ran at different speeds, so their wall times compare only between runs on one machine. This
 times the updates themselves, every recipe in the same process on the same replay contents:
 
 - each recipe is built as the study ran it (the ``cpu`` preset, the recipe, its setting selected

@@ -11,7 +11,7 @@ observation and the replay bytes per transition at 84x84 RGB.
 
 ``--n-step-curiosity`` instead times the cpu preset's Simoun update (48x48, 3-step returns,
 random shift, batch 64, one thread) with Eq. 13's intrinsic reward of every step of the return
-(issue 17) against the same agent adding only that of the state at t (the behaviour before),
+against the same agent adding only that of the state at t (the form without ``return_mask``),
 alternating in each repeat.
 """
 
@@ -54,7 +54,7 @@ def filled_replay(
 
 def first_step_curiosity(agent: SimounAgent, replay: FrameReplay):
     """Like ``stepper``, but through the n-step call without ``return_mask``: only r^i(s_t)
-    enters each n-step target, as before issue 17 (the same encoder passes but the triplet at
+    enters each n-step target (the same encoder passes but the triplet at
     t+2)."""
     counter = itertools.count()
     cfg = agent.config

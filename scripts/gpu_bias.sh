@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fig. 5 / Fig. 7 evidence on a lent GPU machine (where Ray cannot be installed): the Fig. 6
+# Fig. 5 / Fig. 7 evidence on a GPU machine without Ray: the Fig. 6
 # encoders stacked, flare and dual_interactive (same losses, `--agent.recipe`) trained with
 # `simoun-train --preset cpu` on dm_control cartpole-swingup for STUDY_STEPS env steps, SEEDS,
 # side by side; then `simoun-analyze bias` over the seed-1 runs and `simoun-analyze masks` of the

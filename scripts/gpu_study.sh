@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The recipe comparison of docs/study.md on a lent GPU machine (16 cores, one GPU), where Ray
-# cannot be installed: 6 settings x 3 seeds of `simoun-train --preset cpu` on dm_control
-# cartpole-swingup, run side by side as plain processes for at most STUDY_SECONDS each, then
-# packed (logs and CSVs, no checkpoints) into $OUT/study.tgz for `simoun-report`.
+# The recipe comparison of docs/study.md on a GPU machine (16 cores, one GPU) without Ray:
+# 6 settings x 3 seeds of `simoun-train --preset cpu` on dm_control cartpole-swingup, run side
+# by side as plain processes for at most STUDY_SECONDS each, then packed (logs and CSVs, no
+# checkpoints) into $OUT/study.tgz for `simoun-report`.
 # Usage (from the repo root, wheels in .devkit/whl, a trimmed dm_control in .devkit/site):
 #   STUDY_SECONDS=470 bash scripts/gpu_study.sh
 set -u

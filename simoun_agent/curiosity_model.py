@@ -166,8 +166,8 @@ class CuriosityModel(OnlineModel):
     thread; a later ``watch`` starts a new one.
 
     Measured with ``benchmarks/curiosity.py`` (dm_control cartpole-swingup at 84x84, one torch
-    thread, a shared 2-core CPU under load; the README has the tables): the defaults added
-    11-21 % to the env's step time for the features and 5-29 % with training in the thread, in
+    thread, a shared 2-core CPU under load; tables in docs/intrinsic-rewards.md): the defaults
+    added 11-21 % to the env's step time for the features and 5-29 % with training in the thread, in
     three runs. On a GPU pass ``device="cuda"``. ``last_metrics`` holds the last published step's
     losses, its duration (``update_ms``), the wait for it (``wait_ms``) and the batch standard
     deviation of f_m and f_a (``motion_std``, ``appearance_std``: near 0 means the features

@@ -15,6 +15,7 @@ from simoun_wrappers.curiosity_reward import (
 )
 from simoun_wrappers.distractors import ColorShift, MovingBackground
 from simoun_wrappers.frames import FrameTriplet
+from simoun_wrappers.intrinsic_reward import ConstantBonusReward, ConstantBonusVectorReward
 from simoun_wrappers.motion import ResidualMotion, residual_motion
 from simoun_wrappers.observation import SimounObservation
 from simoun_wrappers.rnd import RNDReward, RNDVectorReward
@@ -23,6 +24,8 @@ from simoun_wrappers.sb3_check import check_sb3_policy
 __all__ = [
     "ActionRepeat",
     "ColorShift",
+    "ConstantBonusReward",
+    "ConstantBonusVectorReward",
     "ConsistencyCuriosityReward",
     "ConsistencyCuriosityVectorReward",
     "FeatureSource",

@@ -9,18 +9,12 @@ trained Simoun agent's encoder). The wrappers are ``simoun_wrappers.intrinsic_re
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import VectorEnv
 
-from simoun_wrappers.curiosity import (
-    FeatureSource,
-    RunningMax,
-    consistency_distance,
-    consistency_reward,
-)
+from simoun_wrappers.curiosity import FeatureSource, consistency_distance
+from simoun_wrappers.intrinsic_normalization import Normalization, PaperMaxima
 from simoun_wrappers.intrinsic_reward import (
     IntrinsicReward,
     IntrinsicSignal,
@@ -31,21 +25,16 @@ from simoun_wrappers.intrinsic_reward import (
 __all__ = ["ConsistencyCuriosityReward", "ConsistencyCuriosityVectorReward", "ConsistencySignal"]
 
 
+PAPER_DECAY = 2e-5
+"""Eq. 13's lambda per environment step (CCLF's value for its similar term)"""
+
+
 class ConsistencySignal(IntrinsicSignal):
-    """Eq. 13 without its weight C: ``exp(-decay * t) * d * r_e_max / r_i_max``.
+    """Eq. 13's distance ``d``: how far the motion features disagree with the appearance
+    features' frame-to-frame changes (:func:`~simoun_wrappers.curiosity.consistency_distance`),
+    from a :class:`~simoun_wrappers.curiosity.FeatureSource`."""
 
-    ``__call__(triplets, extrinsic)`` computes ``d`` with the feature source, raises the running
-    maxima with the batch (so the result is <= ``r_e_max``), computes Eq. 13 at the current
-    global step, then advances the step by the batch size (one env step per sub-env).
-    """
-
-    def __init__(
-        self,
-        features: FeatureSource | SharedSource,
-        decay: float,
-        r_e_max_init: float,
-        r_i_max_init: float,
-    ) -> None:
+    def __init__(self, features: FeatureSource | SharedSource) -> None:
         super().__init__(features)
         if not isinstance(self.source, FeatureSource):
             raise TypeError(
@@ -53,21 +42,13 @@ class ConsistencySignal(IntrinsicSignal):
                 f"f_a (B, 3, D)), got {type(self.source).__name__}. Use e.g. "
                 "simoun_agent.curiosity_model.CuriosityModel."
             )
-        if not decay >= 0:  # also refuses NaN
-            raise ValueError(
-                f"decay must be a number >= 0, got decay={decay}; use the paper's decay=2e-5, or "
-                "decay=0 for a reward that never fades."
-            )
-        self.decay = float(decay)
-        self.maxima = RunningMax(r_e_max=r_e_max_init, r_i_max=r_i_max_init)
-        self.step = 0
 
     @property
     def features(self) -> FeatureSource:
         """The feature source (this signal's ``source``)."""
         return self.source
 
-    def __call__(self, triplets: np.ndarray, extrinsic: np.ndarray) -> np.ndarray:
+    def raw(self, triplets: np.ndarray) -> np.ndarray:
         f_m, f_a = self.source(triplets)
         f_m = np.asarray(f_m, dtype=np.float32)
         f_a = np.asarray(f_a, dtype=np.float32)
@@ -81,25 +62,12 @@ class ConsistencySignal(IntrinsicSignal):
                 f"The feature source returned {f_m.shape[0]} feature rows for {len(triplets)} "
                 "triplets; it must return one row per triplet."
             )
-        distance = consistency_distance(f_m, f_a)
-        self.maxima.update(extrinsic, distance)
-        reward = consistency_reward(
-            distance, self.step, self.maxima.r_e_max, self.maxima.r_i_max, 1.0, self.decay
-        )
-        self.step += len(triplets)
-        return reward.astype(np.float64)
-
-    def state_dict(self) -> dict[str, Any]:
-        """The global step and both running maxima."""
-        return {"step": self.step, **self.maxima.state_dict()}
-
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        self.maxima.load_state_dict(state)
-        self.step = int(state["step"])
+        return consistency_distance(f_m, f_a).astype(np.float64)
 
 
 class ConsistencyArguments:
-    """The consistency wrappers' constructor: ``features`` and Eq. 13's constants."""
+    """The consistency wrappers' constructor: ``features``, Eq. 13's constants, and the
+    normalization."""
 
     signal_type = ConsistencySignal
 
@@ -108,9 +76,12 @@ class ConsistencyArguments:
         env: gym.Env | VectorEnv,
         features: FeatureSource,
         scale: float = 0.2,
-        decay: float = 2e-5,
+        decay: float | None = None,
         r_e_max_init: float = 1.0,
         r_i_max_init: float = 1.0,
+        normalization: str | Normalization = "paper",
+        warmup: int = 0,
+        progress: float | None = None,
     ) -> None:
         """Wrap ``env``, whose observations are Simoun triplets.
 
@@ -120,20 +91,29 @@ class ConsistencyArguments:
                 :class:`ConsistencyCuriosityReward`, a vector env for
                 :class:`ConsistencyCuriosityVectorReward`.
             features: the :class:`FeatureSource` giving ``f_m`` and ``f_a``.
-            scale: the temperature weight C of Eq. 13.
-            decay: lambda of Eq. 13, per environment step.
-            r_e_max_init: initial running maximum of ``|r_e|`` (> 0).
-            r_i_max_init: initial running maximum of ``d`` (> 0). Both defaults match
-                ``simoun_agent.AgentConfig``; a tiny ``r_i_max_init`` lets the first distances set
-                the scale instead.
+            scale: the weight of the normalized reward (C of Eq. 13).
+            decay: lambda of Eq. 13's ``exp(-lambda * t)``, per environment step; None: the
+                paper's 2e-5 with ``normalization="paper"`` (Eq. 13 as written), else 0 (the
+                literature's normalizations have no schedule).
+            r_e_max_init: initial running maximum of ``|r_e|`` (> 0; ``"paper"`` only).
+            r_i_max_init: initial running maximum of ``d`` (> 0; ``"paper"`` only). Both
+                defaults match ``simoun_agent.AgentConfig``; a tiny ``r_i_max_init`` lets the
+                first distances set the scale instead.
+            normalization: a name of ``simoun_wrappers.intrinsic_normalization.NORMALIZATIONS``
+                or a ``Normalization``. ``"paper"`` (Eq. 13 as written) is always positive: a
+                bonus for staying alive to an on-policy learner (see docs/intrinsic-rewards.md).
+            warmup: transitions that get reward 0 while the statistics settle.
+            progress: None, or NovelD's alpha: pay ``max(d(s') - alpha * d(s), 0)``.
         """
+        if decay is None:
+            decay = PAPER_DECAY if normalization == PaperMaxima.name else 0.0
         super().__init__(
             env,
             scale,
-            features=features,
-            decay=decay,
-            r_e_max_init=r_e_max_init,
-            r_i_max_init=r_i_max_init,
+            normalization,
+            {"decay": decay, "warmup": warmup, "progress": progress},
+            {"features": features},
+            {"r_e_max_init": r_e_max_init, "r_i_max_init": r_i_max_init},
         )
 
 
@@ -142,14 +122,16 @@ class ConsistencyCuriosityReward(ConsistencyArguments, IntrinsicReward):
 
     At every step the wrapper encodes the new observation's triplet ``[o_{t-1}, o_t, o_{t+1}]``
     with ``features``, measures how far the motion features disagree with the appearance
-    features' frame-to-frame changes, and returns ``r_e + r_i`` with
-    ``r_i = scale * exp(-decay * t) * d * r_e_max / r_i_max``. ``r_e_max`` is the running maximum
-    of ``|r_e|`` and ``r_i_max`` the running maximum of ``d``, both raised before ``r_i`` is
-    computed, so ``r_i <= scale * r_e_max``. ``t`` counts the steps taken through this wrapper.
-    ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"``.
+    features' frame-to-frame changes (``d``), and returns ``r_e + r_i`` with
+    ``r_i = scale * exp(-decay * t) * normalize(d)``. With ``normalization="paper"`` this is
+    Eq. 13: ``normalize(d) = d * r_e_max / r_i_max``, ``r_e_max`` the running maximum of
+    ``|r_e|`` and ``r_i_max`` that of ``d``, both raised before ``r_i`` is computed, so
+    ``r_i <= scale * r_e_max``. ``t`` counts the steps taken through this wrapper. ``info`` gets
+    ``"reward_extrinsic"`` and ``"reward_intrinsic"``.
 
     Feature sources that learn online (with a ``watch`` method) are handed every transition.
-    The running maxima and the step are in ``state_dict()`` / ``load_state_dict()`` and are
+    The normalization's statistics and the step are in ``state_dict()`` / ``load_state_dict()``
+    and are
     pickled with the wrapper; in an ``AsyncVectorEnv`` read them with
     ``envs.call("state_dict")``. For ``gym.make_vec`` prefer
     :class:`ConsistencyCuriosityVectorReward`: one feature source, one batched call for all
@@ -178,7 +160,8 @@ class ConsistencyCuriosityVectorReward(ConsistencyArguments, IntrinsicVectorRewa
 
     Same reward as :class:`ConsistencyCuriosityReward`, but one feature source and one running
     maximum serve all sub-envs, and the features of all active sub-envs are computed in a single
-    call. The autoreset steps are skipped in both autoreset modes (see
+    call; ``"return_std"`` keeps one discounted return per sub-env. The autoreset steps are
+    skipped in both autoreset modes (see
     :class:`~simoun_wrappers.intrinsic_reward.IntrinsicVectorReward`). The global step ``t``
     counts the sub-env transitions scored (one per sub-env per vector step, autoreset steps left
     out). ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` arrays of shape

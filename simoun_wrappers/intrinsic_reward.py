@@ -1,11 +1,13 @@
 """One reward-wrapper mechanism for intrinsic rewards, for a single env and a vector env.
 
-``reward = r_e + scale * r_i`` with ``r_i`` from an :class:`IntrinsicSignal`: Simoun's
-consistency curiosity (Eq. 13, ``simoun_wrappers.curiosity_reward``) and random network
-distillation (``simoun_wrappers.rnd``) are one signal class each over the same two wrappers
-(:class:`IntrinsicReward`, :class:`IntrinsicVectorReward`), which handle the rest: reading the
-Simoun frame triplets, skipping the autoreset steps of a vector env, handing each transition to
-a source that learns online, ``info``, state and ``close``.
+``reward = r_e + scale * exp(-decay * t) * normalize(x)``, ``x`` from an
+:class:`IntrinsicSignal`: Simoun's consistency distance (``simoun_wrappers.curiosity_reward``),
+random network distillation's error (``simoun_wrappers.rnd``) and a constant bonus
+(:class:`ConstantSignal`) are one signal class each over the same two wrappers
+(:class:`IntrinsicReward`, :class:`IntrinsicVectorReward`), and every signal takes every
+normalization of ``simoun_wrappers.intrinsic_normalization``. The wrappers handle the rest:
+reading the Simoun frame triplets, skipping the autoreset steps of a vector env, handing each
+transition to a source that learns online, ``info``, state and ``close``.
 """
 
 from __future__ import annotations
@@ -20,7 +22,13 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
+from simoun_wrappers.intrinsic_normalization import Normalization, make_normalization
+
 __all__ = [
+    "ConstantBonusReward",
+    "ConstantBonusVectorReward",
+    "ConstantSignal",
+    "IntrinsicMechanism",
     "IntrinsicReward",
     "IntrinsicSignal",
     "IntrinsicVectorReward",
@@ -97,30 +105,22 @@ class SharedSource:
 
 
 class IntrinsicSignal(ABC):
-    """An intrinsic reward computed from the frame triplets the env reaches.
+    """A raw intrinsic value for each frame triplet reached: novelty, disagreement, a bonus.
 
-    ``__call__(triplets, extrinsic)`` returns the *normalized* intrinsic reward of each
-    transition (the wrapper multiplies it by its ``scale``), updating the signal's running
-    statistics with the batch first. ``source`` is the model behind it; when it has
-    ``watch(triplets, actions, next_triplets, terminated, truncated)`` it is handed every scored
-    transition (to learn online), and its ``close()`` is called by the wrappers' ``close()``.
-    Subclasses implement ``__call__``, ``state_dict`` and ``load_state_dict``.
+    :meth:`raw` returns one finite float per triplet; the wrappers normalize it (one
+    :class:`~simoun_wrappers.intrinsic_normalization.Normalization` for every signal) and weight
+    it. ``source`` is the model behind the signal (None for a signal that needs none); when it
+    has ``watch(triplets, actions, next_triplets, terminated, truncated)`` it is handed every
+    scored transition (to learn online), and its ``close()`` is called by the wrappers'
+    ``close()``. A new signal is one subclass implementing :meth:`raw`.
     """
 
-    def __init__(self, source: Any) -> None:
+    def __init__(self, source: Any = None) -> None:
         self.source = SharedSource.unwrap(source)
 
     @abstractmethod
-    def __call__(self, triplets: np.ndarray, extrinsic: np.ndarray) -> np.ndarray:
-        """``(B,)`` float64 normalized intrinsic rewards of the triplets reached."""
-
-    @abstractmethod
-    def state_dict(self) -> dict[str, Any]:
-        """The signal's running statistics (the source keeps its own state)."""
-
-    @abstractmethod
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned."""
+    def raw(self, triplets: np.ndarray) -> np.ndarray:
+        """``(B,)`` float64 raw values of the triplets ``uint8 (B, 3, C, H, W)``."""
 
     def watch(self, *transitions: np.ndarray) -> None:
         """Hand a batch of ``transitions`` (``triplets, actions, next_triplets, terminated,
@@ -136,15 +136,42 @@ class IntrinsicSignal(ABC):
             close()
 
 
+class ConstantSignal(IntrinsicSignal):
+    """1 for every transition: with ``normalization="none"`` and ``scale=b``, a constant bonus of
+    ``b`` a step, the control that tells a survival bonus from a novelty reward."""
+
+    def raw(self, triplets: np.ndarray) -> np.ndarray:
+        return np.ones(len(triplets), dtype=np.float64)
+
+
 def check_scale(scale: float) -> float:
     """``scale`` as a float, or a clear error when it is negative, NaN or infinite."""
     if not (isinstance(scale, (int, float, np.number)) and math.isfinite(scale) and scale >= 0):
         raise ValueError(
             f"scale must be a finite number >= 0 (the weight of the intrinsic reward), got "
-            f"{scale!r}; use e.g. scale=0.2, or scale=0 to log the intrinsic reward without "
+            f"{scale!r}; use e.g. scale=0.01, or scale=0 to log the intrinsic reward without "
             "adding it."
         )
     return float(scale)
+
+
+def check_weighting(decay: float, warmup: int, progress: float | None) -> None:
+    """A clear error for a ``decay``, ``warmup`` or ``progress`` out of range."""
+    if not (isinstance(decay, (int, float, np.number)) and decay >= 0 and math.isfinite(decay)):
+        raise ValueError(
+            f"decay must be a finite number >= 0 (lambda of exp(-lambda * t), per env step), got "
+            f"{decay!r}; use the paper's decay=2e-5, or decay=0 for a weight that never fades."
+        )
+    if not (isinstance(warmup, (int, np.integer)) and warmup >= 0):
+        raise ValueError(
+            f"warmup must be an int >= 0 (transitions that get no reward while the statistics "
+            f"settle), got {warmup!r}; e.g. warmup=1024."
+        )
+    if progress is not None and not (isinstance(progress, (int, float)) and 0 < progress <= 1):
+        raise ValueError(
+            f"progress must be None or a number in (0, 1] (NovelD's alpha), got {progress!r}; "
+            "NovelD uses progress=0.5."
+        )
 
 
 def check_extrinsic(extrinsic: np.ndarray) -> None:
@@ -156,30 +183,91 @@ def check_extrinsic(extrinsic: np.ndarray) -> None:
         )
 
 
-class IntrinsicState:
-    """What the two wrappers share: building their signal from the constructor's arguments, and
-    ``state_dict`` / ``load_state_dict`` / ``close`` from it."""
+class IntrinsicMechanism:
+    """What the two wrappers share: the signal, its normalization and weight, and scoring.
+
+    The reward of a transition ``s -> s'`` scored ``t`` transitions after the wrapper started:
+
+    ``r_i = scale * exp(-decay * t) * normalize(x)``, ``x = signal(s')``, or with ``progress``
+    alpha ``x = max(signal(s') - alpha * signal(s), 0)`` (NovelD, Zhang et al. 2021: pay for
+    progress into less familiar states, not for being in them; their episodic first-visit gate
+    is not applied). During the first ``warmup`` transitions ``r_i = 0``; the second half of the
+    warm-up already raises the normalization's statistics (Burda et al. step a random agent to
+    set theirs before training).
+    """
 
     signal_type: ClassVar[type[IntrinsicSignal]]
-    """the signal a wrapper class builds, from its constructor's arguments but ``env`` and
-    ``scale``"""
-    curiosity: IntrinsicSignal
+    """the signal a wrapper class builds, from its constructor's signal arguments"""
+    signal: IntrinsicSignal
 
-    def _build_signal(self, scale: float, arguments: dict[str, Any]) -> IntrinsicSignal:
-        """Record the constructor's arguments for ``env.spec`` (the source, the first of
-        ``arguments``, held by reference: see :class:`SharedSource`) and build the signal."""
-        name, source = next(iter(arguments.items()))
-        recorded = {**arguments, name: SharedSource(SharedSource.unwrap(source)), "scale": scale}
-        gym.utils.RecordConstructorArgs.__init__(self, **recorded)
-        return self.signal_type(**arguments)
+    def _build(
+        self,
+        scale: float,
+        normalization: str | Normalization,
+        weighting: dict[str, Any],
+        arguments: dict[str, Any],
+        paper: dict[str, float],
+    ) -> None:
+        """Check and keep the weighting, build the signal from ``arguments`` (its source first)
+        and the normalization, and record every constructor argument for ``env.spec`` (the
+        source held by reference: see :class:`SharedSource`)."""
+        self.scale = check_scale(scale)
+        check_weighting(**weighting)
+        self.decay = float(weighting["decay"])
+        self.warmup = int(weighting["warmup"])
+        self.progress = weighting["progress"]
+        recorded = dict(arguments)
+        if arguments:
+            name, source = next(iter(arguments.items()))
+            recorded[name] = SharedSource(SharedSource.unwrap(source))
+        gym.utils.RecordConstructorArgs.__init__(
+            self, **recorded, scale=scale, normalization=normalization, **weighting, **paper
+        )
+        self.signal = self.signal_type(**arguments)
+        self.normalization = make_normalization(normalization, **paper)
+        self.scored = 0
+        """transitions scored so far: the step t of the weight and the warm-up's clock"""
+
+    def _score(
+        self, previous: np.ndarray, reached: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray
+    ) -> np.ndarray:
+        """``(B,)`` weighted intrinsic rewards of the transitions ``previous -> reached``."""
+        if self.progress is None:
+            raw = self._raw(reached)
+        else:
+            both = self._raw(np.concatenate([previous, reached]))
+            raw = np.maximum(both[len(reached) :] - self.progress * both[: len(reached)], 0.0)
+        position = self.scored + np.arange(len(raw))
+        normalized = self.normalization(raw, extrinsic, envs, position >= self.warmup // 2)
+        weight = self.scale * math.exp(-self.decay * self.scored)
+        self.scored += len(raw)
+        return np.where(position >= self.warmup, weight * normalized, 0.0)
+
+    def _raw(self, triplets: np.ndarray) -> np.ndarray:
+        raw = np.asarray(self.signal.raw(triplets), dtype=np.float64)
+        if raw.shape != (len(triplets),):
+            raise ValueError(
+                f"{type(self.signal).__name__} returned shape {raw.shape} for {len(triplets)} "
+                f"triplets; it must return one value per triplet, shape ({len(triplets)},)."
+            )
+        if not np.all(np.isfinite(raw)):
+            bad = raw[~np.isfinite(raw)][0]
+            raise ValueError(
+                f"{type(self.signal).__name__} gave the non-finite intrinsic value {bad} at "
+                f"transition {self.scored} of this wrapper; its model has diverged (lower its "
+                "learning rate) or got a bad input."
+            )
+        return raw
 
     def state_dict(self) -> dict[str, Any]:
-        """The signal's running statistics (the source keeps its own state)."""
-        return self.curiosity.state_dict()
+        """The transitions scored and the normalization's statistics (the source keeps its own
+        state)."""
+        return {"scored": self.scored, "normalization": self.normalization.state_dict()}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what :meth:`state_dict` returned."""
-        self.curiosity.load_state_dict(state)
+        self.normalization.load_state_dict(state["normalization"])
+        self.scored = int(state["scored"])
 
     def close(self) -> None:
         """Close the env, then the source (stops a model's update thread; a model shared with
@@ -187,21 +275,29 @@ class IntrinsicState:
         try:
             super().close()
         finally:
-            self.curiosity.close()
+            self.signal.close()
 
 
-class IntrinsicReward(IntrinsicState, gym.Wrapper, gym.utils.RecordConstructorArgs):
-    """``r_e + scale * r_i`` for a single env, ``r_i`` from the class's signal on the triplet
-    reached.
+class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """``r_e + r_i`` for a single env, ``r_i`` from the class's signal on the triplet reached
+    (see :class:`IntrinsicMechanism` for the normalization and the weight).
 
-    ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` (``scale * r_i``); the
-    reward returned is their sum. Subclasses (``ConsistencyCuriosityReward``, ``RNDReward``)
-    name their ``signal_type`` and give their constructor's signature.
+    ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` (``r_i``); the reward returned
+    is their sum. Subclasses (``ConsistencyCuriosityReward``, ``RNDReward``,
+    ``ConstantBonusReward``) name their ``signal_type`` and give their constructor's signature.
     """
 
-    def __init__(self, env: gym.Env, scale: float, **arguments: Any) -> None:
-        """Wrap ``env``; ``arguments``: the signal's, its source first (recorded in
-        ``env.spec``)."""
+    def __init__(
+        self,
+        env: gym.Env,
+        scale: float,
+        normalization: str | Normalization,
+        weighting: dict[str, Any],
+        arguments: dict[str, Any],
+        paper: dict[str, float],
+    ) -> None:
+        """Wrap ``env``; ``weighting``: ``decay``, ``warmup``, ``progress``; ``arguments``: the
+        signal's, its source first; ``paper``: the ``"paper"`` normalization's initial maxima."""
         if isinstance(env, VectorEnv):
             vector = type(self).__name__.replace("Reward", "VectorReward")
             raise TypeError(
@@ -209,11 +305,9 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper, gym.utils.RecordConstructorAr
                 f"{vector}(envs, ...) on the vector env, or put {type(self).__name__} in each "
                 "sub-env (gym.make_vec(..., wrappers=[...]))"
             )
-        self.scale = check_scale(scale)
-        signal = self._build_signal(scale, arguments)
+        self._build(scale, normalization, weighting, arguments, paper)
         gym.Wrapper.__init__(self, env)
         self._read = triplet_reader(env.observation_space)
-        self.curiosity = signal
         self._last_triplet: np.ndarray | None = None
 
     def reset(
@@ -231,8 +325,8 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper, gym.utils.RecordConstructorAr
         batch = np.array([extrinsic], dtype=np.float64)
         check_extrinsic(batch)
         triplet = self._read(obs)
-        intrinsic = self.scale * float(self.curiosity(triplet, batch)[0])
-        self.curiosity.watch(
+        intrinsic = float(self._score(self._last_triplet, triplet, batch, ONE_ENV)[0])
+        self.signal.watch(
             self._last_triplet,
             np.asarray(action)[None],
             triplet,
@@ -244,26 +338,42 @@ class IntrinsicReward(IntrinsicState, gym.Wrapper, gym.utils.RecordConstructorAr
         return obs, extrinsic + intrinsic, terminated, truncated, info
 
 
-class IntrinsicVectorReward(IntrinsicState, VectorWrapper, gym.utils.RecordConstructorArgs):
-    """``r_e + scale * r_i`` for every sub-env of a vector env, in one batched signal call.
+ONE_ENV = np.zeros(1, dtype=np.int64)
+"""the sub-env index of a single env's transitions"""
 
-    One signal (one source, one set of running statistics) serves all sub-envs, and the triplets
-    of all active sub-envs are scored in a single call. With ``AutoresetMode.NEXT_STEP``
-    (Gymnasium's default) the step after a sub-env's episode ended only resets it: that dummy
-    step gets no intrinsic reward, does not move the statistics and is not handed to the source
-    (as Gymnasium's vector ``NormalizeReward`` skips it). With ``AutoresetMode.SAME_STEP`` the
-    ending step is scored on the episode's last triplet, ``info["final_obs"]``, since the
-    returned observation already starts the next one. ``info`` gets ``"reward_extrinsic"`` and
+
+class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordConstructorArgs):
+    """``r_e + r_i`` for every sub-env of a vector env, in one batched signal call.
+
+    One signal (one source, one normalization) serves all sub-envs, and the triplets of all
+    active sub-envs are scored in a single call. With ``AutoresetMode.NEXT_STEP`` (Gymnasium's
+    default) the step after a sub-env's episode ended only resets it: that dummy step gets no
+    intrinsic reward, does not move the statistics and is not handed to the source (as
+    Gymnasium's vector ``NormalizeReward`` skips it). With ``AutoresetMode.SAME_STEP`` the ending
+    step is scored on the episode's last triplet, ``info["final_obs"]``, since the returned
+    observation already starts the next one. ``info`` gets ``"reward_extrinsic"`` and
     ``"reward_intrinsic"`` arrays of shape ``(num_envs,)``.
     """
 
-    def __init__(self, env: VectorEnv, scale: float, **arguments: Any) -> None:
-        """Wrap the vector env ``env``; ``arguments`` as in :class:`IntrinsicReward`."""
-        self.scale = check_scale(scale)
-        signal = self._build_signal(scale, arguments)
+    def __init__(
+        self,
+        env: VectorEnv,
+        scale: float,
+        normalization: str | Normalization,
+        weighting: dict[str, Any],
+        arguments: dict[str, Any],
+        paper: dict[str, float],
+    ) -> None:
+        """Wrap the vector env ``env``; the other arguments as in :class:`IntrinsicReward`."""
+        if not isinstance(env, VectorEnv):
+            single = type(self).__name__.replace("VectorReward", "Reward")
+            raise TypeError(
+                f"{type(self).__name__} wraps a vector env, got {env}; use {single}(env, ...) "
+                "on a single env."
+            )
+        self._build(scale, normalization, weighting, arguments, paper)
         VectorWrapper.__init__(self, env)
         self._read = triplet_reader(env.single_observation_space)
-        self.curiosity = signal
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
         self._prev_dones = np.zeros(self.num_envs, dtype=bool)
         self._last_triplets: np.ndarray | None = None
@@ -300,8 +410,13 @@ class IntrinsicVectorReward(IntrinsicState, VectorWrapper, gym.utils.RecordConst
         check_extrinsic(extrinsic[active])
         intrinsic = np.zeros(self.num_envs, dtype=np.float64)
         if active.any():
-            intrinsic[active] = self.scale * self.curiosity(scored[active], extrinsic[active])
-            self.curiosity.watch(
+            intrinsic[active] = self._score(
+                self._last_triplets[active],
+                scored[active],
+                extrinsic[active],
+                np.flatnonzero(active),
+            )
+            self.signal.watch(
                 self._last_triplets[active],
                 np.asarray(actions)[active],
                 scored[active],
@@ -319,3 +434,60 @@ class IntrinsicVectorReward(IntrinsicState, VectorWrapper, gym.utils.RecordConst
             "_reward_intrinsic": everywhere,
         }
         return obs, extrinsic + intrinsic, terminated, truncated, info
+
+
+class ConstantBonusArguments:
+    """The constant-bonus wrappers' constructor: the bonus per step."""
+
+    signal_type = ConstantSignal
+
+    def __init__(self, env: gym.Env | VectorEnv, scale: float, decay: float = 0.0) -> None:
+        """Wrap ``env``, whose observations are Simoun triplets (read but not used).
+
+        Args:
+            env: a single env for :class:`ConstantBonusReward`, a vector env for
+                :class:`ConstantBonusVectorReward`.
+            scale: the bonus paid at every step.
+            decay: lambda of a weight ``exp(-lambda * t)``, per environment step.
+        """
+        super().__init__(
+            env, scale, "none", {"decay": decay, "warmup": 0, "progress": None}, {}, {}
+        )
+
+
+class ConstantBonusReward(ConstantBonusArguments, IntrinsicReward):
+    """Add a constant ``scale`` to every step's reward: the control arm of an intrinsic-reward
+    study. A reward that helps only as much as this bonus helps by paying for survival, not for
+    novelty (Burda et al. 2018, "Death is not the end").
+
+    Example:
+        >>> import gymnasium as gym
+        >>> from simoun_wrappers import SimounObservation
+        >>> from simoun_wrappers.intrinsic_reward import ConstantBonusReward
+        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=16)
+        >>> env = ConstantBonusReward(env, scale=0.1)
+        >>> _ = env.reset(seed=0)
+        >>> _, reward, _, _, info = env.step(0)
+        >>> reward, info["reward_intrinsic"]
+        (1.1, 0.1)
+    """
+
+
+class ConstantBonusVectorReward(ConstantBonusArguments, IntrinsicVectorReward):
+    """A constant ``scale`` added to every scored step of every sub-env (the autoreset steps
+    get nothing, as in :class:`IntrinsicVectorReward`).
+
+    Example:
+        >>> import gymnasium as gym
+        >>> import numpy as np
+        >>> from simoun_wrappers import SimounObservation
+        >>> from simoun_wrappers.intrinsic_reward import ConstantBonusVectorReward
+        >>> envs = gym.make_vec("CartPole-v1", num_envs=2, vectorization_mode="sync",
+        ...                     render_mode="rgb_array",
+        ...                     wrappers=[lambda e: SimounObservation(e, size=16)])
+        >>> envs = ConstantBonusVectorReward(envs, scale=0.1)
+        >>> _ = envs.reset(seed=0)
+        >>> _, rewards, _, _, info = envs.step(np.array([0, 1]))
+        >>> rewards.tolist()
+        [1.1, 1.1]
+    """

@@ -4,19 +4,19 @@ The standard comparator for Simoun's consistency curiosity, on the same wrappers
 (``simoun_wrappers.intrinsic_reward``): only the signal differs. A novelty source (e.g.
 ``simoun_agent.rnd_model.RNDModel``: a fixed random target network and a predictor trained to
 match it, on observations normalized by a running mean/std and clipped to [-5, 5]) gives the
-prediction error of the newest frame of each triplet; :class:`RNDSignal` divides it by a running
-standard deviation of the errors. Nothing here imports torch.
+prediction error of the newest frame of each triplet (:class:`RNDSignal`); by default the
+wrappers divide it by the running standard deviation of the errors. Nothing here imports torch.
 """
 
 from __future__ import annotations
 
-from typing import Any, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import VectorEnv
-from gymnasium.wrappers.utils import RunningMeanStd
 
+from simoun_wrappers.intrinsic_normalization import Normalization
 from simoun_wrappers.intrinsic_reward import (
     IntrinsicReward,
     IntrinsicSignal,
@@ -42,21 +42,9 @@ class NoveltySource(Protocol):
 
 
 class RNDSignal(IntrinsicSignal):
-    """The novelty source's error divided by the running standard deviation of the errors.
+    """The novelty source's error on the newest frame of each triplet."""
 
-    The running mean/std (Gymnasium's ``RunningMeanStd``) is raised with the batch first, then
-    ``error / sqrt(var + 1e-8)`` is returned. The first ``warmup`` scored transitions get reward
-    0, as Burda et al. step a random agent to set their normalization before training: in the
-    first half only the source learns from them (an ``RNDModel``'s per-pixel observation
-    statistics, from a few frames at first, make early errors huge: measured on
-    MiniGrid-DoorKey-6x6 with 8 random sub-envs, counting those errors left the std at 4.4 and
-    the rewards of steps 400-600 at 0.003), in the second half they also set the error
-    statistics, so the first reward is not divided by the std of a handful of errors. (Burda et
-    al. divide by the std of the discounted intrinsic *return*; this divides by the std of the
-    reward itself, which needs no per-env return and no discount.)
-    """
-
-    def __init__(self, novelty: NoveltySource | SharedSource, warmup: int) -> None:
+    def __init__(self, novelty: NoveltySource | SharedSource) -> None:
         super().__init__(novelty)
         if not isinstance(self.source, NoveltySource):
             raise TypeError(
@@ -64,19 +52,8 @@ class RNDSignal(IntrinsicSignal):
                 f"errors), got {type(self.source).__name__}. Use e.g. "
                 "simoun_agent.rnd_model.RNDModel.for_env(env)."
             )
-        if not (isinstance(warmup, (int, np.integer)) and warmup >= 0):
-            raise ValueError(
-                f"warmup must be an int >= 0 (transitions that get no reward while the "
-                f"statistics settle), got {warmup!r}; e.g. warmup=1024."
-            )
-        self.warmup = int(warmup)
-        # epsilon=0: no prior pseudo-sample (Gymnasium's default is one of weight 1e-4 with
-        # variance 1, which outweighs the variance of errors that differ by less than 1e-2)
-        self.errors = RunningMeanStd(epsilon=0.0, shape=())
-        self.scored = 0
-        """transitions scored so far"""
 
-    def __call__(self, triplets: np.ndarray, extrinsic: np.ndarray) -> np.ndarray:
+    def raw(self, triplets: np.ndarray) -> np.ndarray:
         errors = self.source(triplets)
         errors = None if isinstance(errors, tuple) else np.asarray(errors, dtype=np.float64)
         if errors is None or errors.shape != (len(triplets),):
@@ -87,39 +64,17 @@ class RNDSignal(IntrinsicSignal):
                 f"({len(triplets)},). (A FeatureSource such as CuriosityModel goes with "
                 "ConsistencyCuriosityReward, not RNDReward.)"
             )
-        if not (np.all(np.isfinite(errors)) and np.all(errors >= 0)):
+        if np.any(errors < 0):  # a non-finite error is named with its step by the wrapper
             raise ValueError(
                 f"The novelty source {type(self.source).__name__} returned {errors}: errors must "
-                "be finite and >= 0; its predictor has diverged (lower its learning rate)."
+                "be >= 0 (a distance or a squared error)."
             )
-        position = self.scored + np.arange(len(errors))
-        self.scored += len(errors)
-        # The first half of the warm-up only reaches the source (its observation statistics
-        # settle); the second half also sets the error statistics; rewards start after it.
-        counted = position >= self.warmup // 2
-        if counted.any():
-            self.errors.update(errors[counted])
-        normalized = errors / np.sqrt(self.errors.var + 1e-8)
-        return np.where(position >= self.warmup, normalized, 0.0)
-
-    def state_dict(self) -> dict[str, Any]:
-        """The transitions scored and the running mean, variance and count of the errors."""
-        return {
-            "scored": self.scored,
-            "error_mean": float(self.errors.mean),
-            "error_var": float(self.errors.var),
-            "error_count": float(self.errors.count),
-        }
-
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        self.errors.mean = np.float64(state["error_mean"])
-        self.errors.var = np.float64(state["error_var"])
-        self.errors.count = float(state["error_count"])
-        self.scored = int(state["scored"])
+        return errors
 
 
 class RNDArguments:
-    """The RND wrappers' constructor: the novelty source, the scale and the warm-up."""
+    """The RND wrappers' constructor: the novelty source, the scale, the normalization and the
+    warm-up."""
 
     signal_type = RNDSignal
 
@@ -129,6 +84,9 @@ class RNDArguments:
         novelty: NoveltySource,
         scale: float = 0.05,
         warmup: int = 1024,
+        normalization: str | Normalization = "reward_std",
+        decay: float = 0.0,
+        progress: float | None = None,
     ) -> None:
         """Wrap ``env``, whose observations are Simoun triplets.
 
@@ -138,10 +96,27 @@ class RNDArguments:
                 env for :class:`RNDVectorReward`.
             novelty: the :class:`NoveltySource`, e.g. ``RNDModel.for_env(env)``.
             scale: the weight of the normalized error in the reward.
-            warmup: transitions that get reward 0 while the statistics settle (see
-                :class:`RNDSignal`); 1024 is one PPO rollout of 8 sub-envs x 128 steps.
+            warmup: transitions that get reward 0 while the statistics settle: in the first half
+                only the source learns from them (an ``RNDModel``'s per-pixel observation
+                statistics, from a few frames at first, make early errors huge: measured on
+                MiniGrid-DoorKey-6x6 with 8 random sub-envs, counting those errors left the std
+                at 4.4 and the rewards of steps 400-600 at 0.003), in the second half they also
+                set the normalization's statistics. 1024 is one PPO rollout of 8 sub-envs x 128
+                steps.
+            normalization: a name of ``simoun_wrappers.intrinsic_normalization.NORMALIZATIONS``
+                or a ``Normalization``; ``"reward_std"`` divides by the running std of the errors,
+                ``"return_std"`` by that of the discounted intrinsic return as Burda et al. do.
+            decay: lambda of a weight ``exp(-lambda * t)``, per environment step.
+            progress: None, or NovelD's alpha: pay ``max(e(s') - alpha * e(s), 0)``.
         """
-        super().__init__(env, scale, novelty=novelty, warmup=warmup)
+        super().__init__(
+            env,
+            scale,
+            normalization,
+            {"decay": decay, "warmup": warmup, "progress": progress},
+            {"novelty": novelty},
+            {},
+        )
 
 
 class RNDReward(RNDArguments, IntrinsicReward):
@@ -149,9 +124,10 @@ class RNDReward(RNDArguments, IntrinsicReward):
 
     ``r = r_e + scale * e / std(e)``: ``e`` is the novelty source's error on the newest frame of
     the triplet reached (an ``RNDModel``'s predictor against its fixed random target), ``std(e)``
-    the running standard deviation of the errors (see :class:`RNDSignal`). ``info`` gets
+    the running standard deviation of the errors (``normalization="reward_std"``; see
+    :class:`RNDArguments` for the others). ``info`` gets
     ``"reward_extrinsic"`` and ``"reward_intrinsic"``; a source with ``watch`` is handed every
-    transition. The error statistics are in ``state_dict()`` / ``load_state_dict()``. For
+    transition. The normalization's statistics are in ``state_dict()`` / ``load_state_dict()``. For
     ``gym.make_vec`` prefer :class:`RNDVectorReward`.
 
     Example:

@@ -1,4 +1,4 @@
-"""SimounAgent and FrameReplay misuse from the reliability audit (issue 22): each a clear error
+"""SimounAgent and FrameReplay misuse: each a clear error
 or the right result, on real environments."""
 
 import gymnasium as gym

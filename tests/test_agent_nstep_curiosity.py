@@ -1,4 +1,4 @@
-"""Eq. 13's intrinsic reward in n-step targets (issue 17): every step of the return adds the
+"""Eq. 13's intrinsic reward in n-step targets: every step of the return adds the
 intrinsic reward of its own state, sum_{j<m} gamma^j (r^e_{t+1+j} + r^i(s_{t+j})), with r^i of
 each s_{t+j} computed here from the online features of the triplet ending at frame t+j, rebuilt
 from the episodes themselves (not from the replay's arrays); one episode is truncated and one
@@ -145,7 +145,7 @@ def test_each_step_of_the_n_step_target_adds_the_intrinsic_reward_of_its_state()
 
 
 def test_without_the_mask_only_the_state_at_t_adds_its_intrinsic_reward():
-    """The call without ``return_mask`` (the behaviour before issue 17) is still accepted."""
+    """The call without ``return_mask`` (only the state at t adds r^i) is still accepted."""
     agent, _, batch, keys = agent_and_batch()
     frames = episodes_and_replay()[0]
     first = eq13_distance(agent, np.stack([triplet(frames[e], t) for e, t in keys]))

@@ -1,6 +1,6 @@
-"""simoun-train / simoun-eval conventions and misuse (issue 10): boolean switches, --version,
+"""simoun-train / simoun-eval conventions and misuse: boolean switches, --version,
 plain status lines without a terminal, resume and rerun mistakes, one trainer per run directory,
-no silent overwrite of an evaluation; simoun-eval stops promptly on SIGTERM (issue 14)."""
+no silent overwrite of an evaluation; simoun-eval stops promptly on SIGTERM."""
 
 import json
 import os

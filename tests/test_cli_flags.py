@@ -1,4 +1,4 @@
-"""The config flags as tyro reads them (issue 18): the overrides are the keys the command line
+"""The config flags as tyro reads them: the overrides are the keys the command line
 names, whatever their value; switches, lists, dicts and none in every spelling; help shows the
 named preset's values as defaults."""
 

@@ -1,5 +1,5 @@
 """Every config value is checked when the config is built: the error names the flag, the value
-and the fix (issue 10). One bad value per field, and every field has a row."""
+and the fix. One bad value per field, and every field has a row."""
 
 import math
 

@@ -203,7 +203,7 @@ def test_a_pickled_model_keeps_its_unpublished_step_and_not_the_thread():
     env.reset(seed=0)
     for _ in range(20):
         env.step(np.zeros(1, np.float32))
-    model = env.curiosity.features
+    model = env.signal.features
     clone = pickle.loads(pickle.dumps(model))
     assert clone.pending and clone._thread is None and clone.updates == model.updates
     env.step(np.zeros(1, np.float32))
@@ -224,7 +224,7 @@ def test_a_model_nobody_closed_stops_its_thread_when_freed():
     env.reset(seed=0)
     for _ in range(20):
         env.step(np.zeros(1, np.float32))
-    thread = env.curiosity.features._thread.thread
+    thread = env.signal.features._thread.thread
     assert thread.is_alive()
     del env
     gc.collect()

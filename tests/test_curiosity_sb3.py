@@ -45,13 +45,15 @@ def test_ppo_trains_on_extrinsic_plus_intrinsic_reward_through_the_wrapper(small
     seen = RewardsSeen()
     ppo.learn(total_timesteps=192, callback=seen)
     assert ppo.num_timesteps == 192
-    assert env.state_dict()["step"] == 192
+    assert env.state_dict()["scored"] == 192
     assert model.updates == (192 - 32) // 8  # one more started, published at its next due step
     rewards, extrinsic, intrinsic = (np.array(v) for v in zip(*seen.steps, strict=True))
     assert len(rewards) == 192
     # PPO was trained on r_e + r_i (Eq. 12), r_i from Eq. 13 at every step
     np.testing.assert_allclose(rewards, extrinsic + intrinsic, rtol=1e-6)
-    assert np.all(intrinsic > 0) and np.all(intrinsic <= 0.2 * env.state_dict()["r_e_max"] + 1e-6)
+    assert np.all(intrinsic > 0) and np.all(
+        intrinsic <= 0.2 * env.state_dict()["normalization"]["r_e_max"] + 1e-6
+    )
 
 
 @pytest.mark.parametrize(

@@ -67,7 +67,10 @@ def test_reward_is_eq13_by_hand_with_running_maxima():
         assert info["reward_intrinsic"] == pytest.approx(expected, rel=1e-5)
         assert reward == pytest.approx(info["reward_extrinsic"] + expected, rel=1e-6)
         assert info["reward_intrinsic"] <= 0.3 * r_e_max + 1e-9
-    assert env.state_dict() == {"step": 12, "r_e_max": r_e_max, "r_i_max": pytest.approx(r_i_max)}
+    assert env.state_dict() == {
+        "scored": 12,
+        "normalization": {"r_e_max": r_e_max, "r_i_max": pytest.approx(r_i_max)},
+    }
 
 
 def test_folded_observation_gives_the_same_reward_as_the_dict_one():
@@ -87,7 +90,7 @@ def test_intrinsic_reward_decays_with_the_global_step():
     for step in (0, 50_000):
         env = ConsistencyCuriosityReward(cartpole(), ProjectionFeatures(3 * SIZE * SIZE))
         # Large maxima that the first steps cannot raise: only the step differs.
-        env.load_state_dict({"step": step, "r_e_max": 10.0, "r_i_max": 1e6})
+        env.load_state_dict({"scored": step, "normalization": {"r_e_max": 10.0, "r_i_max": 1e6}})
         env.reset(seed=1)
         intrinsic.append([env.step(0)[4]["reward_intrinsic"] for _ in range(3)])
     ratio = np.array(intrinsic[1]) / np.array(intrinsic[0])
@@ -105,7 +108,9 @@ def test_after_warm_up_intrinsic_never_exceeds_scale_times_r_e_max():
     env.action_space.seed(0)
     for _ in range(40):
         *_, terminated, truncated, info = env.step(env.action_space.sample())
-        assert info["reward_intrinsic"] <= 0.2 * env.state_dict()["r_e_max"] * (1 + 1e-6)
+        assert info["reward_intrinsic"] <= 0.2 * env.state_dict()["normalization"]["r_e_max"] * (
+            1 + 1e-6
+        )
         if terminated or truncated:
             env.reset()
 
@@ -131,11 +136,11 @@ def test_wrong_observations_are_refused_with_the_fix():
     with pytest.raises(TypeError, match="FeatureSource"):
         ConsistencyCuriosityReward(cartpole(), features="encoder")
     source = ProjectionFeatures(3 * SIZE * SIZE)
-    with pytest.raises(ValueError, match=r"scale must be a finite number >= 0.*scale=0.2"):
+    with pytest.raises(ValueError, match=r"scale must be a finite number >= 0.*scale=0.01"):
         ConsistencyCuriosityReward(cartpole(), source, scale=-0.2)
     with pytest.raises(ValueError, match=r"scale must be a finite number >= 0"):
         ConsistencyCuriosityVectorReward(make_vec(1), source, scale=float("inf"))
-    with pytest.raises(ValueError, match=r"decay must be a number >= 0.*decay=2e-5"):
+    with pytest.raises(ValueError, match=r"decay must be a finite number >= 0.*decay=2e-5"):
         ConsistencyCuriosityVectorReward(make_vec(1), source, decay=float("nan"))
 
 
@@ -148,7 +153,7 @@ def test_state_survives_pickling_and_async_vector_env():
     for _ in range(7):
         env.step(env.action_space.sample())
     clone = cloudpickle.loads(cloudpickle.dumps(env))
-    assert clone.state_dict() == env.state_dict() and clone.state_dict()["step"] == 7
+    assert clone.state_dict() == env.state_dict() and clone.state_dict()["scored"] == 7
     _, r_a, *_ = env.step(np.zeros(2, np.float32))
     _, r_b, *_ = clone.step(np.zeros(2, np.float32))
     assert r_a == r_b
@@ -165,9 +170,14 @@ def test_state_survives_pickling_and_async_vector_env():
         for _ in range(4):
             envs.step(np.zeros((2, 2), np.float32))
         states = envs.call("state_dict")
-        assert [s["step"] for s in states] == [4, 4]
-        envs.call("load_state_dict", {"step": 99, "r_e_max": 2.0, "r_i_max": 3.0})
-        assert envs.call("state_dict") == ({"step": 99, "r_e_max": 2.0, "r_i_max": 3.0},) * 2
+        assert [s["scored"] for s in states] == [4, 4]
+        envs.call(
+            "load_state_dict", {"scored": 99, "normalization": {"r_e_max": 2.0, "r_i_max": 3.0}}
+        )
+        assert (
+            envs.call("state_dict")
+            == ({"scored": 99, "normalization": {"r_e_max": 2.0, "r_i_max": 3.0}},) * 2
+        )
     finally:
         envs.close()
 
@@ -210,12 +220,12 @@ def test_vector_version_skips_the_next_step_autoreset_step():
             break
     else:
         pytest.fail("no single sub-env ended within 200 random CartPole steps")
-    before, watched = envs.state_dict()["step"], len(source.watched)
+    before, watched = envs.state_dict()["scored"], len(source.watched)
     _, rewards, _, _, info = envs.step(np.zeros(2, dtype=np.int64))
     # the step after an episode ended is only the reset: no reward, no statistics, not watched
     assert info["reward_intrinsic"][ended] == 0.0 and rewards[ended] == 0.0
     assert info["reward_intrinsic"][~ended] > 0.0
-    assert envs.state_dict()["step"] == before + 1
+    assert envs.state_dict()["scored"] == before + 1
     assert len(source.watched) == watched + 1 and source.watched[-1][2] == 1
     envs.close()
 
@@ -232,7 +242,7 @@ def test_vector_same_step_mode_scores_the_final_observation():
         if len(ended):
             i = ended[0]
             final = info["final_obs"][i]["frames"]
-            expected = 0.2 * math.exp(-2e-5 * (envs.state_dict()["step"] - 2))
+            expected = 0.2 * math.exp(-2e-5 * (envs.state_dict()["scored"] - 2))
             expected *= hand_distance(source, final) / 1e6
             assert info["reward_intrinsic"][i] == pytest.approx(expected, rel=1e-5)
             break
@@ -250,7 +260,7 @@ def test_passes_check_env_and_rebuilds_from_its_spec():
     assert isinstance(rebuilt, ConsistencyCuriosityReward) and rebuilt.scale == 0.5
     # a wrapper above deep-copies the spec, but not the feature source (a model's weights, buffer)
     above = gym.make(gym.wrappers.RecordEpisodeStatistics(env).spec)
-    assert above.env.curiosity.features is source and rebuilt.curiosity.features is source
+    assert above.env.signal.features is source and rebuilt.signal.features is source
     rebuilt.reset(seed=0)
     assert "reward_intrinsic" in rebuilt.step(0)[4]
 
@@ -273,7 +283,7 @@ def test_vector_version_watches_only_transitions_within_an_episode(mode):
         for triplets, nexts, _ in source.watched
         for a, b in zip(triplets, nexts, strict=True)
     ]
-    assert len(pairs) == envs.state_dict()["step"]
+    assert len(pairs) == envs.state_dict()["scored"]
     for triplet, following in pairs:
         np.testing.assert_array_equal(following[:2], triplet[1:])
     envs.close()

@@ -44,7 +44,7 @@ def vector(mode: AutoresetMode, n: int = 2) -> SyncVectorEnv:
 
 @pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
 def test_the_vector_reward_is_the_extrinsic_plus_the_scaled_intrinsic(mode):
-    envs = RNDVectorReward(vector(mode), Recorder(), scale=0.5, warmup=0)
+    envs = RNDVectorReward(vector(mode), Recorder(), scale=0.5, warmup=0, normalization="none")
     envs.reset(seed=[0, 1])
     for t in range(4):
         _, rewards, _, _, info = envs.step(np.array([t % 2, 1 - t % 2]))
@@ -57,7 +57,7 @@ def test_the_vector_reward_is_the_extrinsic_plus_the_scaled_intrinsic(mode):
 
 
 def test_the_single_reward_is_the_extrinsic_plus_the_scaled_intrinsic():
-    env = RNDReward(cartpole(), Recorder(), scale=0.5, warmup=0)
+    env = RNDReward(cartpole(), Recorder(), scale=0.5, warmup=0, normalization="none")
     env.reset(seed=0)
     _, reward, *_, info = env.step(0)
     assert info["reward_extrinsic"] == 1.0 and info["reward_intrinsic"] > 0
@@ -125,7 +125,7 @@ def test_a_masked_reset_renews_only_the_masked_sub_envs_triplets():
 
 def test_a_masked_reset_leaves_the_other_sub_envs_autoreset_step_unscored():
     source = Recorder()
-    envs = RNDVectorReward(vector(AutoresetMode.NEXT_STEP), source, warmup=0)
+    envs = RNDVectorReward(vector(AutoresetMode.NEXT_STEP), source, warmup=0, normalization="none")
     envs.reset(seed=[0, 1])
     terminated = np.zeros(2, dtype=bool)
     while not terminated[0]:  # sub-env 0 falls; sub-env 1, balanced by turns, does not yet
@@ -146,7 +146,7 @@ def test_a_step_before_reset_is_refused_and_close_closes_the_source():
         action = wrapped.action_space.sample()
         with pytest.raises(gym.error.ResetNeeded, match="Call reset"):
             wrapped.step(action)
-        source = wrapped.curiosity.source
+        source = wrapped.signal.source
         wrapped.close()
         assert source.closed == 1
 
@@ -176,10 +176,10 @@ class Features:
 
 def test_the_consistency_wrapper_starts_from_its_maxima_and_defaults():
     env = ConsistencyCuriosityReward(cartpole(), Features(), r_e_max_init=3.0, r_i_max_init=2.0)
-    assert env.state_dict() == {"step": 0, "r_e_max": 3.0, "r_i_max": 2.0}
+    assert env.state_dict() == {"scored": 0, "normalization": {"r_e_max": 3.0, "r_i_max": 2.0}}
     env = ConsistencyCuriosityReward(cartpole(), Features())
-    assert env.scale == 0.2 and env.curiosity.decay == 2e-5
-    assert env.state_dict() == {"step": 0, "r_e_max": 1.0, "r_i_max": 1.0}
+    assert env.scale == 0.2 and env.decay == 2e-5
+    assert env.state_dict() == {"scored": 0, "normalization": {"r_e_max": 1.0, "r_i_max": 1.0}}
 
 
 def test_scale_zero_logs_the_intrinsic_reward_without_adding_it():
@@ -187,7 +187,7 @@ def test_scale_zero_logs_the_intrinsic_reward_without_adding_it():
     env.reset(seed=0)
     _, reward, *_, info = env.step(0)
     assert reward == info["reward_extrinsic"] == 1.0 and info["reward_intrinsic"] == 0.0
-    assert env.curiosity.scored == 1  # the signal still ran
+    assert env.scored == 1  # the signal still ran
 
 
 def test_the_errors_name_the_wrapper_and_the_source():

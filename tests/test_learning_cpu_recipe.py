@@ -53,7 +53,7 @@ def trained_and_random(run_dir, seed: int) -> tuple[float, float]:
 def test_cpu_preset_agent_beats_a_random_policy_on_point_reach(tmp_path):
     """800 env steps (100 random, then one update per step) at 24x24, batch 32, seed 0.
 
-    Measured (2026-12-02, commit 1ef25e7, 2 shared CPU cores, torch 1 thread; 45-120 s a run
+    Measured (commit 1ef25e7, 2 shared CPU cores, torch 1 thread; 45-120 s a run
     on the loaded machine, about 25 s of CPU), mean return over the same 20 episodes:
 
     | seed | trained | random policy |

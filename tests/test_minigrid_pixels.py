@@ -87,14 +87,14 @@ def test_ppo_trains_on_extrinsic_plus_intrinsic(arm, small_ppo):
     ppo = small_ppo(env)
     seen = RewardsSeen()
     ppo.learn(total_timesteps=256, callback=seen)
-    model = env.curiosity.source
+    model = env.signal.source
     assert ppo.num_timesteps == 256 and model.updates == (256 - 32) // 8
     rewards, extrinsic, intrinsic = (np.array(v) for v in zip(*seen.steps, strict=True))
     np.testing.assert_allclose(rewards, extrinsic + intrinsic, rtol=1e-6)
     # DoorKey pays only on reaching the goal: 0 on every other step
     assert np.all((extrinsic == 0) | (extrinsic > 0))
     if arm == "consistency":
-        r_e_max = env.state_dict()["r_e_max"]
+        r_e_max = env.state_dict()["normalization"]["r_e_max"]
         assert np.all(intrinsic <= 0.2 * r_e_max + 1e-9)
         # A still triplet (a no-op or a move into a wall: 106 of these 256 PPO steps)
         # has no motion and no appearance change. With the initial weights (zero biases) its
@@ -106,9 +106,9 @@ def test_ppo_trains_on_extrinsic_plus_intrinsic(arm, small_ppo):
         assert np.all(intrinsic[initial & still] < 1e-6)
         assert np.all(intrinsic[initial & ~still] > 1e-6)
         assert np.all(intrinsic[~initial] > 0)
-        assert env.state_dict()["step"] == 256
+        assert env.state_dict()["scored"] == 256
     else:
         assert np.all(intrinsic[:64] == 0) and np.all(intrinsic[64:] > 0)
         assert env.state_dict()["scored"] == 256
-        assert env.state_dict()["error_count"] == 256 - 64 // 2  # from mid warm-up on
+        assert env.state_dict()["normalization"]["count"] == 256 - 64 // 2  # from mid warm-up on
     env.close()

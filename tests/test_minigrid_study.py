@@ -190,7 +190,7 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     assert torch.equal(torch.get_rng_state(), saved["rng"]["torch"])
     env_rng = [g.bit_generator.state for g in training.timed.get_attr("np_random")]
     assert env_rng == saved["env_rng"]
-    model = training.envs.curiosity.source
+    model = training.envs.signal.source
     assert model.updates == saved["intrinsic"]["model"]["updates"] > 0
     assert [r["env_step"] for r in training.log.eval_rows] == [0, 1024]
     training.close()

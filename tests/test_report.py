@@ -350,7 +350,7 @@ def test_at_wall_time_uses_the_last_evaluation_within_it_of_runs_that_trained_pa
 
 
 def test_a_seed_counts_once_the_finished_run_then_the_most_recent_kept(runs_dir, tmp_path):
-    """A plain run and a sweep trial of the same config and seed (issue 22) count once."""
+    """A plain run and a sweep trial of the same config and seed count once."""
     root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "runs")
     trial = root / "sweep" / "agent.lr=0.001" / "simoun-PointReach-v0" / "s0"
     shutil.copytree(root / "a-s0", trial)

@@ -1,4 +1,4 @@
-"""What a run does when something fails under it (issue 22): a full disk at a checkpoint, a NaN
+"""What a run does when something fails under it: a full disk at a checkpoint, a NaN
 reward from the env, the temporary a ``kill -9`` leaves halfway through a checkpoint.
 
 The full disk is real, not a mock: a subprocess under ``RLIMIT_FSIZE`` (its writes past the limit

@@ -12,9 +12,9 @@ MARGIN = 6.0
 def test_short_run_on_point_reach_beats_a_random_policy(tmp_path):
     """800 env steps (100 random, then one update per step) on simoun/PointReach-v0, seed 0.
 
-    Measured (2026-12-01, 2 shared CPU cores under load, torch 1 thread; 25-72 s a run), mean
+    Measured (2 shared CPU cores under load, torch 1 thread; 25-72 s a run), mean
     return over the same 20 evaluation episodes, with the seed streams of
-    simoun_agent.run.seeds (episode starts differ from those of the scheme before it):
+    simoun_agent.run.seeds (one SeedSequence per run):
 
     | seed | trained | random policy |
     |------|---------|---------------|

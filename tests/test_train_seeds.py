@@ -1,4 +1,4 @@
-"""Seeds (issue 17): every stream of a run comes from one SeedSequence(seed), so runs of different
+"""Seeds: every stream of a run comes from one SeedSequence(seed), so runs of different
 seeds share no training or evaluation episode start, and a run evaluates on the same episodes at
 every evaluation, never on its training ones."""
 

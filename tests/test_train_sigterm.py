@@ -1,4 +1,4 @@
-"""SIGTERM stops simoun-train like the first Ctrl-C, on dm_control and on highway-env (issue 14).
+"""SIGTERM stops simoun-train like the first Ctrl-C, on dm_control and on highway-env.
 
 Each case runs the real command in a subprocess on a tiny configuration. highway-env renders
 through pygame, whose SDL would take SIGTERM for itself: these runs set

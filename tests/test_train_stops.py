@@ -1,8 +1,8 @@
-"""A stop in every phase of a run (issue 22): Ctrl-C or SIGTERM during the warm-up, an evaluation
+"""A stop in every phase of a run: Ctrl-C or SIGTERM during the warm-up, an evaluation
 (the initial one, a later one, the final one) or the final video is acknowledged at once, writes
 a checkpoint and exits with 130 / 143; an evaluation is abandoned, never logged halfway, and
 runs again on resume, which ends where a run that never stopped ends. Callbacks' ``on_start`` and
-``on_end`` run however a run ends (issue 18).
+``on_end`` run however a run ends.
 
 The signal tests run the real command in a subprocess and poll its output or run directory for
 the phase they want to interrupt (no fixed sleeps); the phase is named in the stop message.

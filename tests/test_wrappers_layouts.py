@@ -1,4 +1,4 @@
-"""What SimounObservation takes as pixels (issue 22): RGBA (alpha dropped), a Dict's "pixels"
+"""What SimounObservation takes as pixels: RGBA (alpha dropped), a Dict's "pixels"
 entry over render(); refused with the conversion to make: MiniGrid's object-id grid, channel-first
 planes and stacked grayscale frames."""
 

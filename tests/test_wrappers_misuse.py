@@ -1,5 +1,5 @@
-"""Wrapper misuse from a new user's audit (issue 10): each case is a clear error, never a
-silently wrong observation. Headless import order and SDL's signal handlers (issue 14)."""
+"""Wrapper misuse a new user runs into: each case is a clear error, never a
+silently wrong observation. Headless import order and SDL's signal handlers."""
 
 import os
 import signal

@@ -1,4 +1,4 @@
-"""Wrapper order (issue 22): a wrapper that belongs under the frame stack refuses to go over it,
+"""Wrapper order: a wrapper that belongs under the frame stack refuses to go over it,
 naming the order to use, and the right order does what the wrong one silently would not."""
 
 import gymnasium as gym

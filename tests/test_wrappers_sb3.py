@@ -1,4 +1,4 @@
-"""The supported Stable-Baselines3 path (issue 22): ``fold_frames=True`` with ``CnnPolicy``; what
+"""The supported Stable-Baselines3 path: ``fold_frames=True`` with ``CnnPolicy``; what
 SB3 does with the Dict form, and ``check_sb3_policy`` saying why and what to use."""
 
 import gymnasium as gym

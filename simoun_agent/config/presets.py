@@ -74,7 +74,7 @@ PRESETS["highway"] = Preset(
     },
     envs="highway",
 )
-CPU_PRESET_TIME = "52-81 min wall beside a second run on 2 loaded cores (measured 2026-12-02)"
+CPU_PRESET_TIME = "52-81 min wall beside a second run on 2 loaded cores (measured: dmc100k v1)"
 """Time of one cpu-preset run: the dmc100k study's 5 evaluation seeds on cartpole-swingup
 (docs/main-job), 3,101-4,858 s wall at a load average of 5-8 (1,916-1,997 s of process CPU
 time where a run went in one part): the one figure the help text and the README quote; update

@@ -1,4 +1,4 @@
-"""Does an intrinsic reward help PPO on MiniGrid from pixels? Issue 21's study.
+"""Does an intrinsic reward help PPO on MiniGrid from pixels? The MiniGrid study.
 
 Stable-Baselines3 PPO (``CnnPolicy``, rl-baselines3-zoo's MiniGrid settings, the same for every
 arm) on MiniGrid-DoorKey-6x6 (400k env steps, 5 seeds) and -8x8 (1M, 3 seeds), three arms: no

@@ -4,6 +4,7 @@ python -m simoun_agent.minigrid_study run                  # every unfinished ru
 python -m simoun_agent.minigrid_study run --address auto   # on a running Ray cluster
 python -m simoun_agent.minigrid_study report               # docs/studies/minigrid/report/
 python -m simoun_agent.minigrid_study probe                # docs/studies/minigrid/probe/
+python -m simoun_agent.minigrid_study select --archive A   # a tuning archive's selection
 """
 
 from __future__ import annotations
@@ -70,9 +71,15 @@ class Probe:
     """where probe.csv and probe.md go"""
 
 
+@dataclass
+class Select(Report):
+    """Apply the tuning phase's selection rule to a tuning archive (selection.md, .json)."""
+
+
 Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
     Annotated[Run, tyro.conf.subcommand("run")],
     Annotated[Report, tyro.conf.subcommand("report")],
+    Annotated[Select, tyro.conf.subcommand("select")],
     Annotated[Probe, tyro.conf.subcommand("probe")],
 ]
 
@@ -103,6 +110,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
             print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
             return 1 if outcome["failed"] else 0
+        if isinstance(args, Select):
+            from simoun_agent.minigrid_study.select import write_selection
+
+            print(write_selection(spec, args.archive))
+            return 0
         from simoun_agent.minigrid_study.report import write_report
 
         print(write_report(spec, args.archive))

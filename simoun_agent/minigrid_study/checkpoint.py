@@ -1,5 +1,5 @@
-"""Mid-run checkpoints of a study run, so that a run whose process was ended (a session's end, a
-preempted cluster node) goes on from its last checkpoint instead of from scratch.
+"""Mid-run checkpoints of a study run, so that a run whose process was ended (a machine
+handed back, a preempted cluster node) goes on from its last checkpoint instead of from scratch.
 
 A checkpoint is written atomically at the first rollout after each evaluation (after PPO's
 update, with an empty rollout buffer). It holds PPO's policy and optimizer and its step and
@@ -34,16 +34,18 @@ CHECKPOINT = "checkpoint.pt"
 
 def intrinsic_state(envs: Any) -> dict[str, Any] | None:
     """The intrinsic-reward wrapper's statistics and its model's state (None: no wrapper)."""
-    if not hasattr(envs, "curiosity"):
+    if not hasattr(envs, "signal"):
         return None
-    return {"signal": envs.state_dict(), "model": envs.curiosity.source.state_dict()}
+    source = envs.signal.source
+    return {"signal": envs.state_dict(), "model": None if source is None else source.state_dict()}
 
 
 def load_intrinsic_state(envs: Any, state: dict[str, Any] | None) -> None:
     """Restore what :func:`intrinsic_state` returned into the wrapper ``envs``."""
     if state is not None:
         envs.load_state_dict(state["signal"])
-        envs.curiosity.source.load_state_dict(state["model"])
+        if state["model"] is not None:
+            envs.signal.source.load_state_dict(state["model"])
 
 
 class RunCheckpoint(BaseCallback):

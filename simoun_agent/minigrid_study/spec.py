@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
-from simoun_agent.minigrid_study.arms import ARMS
+from simoun_agent.minigrid_study.arms import ARMS, parse_arm
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -77,8 +77,9 @@ class StudySpec:
 
     tasks: tuple[Task, ...] = field(default_factory=default_tasks)
     """the tasks with their budgets and seeds"""
-    arms: tuple[str, ...] = tuple(ARMS)
-    """arms of ``simoun_agent.minigrid_study.arms.ARMS``"""
+    arms: tuple[str, ...] = ("ppo", "consistency", "rnd")
+    """arms: entries of ``simoun_agent.minigrid_study.arms.ARMS``, each optionally with settings
+    (``"rnd,normalization=return_std,scale=0.01"``)"""
     ppo: PPOSettings = field(default_factory=PPOSettings)
     """PPO's settings, shared by every arm"""
     evaluations: int = 20
@@ -92,12 +93,12 @@ class StudySpec:
     """torch device of PPO and of the intrinsic-reward models"""
 
     def __post_init__(self) -> None:
-        unknown = [arm for arm in self.arms if arm not in ARMS]
-        if unknown or not self.arms:
-            raise SetupError(
-                f"spec arms {list(self.arms)}: unknown {unknown or 'none given'}; choose from "
-                f"{list(ARMS)}"
-            )
+        if not self.arms:
+            raise SetupError(f"spec arms: none given; choose from {list(ARMS)}")
+        for arm in self.arms:
+            parse_arm(arm)
+        if len(set(self.arms)) != len(self.arms):
+            raise SetupError(f"spec arms {list(self.arms)}: an arm is listed twice")
         for task in self.tasks:
             if task.steps < self.ppo.n_envs * self.ppo.n_steps:
                 raise SetupError(

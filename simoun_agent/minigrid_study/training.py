@@ -11,7 +11,7 @@ import numpy as np
 import torch
 from stable_baselines3 import PPO
 
-from simoun_agent.minigrid_study.arms import ARMS
+from simoun_agent.minigrid_study.arms import build_arm
 from simoun_agent.minigrid_study.envs import SB3VecEnv, pixel_vector_env
 from simoun_agent.minigrid_study.spec import Run, StudySpec
 from simoun_agent.minigrid_study.study_log import StudyLog
@@ -64,7 +64,9 @@ def set_up(spec: StudySpec, run: Run, run_dir: Path, commit: str | None = None) 
     seeds = {"env": env_seed, "ppo": ppo_seed, "model": model_seed}
     config = {"run": run.name, "commit": commit, "seeds": seeds, "spec": spec.to_json()}
     write_json(run_dir / CONFIG, config)
-    envs = ARMS[run.arm](pixel_vector_env(run.task.env_id, spec.ppo.n_envs), model_seed, device)
+    envs = build_arm(
+        run.arm, pixel_vector_env(run.task.env_id, spec.ppo.n_envs), model_seed, device
+    )
     timed = TimedVecEnv(SB3VecEnv(envs))
     eval_envs = SB3VecEnv(pixel_vector_env(run.task.env_id, spec.eval_episodes))
     ppo = PPO("CnnPolicy", timed, seed=ppo_seed, device=device, **spec.ppo.kwargs())

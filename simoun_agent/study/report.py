@@ -371,8 +371,8 @@ def time_section(results: list[RunResult]) -> list[str]:
         "",
         "Wall time: seconds in the training loop (`summary.json`, evaluations included). CPU "
         "time: user + system seconds of the trial's process (`trial.json`, summed over its "
-        "parts); a part whose process was ended (a session's end) recorded none, so a run with "
-        "such a part is left out of the mean, which then says over how many runs it is. Load: "
+        "parts); a part whose process was ended (a machine handed back) recorded none, so a run "
+        "with such a part is left out of the mean, which then says over how many runs it is. Load: "
         "the 1-minute load average per CPU when the trial started (above 1, runs waited for a "
         "CPU and their wall times are inflated).",
         "",

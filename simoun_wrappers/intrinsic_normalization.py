@@ -1,0 +1,309 @@
+"""How a raw intrinsic signal becomes the reward an algorithm sees: one choice for every signal.
+
+A raw signal (Simoun's consistency distance ``d``, RND's prediction error, a constant) has a
+scale no learner should depend on, and its sign decides what it teaches: always positive, it
+pays an on-policy learner for staying alive (Burda et al. 2018, "Large-Scale Study of
+Curiosity-Driven Learning", section "Death is not the end"). The normalisations here:
+
+==============  =========================================================  ========================
+name            reward for raw value ``x``                                 source
+==============  =========================================================  ========================
+``paper``       ``x * r_e_max / r_i_max`` (running maxima of ``|r_e|``     Simoun, Eq. 13
+                and ``x``, raised with the batch first): in ``[0, r_e_max]``
+``reward_std``  ``x / std(x)``, running std of the raw values              RLeXplore's ``rms``
+``return_std``  ``x / std(R)``, running std of the discounted intrinsic    Burda et al. 2019 (RND),
+                return ``R <- gamma * R + x`` per sub-env, never reset     ``RewardForwardFilter``
+``standardize`` ``(x - mean(x)) / std(x)``: zero mean                      DEIR (Wan et al. 2023)
+``none``        ``x``                                                      (the raw signal)
+==============  =========================================================  ========================
+
+Each is a class with ``__call__(raw, extrinsic, envs, counted)``: the statistics are raised with
+the ``counted`` rows first, then every row is normalized. A statistic that has not spread yet
+(a running std of 0, as after a first batch of equal values) gives 0 rather than a division by
+zero: documented on each class. Nothing here imports torch.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from typing import Any, ClassVar
+
+import numpy as np
+from gymnasium.wrappers.utils import RunningMeanStd
+
+from simoun_wrappers.curiosity import RunningMax
+
+__all__ = [
+    "NORMALIZATIONS",
+    "Normalization",
+    "PaperMaxima",
+    "Raw",
+    "ReturnStd",
+    "RewardStd",
+    "Standardize",
+    "make_normalization",
+]
+
+TINY_STD = 1e-8
+"""a running std at or below this has not spread yet: the normalized reward is 0"""
+
+
+def running_moments() -> RunningMeanStd:
+    """Gymnasium's ``RunningMeanStd`` with no prior pseudo-sample (its default adds one of weight
+    1e-4 and variance 1, which outweighs the variance of values that differ by less than 1e-2)."""
+    return RunningMeanStd(epsilon=0.0, shape=())
+
+
+def divide_by_std(values: np.ndarray, moments: RunningMeanStd) -> np.ndarray:
+    """``values / std``, or 0 everywhere while the std is at most :data:`TINY_STD`."""
+    std = math.sqrt(max(float(moments.var), 0.0))
+    if std <= TINY_STD:
+        return np.zeros_like(values, dtype=np.float64)
+    return values / std
+
+
+def moments_state(moments: RunningMeanStd) -> dict[str, float]:
+    return {"mean": float(moments.mean), "var": float(moments.var), "count": float(moments.count)}
+
+
+def load_moments(moments: RunningMeanStd, state: dict[str, float]) -> None:
+    moments.mean = np.float64(state["mean"])
+    moments.var = np.float64(state["var"])
+    moments.count = float(state["count"])
+
+
+class Normalization(ABC):
+    """Turns a batch of raw intrinsic values into normalized rewards, keeping running statistics.
+
+    ``__call__(raw, extrinsic, envs, counted)``: ``raw`` ``(B,)`` finite floats, ``extrinsic``
+    ``(B,)`` the env's rewards of the same transitions, ``envs`` ``(B,)`` the sub-env index of
+    each row (0 for a single env), ``counted`` ``(B,)`` bool: the rows that update the
+    statistics (the others, inside a warm-up, are normalized with the statistics as they are).
+    """
+
+    name: ClassVar[str]
+    """the name a wrapper's ``normalization`` argument takes"""
+
+    @abstractmethod
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        """``(B,)`` float64 normalized rewards."""
+
+    @abstractmethod
+    def state_dict(self) -> dict[str, Any]:
+        """The running statistics."""
+
+    @abstractmethod
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        """Restore what :meth:`state_dict` returned."""
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+class PaperMaxima(Normalization):
+    """Eq. 13's normalisation: ``x * r_e_max / r_i_max``.
+
+    ``r_e_max`` is the running maximum of ``|r_e|`` and ``r_i_max`` that of the raw value, both
+    raised with the counted rows before the batch is normalized (:class:`RunningMax`), so the
+    reward lies in ``[0, r_e_max]`` for a non-negative signal. With the wrapper's weight
+    ``scale * exp(-decay * t)`` this is Eq. 13 exactly (``consistency_reward``). It is always
+    positive: to an on-policy learner, a bonus for staying alive.
+
+    Example:
+        >>> import numpy as np
+        >>> norm = PaperMaxima(r_e_max_init=1.0, r_i_max_init=1.0)
+        >>> norm(np.array([2.0, 1.0]), np.array([0.0, 0.5]), np.zeros(2, int), np.ones(2, bool))
+        array([1. , 0.5])
+    """
+
+    name = "paper"
+
+    def __init__(self, r_e_max_init: float = 1.0, r_i_max_init: float = 1.0) -> None:
+        self.maxima = RunningMax(r_e_max=r_e_max_init, r_i_max=r_i_max_init)
+
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        self.maxima.update(extrinsic[counted], raw[counted])
+        return raw * (self.maxima.r_e_max / self.maxima.r_i_max)
+
+    def state_dict(self) -> dict[str, Any]:
+        return self.maxima.state_dict()
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        self.maxima.load_state_dict(state)
+
+
+class RewardStd(Normalization):
+    """``x / std(x)``: the raw value over the running standard deviation of the raw values
+    (RLeXplore's default ``rms`` normalisation, rllte ``BaseReward``). No mean is subtracted, so
+    a non-negative signal stays non-negative. While the std is 0 the reward is 0.
+
+    Example:
+        >>> import numpy as np
+        >>> norm = RewardStd()
+        >>> norm(np.array([1.0, 3.0]), np.zeros(2), np.zeros(2, int), np.ones(2, bool))
+        array([1., 3.])
+    """
+
+    name = "reward_std"
+
+    def __init__(self) -> None:
+        self.moments = running_moments()
+
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        if counted.any():
+            self.moments.update(raw[counted])
+        return divide_by_std(raw, self.moments)
+
+    def state_dict(self) -> dict[str, Any]:
+        return moments_state(self.moments)
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        load_moments(self.moments, state)
+
+
+class ReturnStd(Normalization):
+    """``x / std(R)``: the raw value over the running standard deviation of the discounted
+    intrinsic return ``R <- gamma * R + x``, one ``R`` per sub-env, never reset at episode ends
+    (Burda et al. 2019, "Exploration by Random Network Distillation": the intrinsic return is
+    non-episodic; their ``RewardForwardFilter`` with gamma 0.99). No mean is subtracted. Each
+    row's ``R`` is advanced in batch order (a sub-env appears once per vector step); the
+    counted rows' ``R`` raise the statistics. While the std is 0 the reward is 0.
+
+    Example:
+        >>> import numpy as np
+        >>> norm = ReturnStd(gamma=0.5)
+        >>> _ = norm(np.array([2.0, 4.0]), np.zeros(2), np.array([0, 1]), np.ones(2, bool))
+        >>> norm.returns   # R after one step: the raw values
+        array([2., 4.])
+        >>> norm(np.array([2.0, 0.0]), np.zeros(2), np.array([0, 1]), np.ones(2, bool)).round(3)
+        array([2.412, 0.   ])
+        >>> norm.returns   # 0.5 * R + x; the std of R over [2, 4, 3, 2] is 0.829
+        array([3., 2.])
+    """
+
+    name = "return_std"
+
+    def __init__(self, gamma: float = 0.99) -> None:
+        if not (isinstance(gamma, (int, float)) and 0 <= gamma < 1):
+            raise ValueError(
+                f"gamma must be a number in [0, 1) (the intrinsic return's discount), got "
+                f"{gamma!r}; RND uses gamma=0.99."
+            )
+        self.gamma = float(gamma)
+        self.returns = np.zeros(0, dtype=np.float64)
+        """the discounted intrinsic return of each sub-env so far"""
+        self.moments = running_moments()
+
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        if len(envs) and envs.max() >= len(self.returns):
+            grown = np.zeros(int(envs.max()) + 1, dtype=np.float64)
+            grown[: len(self.returns)] = self.returns
+            self.returns = grown
+        batch_returns = np.empty(len(raw), dtype=np.float64)
+        for row, (env, value) in enumerate(zip(envs, raw, strict=True)):
+            self.returns[env] = self.gamma * self.returns[env] + value
+            batch_returns[row] = self.returns[env]
+        if counted.any():
+            self.moments.update(batch_returns[counted])
+        return divide_by_std(raw, self.moments)
+
+    def state_dict(self) -> dict[str, Any]:
+        return {**moments_state(self.moments), "returns": self.returns.tolist()}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        load_moments(self.moments, state)
+        self.returns = np.asarray(state["returns"], dtype=np.float64)
+
+    def __repr__(self) -> str:
+        return f"ReturnStd(gamma={self.gamma})"
+
+
+class Standardize(Normalization):
+    """``(x - mean(x)) / std(x)``: zero-mean standardisation with the running mean and std of the
+    raw values (DEIR, Wan et al. 2023, ``int_rew_norm=1``; it uses an exponential moving average
+    where this uses the running mean over all values). About half the steps are paid and half
+    charged, so a policy gains nothing by prolonging its episode unless what it sees is more
+    novel than usual. While the std is 0 the reward is 0.
+
+    Example:
+        >>> import numpy as np
+        >>> norm = Standardize()
+        >>> norm(np.array([1.0, 3.0]), np.zeros(2), np.zeros(2, int), np.ones(2, bool))
+        array([-1.,  1.])
+    """
+
+    name = "standardize"
+
+    def __init__(self) -> None:
+        self.moments = running_moments()
+
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        if counted.any():
+            self.moments.update(raw[counted])
+        return divide_by_std(raw - float(self.moments.mean), self.moments)
+
+    def state_dict(self) -> dict[str, Any]:
+        return moments_state(self.moments)
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        load_moments(self.moments, state)
+
+
+class Raw(Normalization):
+    """``x``: the raw signal unchanged (a constant bonus, or a signal already on a known scale).
+
+    Example:
+        >>> import numpy as np
+        >>> Raw()(np.array([0.5]), np.zeros(1), np.zeros(1, int), np.ones(1, bool))
+        array([0.5])
+    """
+
+    name = "none"
+
+    def __call__(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        return raw.astype(np.float64)
+
+    def state_dict(self) -> dict[str, Any]:
+        return {}
+
+    def load_state_dict(self, state: dict[str, Any]) -> None:
+        return None
+
+
+NORMALIZATIONS: dict[str, type[Normalization]] = {
+    cls.name: cls for cls in (PaperMaxima, RewardStd, ReturnStd, Standardize, Raw)
+}
+"""normalization name -> class"""
+
+
+def make_normalization(normalization: str | Normalization, **paper: float) -> Normalization:
+    """``normalization`` itself when it is a :class:`Normalization`, else the registered class of
+    that name, built with its defaults (``paper``: ``r_e_max_init`` / ``r_i_max_init``, used by
+    ``"paper"`` only)."""
+    if isinstance(normalization, Normalization):
+        return normalization
+    if normalization not in NORMALIZATIONS:
+        from difflib import get_close_matches
+
+        close = get_close_matches(str(normalization), NORMALIZATIONS, n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise ValueError(
+            f"normalization={normalization!r} is not one of {list(NORMALIZATIONS)}; {hint}"
+            "or pass a Normalization instance (e.g. ReturnStd(gamma=0.999))."
+        )
+    if normalization == PaperMaxima.name:
+        return PaperMaxima(**paper)
+    return NORMALIZATIONS[normalization]()
