@@ -127,9 +127,16 @@ def to_dict(config: TrainConfig) -> dict[str, Any]:
     return json.loads(json.dumps(dataclasses.asdict(config)))
 
 
+SAVED_BEFORE = {"agent.next_state_encoder": "online"}
+"""What a saved config that lacks a key ran with, where that differs from today's default: the
+key was added with this value as its default, which the default has since left."""
+
+
 def from_dict(data: dict[str, Any]) -> TrainConfig:
-    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know."""
-    flat = flatten(data)
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know. A key
+    the config predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did),
+    else this version's default."""
+    flat = {**SAVED_BEFORE, **flatten(data)}
     check_keys(
         flat,
         "saved config",
