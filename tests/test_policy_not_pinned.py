@@ -1,84 +1,171 @@
-"""No recipe's policy gets pinned at the action bounds for good: each is trained briefly on
-dm_control cartpole-swingup (through shimmy) at a tiny size, and after the warm-up its
-evaluation actions on fixed observations keep changing from one evaluation to the next and are
-not all at the bounds.
+"""No recipe's policy gets pinned at the action bounds: the agent of one recipe of each policy
+path (the recipes that differ only in the representation share one) is trained on the
+transitions of dm_control cartpole-swingup (through shimmy, the cpu preset at 24x24), and its
+evaluation actions on fixed observations keep changing from one probe to the next and are not
+all at the bounds at the end.
 
 The failure this catches: a deterministic policy whose pre-tanh output Adam drives to |x| ~ 8,
 where tanh' ~ 1e-6, so the actor stays at a = -1 on every state (measured on the dmc100k study's
-drqv2 runs: the same evaluation return to 8 digits for 40k env steps). A plateau the policy
-leaves is no failure: only actions that are all at the bounds and no longer move are.
+drqv2 runs: the same evaluation return to 8 digits for 40k env steps). It needs only a critic
+whose Q slope in the action has the same sign at every state, which random-action cartpole data
+gives within a few hundred updates; a plateau the policy leaves is no failure, only actions that
+are all at the bounds and no longer move are.
+
+Rendering dominates the cost of a cartpole step (tens of ms per frame on a CPU), so the
+transitions are collected once, with uniform random actions as in the warm-up, and every recipe
+trains on a copy of that replay: one gradient step per ``update_every_steps`` agent steps, as
+the training loop takes them. The drqv2 values of the dmc100k study's runs (one shared FC +
+LayerNorm, an update every agent step) are the case that must be caught.
 """
 
+import copy
+import dataclasses
 import itertools
 
 import numpy as np
 import pytest
 import torch
 
+from simoun_agent import FrameReplay, SimounAgent
 from simoun_agent.config import RECIPES, resolve
-from simoun_agent.run import train
-from simoun_agent.run.callback import TrainCallback
+from simoun_agent.run.make_env import make_env
 
-TINY = {
+SMALL = {
     "env": "dm_control/cartpole-swingup-v0",
     "image_size": 24,
-    "total_env_steps": 3200,
-    "warmup_agent_steps": 50,
-    "replay_capacity": 5000,
-    "eval_every": 800,
-    "eval_episodes": 1,
-    "checkpoint_every": 10**9,
-    "video": False,
-    "progress": False,
-    "device": "cpu",
-    "torch_threads": 1,
     "seed": 1,
-    "agent.batch_size": 32,
+    "agent.batch_size": 16,
     "agent.num_filters": 8,
     "agent.feature_dim": 16,
     "agent.aux_hidden_dim": 16,
 }
 """The cpu preset (action repeat 8, hidden 256, each recipe's learning rates and schedules) at
-24x24 with batch 32 and 8 filters: 400 decisions, about 350 of them followed by updates."""
+24x24 with batch 16 and 8 filters."""
 
+COLLECTED = 128
+"""agent steps of uniform random actions in the replay (one 125-step episode and the start of
+the next)"""
+AGENT_STEPS = 240
+"""agent steps trained for: 240 gradient steps at one per agent step, 120 at one per 2 (drqv2
+with DRQV2_PINNED has every action at the bounds after about 200)"""
+PROBE_EVERY = 60
+"""agent steps between two readings of the actions"""
 BOUND = 1.0 - 1e-3
 """|a| above this is at the bound"""
 MOVED = 1e-4
-"""the largest change of any action between two evaluations that counts as moving"""
+"""the largest change of any action between two readings that counts as moving"""
 PROBES = 32
-"""observations the actions are read on: a random-action episode's first frames"""
+"""observations the actions are read on: the first frames of a random-action episode"""
+
+DRQV2_PINNED = {
+    "agent.separate_trunks": False,
+    "agent.pixel_offset": 0.0,
+    "agent.independent_next_shift": False,
+    "agent.update_every_steps": 1,
+    "agent.target_update_every": 2,
+    "agent.exploration_steps": 1_000_000,
+}
+"""drqv2 with the values its dmc100k study runs had: the encoder's FC + LayerNorm shared by
+actor and critic (the actor reading it detached), pixels x / 255, one shift offset for obs and
+next obs, a critic and actor update every agent step with the targets every 2nd, the medium
+tasks' schedule on cartpole-swingup.
+Its policy sat at a = -1 for good in the dmc100k study; here it must be caught."""
 
 
-class ActionProbe(TrainCallback):
-    """The deterministic (evaluation) actions on fixed observations, at every evaluation."""
-
-    def on_start(self, run: train.Run) -> None:
-        env = run.eval_env
-        rng = np.random.default_rng(0)
-        obs, _ = env.reset(seed=12_345)
-        frames = [obs["frames"]]
-        while len(frames) < PROBES:
-            obs, *_ = env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-            frames.append(obs["frames"])
-        self.frames = np.stack(frames)
-        self.actions: list[tuple[int, np.ndarray]] = []
-
-    def on_evaluation(self, run: train.Run, metrics: dict[str, float]) -> None:
-        with torch.no_grad():
-            actions = np.stack([run.agent.act(f, deterministic=True) for f in self.frames])
-        self.actions.append((run.counters.env_step, actions))
+REPRESENTATION = {"encoder", "transition_weight", "contrastive_weight", "reward_weight"}
+REPRESENTATION |= {"curiosity", "recipe"}
+"""Fields that change the state the actor and the critic read, not how they learn from it."""
 
 
-@pytest.mark.parametrize("recipe", list(RECIPES))
-def test_the_policy_is_not_pinned_at_the_action_bounds(recipe, tmp_path):
-    config = resolve("cpu", {**TINY, "agent.recipe": recipe, "run_dir": str(tmp_path / "run")})
-    probe = ActionProbe()
-    train.train(train.create_run(config), [probe])
-    warmup = config.warmup_agent_steps * config.resolved_action_repeat()
-    trained = [(step, actions) for step, actions in probe.actions if step > warmup]
-    assert len(trained) >= 3, [step for step, _ in probe.actions]
-    shown = {step: np.round(actions[:4, 0], 6).tolist() for step, actions in trained}
-    for (_, before), (step, after) in itertools.pairwise(trained):
-        assert np.abs(after - before).max() > MOVED, f"no action moved by env step {step}: {shown}"
-    _, last = trained[-1]
-    assert (np.abs(last) < BOUND).any(), f"every action at the bounds at the end: {shown}"
+def policy_path(recipe: str) -> dict:
+    """The recipe's resolved agent config on the test task, its representation fields left out:
+    what decides how the actor and the critic are trained."""
+    agent = resolve("cpu", {**SMALL, "agent.recipe": recipe}).agent
+    return {k: v for k, v in dataclasses.asdict(agent).items() if k not in REPRESENTATION}
+
+
+PATHS = {}
+for name in RECIPES:
+    PATHS.setdefault(str(policy_path(name)), name)
+TRAINED = list(PATHS.values())
+"""One recipe of each policy path, the first in RECIPES' order (simoun for its ablations and the
+Fig. 6 encoders, which differ from it in the representation alone; drqv2 for drqv2_easy, whose
+schedule is drqv2's own on cartpole-swingup)."""
+
+
+@pytest.fixture(scope="module")
+def collected() -> tuple[FrameReplay, np.ndarray]:
+    """The replay of COLLECTED random agent steps and the PROBES observations."""
+    config = resolve("cpu", SMALL)
+    env = make_env(config)
+    rng = np.random.default_rng(0)
+    replay = FrameReplay(COLLECTED + 8, env.observation_space["frames"].shape[1:], 1, seed=0)
+    probes = []
+    obs, _ = env.reset(seed=12_345)
+    replay.start_episode(obs["frames"][-1])
+    for _ in range(COLLECTED):
+        if len(probes) < PROBES:
+            probes.append(obs["frames"])
+        action = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, _ = env.step(action)
+        replay.add(action, reward, obs["frames"][-1], terminated, truncated)
+        if terminated or truncated:
+            obs, _ = env.reset(seed=int(rng.integers(2**31)))
+            replay.start_episode(obs["frames"][-1])
+    env.close()
+    return replay, np.stack(probes)
+
+
+def probe_actions(
+    overrides: dict, collected: tuple[FrameReplay, np.ndarray]
+) -> list[tuple[int, np.ndarray]]:
+    """Train the agent of ``overrides`` on a copy of the collected replay for AGENT_STEPS agent
+    steps; its deterministic actions on the probes every PROBE_EVERY agent steps."""
+    config = resolve("cpu", {**SMALL, **overrides})
+    replay, probes = copy.deepcopy(collected[0]), collected[1]
+    torch.manual_seed(config.seed)
+    agent = SimounAgent(probes.shape[2:], 1, config.agent, device="cpu")
+    repeat = config.resolved_action_repeat()
+    readings = []
+    for agent_step in range(1, AGENT_STEPS + 1):
+        if agent_step % config.agent.update_every_steps == 0:
+            agent.update(replay, (COLLECTED + agent_step) * repeat)
+        if agent_step % PROBE_EVERY == 0:
+            with torch.no_grad():
+                actions = np.stack([agent.act(frames, deterministic=True) for frames in probes])
+            readings.append((agent_step, actions))
+    return readings
+
+
+def pinned(readings: list[tuple[int, np.ndarray]]) -> str | None:
+    """What pins the policy, or None: no action moved between two readings, or every action is
+    at the bounds at the end."""
+    shown = {step: np.round(actions[:4, 0], 6).tolist() for step, actions in readings}
+    for (_, before), (step, after) in itertools.pairwise(readings):
+        if np.abs(after - before).max() <= MOVED:
+            return f"no action moved by agent step {step}: {shown}"
+    if (np.abs(readings[-1][1]) >= BOUND).all():
+        return f"every action at the bounds at the end: {shown}"
+    return None
+
+
+def test_every_recipe_shares_its_policy_path_with_a_trained_one():
+    """A recipe that gets an actor, critic or optimiser setting of its own becomes a case of
+    its own: the cases are the distinct paths, and they are more than one."""
+    assert TRAINED[:2] == ["simoun", "drq"] and {"drqv2", "rad", "curl", "sac"} <= set(TRAINED)
+    assert "drqv2_easy" not in TRAINED and "simoun_no_aux" not in TRAINED
+    for name in RECIPES:
+        assert policy_path(name) in [policy_path(trained) for trained in TRAINED], name
+
+
+@pytest.mark.parametrize("recipe", TRAINED)
+def test_the_policy_is_not_pinned_at_the_action_bounds(recipe, collected):
+    readings = probe_actions({"agent.recipe": recipe}, collected)
+    assert len(readings) == AGENT_STEPS // PROBE_EVERY
+    assert pinned(readings) is None
+
+
+def test_drqv2_with_the_values_of_its_pinned_study_runs_is_caught(collected):
+    readings = probe_actions({"agent.recipe": "drqv2", **DRQV2_PINNED}, collected)
+    assert pinned(readings) is not None
+    assert (np.abs(readings[-1][1]) >= BOUND).all()
