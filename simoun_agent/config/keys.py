@@ -144,7 +144,8 @@ def check_keys(keys: Any, source: str = "", fix: str = HELP_FIX) -> None:
     close matches (:func:`close_match`); ``source`` says where the keys came from (none: the
     user) and ``fix`` how to correct them. The user's overrides, presets, recipes and saved
     configs all pass here."""
-    unknown = [key for key in keys if key not in config_fields()]
+    known = config_fields()  # reads the dataclasses' source: once, not once per key
+    unknown = [key for key in keys if key not in known]
     if unknown:
         named = ", ".join(key + close_match(key) for key in unknown)
         where = f"{source}: " if source else ""
