@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 import torch
+from flag_lists import override
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
@@ -37,7 +38,7 @@ TINY = [
 
 
 def run_flags(run_dir: Path, steps: int = 40, *extra: str) -> list[str]:
-    return [*TINY, "--run-dir", str(run_dir), "--total-env-steps", str(steps), *extra]
+    return override(TINY, "--run-dir", str(run_dir), "--total-env-steps", str(steps), *extra)
 
 
 def exit_message(capsys, main, argv) -> str:
@@ -184,7 +185,7 @@ def test_simoun_eval_does_not_overwrite_an_earlier_evaluation(finished, capsys):
 def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):
     run_dir = tmp_path / "highway"
     highway = '{"config": {"action": {"type": "ContinuousAction"}, "duration": 4}}'
-    flags = [*TINY, "--env", "highway-fast-v0", "--env-kwargs", highway]
+    flags = override(TINY, "--env", "highway-fast-v0", "--env-kwargs", highway)
     assert train_cli.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "12"]) == 0
     process = subprocess.Popen(
         [sys.executable, "-m", "simoun_agent.cli.eval", str(run_dir), "--episodes", "10000"],
@@ -231,7 +232,7 @@ def test_env_module_is_saved_so_resume_and_simoun_eval_rebuild_the_env(tmp_path,
     (tmp_path / "simoun_test_envs.py").write_text(ENV_MODULE)
     monkeypatch.syspath_prepend(str(tmp_path))
     run_dir = tmp_path / "run"
-    flags = [*TINY, "--env", "simoun_test_envs:simoun-test/WideReach-v0", "--no-progress"]
+    flags = override(TINY, "--env", "simoun_test_envs:simoun-test/WideReach-v0", "--no-progress")
     assert train_cli.main([*flags, "--run-dir", str(run_dir), "--total-env-steps", "20"]) == 0
     config = json.loads((run_dir / "config.json").read_text())
     assert (config["env"], config["env_module"]) == ("simoun-test/WideReach-v0", "simoun_test_envs")
@@ -250,7 +251,7 @@ def test_env_module_is_saved_so_resume_and_simoun_eval_rebuild_the_env(tmp_path,
 
 def test_a_missing_env_module_and_bad_env_kwargs_end_in_one_line_not_a_traceback(tmp_path, capsys):
     run_dir = tmp_path / "run"
-    flags = [*run_flags(run_dir, 20), "--env", "simoun_no_such_package:Thing-v0"]
+    flags = override(run_flags(run_dir, 20), "--env", "simoun_no_such_package:Thing-v0")
     err = exit_message(capsys, train_cli.main, flags)
     assert "'simoun_no_such_package' is not installed" in err and "pip install" in err
     flags = [*run_flags(run_dir, 20), "--env-kwargs", '{"foo": 1}']
@@ -269,11 +270,9 @@ def test_set_with_a_misspelled_key_suggests_by_meaning_and_takes_the_flag_spelli
         capsys, train_cli.main, [*run_flags(tmp_path / "run"), "--set", "agent.learning_rate=3e-4"]
     )
     assert "unknown config key agent.learning_rate (did you mean agent.lr?)" in err
-    argv = [
-        *run_flags(tmp_path / "run", 20, "--no-progress", "--no-video"),
-        "--set",
-        "agent.batch-size=10",
-    ]
+    base = run_flags(tmp_path / "run", 20, "--no-progress", "--no-video")
+    at = base.index("--agent.batch-size")
+    argv = [*base[:at], *base[at + 2 :], "--set", "agent.batch-size=10"]
     assert train_cli.main(argv) == 0
     assert json.loads((tmp_path / "run" / "config.json").read_text())["agent"]["batch_size"] == 10
 

@@ -63,7 +63,8 @@ def test_an_unknown_preset_is_refused_before_parsing(capsys):
     with pytest.raises(SystemExit) as exit_info:
         train_cli.main(["--preset", "cpuu"])
     assert exit_info.value.code == 2
-    assert "simoun-train: error: unknown preset 'cpuu'; choose one of" in capsys.readouterr().err
+    expected = "simoun-train: error: unknown preset 'cpuu' (did you mean 'cpu'?); choose one of"
+    assert expected in capsys.readouterr().err
 
 
 def test_an_unknown_set_key_is_refused_with_the_close_match():

@@ -51,5 +51,6 @@ def test_a_saved_config_with_a_misspelled_key_is_refused_with_the_close_match():
 def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
     with pytest.raises(SetupError, match=r"unknown recipe --agent.recipe 'drqv3' \(did you mean "):
         resolve(None, {"agent.recipe": "drqv3"})
-    with pytest.raises(SetupError, match=r"unknown preset 'gpu'; choose one of .*cpu"):
+    refused = r"unknown preset 'gpu' \(did you mean 'cpu'\?\); choose one of .*cpu"
+    with pytest.raises(SetupError, match=refused):
         resolve("gpu", {})

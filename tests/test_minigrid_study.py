@@ -45,6 +45,7 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
     spec_file = tmp_path / "spec.json"
     spec_file.write_text(json.dumps(TINY))
     archive, work = tmp_path / "archive", tmp_path / "work"
+    archive.mkdir()  # a study's archive is never created by default
     paths = ["--archive", str(archive), "--spec", str(spec_file)]
     done = study("run", *paths, "--work-dir", str(work))
     assert done.returncode == 0, done.stderr[-4000:]
@@ -215,6 +216,7 @@ def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_go
     tiny = {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 8192}], "arms": ["ppo"]}
     spec_file.write_text(json.dumps({**tiny, "evaluations": 8}))
     archive, work = tmp_path / "archive", tmp_path / "work"
+    archive.mkdir()  # a study's archive is never created by default
     paths = ["--archive", str(archive), "--spec", str(spec_file), "--work-dir", str(work)]
     archived = archive / "MiniGrid-DoorKey-5x5-v0" / "ppo" / "s0" / CHECKPOINT
     command = [sys.executable, "-m", "simoun_agent.minigrid_study", "run", *paths]

@@ -16,6 +16,7 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+from flag_lists import override
 from test_train_resume import tiny_config
 from test_train_sigterm import TINY
 
@@ -45,7 +46,7 @@ checkpoints at env steps 20-80 fit, those from 100 on do not."""
 
 def test_a_full_disk_keeps_the_last_checkpoint_and_stops_after_three_failures(tmp_path):
     run_dir = tmp_path / "run"
-    flags = [*TINY, "--env", "simoun/PointReach-v0", "--checkpoint-every", "20"]
+    flags = override(TINY, "--env", "simoun/PointReach-v0", "--checkpoint-every", "20")
     flags += ["--total-env-steps", "1000", "--eval-every", "1000", "--run-dir", str(run_dir)]
     done = subprocess.run(
         [sys.executable, "-c", UNDER_FILE_SIZE_LIMIT, str(FILE_SIZE_LIMIT), *flags],

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 import torch
+from flag_lists import override
 from test_train_resume import tiny_config, weights, without_wall_time
 from test_train_sigterm import CARTPOLE, TINY
 
@@ -120,7 +121,11 @@ def child():
 
 
 def trainer(run_dir: Path, *flags: str) -> list[str]:
-    return ["-m", "simoun_agent.cli.train", *POINT_REACH, *flags, "--run-dir", str(run_dir)]
+    return [
+        "-m",
+        "simoun_agent.cli.train",
+        *override(POINT_REACH, *flags, "--run-dir", str(run_dir)),
+    ]
 
 
 def counters(run_dir: Path) -> dict:
@@ -204,7 +209,9 @@ sys.exit(train_cli.main(sys.argv[1:]))
 
 def test_sigterm_before_the_final_video_and_resume_records_it(child, tmp_path):
     run_dir = tmp_path / "run"
-    flags = [*POINT_REACH, "--eval-every", "1000", "--total-env-steps", "40", "--video", "true"]
+    flags = override(
+        POINT_REACH, "--eval-every", "1000", "--total-env-steps", "40", "--video", "true"
+    )
     process = child(["-c", SIGTERM_AFTER_THE_FINAL_EVALUATION, *flags, "--run-dir", str(run_dir)])
     assert process.returncode() == 143, process.output
     assert acknowledged_then_stopped(process.output, "SIGTERM", "the final video"), process.output

@@ -80,11 +80,13 @@ def update_bytes(config: TrainConfig) -> int:
         agent = SimounAgent(shape, ACTION_DIM, agent_config, device="meta")
     held = 0
     for part in vars(agent).values():
-        if isinstance(part, torch.optim.Optimizer):
-            # fused Adam has no meta kernel; the plain one allocates the same states
-            part.defaults["fused"] = False
-            for group in part.param_groups:
-                group["fused"] = False
+        # an optimiser, or a tuple of them (CURL's contrastive step has two)
+        for optimizer in part if isinstance(part, tuple) else (part,):
+            if isinstance(optimizer, torch.optim.Optimizer):
+                # fused Adam has no meta kernel; the plain one allocates the same states
+                optimizer.defaults["fused"] = False
+                for group in optimizer.param_groups:
+                    group["fused"] = False
         if isinstance(part, torch.nn.Module):
             held += sum(t.numel() * t.element_size() for t in part.state_dict().values())
     batch = agent_config.batch_size

@@ -1,0 +1,27 @@
+"""Building command lines in tests: a base list of flags with some of them given new values.
+
+The command lines refuse a flag given twice with different values, so a test that changes a
+flag of a shared base list replaces it instead of appending a second value.
+"""
+
+
+def override(base: list[str], *flags: str) -> list[str]:
+    """``base`` without the flags (and their values) that ``flags`` gives, then ``flags``.
+
+    Flags are ``--name value`` pairs, or a lone ``--name`` followed by another flag.
+
+    >>> override(["--env", "a", "--seed", "1"], "--env", "b")
+    ['--seed', '1', '--env', 'b']
+    """
+    given = {flag for flag in flags if flag.startswith("--")}
+    kept, skip = [], False
+    for position, item in enumerate(base):
+        if skip:
+            skip = False
+            continue
+        if item in given:
+            following = base[position + 1] if position + 1 < len(base) else "--"
+            skip = not following.startswith("--")
+            continue
+        kept.append(item)
+    return [*kept, *flags]
