@@ -544,10 +544,9 @@ def test_generalization_plays_each_final_agent_on_the_train_mode_and_each_distra
         with (study_dir / name / "generalization.csv").open(newline="") as f:
             rows = list(csv.DictReader(f))
         assert [row["mode"] for row in rows] == ["train", "color_easy", "video_hard"]
-        assert {row["episodes"] for row in rows} == {"1"} and {row["env_step"] for row in rows} == {
-            "60"
-        }
         summary = json.loads((study_dir / name / "summary.json").read_text())
+        assert {row["episodes"] for row in rows} == {"1"}
+        assert {row["env_step"] for row in rows} == {str(summary["env_step"])}  # the final agent
         # the train mode is the run's own final evaluation: same agent, seeds and episodes
         assert float(rows[0]["return_mean"]) == pytest.approx(summary["final_eval"]["return_mean"])
         assert (archive / name / "generalization.csv").read_bytes() == (
