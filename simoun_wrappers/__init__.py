@@ -24,10 +24,10 @@ from simoun_wrappers.sb3_check import check_sb3_policy
 __all__ = [
     "ActionRepeat",
     "ColorShift",
-    "ConstantBonusReward",
-    "ConstantBonusVectorReward",
     "ConsistencyCuriosityReward",
     "ConsistencyCuriosityVectorReward",
+    "ConstantBonusReward",
+    "ConstantBonusVectorReward",
     "FeatureSource",
     "FrameTriplet",
     "MovingBackground",

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import math
+import sys
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
 
-from simoun_wrappers.frames import refuse_over_frame_stack
+from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 
 
 class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
@@ -35,6 +37,7 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
             env: the environment to wrap.
             repeat: inner steps per agent step, a positive int (1 changes nothing).
         """
+        check_single_env(env, "ActionRepeat")
         gym.utils.RecordConstructorArgs.__init__(self, repeat=repeat)
         gym.Wrapper.__init__(self, env)
         if not isinstance(repeat, (int, np.integer)) or repeat < 1:
@@ -51,10 +54,15 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.repeat = int(repeat)
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
-        total = 0.0
+        total, finite = 0.0, True
         for _ in range(self.repeat):
             obs, reward, terminated, truncated, info = self.env.step(action)
             total += float(reward)
+            finite = finite and math.isfinite(float(reward))
             if terminated or truncated:
                 break
+        if finite and not math.isfinite(total):
+            # finite rewards whose sum overflows: the largest float, not an inf that a learner
+            # would take for a broken env
+            total = math.copysign(sys.float_info.max, total)
         return obs, total, terminated, truncated, info

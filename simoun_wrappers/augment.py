@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
-from simoun_wrappers.frames import refuse_over_frame_stack
+from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
 if TYPE_CHECKING:
@@ -187,6 +187,7 @@ class RandomConvolution(ChainWrapper):
             kernel_size: odd kernel width; the image keeps its size.
             source: ``"auto"``, ``"observation"`` or ``"render"``, as in ``SimounObservation``.
         """
+        check_single_env(env, "RandomConvolution")
         gym.utils.RecordConstructorArgs.__init__(self, kernel_size=kernel_size, source=source)
         import torch
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -11,7 +12,7 @@ import numpy as np
 from gymnasium import spaces
 
 from simoun_wrappers.augment import RandomConvolution
-from simoun_wrappers.frames import refuse_over_frame_stack
+from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import parse_size
 
 Camera = int | str | Mapping[str, Any] | Callable[[gym.Env], np.ndarray]
@@ -46,7 +47,7 @@ def _dm_control_view(env: gym.Env, camera: int | str, hw: tuple[int, int] | None
         render = env.get_wrapper_attr("render_camera")
     except AttributeError:
         render = physics.render
-    return lambda: render(camera_id=camera, **kwargs)
+    return functools.partial(render, camera_id=camera, **kwargs)  # picklable, unlike a lambda
 
 
 def _highway_view(env: gym.Env, viewport: Mapping[str, Any], hw: tuple[int, int] | None):
@@ -125,6 +126,7 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
             cameras: one entry per view (see the class docstring), left to right.
             size: every view's ``(H, W)`` (an int means square); None keeps each view's size.
         """
+        check_single_env(env, "MultiCamera")
         gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
         gym.ObservationWrapper.__init__(self, env)
         refuse_over_frame_stack(
@@ -163,11 +165,14 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         if isinstance(camera, Mapping):
             return _highway_view(self.env, camera, self._hw)
         if callable(camera):
-            return lambda: self._checked(camera(self.env), camera)
+            return functools.partial(self._view_of, camera)
         raise TypeError(
             f"camera {camera!r} not understood; use a dm_control camera id or name, a "
             f"highway-env viewport dict, or a callable env -> (H, W, 3) uint8 image."
         )
+
+    def _view_of(self, camera: Callable) -> np.ndarray:
+        return self._checked(camera(self.env), camera)
 
     def _checked(self, image: Any, camera: Callable) -> np.ndarray:
         if not isinstance(image, np.ndarray) or image.dtype != np.uint8:

@@ -71,6 +71,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
             env: the environment to wrap.
             num_frames: how many consecutive observations to stack (``k``).
         """
+        check_single_env(env, "FrameTriplet")
         gym.utils.RecordConstructorArgs.__init__(self, num_frames=num_frames)
         gym.Wrapper.__init__(self, env)
         if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
@@ -115,6 +116,28 @@ def frame_stack_in(env: gym.Env) -> gym.Wrapper | None:
             return inner
         inner = inner.env
     return None
+
+
+def check_single_env(env: Any, owner: str) -> None:
+    """Raise TypeError unless ``env`` is one ``gymnasium.Env``: a vector env is told to wrap
+    each of its sub-envs (``gym.make_vec(..., wrappers=[...])``), anything else names the type
+    expected and the type given.
+
+    Args:
+        env: the env ``owner`` was given.
+        owner: the wrapper being built, as the user writes it (``"SimounObservation"``).
+    """
+    if isinstance(env, gym.Env):
+        return
+    if isinstance(env, gym.vector.VectorEnv):
+        raise TypeError(
+            f"{owner} wraps one env, got the vector env {type(env).__name__}: wrap each sub-env "
+            f"instead, gym.make_vec(env_id, num_envs, wrappers=[lambda e: {owner}(e, ...)])"
+        )
+    raise TypeError(
+        f"{owner}'s env must be a gymnasium.Env, got {type(env).__name__} ({env!r:.60}); "
+        f"e.g. {owner}(gym.make(env_id, render_mode='rgb_array'), ...)"
+    )
 
 
 def refuse_over_frame_stack(env: gym.Env, owner: str, why: str, right_order: str) -> None:

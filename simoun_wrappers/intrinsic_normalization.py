@@ -150,6 +150,8 @@ class RewardStd(Normalization):
     """
 
     name = "reward_std"
+    centred: ClassVar[bool] = False
+    """subtract the running mean before dividing (:class:`Standardize`)"""
 
     def __init__(self) -> None:
         self.moments = running_moments()
@@ -159,7 +161,8 @@ class RewardStd(Normalization):
     ) -> np.ndarray:
         if counted.any():
             self.moments.update(raw[counted])
-        return divide_by_std(raw, self.moments)
+        centre = float(self.moments.mean) if self.centred else 0.0
+        return divide_by_std(raw - centre, self.moments)
 
     def state_dict(self) -> dict[str, Any]:
         return moments_state(self.moments)
@@ -227,7 +230,7 @@ class ReturnStd(Normalization):
         return f"ReturnStd(gamma={self.gamma})"
 
 
-class Standardize(Normalization):
+class Standardize(RewardStd):
     """``(x - mean(x)) / std(x)``: zero-mean standardisation with the running mean and std of the
     raw values (DEIR, Wan et al. 2023, ``int_rew_norm=1``; it uses an exponential moving average
     where this uses the running mean over all values). About half the steps are paid and half
@@ -242,22 +245,7 @@ class Standardize(Normalization):
     """
 
     name = "standardize"
-
-    def __init__(self) -> None:
-        self.moments = running_moments()
-
-    def __call__(
-        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
-    ) -> np.ndarray:
-        if counted.any():
-            self.moments.update(raw[counted])
-        return divide_by_std(raw - float(self.moments.mean), self.moments)
-
-    def state_dict(self) -> dict[str, Any]:
-        return moments_state(self.moments)
-
-    def load_state_dict(self, state: dict[str, Any]) -> None:
-        load_moments(self.moments, state)
+    centred = True
 
 
 class Raw(Normalization):

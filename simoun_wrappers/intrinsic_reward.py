@@ -183,7 +183,7 @@ def check_extrinsic(extrinsic: np.ndarray) -> None:
         )
 
 
-class IntrinsicMechanism:
+class IntrinsicMechanism(ABC):
     """What the two wrappers share: the signal, its normalization and weight, and scoring.
 
     The reward of a transition ``s -> s'`` scored ``t`` transitions after the wrapper started:
@@ -198,19 +198,37 @@ class IntrinsicMechanism:
 
     signal_type: ClassVar[type[IntrinsicSignal]]
     """the signal a wrapper class builds, from its constructor's signal arguments"""
+    vector: ClassVar[bool]
+    """whether the wrapper takes a vector env"""
     signal: IntrinsicSignal
 
-    def _build(
+    def __init__(
         self,
+        env: gym.Env | VectorEnv,
         scale: float,
         normalization: str | Normalization,
         weighting: dict[str, Any],
         arguments: dict[str, Any],
         paper: dict[str, float],
     ) -> None:
-        """Check and keep the weighting, build the signal from ``arguments`` (its source first)
-        and the normalization, and record every constructor argument for ``env.spec`` (the
-        source held by reference: see :class:`SharedSource`)."""
+        """Wrap ``env``; ``weighting``: ``decay``, ``warmup``, ``progress``; ``arguments``: the
+        signal's, its source first; ``paper``: the ``"paper"`` normalization's initial maxima.
+
+        Checks the env's kind and every value, builds the signal from ``arguments`` and the
+        normalization, and records every constructor argument for ``env.spec`` (the source held
+        by reference: see :class:`SharedSource`)."""
+        name = type(self).__name__
+        if isinstance(env, VectorEnv) != self.vector:
+            if self.vector:
+                raise TypeError(
+                    f"{name} wraps a vector env, got {env}; use "
+                    f"{name.replace('VectorReward', 'Reward')}(env, ...) on a single env."
+                )
+            raise TypeError(
+                f"{name} wraps a single env, got the vector env {env}; use "
+                f"{name.replace('Reward', 'VectorReward')}(envs, ...) on the vector env, or put "
+                f"{name} in each sub-env (gym.make_vec(..., wrappers=[...]))"
+            )
         self.scale = check_scale(scale)
         check_weighting(**weighting)
         self.decay = float(weighting["decay"])
@@ -227,6 +245,11 @@ class IntrinsicMechanism:
         self.normalization = make_normalization(normalization, **paper)
         self.scored = 0
         """transitions scored so far: the step t of the weight and the warm-up's clock"""
+        self._attach(env)
+
+    @abstractmethod
+    def _attach(self, env: Any) -> None:
+        """Initialise the wrapper base class on ``env`` and the wrapper's own state."""
 
     def _score(
         self, previous: np.ndarray, reached: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray
@@ -287,25 +310,9 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
     ``ConstantBonusReward``) name their ``signal_type`` and give their constructor's signature.
     """
 
-    def __init__(
-        self,
-        env: gym.Env,
-        scale: float,
-        normalization: str | Normalization,
-        weighting: dict[str, Any],
-        arguments: dict[str, Any],
-        paper: dict[str, float],
-    ) -> None:
-        """Wrap ``env``; ``weighting``: ``decay``, ``warmup``, ``progress``; ``arguments``: the
-        signal's, its source first; ``paper``: the ``"paper"`` normalization's initial maxima."""
-        if isinstance(env, VectorEnv):
-            vector = type(self).__name__.replace("Reward", "VectorReward")
-            raise TypeError(
-                f"{type(self).__name__} wraps a single env, got the vector env {env}; use "
-                f"{vector}(envs, ...) on the vector env, or put {type(self).__name__} in each "
-                "sub-env (gym.make_vec(..., wrappers=[...]))"
-            )
-        self._build(scale, normalization, weighting, arguments, paper)
+    vector = False
+
+    def _attach(self, env: gym.Env) -> None:
         gym.Wrapper.__init__(self, env)
         self._read = triplet_reader(env.observation_space)
         self._last_triplet: np.ndarray | None = None
@@ -355,23 +362,9 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     ``"reward_intrinsic"`` arrays of shape ``(num_envs,)``.
     """
 
-    def __init__(
-        self,
-        env: VectorEnv,
-        scale: float,
-        normalization: str | Normalization,
-        weighting: dict[str, Any],
-        arguments: dict[str, Any],
-        paper: dict[str, float],
-    ) -> None:
-        """Wrap the vector env ``env``; the other arguments as in :class:`IntrinsicReward`."""
-        if not isinstance(env, VectorEnv):
-            single = type(self).__name__.replace("VectorReward", "Reward")
-            raise TypeError(
-                f"{type(self).__name__} wraps a vector env, got {env}; use {single}(env, ...) "
-                "on a single env."
-            )
-        self._build(scale, normalization, weighting, arguments, paper)
+    vector = True
+
+    def _attach(self, env: VectorEnv) -> None:
         VectorWrapper.__init__(self, env)
         self._read = triplet_reader(env.single_observation_space)
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)

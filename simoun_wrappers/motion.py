@@ -8,6 +8,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from simoun_wrappers.frames import check_single_env
+
 
 def residual_motion(frames: np.ndarray) -> np.ndarray:
     """Residual motion ``[o_{t-1} - o_{t-2}, o_t - o_{t-1}]`` of a frame stack (paper Sec. 3.2).
@@ -69,6 +71,7 @@ class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         Args:
             env: a stacked-frame environment, e.g. ``FrameTriplet`` over channel-first images.
         """
+        check_single_env(env, "ResidualMotion")
         gym.utils.RecordConstructorArgs.__init__(self)
         gym.ObservationWrapper.__init__(self, env)
         space = env.observation_space

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+import operator
 from copy import deepcopy
 
 import gymnasium as gym
@@ -15,7 +17,7 @@ from gymnasium.wrappers import (
     TransformObservation,
 )
 
-from simoun_wrappers.frames import FrameTriplet, frame_stack_in
+from simoun_wrappers.frames import FrameTriplet, check_single_env, frame_stack_in
 from simoun_wrappers.motion import ResidualMotion
 
 _SOURCES = ("auto", "observation", "render")
@@ -39,7 +41,10 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     """``size`` as ``(H, W)``; an int means a square; None stays None (keep the image's size)."""
     if size is None:
         return None
-    pair = (size, size) if isinstance(size, (int, np.integer)) else tuple(size)
+    if isinstance(size, (int, np.integer)):
+        pair = (size, size)
+    else:
+        pair = tuple(size) if isinstance(size, (tuple, list)) else (size,)
     if len(pair) != 2 or not all(isinstance(v, (int, np.integer)) and v > 0 for v in pair):
         raise ValueError(
             f"size must be a positive int or an (H, W) pair of positive ints, got {size!r}; "
@@ -117,6 +122,17 @@ def layout_hint(space: gym.Space) -> str | None:
     return None
 
 
+# The chain's transforms are module-level functions (or partials of them), not lambdas, so a
+# SimounObservation pickles whenever the env it wraps does (vector envs' subprocesses, Ray).
+def _channel_first(obs: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
+    """An ``(H, W[, C])`` image as ``(C, H, W)``."""
+    return obs.reshape(shape).transpose(2, 0, 1)
+
+
+def _frames_dict(frames: np.ndarray) -> dict[str, np.ndarray]:
+    return {"frames": frames}
+
+
 def _rgba(space: gym.Space) -> bool:
     return isinstance(space, spaces.Box) and len(space.shape) == 3 and space.shape[-1] == 4
 
@@ -125,7 +141,7 @@ def _drop_alpha(env: gym.Env) -> gym.Env:
     """``env`` with the alpha channel of its ``(H, W, 4)`` image observations dropped."""
     height, width, _ = env.observation_space.shape
     rgb = spaces.Box(0, 255, (height, width, 3), dtype=env.observation_space.dtype)
-    return TransformObservation(env, lambda o: o[..., :3], rgb)
+    return TransformObservation(env, operator.itemgetter((Ellipsis, slice(0, 3))), rgb)
 
 
 def pixel_env(
@@ -159,7 +175,7 @@ def pixel_env(
             )
         space = env.observation_space
         if isinstance(space, spaces.Dict) and isinstance(space.spaces.get("pixels"), spaces.Box):
-            chain = TransformObservation(env, lambda o: o["pixels"], space["pixels"])
+            chain = TransformObservation(env, operator.itemgetter("pixels"), space["pixels"])
         if _rgba(chain.observation_space):
             chain = _drop_alpha(chain)
     layout = image_layout(chain.observation_space)
@@ -220,6 +236,10 @@ def pixel_env(
     return pixels, True
 
 
+def _rebuilt(cls: type, source_env: gym.Env, kwargs: dict) -> gym.Env:
+    return cls(source_env, **kwargs)
+
+
 class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """A wrapper built as a chain of inner wrappers over ``source_env``, recorded as itself only.
 
@@ -232,6 +252,19 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def __init__(self, chain: gym.Env, source_env: gym.Env) -> None:
         gym.Wrapper.__init__(self, chain)
         self._source_env = source_env
+
+    def __reduce__(self) -> tuple:
+        """Pickled as its arguments around the pickled source env, since gymnasium's wrappers in
+        the chain (AddRenderObservation, ResizeObservation) hold lambdas: it pickles whenever
+        the source env does. The copy is built anew, so it is reset before its first step."""
+        return (_rebuilt, (type(self), self._source_env, dict(self._saved_kwargs)))
+
+    def __deepcopy__(self, memo: dict) -> ChainWrapper:
+        # a deep copy keeps the state (frames, RNGs): copy.deepcopy would use __reduce__
+        copied = object.__new__(type(self))
+        memo[id(self)] = copied
+        copied.__dict__.update(deepcopy(self.__dict__, memo))
+        return copied
 
     @property
     def spec(self) -> EnvSpec | None:
@@ -319,6 +352,7 @@ class SimounObservation(ChainWrapper):
             source: ``"auto"`` (image observation if there is one, else ``render()``),
                 ``"observation"`` or ``"render"``.
         """
+        check_single_env(env, "SimounObservation")
         gym.utils.RecordConstructorArgs.__init__(
             self,
             size=size,
@@ -348,17 +382,19 @@ class SimounObservation(ChainWrapper):
             channels = 1
         frame_space = spaces.Box(0, 255, (channels, height, width), dtype=np.uint8)
         chain = TransformObservation(
-            chain, lambda o: o.reshape(height, width, channels).transpose(2, 0, 1), frame_space
+            chain, functools.partial(_channel_first, shape=(height, width, channels)), frame_space
         )
         chain = FrameTriplet(chain, num_frames)
         if fold_frames:
             folded = spaces.Box(0, 255, (num_frames * channels, height, width), dtype=np.uint8)
-            chain = TransformObservation(chain, lambda o: o.reshape(folded.shape), folded)
+            chain = TransformObservation(
+                chain, functools.partial(np.reshape, shape=folded.shape), folded
+            )
         elif motion:
             chain = ResidualMotion(chain)
         else:
             chain = TransformObservation(
-                chain, lambda o: {"frames": o}, spaces.Dict({"frames": chain.observation_space})
+                chain, _frames_dict, spaces.Dict({"frames": chain.observation_space})
             )
         ChainWrapper.__init__(self, chain, env)
         if from_render:

@@ -10,6 +10,8 @@ refuses it with SB3's advice to use ``MultiInputPolicy``. The supported path is
 
 from __future__ import annotations
 
+import difflib
+
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
@@ -22,6 +24,11 @@ _FIX = (
     "(k*C, H, W) uint8 image that SB3's NatureCNN convolves (motion is then left out; "
     "residual_motion(obs.reshape(k, C, H, W)) recovers it)."
 )
+
+
+SB3_POLICIES = ("CnnPolicy", "MlpPolicy", "MultiInputPolicy")
+"""The policy names every SB3 algorithm for images registers (a name outside them is a
+``KeyError`` inside SB3)."""
 
 
 def _policy_kind(policy: str | type) -> str:
@@ -37,8 +44,9 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
 
     Args:
         env: an env (or vector env, or its observation space) built with ``SimounObservation``.
-        policy: the policy given to the SB3 algorithm, a name (``"CnnPolicy"``) or a class;
-            custom policies (neither Cnn, Mlp nor MultiInput in the name) pass unchecked.
+        policy: the policy given to the SB3 algorithm, a name (``"CnnPolicy"``: one of
+            :data:`SB3_POLICIES`, a misspelling is refused with its close match) or a class;
+            custom policy classes (neither Cnn, Mlp nor MultiInput in the name) pass unchecked.
 
     Example:
         >>> import gymnasium as gym
@@ -52,7 +60,24 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
         ...
         ValueError: MultiInputPolicy would flatten the (3, 3, 64, 64) frame stack ...
     """
-    space = env if isinstance(env, spaces.Space) else env.observation_space
+    if isinstance(policy, str) and policy not in SB3_POLICIES:
+        match = difflib.get_close_matches(policy, SB3_POLICIES, n=1, cutoff=0.5)
+        hint = f" (did you mean {match[0]!r}?)" if match else ""
+        raise ValueError(
+            f"policy {policy!r} is not a Stable-Baselines3 policy name{hint}; SB3 knows "
+            f"{', '.join(map(repr, SB3_POLICIES))} (or pass a policy class)"
+        )
+    if not isinstance(policy, (str, type)):
+        raise TypeError(f"policy must be a policy name (str) or class, got {type(policy).__name__}")
+    if isinstance(env, spaces.Space):
+        space = env
+    elif isinstance(getattr(env, "observation_space", None), spaces.Space):
+        space = env.observation_space
+    else:
+        raise TypeError(
+            "env must be a gymnasium Env, a VectorEnv or an observation space, got "
+            f"{type(env).__name__}"
+        )
     kind = _policy_kind(policy)
     if not kind:
         return policy

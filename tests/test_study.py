@@ -20,7 +20,7 @@ from simoun_agent.config import RECIPES, SetupError
 from simoun_agent.study.plan import evaluation_runs, tuning_runs
 from simoun_agent.study.provenance import code_version
 from simoun_agent.study.report import RunResult, cost_curves, mean_cpu, read_result
-from simoun_agent.study.runner import check_same_spec
+from simoun_agent.study.runner import StudyOptions, check_same_spec, open_study
 from simoun_agent.study.spec import load_spec
 from simoun_agent.study.toml_lines import key_line
 
@@ -230,14 +230,52 @@ def test_resume_with_another_spec_and_a_new_study_over_an_old_one_are_refused(st
     (spec_path.parent / "changed").mkdir(exist_ok=True)
     other = write_spec(
         spec_path.parent / "changed" / spec_path.name,
-        SPEC.replace('seeds = "1-2"', 'seeds = "1-3"'),
+        SPEC.replace("eval_episodes = 1", "eval_episodes = 2"),
     )
     with pytest.raises(SystemExit):
         cli.main(["run", str(other), "--study-dir", str(study_dir), "--resume"])
-    assert "is not the spec this study was started with" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "would be trained otherwise under the changed spec (eval_episodes: 1 when it ran" in err
     with pytest.raises(SystemExit):
         cli.main(["run", str(spec_path), "--study-dir", str(study_dir)])
     assert "already holds a study; continue it with --resume" in capsys.readouterr().err
+
+
+def test_a_spec_fixed_after_a_failure_resumes_keeping_the_finished_runs(study, tmp_path):
+    _, study_dir, _ = study
+    shutil.copytree(study_dir, tmp_path / "s", ignore=shutil.ignore_patterns("tune"))
+    restamp(tmp_path / "s" / "study.json")
+    options = StudyOptions(study_dir=tmp_path / "s", resume=True)
+    # a held-out seed added: every finished run stays as it ran
+    (tmp_path / "fixed").mkdir()
+    fixed = write_spec(
+        tmp_path / "fixed" / "tiny.toml", SPEC.replace('seeds = "1-2"', 'seeds = "1-3"')
+    )
+    record = open_study(cli.spec_from(str(fixed)), str(fixed), options)
+    assert record["spec"] == cli.spec_from(str(fixed)).to_json()
+    assert record["spec_text"] == fixed.read_text()
+    assert record["parts"][-1]["spec_changed"]["keys"] == ["evaluation"]
+    # a grid value added once the evaluation ran would select again
+    regrid = write_spec(tmp_path / "regrid.toml", SPEC.replace("[1, 3]", "[1, 3, 5]"))
+    with pytest.raises(SetupError, match=r"the evaluation of (sac|simoun) has started"):
+        open_study(cli.spec_from(str(regrid)), str(regrid), options)
+
+
+@pytest.mark.parametrize(
+    ("task", "said"),
+    [("CartPole-v1", "Discrete(2)"), ("minigrid:MiniGrid-Empty-5x5-v0", "Discrete(7)")],
+)
+def test_plan_refuses_a_discrete_action_task_naming_the_spec_line(task, said, tmp_path, capsys):
+    evaluated = 'tasks = ["simoun/PointReach-v0"]\nseeds = "1-2"'
+    text = SPEC.replace(evaluated, evaluated.replace("simoun/PointReach-v0", task))
+    path = write_spec(tmp_path / "discrete.toml", text)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(path), "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    line = key_line(text, ("evaluation", "tasks"))
+    assert f"{path}:{line}: [evaluation] tasks: " in err and said in err, err
+    assert "Replace it in [evaluation] tasks" in err and "Traceback" not in err
 
 
 def test_plan_lists_every_run_and_a_measured_estimate(tmp_path, capsys):

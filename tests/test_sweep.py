@@ -120,29 +120,22 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
 
 
 def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path, capsys):
-    # A replay of 50 transitions passes the config checks (it is one batch of 50) but, room
-    # kept for the reset frames of 50-step episodes, holds 49 whole windows of PointReach's
-    # 20-step ones at agent step 52: that trial raises there, inside Ray.
+    # A PointReach whose step is NaN passes every check before Ray (it is made and is fine until
+    # it steps) but returns NaN rewards: that trial stops inside Ray at its first step.
     sweep_dir = tmp_path / "failing"
-    tiny = [
-        "agent.batch_size=50" if a == "agent.batch_size=8" else a
-        for a in tiny_without("--replay-capacity")
-    ]
-    argv = [*tiny, "--grid", "replay_capacity=50,1000"]
+    argv = [*TINY, "--grid", 'env_kwargs={"step_size": NaN},{}']
     argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir)]
     assert cli.main([*argv, "--verbose", "0"]) == 1
-    bad, good = sweep_dir / "replay_capacity=50", sweep_dir / "replay_capacity=1000"
+    bad, good = sorted(sweep_dir.glob("env_kwargs=*"), key=lambda p: len(p.name), reverse=True)
     assert (good / "simoun-PointReach-v0/s0/summary.json").is_file()
     assert not (bad / "simoun-PointReach-v0/s0/summary.json").exists()
     error = (bad / "simoun-PointReach-v0/s0/error.txt").read_text()
-    assert "cannot sample 50 transitions: the replay holds 49" in error
+    assert "the evaluation env returned the reward nan at step 1" in error
+    assert "TypeError" not in error  # the trial's own error, not Ray's failure to copy it
     err = capsys.readouterr().err
-    assert "FAILED replay_capacity=50/simoun-PointReach-v0/s0" in err
+    assert 'FAILED env_kwargs={"step_size":NaN}/simoun-PointReach-v0/s0' in err
     assert "--resume" in err
-    assert [(row["variant"], row["n"]) for row in report_rows(sweep_dir)] == [
-        ("replay_capacity=50", "0"),
-        ("replay_capacity=1000", "1"),
-    ]
+    assert [row["n"] for row in report_rows(sweep_dir)] == ["0", "1"]
     assert "## Failed runs" in (sweep_dir / "report.md").read_text()
 
 
@@ -276,14 +269,38 @@ def error_of(argv: list[str], capsys) -> str:
         (["--cpus-per-trial", "0"], "--cpus-per-trial must be at least 1, got 0"),
         (["--envs", "simoun/PointReach-v0,"], "--envs 'simoun/PointReach-v0,' has an empty id"),
         (["--envs", "simoun/PointReach-v0", "--env", "simoun/PointReach-v0"], "give the envs once"),
+        (
+            ["--envs", "simoun/PointReach-v0,dm_control/cartpole-swingup-v1"],
+            "--envs dm_control/cartpole-swingup-v1: unknown environment id "
+            "'dm_control/cartpole-swingup-v1'; did you mean dm_control/cartpole-swingup-v0",
+        ),
+        (["--envs", "CartPole-v1"], "--envs CartPole-v1: CartPole-v1 has action space Discrete(2)"),
+        (["--env", "MiniGrid-Empty-5x5-v0", "--env-module", "minigrid"], "Discrete(7)"),
     ],
 )  # fmt: skip
 def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, capsys):
     sweep_dir = tmp_path / "bad"
-    base = tiny_without("--env") if "--envs" in flags else TINY  # --envs replaces --env
+    base = tiny_without("--env") if {"--envs", "--env"} & set(flags) else TINY
     err = error_of([*base, *flags, "--sweep-dir", str(sweep_dir)], capsys)
     assert message in err
     assert not sweep_dir.exists()
+
+
+def test_a_replay_or_a_batch_the_run_cannot_hold_is_refused_before_ray_starts(tmp_path, capsys):
+    tiny = tiny_without("--replay-capacity")
+    # full, a replay of 50 keeps 49 whole windows of PointReach's 20-step episodes
+    small = ["agent.batch_size=50" if a == "agent.batch_size=8" else a for a in tiny]
+    argv = [*small, "--grid", "replay_capacity=50,1000", "--sweep-dir", str(tmp_path / "r")]
+    err = error_of(argv, capsys)
+    assert "trial replay_capacity=50/simoun-PointReach-v0/s1: --replay-capacity 50 keeps" in err
+    assert "fewer than a batch of 50 (--agent.batch-size 50)" in err
+    assert "Set --replay-capacity 54 or more" in err
+    # 512x512 frames at a batch of 512: hundreds of GB for one update
+    bigger = {"32": "512", "agent.batch_size=8": "agent.batch_size=512"}  # --image-size 32
+    err = error_of([*(bigger.get(a, a) for a in TINY), "--sweep-dir", str(tmp_path / "r")], capsys)
+    assert "trial base/simoun-PointReach-v0/s0: --image-size 512 with --agent.batch-size 512" in err
+    assert "so the run would be killed" in err
+    assert not (tmp_path / "r").exists()
 
 
 def test_resume_with_another_grid_is_refused_and_changes_nothing(sweep_dir, capsys):

@@ -207,3 +207,19 @@ def test_atomic_write_leaves_nothing_when_the_write_fails(tmp_path):
         atomic_write(target, lambda tmp: tmp.write_text("new" * 10_000))
     assert failure.value.errno == errno.ENOSPC
     assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["file.txt"]
+
+
+def test_a_nan_reward_in_an_evaluation_stops_with_a_checkpoint_naming_step_and_value(
+    tmp_path, capsys
+):
+    run_dir = tmp_path / "run"
+    flags = [*TINY, "--env", NAN_ENV, "--env-kwargs", '{"nan_at": 5}', "--run-dir", str(run_dir)]
+    # the initial evaluation plays before any training step: its env's 5th step is NaN
+    assert train_cli.main([*flags, "--total-env-steps", "100"]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "returned the reward nan at step 5 of evaluation episode 0" in err
+    assert "Stopped at env step 0 with a checkpoint" in err and "--resume" in err
+    counters = load_checkpoint(run_dir)["state"]["counters"]
+    assert counters["env_step"] == 0 and counters["eval_pending"]
+    assert not (run_dir / "eval.csv").is_file() or read_csv(run_dir / "eval.csv") == []

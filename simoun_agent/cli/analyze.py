@@ -28,7 +28,7 @@ from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
 from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
 from simoun_agent.analysis.report import RunBias, write_report
 from simoun_agent.analysis.runs import play_episode, prepare_output
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.load import LoadedRun, load_run
@@ -270,6 +270,7 @@ DESCRIPTION = (
 )
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-analyze``."""
     args = parse(Command, argv, PROG, DESCRIPTION)

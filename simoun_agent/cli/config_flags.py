@@ -13,6 +13,8 @@ its saved value.
 from __future__ import annotations
 
 import functools
+import json
+import typing
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any
@@ -21,7 +23,13 @@ import tyro
 
 from simoun_agent.cli.flags import negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
-from simoun_agent.config.keys import check_keys, config_fields, parse_value
+from simoun_agent.config.keys import (
+    FALSE_WORDS,
+    TRUE_WORDS,
+    check_keys,
+    config_fields,
+    parse_value,
+)
 
 PRESETS_HELP = "start from a named preset: " + ", ".join(PRESETS)
 RECIPES_HELP = "agent recipes (--agent.recipe NAME):\n" + "\n".join(
@@ -52,15 +60,19 @@ def config_default(argv: Sequence[str]) -> TrainConfig:
 
 
 def preset_in(argv: Sequence[str]) -> str | None:
-    """The value of ``--preset NAME`` / ``--preset=NAME`` in ``argv``, else None."""
+    """The value of ``--preset NAME`` / ``--preset=NAME`` in ``argv``, else None; SetupError
+    when it is given twice with different names."""
+    names = []
     for i, arg in enumerate(argv):
         if arg == "--":
             break
         if arg == "--preset" and i + 1 < len(argv):
-            return argv[i + 1]
+            names.append(argv[i + 1])
         if arg.startswith("--preset="):
-            return arg.partition("=")[2]
-    return None
+            names.append(arg.partition("=")[2])
+    if len(set(names)) > 1:
+        raise SetupError(f"--preset is given twice ({' and '.join(names)}); give it once")
+    return names[0] if names else None
 
 
 @functools.cache
@@ -93,6 +105,7 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
     the ``--set`` pairs, typed."""
     known = config_flags()
     fields = config_fields()
+    check_given_once(argv, flags.set)
     given = {}
     for arg in argv:
         if arg == "--":
@@ -111,3 +124,54 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
         check_keys([key])  # an unknown key fails here, with its close matches
         given[key] = parse_value(key, value, fields[key][0])
     return given
+
+
+def check_given_once(argv: Sequence[str], pairs: Sequence[str]) -> None:
+    """Raise SetupError for a config key given twice with different values, by its flag or by
+    ``--set`` (``--seed 1 --seed 2``, ``--seed 1 --set seed=2``): one of them would win without
+    a word. A list key's flag is meant to be repeated (``--eval-distraction a
+    --eval-distraction b``) and is exempt; the same value twice is harmless."""
+    known = config_flags()
+    fields = config_fields()
+    given: dict[str, list[tuple[str, Any]]] = {}
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        name, eq, text = arg.partition("=")
+        key = known.get(name)
+        if key is None:
+            continue
+        kind = fields[key][0]
+        if typing.get_origin(kind) is tuple or kind is tuple:
+            continue
+        if kind is bool:
+            following = argv[i + 1].lower() if i + 1 < len(argv) else ""
+            if name != key_flag(key):  # a negation
+                value = False
+            elif eq:
+                value = text.lower() in TRUE_WORDS
+            elif following in TRUE_WORDS + FALSE_WORDS:
+                value = following in TRUE_WORDS
+                arg = f"{arg} {argv[i + 1]}"
+            else:
+                value = True
+        else:
+            if not eq and i + 1 >= len(argv):
+                continue  # tyro says the value is missing
+            value = parse_value(key, text if eq else argv[i + 1], kind)
+        given.setdefault(key, []).append(
+            (arg if eq or kind is bool else f"{arg} {argv[i + 1]}", value)
+        )
+    for pair in pairs:
+        key, sep, text = pair.partition("=")
+        key = key.replace("-", "_")
+        if sep and key in fields:
+            given.setdefault(key, []).append(
+                (f"--set {pair}", parse_value(key, text, fields[key][0]))
+            )
+    for key, uses in given.items():
+        if len({json.dumps(value, default=str) for _, value in uses}) > 1:
+            raise SetupError(
+                f"{key} is given twice with different values ({' and '.join(u for u, _ in uses)}); "
+                "give it once"
+            )

@@ -22,7 +22,7 @@ from typing import Annotated
 import tyro
 from tqdm import tqdm
 
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
@@ -107,6 +107,7 @@ class EvalCommand:
     video_* modes (none: a procedural moving background)"""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
     args = parse(EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"))

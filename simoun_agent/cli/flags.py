@@ -14,18 +14,21 @@ to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not
 * booleans are switches, ``--video`` / ``--no-video`` (``--agent.no-curiosity`` in a section),
   and the older spelling with a value, ``--video false`` or ``--video=false``, still works:
   :func:`bool_argv` rewrites it to the switch before parsing;
-* every command answers ``--version``; help printed to a pipe is not wrapped at 80 columns.
+* every command answers ``--version``; help printed to a pipe is not wrapped at 80 columns;
+  output into a pipe that closed early (``simoun-report DIR | head``) ends the command
+  quietly (:func:`quiet_pipe`).
 """
 
 from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import json
 import os
 import sys
 import typing
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from importlib.metadata import PackageNotFoundError, version
 from typing import Annotated, Any, NoReturn, TypeVar
 
@@ -176,6 +179,11 @@ def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
             word, step = argv[i + 1], 2
         elif name in flags and eq and word.lower() in words:
             step = 1
+        elif name in flags and eq:
+            raise ValueError(
+                f"{name} is a switch: it takes true or false ({name}=true, {name}=false), or "
+                f"give {name} / {negated(name)} alone; got {argv[i]!r}"
+            )
         else:
             out.append(former.get(argv[i], argv[i]))
             i += 1
@@ -215,12 +223,16 @@ def parse(
     if "--version" in argv:
         print(f"{prog} {installed_version()}")
         sys.exit(0)
+    try:
+        argv = bool_argv(argv, switches)
+    except ValueError as err:
+        fail(prog, err)
     with _help_unwrapped_in_pipes():
         return tyro.cli(
             cls,
             prog=prog,
             description=description,
-            args=bool_argv(argv, switches),
+            args=argv,
             default=MISSING_NONPROP if default is None else default,
             registry=REGISTRY,
         )
@@ -243,3 +255,27 @@ def fail(prog: str, message: object) -> NoReturn:
     """``PROG: error: MESSAGE`` on stderr, then exit status 2 (bad input)."""
     print(f"{prog}: error: {message}", file=sys.stderr)
     sys.exit(2)
+
+
+CLOSED_PIPE_EXIT = 141
+"""Exit status after the reader of stdout went away: a shell's status for a command ended by
+SIGPIPE (128 + 13), as ``cat`` or ``grep`` would end."""
+
+
+def quiet_pipe(main: Callable[..., int]) -> Callable[..., int]:
+    """``main`` that ends quietly with :data:`CLOSED_PIPE_EXIT` when its output pipe closes
+    early (``| head``) instead of printing a traceback. SIGPIPE itself stays ignored, as Python
+    sets it: a Ray driver writes to sockets whose peer may go, which must raise, not kill."""
+
+    @functools.wraps(main)
+    def wrapped(argv: Sequence[str] | None = None) -> int:
+        try:
+            return main(argv)
+        except BrokenPipeError:
+            # the interpreter flushes stdout again at exit: point it at /dev/null so that
+            # flush has nowhere to fail
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            return CLOSED_PIPE_EXIT
+
+    return wrapped

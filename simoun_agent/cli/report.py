@@ -15,7 +15,7 @@ from typing import Annotated
 
 import tyro
 
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.sweep.report import write_report
 
@@ -46,13 +46,15 @@ class ReportCommand:
     it, so the run directory is left as simoun-train wrote it)"""
     at_step: Annotated[int | None, BUDGET, tyro.conf.arg(metavar="N")] = None
     """compare at an equal budget of N env steps: a run counts, finished or not, only with an
-    evaluation at exactly N (runs evaluated elsewhere are listed as short)"""
+    evaluation at N, or the nearest within half its eval_every (listed in the report; runs
+    evaluated elsewhere are listed as short)"""
     at_wall_time: Annotated[float | None, BUDGET, tyro.conf.arg(metavar="SECONDS")] = None
     """compare at an equal wall-time budget: a run counts, finished or not, if it trained past
     SECONDS (an evaluation at or after it), with its last evaluation at or before SECONDS (runs
     that stopped earlier are listed as short)"""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""
     args = parse(ReportCommand, argv, PROG, DESCRIPTION)

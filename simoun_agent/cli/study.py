@@ -26,8 +26,9 @@ from typing import Annotated, Union
 
 import tyro
 
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.study.checks import check_study
 from simoun_agent.study.plan import describe
 from simoun_agent.study.runner import StudyOptions, report_study, run_study, spec_from
 from simoun_agent.sweep.launch import load_ray
@@ -96,6 +97,7 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 """The command line: plan a study, run it, or write its report again."""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""
     args = parse(Command, argv, PROG, DESCRIPTION)
@@ -104,6 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if isinstance(args, Plan):
             if args.probe_updates < 0:
                 raise SetupError("--probe-updates must be 0 or more")
+            check_study(spec, args.spec)
             print(describe(spec, args.spec, args.probe_updates))
             return 0
         if isinstance(args, Report):

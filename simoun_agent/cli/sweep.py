@@ -27,10 +27,10 @@ from simoun_agent.cli.config_flags import (
     config_switches,
     overrides_from,
 )
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_agent.sweep import report
-from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec
+from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
 from simoun_agent.sweep.launch import (
     check_fits,
     connect,
@@ -132,6 +132,7 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
     return saved
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-sweep``."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -152,6 +153,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         fail(PROG, err)
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
+    try:
+        check_runnable(todo, "--envs" if args.envs or len(spec.envs) > 1 else "--env")
+    except SetupError as err:
+        fail(PROG, err)
     print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
     terminated: list[bool] = []
     if todo:

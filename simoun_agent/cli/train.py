@@ -30,7 +30,7 @@ from simoun_agent.cli.config_flags import (
     config_switches,
     overrides_from,
 )
-from simoun_agent.cli.flags import fail, parse
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
@@ -76,6 +76,7 @@ class TrainCommand:
     """the run config"""
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""
     argv = list(sys.argv[1:] if argv is None else argv)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 import dataclasses
+import functools
 import inspect
 import itertools
 import json
@@ -34,6 +35,7 @@ def field_docs(cls: type) -> dict[str, str]:
     return docs
 
 
+@functools.cache  # parsing the source costs ~1 ms a class, and resolve() reads every class
 def _own_field_docs(cls: type) -> dict[str, str]:
     try:
         tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
@@ -144,7 +146,8 @@ def check_keys(keys: Any, source: str = "", fix: str = HELP_FIX) -> None:
     close matches (:func:`close_match`); ``source`` says where the keys came from (none: the
     user) and ``fix`` how to correct them. The user's overrides, presets, recipes and saved
     configs all pass here."""
-    unknown = [key for key in keys if key not in config_fields()]
+    known = config_fields()
+    unknown = [key for key in keys if key not in known]
     if unknown:
         named = ", ".join(key + close_match(key) for key in unknown)
         where = f"{source}: " if source else ""

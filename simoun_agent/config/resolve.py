@@ -65,7 +65,12 @@ def preset_values(name: str) -> dict[str, Any]:
     """The flat overrides of the preset ``name`` with ``"preset": name``; SetupError for an
     unknown preset or a preset entry with an unknown key."""
     if name not in PRESETS:
-        raise SetupError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
+        hint = difflib.get_close_matches(str(name), PRESETS, n=1)
+        raise SetupError(
+            f"unknown preset {name!r}"
+            + (f" (did you mean {hint[0]!r}?)" if hint else "")
+            + f"; choose one of {', '.join(PRESETS)}"
+        )
     values = flatten(PRESETS[name].overrides)
     check_keys(values, f"preset {name!r}", "fix its entry in simoun_agent.config.presets.PRESETS")
     return {**values, "preset": name}

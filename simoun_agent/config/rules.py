@@ -17,6 +17,7 @@ Example:
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import json
 import math
 import numbers
@@ -35,6 +36,8 @@ class Rule:
     """True for an accepted value"""
     fix: str = ""
     """advice after the error; empty: suggest the field's default"""
+    suggest: Callable[[Any], str] | None = None
+    """the close match of a refused value, as `` (did you mean 'dual'?)``, or empty"""
 
 
 def is_int(value: Any) -> bool:
@@ -79,7 +82,18 @@ def boolean() -> Rule:
 
 
 def one_of(options: Sequence[str]) -> Rule:
-    return Rule("a known name", lambda v: v in options, f"choose one of {', '.join(options)}")
+    return Rule(
+        "a known name",
+        lambda v: v in options,
+        f"choose one of {', '.join(options)}",
+        lambda v: did_you_mean_name(v, options),
+    )
+
+
+def did_you_mean_name(typed: Any, options: Sequence[str]) -> str:
+    """`` (did you mean 'dual'?)`` for a mistyped name of ``options``, or empty."""
+    match = difflib.get_close_matches(str(typed), list(options), n=1) if typed else []
+    return f" (did you mean {match[0]!r}?)" if match else ""
 
 
 def text(optional: bool = False, fix: str = "") -> Rule:
@@ -131,7 +145,10 @@ def check_fields(config: Any, rules: dict[str, Rule], prefix: str) -> None:
             flag = flag_name(prefix, f.name)
             default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
             fix = rule.fix or f"e.g. {flag} {show(default)} (the default)"
-            raise ValueError(f"{flag} {show(value)} ({cls}.{f.name}) must be {rule.need}; {fix}")
+            close = rule.suggest(value) if rule.suggest else ""
+            raise ValueError(
+                f"{flag} {show(value)} ({cls}.{f.name}) must be {rule.need}{close}; {fix}"
+            )
 
 
 def fail(prefix: str, name: str, value: Any, problem: str) -> ValueError:

@@ -87,7 +87,8 @@ class TrainConfig:
     run_dir: str | None = None
     """output directory; None: runs/<env>-<preset>-s<seed>-<date>"""
     progress: bool = True
-    """show a progress bar"""
+    """true/false: a progress bar on a terminal (false, or no terminal: one line per
+    evaluation)"""
     agent: AgentConfig = field(default_factory=AgentConfig)
     """the agent's hyperparameters (simoun_agent.config.AgentConfig)"""
 

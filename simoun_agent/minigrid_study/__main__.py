@@ -17,6 +17,7 @@ from typing import Annotated, Union
 
 import tyro
 
+from simoun_agent.cli.flags import installed_version, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.minigrid_study.probe import PROBED, ProbeSettings
 from simoun_agent.minigrid_study.spec import StudySpec, load_spec
@@ -26,15 +27,28 @@ ARCHIVE = Path("docs/studies/minigrid")
 PROG = "python -m simoun_agent.minigrid_study"
 
 
-def spec_for(spec: Path | None, archive: Path) -> StudySpec:
-    """``spec``, else the archive's spec, else the defaults (the study as designed)."""
+def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
+    """``spec``, else the archive's spec, else the defaults (the study as designed) for the
+    archive that holds them (``archive`` is ARCHIVE, or ``new``: a ``run`` may start a study in
+    an empty directory). An archive that is not there is refused rather than made up: a
+    mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
     from simoun_agent.minigrid_study.tune import SPEC_FILE
 
+    if not archive.is_dir():
+        where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
+        in_clone = " (run it from the root of a clone of simoun)" if archive == ARCHIVE else ""
+        start = "; to start a new study, create the directory first" if new else ""
+        raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
     if spec is not None:
         return load_spec(spec)
     if (archive / SPEC_FILE).is_file():
         return load_spec(archive / SPEC_FILE)
-    return StudySpec()
+    if new and (archive == ARCHIVE or not any(archive.iterdir())):
+        return StudySpec()
+    raise SetupError(
+        f"--archive {archive} holds no {SPEC_FILE}, so it is not a study's archive; pass the "
+        "archive a run wrote, or --spec FILE for the spec its runs were trained with"
+    )
 
 
 @dataclass
@@ -84,7 +98,11 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 ]
 
 
+@quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
+    if "--version" in (sys.argv[1:] if argv is None else argv):
+        print(f"{PROG} {installed_version()}")
+        return 0
     args = tyro.cli(
         Command,
         prog=PROG,
@@ -97,13 +115,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         from simoun_agent.minigrid_study.probe import write_probe
 
         try:
+            if not args.out.parent.is_dir():
+                raise SetupError(
+                    f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "
+                    "run from the root of a clone of simoun, or pass an --out whose folder exists"
+                )
             print(write_probe(args.settings, args.probes, args.out))
         except ValueError as err:
             print(f"error: {err}", file=sys.stderr)
             return 2
         return 0
     try:
-        spec = spec_for(args.spec, args.archive)
+        spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
         if isinstance(args, Run):
             from simoun_agent.minigrid_study.tune import run_study
 
@@ -116,7 +139,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(write_selection(spec, args.archive))
             return 0
         from simoun_agent.minigrid_study.report import write_report
+        from simoun_agent.minigrid_study.tune import finished_runs
 
+        if not finished_runs(spec, args.archive):
+            raise SetupError(
+                f"--archive {args.archive} holds no finished run of its spec: nothing to report "
+                f"yet; train them with: {PROG} run --archive {args.archive}"
+            )
         print(write_report(spec, args.archive))
     except SetupError as err:
         print(f"error: {err}", file=sys.stderr)

@@ -7,6 +7,7 @@
 | crash intensity    | ego speed (m/s) at the first step flagged crashed; crash rate alongside |
 | average steer      | mean of abs(steering angle) / maximum steering angle                    |
 | average brake      | mean of max(-acceleration, 0) / maximum deceleration (0 when not braking) |
+| (not in Table 2)   | mean speed: mean ego speed (m/s) over the decisions                     |
 
 The ego vehicle's state is read from ``env.unwrapped.vehicle`` (position, speed, the applied
 ``action`` in physical units) and the crash flag from ``info["crashed"]`` after each decision.
@@ -36,6 +37,7 @@ class DrivingEpisode:
     crashed: bool = False
     crash_speed: float = math.nan
     steer: list[float] = field(default_factory=list)
+    speed: list[float] = field(default_factory=list)
     brake: list[float] = field(default_factory=list)
     _position: np.ndarray | None = None
 
@@ -55,6 +57,7 @@ class DrivingEpisode:
         max_brake = abs(min(base.action_type.acceleration_range))
         applied = vehicle.action
         self.steer.append(abs(float(applied.get("steering", 0.0))) / max_steer)
+        self.speed.append(float(vehicle.speed))
         self.brake.append(max(-float(applied.get("acceleration", 0.0)), 0.0) / max_brake)
         if info.get("crashed", vehicle.crashed) and not self.crashed:
             self.crashed = True
@@ -70,5 +73,6 @@ def summarize(episodes: list[DrivingEpisode]) -> dict[str, float]:
         "crash_rate": float(np.mean([e.crashed for e in episodes])),
         "crash_speed": float(np.mean(crash_speeds)) if crash_speeds else math.nan,
         "mean_abs_steer": float(np.mean([np.mean(e.steer) for e in episodes])),
+        "mean_speed": float(np.mean([np.mean(e.speed) if e.speed else math.nan for e in episodes])),
         "brake_fraction": float(np.mean([np.mean(e.brake) for e in episodes])),
     }

@@ -12,12 +12,26 @@ import gymnasium as gym
 import numpy as np
 import torch
 
+from simoun_agent.config import SetupError
 from simoun_agent.run import driving_metrics
 
 
 class EvaluationStopped(Exception):
     """An evaluation abandoned between two steps because its ``stop()`` said so; nothing of it
     is returned, so no partial evaluation is ever logged."""
+
+
+class NonFiniteReward(SetupError):
+    """An evaluation episode got a NaN or infinite reward: its return would be logged, plotted
+    and reported as if it were a score."""
+
+    def __init__(self, reward: float, episode: int, step: int, seed: int) -> None:
+        super().__init__(
+            f"the evaluation env returned the reward {reward} at step {step} of evaluation "
+            f"episode {episode} (reset seed {seed}); rewards must be finite numbers: fix the "
+            "environment"
+        )
+        self.reward = reward
 
 
 def evaluate(
@@ -38,6 +52,7 @@ def evaluate(
 
     ``on_episode(index, return)`` is called after each episode (progress reports). ``stop()`` is
     asked before every step: True raises :class:`EvaluationStopped` (a Ctrl-C during training).
+    A NaN or infinite reward raises :class:`NonFiniteReward`.
 
     Returns:
         metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
@@ -59,6 +74,8 @@ def evaluate(
                     raise EvaluationStopped
                 action = agent.act(obs["frames"], deterministic=True)
                 obs, reward, terminated, truncated, info = env.step(action)
+                if not math.isfinite(reward):
+                    raise NonFiniteReward(float(reward), episode, length + 1, seed + episode)
                 total += float(reward)
                 length += 1
                 done = terminated or truncated

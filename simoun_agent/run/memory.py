@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import os
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import torch
@@ -152,10 +152,34 @@ def estimate(config: TrainConfig) -> MemoryEstimate:
     )
 
 
-def check_memory(config: TrainConfig) -> str | None:
+@dataclass(frozen=True)
+class Spelling:
+    """How the interface a user is in spells a config key and a value for it."""
+
+    prefix: str
+    """``--`` for flags"""
+    separator: str
+    """between the key and its value"""
+    dashes: bool
+    """underscores written as dashes (flags)"""
+
+    def name(self, key: str) -> str:
+        return self.prefix + (key.replace("_", "-") if self.dashes else key)
+
+    def set(self, key: str, value: Any) -> str:
+        return f"{self.name(key)}{self.separator}{value}"
+
+
+FLAGS = Spelling("--", " ", True)
+"""simoun-train's and simoun-sweep's flags: ``--agent.batch-size 16``"""
+SPEC_KEYS = Spelling("", " = ", False)
+"""a study spec's keys: ``agent.batch_size = 16``"""
+
+
+def check_memory(config: TrainConfig, knob: Spelling = FLAGS) -> str | None:
     """Raise SetupError when ``config`` needs more memory than the machine has, naming the
-    estimate and the fix; return a warning when it needs more than :data:`WARN_FRACTION` of it,
-    else None."""
+    estimate and every setting that must change, as ``knob`` spells them; return a warning when it
+    needs more than :data:`WARN_FRACTION` of it, else None."""
     need = estimate(config)
     worst = need.shortfall()
     if worst is None or worst[0] <= WARN_FRACTION:
@@ -165,25 +189,96 @@ def check_memory(config: TrainConfig) -> str | None:
     batch = config.agent.batch_size
     c, h, w = frame_shape(config)
     owner = "this machine" if where == "host" else f"the {where} device"
+    size, batch_set = knob.set("image_size", config.image_size), knob.set("agent.batch_size", batch)
     text = (
-        f"--image-size {config.image_size} with --agent.batch-size {batch}: one gradient update "
-        f"needs at least {need.update / GB:.1f} GB on {need.device} ({batch} windows of "
-        f"{config.agent.num_frames + 1} frames of {c}x{h}x{w}, estimated on torch's meta device) "
-        f"and the full replay {need.replay / GB:.1f} GB of host memory "
-        f"(--replay-capacity {config.replay_capacity}); {owner} has {have / GB:.1f} GB"
+        f"{size} with {batch_set}: one gradient update needs at least {need.update / GB:.1f} GB "
+        f"on {need.device} ({batch} windows of {config.agent.num_frames + 1} frames of "
+        f"{c}x{h}x{w}, estimated on torch's meta device) and the full replay "
+        f"{need.replay / GB:.1f} GB of host memory "
+        f"({knob.set('replay_capacity', config.replay_capacity)}); {owner} has {have / GB:.1f} GB"
     )
     if ratio <= 1:
         return f"{text}. It may not fit: the real peak is higher than this estimate."
-    raise SetupError(f"{text}, so the run would be killed. {_fix(config, need, have, where)}")
+    raise SetupError(f"{text}, so the run would be killed. {_fix(config, need, knob)}")
 
 
-def _fix(config: TrainConfig, need: MemoryEstimate, have: int, where: str) -> str:
-    """What to lower: the replay when it alone fills the host, else the batch (the update is
-    linear in it; half of what is left, as the real peak exceeds the estimate) or the image."""
-    room = have - (need.replay if where == "host" else 0)
-    if room <= 0:
-        frames = int(WARN_FRACTION * have / (need.replay / config.replay_capacity))
-        return f"Lower --replay-capacity to about {frames}, or --image-size (84 is the paper's)"
-    fits = int(WARN_FRACTION * room / (need.update / config.agent.batch_size))
-    batch = f"--agent.batch-size to about {fits}, or " if fits >= 1 else ""
-    return f"Lower {batch}--image-size (84 is the paper's), or --replay-capacity"
+def _fix(config: TrainConfig, need: MemoryEstimate, knob: Spelling) -> str:
+    """Every setting that must change for the run to fit in :data:`WARN_FRACTION` of the memory
+    (the real peak exceeds the estimate): the replay's capacity, the batch (the update is
+    linear in it: networks and optimiser states, plus a share per window), or both when
+    lowering one cannot make room; the image size when not even a batch of one fits."""
+    per_frame = need.replay / config.replay_capacity
+    batch = config.agent.batch_size
+    one = replace(config, agent=replace(config.agent, batch_size=1))
+    fixed = update_bytes(one) if batch > 1 else need.update
+    per_window = max(need.update - fixed, 1) / max(batch - 1, 1)
+    capacity, windows = config.replay_capacity, batch
+
+    def frames_in(room: float) -> int:
+        return int(room / per_frame)
+
+    def windows_in(room: float) -> int:
+        return int((room - fixed) / per_window) + 1
+
+    if need.device.startswith(("cpu", "mps")):  # the update and the replay share the host
+        budget = WARN_FRACTION * (need.host_bytes or 0)
+        if need.update < budget and frames_in(budget - need.update) >= batch:
+            capacity = frames_in(budget - need.update)
+        elif need.replay < budget and windows_in(budget - need.replay) >= 1:
+            windows = windows_in(budget - need.replay)
+        else:
+            capacity, windows = frames_in(budget / 2), windows_in(budget / 2)
+    else:  # the update on the device, the replay on the host
+        if need.host_bytes and need.replay > WARN_FRACTION * need.host_bytes:
+            capacity = frames_in(WARN_FRACTION * need.host_bytes)
+        if need.device_bytes and need.update > WARN_FRACTION * need.device_bytes:
+            windows = windows_in(WARN_FRACTION * need.device_bytes)
+    capacity, windows = min(capacity, config.replay_capacity), min(windows, batch)
+    if windows < 1 or capacity < max(windows, 1):
+        return (
+            f"Lower {knob.name('image_size')} (84 is the paper's; the update grows "
+            "with the fourth power of the side), then the batch or the replay if it still does "
+            "not fit"
+        )
+    changes = [
+        knob.set(key, value)
+        for key, value, now in (
+            ("replay_capacity", capacity, config.replay_capacity),
+            ("agent.batch_size", windows, batch),
+        )
+        if value != now
+    ]
+    both = " and ".join(changes)
+    return f"Set {both} (or lower the image size) so that it fits with room to spare"
+
+
+def replay_holds(config: TrainConfig, capacity: int, episode_steps: int) -> int:
+    """Whole transitions a full replay of ``capacity`` keeps of ``episode_steps``-step
+    episodes: :class:`~simoun_agent.replay.FrameReplay` sizes its ring for 50-step episodes,
+    and each shorter episode's reset frame takes a slot (the oldest windows lose a frame too)."""
+    frames = config.agent.num_frames
+    slots = capacity + (capacity + 48) // 50 + frames
+    return (slots - frames) * episode_steps // (episode_steps + 1) - frames
+
+
+def check_replay(config: TrainConfig, env_steps: int | None, knob: Spelling = FLAGS) -> None:
+    """Raise SetupError when the replay, full, cannot hold one batch of whole transitions of
+    the env's episodes of ``env_steps`` env steps (None: no limit, nothing to check): sampling
+    would fail once the replay is full, hours into a run."""
+    if env_steps is None:
+        return
+    steps = max(1, math.ceil(env_steps / config.resolved_action_repeat()))
+    batch = config.agent.batch_size
+    held = replay_holds(config, config.replay_capacity, steps)
+    if held >= batch:
+        return
+    enough = config.replay_capacity
+    while replay_holds(config, enough, steps) < batch:
+        enough += max(1, enough // 20)
+    raise SetupError(
+        f"{knob.set('replay_capacity', config.replay_capacity)} keeps about {held} whole "
+        f"transitions of {config.env}'s {steps}-step episodes (each episode's first frame takes "
+        f"a slot), fewer than a batch of {batch} ({knob.set('agent.batch_size', batch)}): "
+        f"sampling would fail once the replay is full. Set {knob.set('replay_capacity', enough)} "
+        "or more, or lower the batch size"
+    )

@@ -3,8 +3,9 @@
 On a terminal the bar counts env steps and shows the last episode's and evaluation's returns;
 during an evaluation it shows the episodes done (the first one of a run takes a while: 10
 episodes of an untrained agent before any training step). Without a terminal (nohup, cluster
-jobs, CI) there is one line when the first evaluation starts and one per evaluation after it,
-so logs do not fill with bar redraws.
+jobs, CI), or with the bar switched off (``--no-progress``), there is one line when the first
+evaluation starts and one per evaluation after it, so logs do not fill with bar redraws and a
+run of hours still says how far it is.
 """
 
 from __future__ import annotations
@@ -16,20 +17,20 @@ from tqdm import tqdm
 
 
 class Progress:
-    """The bar or the lines of one training process; nothing when ``enabled`` is False.
+    """The bar or the lines of one training process.
 
     Args:
         total: env steps of the run.
         done: env steps done before this process (a resumed run).
         label: the bar's label (the env id).
-        enabled: the run's ``progress`` setting.
+        enabled: the run's ``progress`` setting: the bar on a terminal (off: lines only).
     """
 
     def __init__(self, total: int, done: int, label: str, enabled: bool) -> None:
         self.total, self.start_step = total, done
         self.start = time.perf_counter()
         show_bar = enabled and sys.stderr.isatty()
-        self.lines = enabled and not show_bar
+        self.lines = not show_bar
         self.bar = tqdm(
             total=total,
             initial=done,

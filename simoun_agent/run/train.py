@@ -21,9 +21,11 @@ continues. During set-up there is nothing to save: a signal stops it at once. On
 time holds a run directory (:mod:`simoun_agent.run.rundir`); ``--overwrite`` starts over a run
 that stopped before its first checkpoint.
 
-Other ends of a run that keep a checkpoint to resume from: a non-finite reward from the env
-stops it (exit 1) with a checkpoint from before that step, naming the step and the env; a full
-disk is the rule of :data:`CHECKPOINT_TRIES` (exit 75).
+Other ends of a run that keep a checkpoint to resume from: a non-finite reward from the env,
+in training or in an evaluation, stops it (exit 1) with a checkpoint from before that step,
+naming the step, the value and the env; a NaN or infinite loss (or intrinsic reward) of the
+updates stops it (exit 1) naming them, keeping the checkpoint from before; a full disk is the
+rule of :data:`CHECKPOINT_TRIES` (exit 75).
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ from simoun_agent.run.checkpoint import (
     save_checkpoint,
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
-from simoun_agent.run.evaluate import EvaluationStopped, evaluate, metrics_json
+from simoun_agent.run.evaluate import EvaluationStopped, NonFiniteReward, evaluate, metrics_json
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -100,6 +102,10 @@ class TrainingError(RuntimeError):
     def __init__(self, message: str, exit_code: int) -> None:
         super().__init__(message)
         self.exit_code = exit_code
+
+    def __reduce__(self) -> tuple:
+        # Ray copies a trial's exception to report it: rebuild it with its exit code
+        return type(self), (str(self), self.exit_code)
 
 
 def default_run_dir(config: TrainConfig) -> Path:
@@ -289,14 +295,24 @@ class Trainer:
         self.phase = f"{what} (abandoned: it runs first on resume)"
         counters.eval_pending = True
         self.progress.evaluation_start(counters.env_step, config.eval_episodes)
-        metrics, _ = evaluate(
-            run.agent,
-            run.eval_env,
-            config.eval_episodes,
-            first_eval_seed(config.seed),
-            on_episode=self.progress.evaluation_episode,
-            stop=run.stop.is_set,
-        )
+        try:
+            metrics, _ = evaluate(
+                run.agent,
+                run.eval_env,
+                config.eval_episodes,
+                first_eval_seed(config.seed),
+                on_episode=self.progress.evaluation_episode,
+                stop=run.stop.is_set,
+            )
+        except NonFiniteReward as err:
+            # the agent is sound (the env's reward is not): save it, the evaluation still
+            # pending, so a resume after the env is fixed plays this evaluation first
+            self.checkpoint(required=f"before the evaluation at env step {counters.env_step}")
+            raise TrainingError(
+                f"{run.config.env}: {err}. Stopped at env step {counters.env_step} with a "
+                f"checkpoint; once fixed, continue with: simoun-train --resume {run.run_dir}",
+                1,
+            ) from None
         for callback in self.callbacks:
             callback.on_evaluation(run, metrics)
         counters.wall_time_s = self.clock.total()
@@ -400,6 +416,10 @@ class Trainer:
             if not (terminated or truncated):
                 continue
             elapsed = time.perf_counter() - episode_start
+            learned = {key: float(value) for key, value in update_metrics.items()}
+            # read once an episode, where the values are synced for the log anyway
+            if bad := {key: value for key, value in learned.items() if not math.isfinite(value)}:
+                self.bad_update(bad)
             self.logger.train_episode(
                 counters.env_step,
                 {
@@ -407,7 +427,7 @@ class Trainer:
                     "return": episode_return,
                     "length": episode_length,
                     "env_steps_per_s": episode_length * repeat / elapsed,
-                    **{key: float(value) for key, value in update_metrics.items()},
+                    **learned,
                 },
             )
             counters.episode += 1
@@ -432,6 +452,25 @@ class Trainer:
             f"{episode_seed}); rewards must be finite numbers. The run stopped with a checkpoint "
             f"at env step {counters.env_step}: fix the environment, then continue with: "
             f"simoun-train --resume {run.run_dir}",
+            1,
+        )
+
+    def bad_update(self, bad: dict[str, float]) -> NoReturn:
+        """Stop on a NaN or infinite loss (or intrinsic reward) of the updates: the weights it
+        reached are no use, so the latest checkpoint, from before it, is kept, not overwritten."""
+        run, step = self.run, self.run.counters.env_step
+        values = ", ".join(f"{key} = {value}" for key, value in bad.items())
+        if self.last_saved_step is None:
+            then = f"no checkpoint was written yet: start over with --run-dir {run.run_dir}"
+            then += " --overwrite"
+        else:
+            then = (
+                f"the latest checkpoint (env step {self.last_saved_step}) is from before it: "
+                f"simoun-train --resume {run.run_dir} continues from there"
+            )
+        raise TrainingError(
+            f"the updates of the episode ending at env step {step} gave {values}: training "
+            f"diverged (lower --agent.lr, or check the rewards' scale). Stopped; {then}",
             1,
         )
 

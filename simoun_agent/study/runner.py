@@ -17,6 +17,7 @@ from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME
 from simoun_agent.study import archive as archiving
 from simoun_agent.study.archive import GENERALIZATION_CSV
+from simoun_agent.study.checks import check_fixed_spec, check_study
 from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_agent.study.generalization import play_modes, playable, to_play
 from simoun_agent.study.plan import (
@@ -68,15 +69,23 @@ def spec_from(path: str) -> StudySpec:
     return spec
 
 
-def load_record(study_dir: Path, archive: Path | None) -> dict[str, Any]:
-    """The saved study record, from the study directory, else from the archive."""
+def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) -> dict[str, Any]:
+    """The saved study record, from the study directory, else from the archive; SetupError
+    with the advice of the command asked (``run --resume``, or ``report``: ``resuming``
+    False) when neither holds one."""
     for where in (study_dir, archive):
         if where is not None and (where / STUDY_FILE).is_file():
             return json.loads((where / STUDY_FILE).read_text())
     places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
+    missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
+    if not resuming:
+        raise SetupError(
+            f"no study to report: {places} holds no {STUDY_FILE}{missing}; pass the "
+            "--study-dir of a study that ran (or its archive, e.g. docs/studies/NAME)"
+        )
     raise SetupError(
-        f"no study to resume: {places} holds no {STUDY_FILE}; drop --resume to start the study, "
-        "or pass the --study-dir (or --archive) of the study to continue"
+        f"no study to resume: {places} holds no {STUDY_FILE}{missing}; drop --resume to start "
+        "the study, or pass the --study-dir (or --archive) of the study to continue"
     )
 
 
@@ -109,13 +118,11 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
         text = Path(spec_path).read_text()
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
-    check_same_spec(
-        record,
-        spec,
-        f"{spec_path} is not the spec this study was started with",
-        f"resume with that spec (its text is in {STUDY_FILE}, spec_text), or start a new study "
-        "in another --study-dir",
-    )
+    changed = check_fixed_spec(record, spec, spec_path, [p for p in (study_dir, archive) if p])
+    if changed:  # a fix that leaves every finished run as it ran: the study goes on under it
+        part["spec_changed"] = {"keys": changed, "before": record["spec_text"]}
+        record.update(spec_file=spec_path, spec_text=Path(spec_path).read_text())
+        record["spec"] = spec.to_json()
     first = record["parts"][0]
     if not same_code(first, code) and not options.allow_other_commit:
         raise SetupError(
@@ -249,6 +256,7 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
     """Tune, select, evaluate, report the study of ``spec`` (read from ``spec_path``); the exit
     status (the sweep's: 130/143 stopped, 1 failed)."""
     study_dir, archive = options.study_dir, options.archive
+    check_study(spec, spec_path)
     record = open_study(spec, spec_path, options)
     save_record(record, [study_dir] + ([archive] if archive is not None else []))
     phases = Phases(spec, spec_path, options, ray)
@@ -286,7 +294,7 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
 def report_study(spec: StudySpec, study_dir: Path) -> Path:
     """Write the report of the finished runs in ``study_dir`` (a study directory or its
     archive) again, with this code, into ``study_dir/report``; returns its ``report.md``."""
-    record = load_record(study_dir, None)
+    record = load_record(study_dir, None, resuming=False)
     check_same_spec(
         record,
         spec,

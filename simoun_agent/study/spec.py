@@ -531,8 +531,9 @@ class _Reader:
         from simoun_agent.run.make_env import ensure_registered
 
         for task in tasks:
+            module, _, env_id = task.rpartition(":")  # MODULE:ID, as the env key takes it
             try:
-                ensure_registered(task)
+                ensure_registered(env_id, module or None)
             except SetupError as err:
                 raise self.fail((name, "tasks"), str(err)) from None
         seeds = self.per_task(table["seeds"], (name, "seeds"), tasks, self.seeds)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import itertools
 import json
 import re
+import sys
 import typing
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -277,6 +278,41 @@ class SweepSpec:
             return cls(**json.loads(path.read_text()))
         except (json.JSONDecodeError, TypeError) as err:
             raise SetupError(f"{path} is corrupt ({err}); start a new sweep") from None
+
+
+def check_runnable(trials: list[Trial], envs_flag: str) -> None:
+    """Make each trial's env once and estimate each configuration's memory on this machine,
+    before Ray starts any trial: SetupError naming the flag and the fix for the first that
+    cannot run (an unknown id with its close matches, discrete actions, frames or a replay
+    the memory cannot hold). ``envs_flag`` is the flag that gave the envs."""
+    # here, not at the top: reading and saving a grid needs neither torch nor the env suites
+    from simoun_agent.run.make_env import check_task
+    from simoun_agent.run.memory import check_memory, check_replay
+
+    made: dict[str, int | None] = {}
+    measured: set[str] = set()
+    for trial in trials:
+        config = resolve(trial.preset, trial.overrides)
+        env = json.dumps([config.env, config.env_kwargs, config.env_module], sort_keys=True)
+        if env not in made:
+            try:
+                made[env] = check_task(config)
+            except SetupError as err:
+                raise SetupError(f"{envs_flag} {trial.env}: {err}") from None
+        try:
+            check_replay(config, made[env])
+        except SetupError as err:
+            raise SetupError(f"trial {trial.name}: {err}") from None
+        memory = {**asdict(config), "env": None, "seed": None, "run_dir": None}
+        key = json.dumps(memory, sort_keys=True, default=str)
+        if key not in measured:
+            measured.add(key)
+            try:
+                warning = check_memory(config)
+            except SetupError as err:
+                raise SetupError(f"trial {trial.name}: {err}") from None
+            if warning:
+                print(f"simoun-sweep: warning: trial {trial.name}: {warning}", file=sys.stderr)
 
 
 def typed(overrides: dict[str, Any]) -> dict[str, Any]:

@@ -148,40 +148,100 @@ def with_defaults(saved: dict[str, Any]) -> dict[str, Any]:
         return saved
 
 
-def find_runs(root: Path) -> list[RunRecord]:
-    """Every run directory under ``root`` (Tune's own records under ``tune/`` skipped)."""
+CURVE_COLUMNS = ("env_step", "return_mean", "wall_time_s")
+"""The eval.csv columns the report reads."""
+
+
+class DamagedRun(Exception):
+    """A run's file cannot be read as the run wrote it (empty, cut short, not a number)."""
+
+
+def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
+    """Every run directory under ``root`` (Tune's own records under ``tune/`` skipped). A run
+    whose config.json, eval.csv or summary.json cannot be read is left out and, when
+    ``damaged`` is given, named there with the file and what is wrong with it."""
     records = []
     for config_path in sorted(root.rglob(CONFIG_NAME)):
         relative = config_path.relative_to(root).parts
         if relative[0] == "tune" or any(part.startswith(".") for part in relative):
             continue
-        run_dir = config_path.parent
         try:
-            config = flatten(with_defaults(json.loads(config_path.read_text())))
-        except json.JSONDecodeError:
-            continue
-        if "env" not in config or "seed" not in config:
-            continue
-        rows = read_csv(run_dir / EVAL_CSV) if (run_dir / EVAL_CSV).is_file() else []
-        curve = {
-            key: np.array([row.get(key, math.nan) for row in rows], dtype=float)
-            for key in ("env_step", "return_mean", "wall_time_s")
-        }
-        summary_path = run_dir / SUMMARY_NAME
-        summary = json.loads(summary_path.read_text()) if summary_path.is_file() else None
-        error_path = run_dir / ERROR_FILE
-        error = None
-        if error_path.is_file() and summary is None:
-            lines = error_path.read_text().strip().splitlines()
-            error = lines[-1] if lines else "failed"
-        written = run_dir / EVAL_CSV if (run_dir / EVAL_CSV).is_file() else config_path
-        records.append(RunRecord(run_dir, config, curve, summary, error, written.stat().st_mtime))
+            records.append(read_run(config_path))
+        except DamagedRun as err:
+            if damaged is not None:
+                damaged.append(f"{config_path.parent.relative_to(root).as_posix()}: {err}")
     return records
 
 
+def read_json(path: Path) -> dict[str, Any]:
+    """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise DamagedRun(f"{path.name} cannot be read ({err})") from None
+    if not isinstance(data, dict):
+        raise DamagedRun(f"{path.name} holds {type(data).__name__}, not a JSON object")
+    return data
+
+
+def read_curve(path: Path) -> dict[str, np.ndarray]:
+    """eval.csv's :data:`CURVE_COLUMNS`, or :class:`DamagedRun`: a file with a column
+    missing, a value that is not a number, or a NaN or infinite return would otherwise blank
+    or bend the statistics of its whole row."""
+    if not path.is_file():
+        return {key: np.zeros(0) for key in CURVE_COLUMNS}
+    try:
+        rows = read_csv(path)
+    except (OSError, UnicodeDecodeError, ValueError, TypeError, csv.Error) as err:
+        raise DamagedRun(f"{path.name} cannot be read ({err})") from None
+    if path.stat().st_size and not rows and "env_step" not in path.read_text():
+        raise DamagedRun(f"{path.name} has no header line")
+    if rows and (missing := [key for key in CURVE_COLUMNS if key not in rows[0]]):
+        raise DamagedRun(f"{path.name} has no column {', '.join(missing)}")
+    curve = {key: np.array([row[key] for row in rows], dtype=float) for key in CURVE_COLUMNS}
+    bad = ~np.isfinite(np.stack(list(curve.values()))).all(axis=0) if rows else []
+    if np.any(bad):
+        line = int(np.argmax(bad)) + 2  # 1-based, after the header
+        raise DamagedRun(f"{path.name} line {line} has an empty, NaN or infinite value")
+    return curve
+
+
+def read_run(config_path: Path) -> RunRecord:
+    """The run of ``config_path``'s directory, or :class:`DamagedRun`."""
+    run_dir = config_path.parent
+    config = flatten(with_defaults(read_json(config_path)))
+    missing = [key for key in ("env", "seed") if key not in config]
+    if missing:
+        raise DamagedRun(f"{CONFIG_NAME} has no {' or '.join(missing)}")
+    curve = read_curve(run_dir / EVAL_CSV)
+    summary_path = run_dir / SUMMARY_NAME
+    summary = read_json(summary_path) if summary_path.is_file() else None
+    if summary is not None:
+        final = summary.get("final_eval", {})
+        value = final.get("return_mean") if isinstance(final, dict) else None
+        if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            raise DamagedRun(f"{SUMMARY_NAME} has no finite final_eval.return_mean ({value})")
+        if not len(curve["env_step"]):
+            raise DamagedRun(f"{EVAL_CSV} holds no evaluation, but the run finished")
+    error_path = run_dir / ERROR_FILE
+    error = None
+    if error_path.is_file() and summary is None:
+        lines = error_path.read_text().strip().splitlines()
+        error = lines[-1] if lines else "failed"
+    written = run_dir / EVAL_CSV if (run_dir / EVAL_CSV).is_file() else config_path
+    return RunRecord(run_dir, config, curve, summary, error, written.stat().st_mtime)
+
+
+TASK_KEYS = {"env", "env_kwargs", "action_repeat"}
+"""Keys that go with the task: runs of one variant on two envs differ in them. Within an env
+they still tell variants apart."""
+
+
 def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
-    """The keys that name a variant: a sweep's grid keys; else the keys that differ within an
-    env, recipe and preset first, each kept only if it tells apart runs the kept ones do not
+    """The keys that name a variant: a sweep's grid keys; else the keys that differ between
+    runs (within an env, or across envs for any key but :data:`TASK_KEYS`: runs configured
+    differently on two tasks are two variants, never pooled as one across tasks), recipe and
+    preset first, each kept only if it tells apart runs the kept ones do not
     (``agent.recipe`` differing implies its encoder, losses... which then add nothing)."""
     sweep_file = root / SWEEP_FILE
     if sweep_file.is_file():
@@ -190,16 +250,25 @@ def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
     candidates.sort(key=lambda key: not key.endswith(("recipe", "preset")))
     keys: list[str] = []
     for key in candidates:
-        if key not in NOT_VARIANT and _splits(records, [*keys, key]) > _splits(records, keys):
+        if key in NOT_VARIANT:
+            continue
+        within_env = _splits(records, [*keys, key]) > _splits(records, keys)
+        across = key not in TASK_KEYS and (
+            _splits(records, [*keys, key], by_env=False) > _splits(records, keys, by_env=False)
+        )
+        if within_env or across:
             keys.append(key)
     return keys
 
 
-def _splits(records: list[RunRecord], keys: list[str]) -> int:
-    """How many groups ``keys`` (with the env) make of the runs."""
+def _splits(records: list[RunRecord], keys: list[str], by_env: bool = True) -> int:
+    """How many groups ``keys`` (with the env, when ``by_env``) make of the runs."""
     return len(
         {
-            json.dumps([record.env, *(record.config.get(key) for key in keys)], sort_keys=True)
+            json.dumps(
+                [record.env if by_env else "", *(record.config.get(key) for key in keys)],
+                sort_keys=True,
+            )
             for record in records
         }
     )
@@ -311,8 +380,10 @@ BUDGETS = {"env_step": "env steps", "wall_time_s": "seconds of wall time"}
 """What ``--at-step`` and ``--at-wall-time`` cut the runs at (an eval.csv column)."""
 
 BUDGET_RULE = (
-    "--at-step N counts a run only if it has an evaluation at exactly N env steps (so every "
-    "row compares evaluations at N, never at 20k beside 30k); --at-wall-time S counts a run "
+    "--at-step N counts a run only if it has an evaluation at N env steps, or within half its "
+    "eval_every of N (a run stopped mid-episode and resumed evaluates a few steps off its "
+    "grid; such runs are listed with the step used), so every row compares evaluations at N, "
+    "never at 20k beside 30k; --at-wall-time S counts a run "
     "only if it trained past S (an evaluation at or after S seconds) and uses its last "
     "evaluation at or before S. Runs that fall short are listed. Each row holds runs of one "
     "evaluation grid (eval_every): runs on another grid than most of their row are listed and "
@@ -332,7 +403,8 @@ def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None
     """
     if shortfall(record, column, budget) is not None:
         return None
-    keep = record.curve[column] <= budget
+    end = nearest_evaluation(record, budget) if column == "env_step" else budget
+    keep = record.curve[column] <= end
     curve = {key: values[keep] for key, values in record.curve.items()}
     summary = {
         "env_step": float(curve["env_step"][-1]),
@@ -342,13 +414,29 @@ def at_budget(record: RunRecord, column: str, budget: float) -> RunRecord | None
     return RunRecord(record.run_dir, record.config, curve, summary, None, record.modified)
 
 
+def nearest_evaluation(record: RunRecord, step: float) -> float | None:
+    """The env step of ``record``'s evaluation at ``step``, else, for a step on its grid (a
+    multiple of its ``eval_every``), of its nearest one within half an ``eval_every`` (a run
+    stopped mid-episode and resumed evaluates off its grid by less than an episode), else
+    None."""
+    x = record.curve["env_step"]
+    if not len(x):
+        return None
+    near = x[np.argmin(np.abs(x - step))]
+    every = record.config.get("eval_every")
+    on_grid = isinstance(every, (int, float)) and every > 0 and step % every == 0
+    if near == step or (on_grid and abs(near - step) <= every / 2):
+        return float(near)
+    return None
+
+
 def shortfall(record: RunRecord, column: str, budget: float) -> str | None:
     """Why ``record`` does not count at ``budget`` of ``column`` (None when it does)."""
     x = record.curve[column]
     if not len(x):
         return "no evaluation yet"
     if column == "env_step":
-        if np.any(x == budget):
+        if nearest_evaluation(record, budget) is not None:
             return None
         if x.max() < budget:
             return f"reached only {x.max():g} env steps"
@@ -406,6 +494,10 @@ class Comparison:
     """runs dropped for repeating a seed of their row, with the run kept instead"""
     off_grid: list[str] = field(default_factory=list)
     """runs left out for another evaluation grid than their row's"""
+    damaged: list[str] = field(default_factory=list)
+    """runs left out for a file that cannot be read, with the file and the problem"""
+    nearby: list[str] = field(default_factory=list)
+    """runs counted at an ``--at-step`` budget with their evaluation nearest to it"""
 
 
 def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Comparison:
@@ -413,24 +505,36 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
     keep one evaluation grid per row (:func:`one_evaluation_grid`) and one run per seed
     (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run."""
     root = Path(root)
-    records = find_runs(root)
+    if not root.is_dir():
+        raise SetupError(f"{root} is not a directory; pass a sweep directory or a run's parent")
+    damaged: list[str] = []
+    records = find_runs(root, damaged)
     if not records:
+        found = f"every run is damaged: {'; '.join(damaged)}" if damaged else "no config.json"
         raise SetupError(
-            f"no runs under {root} (no {CONFIG_NAME} found); pass a sweep directory or a "
-            "directory of simoun-train runs"
+            f"no runs under {root} ({found}); pass a sweep directory or a directory of "
+            "simoun-train runs"
         )
     reasons: dict[Path, str] = {}
+    comparison_nearby: list[str] = []
     if budget is not None:
         column, value = budget
         cut_records = []
         for record in records:
             cut = at_budget(record, column, value)
+            if cut is not None and cut.summary["env_step"] != value and column == "env_step":
+                comparison_nearby.append(
+                    f"{record.label(root)}: its evaluation at {cut.summary['env_step']:g} env "
+                    f"steps (eval_every {show(record.config.get('eval_every'))})"
+                )
             if cut is None and record.error is None:
                 reasons[record.run_dir] = shortfall(record, column, value) or ""
                 record.summary = None
             cut_records.append(cut or record)
         records = cut_records
     comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
+    comparison.damaged = damaged
+    comparison.nearby = comparison_nearby
     for group in comparison.groups:
         # the grid first, so that a copy of a seed on another grid cannot displace its peer
         group.runs, others = one_evaluation_grid(group.runs)
@@ -463,6 +567,19 @@ def variant_scores(groups: list[Group]) -> dict[str, dict[str, np.ndarray]]:
         if group.done:
             scores.setdefault(group.variant, {})[group.env] = group.scores()
     return scores
+
+
+def normalized_only(
+    scores: dict[str, dict[str, np.ndarray]], groups: list[Group]
+) -> dict[str, dict[str, np.ndarray]]:
+    """``scores`` of the tasks with a known maximum return only, when there are several tasks:
+    a raw return pooled with other tasks' scores (or another task's raw returns) weighs by its
+    task's scale, not by how well the variant did. One task pools nothing: all its scores."""
+    if len({group.env for group in groups}) == 1:
+        return scores
+    known = {group.env for group in groups if stats.max_return(group.env_id)}
+    kept = {v: {t: x for t, x in tasks.items() if t in known} for v, tasks in scores.items()}
+    return {variant: tasks for variant, tasks in kept.items() if tasks}
 
 
 def aggregate_rows(scores: dict[str, dict[str, np.ndarray]]) -> list[dict[str, Any]]:
@@ -592,6 +709,12 @@ def _ci(point: float, low: float, high: float) -> str:
     return f"{point:.3g} [{low:.3g}, {high:.3g}]"
 
 
+def raw_tasks(groups: list[Group]) -> list[str]:
+    """The envs whose returns stay raw (no known maximum)."""
+    envs = dict.fromkeys((group.env, group.env_id) for group in groups)
+    return [env for env, env_id in envs if not stats.max_return(env_id)]
+
+
 def normalization_note(groups: list[Group]) -> str:
     """Which envs' returns are divided by what (:data:`stats.NORMALIZERS`)."""
     parts = []
@@ -663,7 +786,13 @@ def markdown(
         "### Across tasks",
         "",
         "IQM over all runs of all the variant's tasks; mean: the mean over tasks of each task's "
-        "mean. The seeds are resampled within each task.",
+        "mean. The seeds are resampled within each task."
+        + (
+            f" Normalized scores only: {', '.join(raw)} (no known maximum) enter no statistic "
+            "across tasks."
+            if len({g.env for g in comparison.groups}) > 1 and (raw := raw_tasks(comparison.groups))
+            else ""
+        ),
         "",
         "| variant | tasks | runs | IQM [95 % CI] | mean [95 % CI] |",
         "|---|---|---:|---:|---:|",
@@ -684,6 +813,16 @@ def markdown(
     if comparison.unfinished:
         title = "Unfinished runs" if budget is None else "Runs short of the budget"
         lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in comparison.unfinished]
+    if comparison.nearby:
+        lines += [
+            "",
+            f"## Runs counted at the evaluation nearest to {budget[1]:g} env steps",
+            "",
+            "No evaluation at exactly the budget (a stop mid-episode and a resume move the "
+            "later evaluations off the grid by less than an episode); the nearest one within "
+            "half its eval_every counts.",
+            "",
+        ] + [f"- {n}" for n in comparison.nearby]
     if comparison.duplicates:
         lines += [
             "",
@@ -702,6 +841,14 @@ def markdown(
         ] + [f"- {o}" for o in comparison.off_grid]
     if comparison.failures:
         lines += ["", "## Failed runs", ""] + [f"- {f}" for f in comparison.failures]
+    if comparison.damaged:
+        lines += [
+            "",
+            "## Damaged runs (not counted)",
+            "",
+            "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
+            "",
+        ] + [f"- {d}" for d in comparison.damaged]
     return "\n".join(lines) + "\n"
 
 
@@ -769,7 +916,8 @@ def write_report(
     groups = comparison.groups
     rows = [group.row() for group in groups]
     scores = variant_scores(groups)
-    aggregates = aggregate_rows(scores)
+    normalized = normalized_only(scores, groups)
+    aggregates = aggregate_rows(normalized)
     improvements = improvement_rows(scores)
     text = markdown(comparison, rows, aggregates, improvements)
     atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
@@ -779,7 +927,7 @@ def write_report(
     atomic_write(out / AGGREGATE_CSV, lambda tmp: tmp.write_text(aggregate_csv))
     improvement_csv = _csv_text(improvements, IMPROVEMENT_COLUMNS)
     atomic_write(out / IMPROVEMENT_CSV, lambda tmp: tmp.write_text(improvement_csv))
-    score = "normalized score (final return / task maximum; raw where none is known)"
+    score = "normalized score (final return / task maximum)"
     plot_panels(
         std_bands(groups, "env_step", None),
         "environment steps",
@@ -799,7 +947,7 @@ def write_report(
         out / IQM_STEPS_PNG,
     )
     plot_panels(
-        {"all tasks": profile_bands(scores)},
+        {"all tasks": profile_bands(normalized)},
         f"tau, {score}",
         "fraction of runs with score > tau (95 % CI)",
         out / PROFILE_PNG,

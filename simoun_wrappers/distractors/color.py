@@ -14,6 +14,7 @@ from simoun_wrappers.distractors._dm_control import (
     dm_control_physics,
     episode_rng,
 )
+from simoun_wrappers.frames import check_single_env
 
 if TYPE_CHECKING:
     import mujoco
@@ -92,6 +93,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
             level: ``"easy"`` (colours near the defaults) or ``"hard"`` (far from them).
             seed: seed of the colour stream; None draws fresh entropy.
         """
+        check_single_env(env, "ColorShift")
         gym.utils.RecordConstructorArgs.__init__(self, level=level, seed=seed)
         gym.Wrapper.__init__(self, env)
         physics = dm_control_physics(env, "ColorShift")

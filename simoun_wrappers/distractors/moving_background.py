@@ -15,6 +15,7 @@ from simoun_wrappers.distractors._dm_control import (
     episode_rng,
 )
 from simoun_wrappers.distractors.backgrounds import ProceduralBackground, VideoBackground
+from simoun_wrappers.frames import check_single_env
 
 
 class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
@@ -69,6 +70,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 play; None for the procedural background.
             seed: seed of the background stream; None draws fresh entropy.
         """
+        check_single_env(env, "MovingBackground")
         gym.utils.RecordConstructorArgs.__init__(
             self, level=level, videos=None if videos is None else str(videos), seed=seed
         )

@@ -1,0 +1,182 @@
+"""Reference drivers for highway-env runs, played through the agent's own evaluation.
+
+A learned driver's return and driving measures mean little alone: highway-env pays at least 0.67
+a decision for staying on the road, so even a car that never touches the controls scores. These
+policies have the agent's ``act(frames, deterministic)`` signature, so
+:func:`~simoun_agent.run.evaluate.evaluate` plays them on the same episodes, through the same
+environment stack, with the same metric code (:mod:`simoun_agent.run.driving_metrics`):
+
+- ``random``: uniform actions in [-1, 1]^2 (:class:`~simoun_agent.run.evaluate.RandomPolicy`);
+- ``zero``: no acceleration, no steering: the car keeps its lane and its initial speed;
+- ``lane-keeping``: :class:`LaneKeeper`, a scripted controller that reads the simulator's state.
+
+    python -m simoun_agent.run.driving_reference --episodes 20 --seed 1000
+
+prints their table on the ``highway-cpu`` preset, one episode per seed from ``--seed`` on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import Protocol
+
+import gymnasium as gym
+import numpy as np
+
+from simoun_agent.config import TrainConfig, resolve
+from simoun_agent.run.evaluate import RandomPolicy, evaluate
+from simoun_agent.run.make_env import make_env
+
+
+class Policy(Protocol):
+    def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray: ...
+
+
+class ZeroPolicy:
+    """Action 0 (no acceleration, no steering): highway-env's car keeps its speed and heading."""
+
+    def __init__(self, action_dim: int) -> None:
+        self.action_dim = action_dim
+
+    def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:
+        return np.zeros(self.action_dim, dtype=np.float32)
+
+
+class LaneKeeper:
+    """A scripted driver on highway-env's state: PD steering on its lane's centre line and an
+    IDM-like speed and gap control behind the car ahead; it never changes lane.
+
+    It reads ``env.unwrapped`` (the ego vehicle, its lane, the car ahead in that lane), not the
+    frames, and returns ``[acceleration, steering]`` in [-1, 1] scaled to the env's
+    ``ContinuousAction`` ranges. The gains are for 5 decisions per second; the speed and gap
+    terms are the Intelligent Driver Model's (Treiber et al. 2000).
+
+    Example:
+        >>> import highway_env, gymnasium as gym
+        >>> env = gym.make("highway-fast-v0", config={"action": {"type": "ContinuousAction"}})
+        >>> _ = env.reset(seed=0)
+        >>> action = LaneKeeper(env).act(None)
+        >>> action.shape, bool(np.all(np.abs(action) <= 1))
+        ((2,), True)
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        target_speed: float = 30.0,
+        time_gap: float = 1.5,
+        min_gap: float = 10.0,
+        lateral_gain: float = 0.05,
+        heading_gain: float = 0.8,
+    ) -> None:
+        """Args:
+        env: the highway-env env (any wrapper of it) whose ego vehicle to drive.
+        target_speed: the free-road speed in m/s; 30 is the top of the reward's speed range.
+        time_gap: seconds of headway kept to the car ahead (IDM's T).
+        min_gap: metres kept to a stopped car ahead (IDM's s0), counted between centres.
+        lateral_gain: steering angle in rad per metre off the lane centre.
+        heading_gain: steering angle in rad per rad of heading error to the lane.
+        """
+        self.env = env
+        self.target_speed = target_speed
+        self.time_gap = time_gap
+        self.min_gap = min_gap
+        self.lateral_gain = lateral_gain
+        self.heading_gain = heading_gain
+
+    def act(self, frames: np.ndarray | None, deterministic: bool = False) -> np.ndarray:
+        base = self.env.unwrapped
+        vehicle = base.vehicle
+        lane = base.road.network.get_lane(vehicle.lane_index)
+        longitudinal, lateral = lane.local_coordinates(vehicle.position)
+        heading_error = (lane.heading_at(longitudinal) - vehicle.heading + math.pi) % (
+            2 * math.pi
+        ) - math.pi
+        steering = -self.lateral_gain * lateral + self.heading_gain * heading_error
+        acceleration = self._idm(base, vehicle)
+        low_a, high_a = base.action_type.acceleration_range
+        low_s, high_s = base.action_type.steering_range
+        action = [
+            2 * (acceleration - low_a) / (high_a - low_a) - 1,
+            2 * (steering - low_s) / (high_s - low_s) - 1,
+        ]
+        return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
+
+    def _idm(self, base, vehicle) -> float:
+        """IDM acceleration (m/s^2): free-road term, and the gap term when a car is ahead."""
+        max_accel, comfort_brake = 3.0, 5.0
+        speed = vehicle.speed
+        acceleration = max_accel * (1 - (max(speed, 0.0) / self.target_speed) ** 4)
+        ahead, _ = base.road.neighbour_vehicles(vehicle, vehicle.lane_index)
+        if ahead is not None:
+            gap = max(vehicle.lane_distance_to(ahead), 1e-3)
+            closing = speed - ahead.speed
+            braking = speed * closing / (2 * math.sqrt(max_accel * comfort_brake))
+            wanted = self.min_gap + max(0.0, speed * self.time_gap + braking)
+            acceleration -= max_accel * (wanted / gap) ** 2
+        return acceleration
+
+
+REFERENCES = ("random", "zero", "lane-keeping")
+
+
+def reference_policy(name: str, env: gym.Env, seed: int) -> Policy:
+    """The reference driver ``name`` (one of :data:`REFERENCES`) for ``env``."""
+    if name == "random":
+        return RandomPolicy(env.action_space.shape[0], seed)
+    if name == "zero":
+        return ZeroPolicy(env.action_space.shape[0])
+    if name == "lane-keeping":
+        return LaneKeeper(env)
+    raise ValueError(f"unknown reference driver {name!r}; choose one of {', '.join(REFERENCES)}")
+
+
+def reference_metrics(config: TrainConfig, episodes: int, seed: int) -> dict[str, dict]:
+    """Each reference driver's evaluation metrics on ``episodes`` episodes seeded from ``seed``."""
+    env = make_env(config)
+    try:
+        return {
+            name: evaluate(reference_policy(name, env, seed), env, episodes, seed)[0]
+            for name in REFERENCES
+        }
+    finally:
+        env.close()
+
+
+COLUMNS = (
+    ("return", "return_mean", "{:.1f}"),
+    ("± std", "return_std", "{:.1f}"),
+    ("crash rate", "crash_rate", "{:.2f}"),
+    ("distance (m)", "distance_m", "{:.0f}"),
+    ("mean speed (m/s)", "mean_speed", "{:.1f}"),
+    ("mean abs(steer)", "mean_abs_steer", "{:.3f}"),
+    ("length", "length_mean", "{:.0f}"),
+)
+"""The table's columns: header, metric key, format."""
+
+
+def markdown_table(metrics: dict[str, dict]) -> str:
+    """One row per driver, the columns of :data:`COLUMNS`."""
+    lines = [
+        "| driver | " + " | ".join(header for header, _, _ in COLUMNS) + " |",
+        "|---" * (len(COLUMNS) + 1) + "|",
+    ]
+    for name, row in metrics.items():
+        cells = [fmt.format(row[key]) for _, key, fmt in COLUMNS]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description="Reference drivers' metrics on highway-cpu.")
+    parser.add_argument("--episodes", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=1000, help="seed of the first episode")
+    parser.add_argument("--preset", default="highway-cpu")
+    args = parser.parse_args(argv)
+    config = resolve(args.preset, {"device": "cpu"})
+    print(markdown_table(reference_metrics(config, args.episodes, args.seed)))
+
+
+if __name__ == "__main__":
+    main()
