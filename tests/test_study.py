@@ -310,6 +310,9 @@ def test_plan_without_a_probe_lists_the_runs_only(tmp_path, capsys):
     assert "runs: 8 tuning + 4 evaluation = 12" in out and "estimated" not in out
 
 
+MAX = "max_concurrent_trials = 2\n"
+"""The spec's last line, after which a bad spec adds an optional table."""
+
 BAD_SPECS = [
     ('recipes = ["simoun", "sac"]', 'recipe = ["simoun", "sac"]',
      "unknown key 'recipe' (did you mean 'recipes'"),
@@ -361,6 +364,18 @@ BAD_SPECS = [
      "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
      "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["simoun_no_auxx"]',
+     "unknown recipe 'simoun_no_auxx' (did you mean 'simoun_no_aux'?)"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\ndrq = ["simoun_no_aux"]',
+     "'drq' is not one of the study's recipes (simoun, sac)"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["sac"]',
+     "'sac' is one of the study's recipes, tuned and compared on its own"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["colour_easy"]',
+     "unknown distraction 'colour_easy' in modes; did you mean 'color_easy'?"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["train"]',
+     "the train mode is always played"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["color_easy"]',
+     "the evaluation task simoun/PointReach-v0 is no dm_control task"),
 ]  # fmt: skip
 """(text of the good spec, its replacement, what the error says[, the text of the line it
 names]): by default the error names the line where the replacement ends."""
