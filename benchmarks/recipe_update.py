@@ -11,8 +11,9 @@ times the updates themselves, every recipe in the same process on the same repla
   updates that run every second step are averaged in), the recipes in a rotated order; medians
   over ``--repeats`` are reported, so a machine shared with other work slows all alike;
 - the table gives milliseconds per update, the ratio to DrQ (the named baseline) and the update
-  time of a whole run of the preset's budget (one update per agent step after the warm-up:
-  12,250 updates in 100k env steps at action repeat 8, 24,750 at 4);
+  time of a whole run of the preset's budget (after the warm-up, one update per
+  ``update_every_steps`` agent steps: 12,250 updates in 100k env steps at action repeat 8, 24,750
+  at 4, half that for drqv2, which updates every 2nd agent step);
 - ``--ablations`` adds the ``simoun_no_<part>`` recipes at Simoun's selected setting, so the table
   also says which part of Simoun (curiosity, the interactive module, the auxiliary losses) costs
   the time.
@@ -71,7 +72,8 @@ def filled(recipe: str, setting: dict, task: str, action_repeat: int, fill: int)
     )
     env, eval_env, agent, replay = build(config)
     learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
-    updates = (config.total_env_steps // action_repeat - learning_starts) * config.updates_per_step
+    updating = config.total_env_steps // action_repeat - learning_starts
+    updates = -(-updating // config.agent.update_every_steps) * config.updates_per_step
     try:
         rng = np.random.default_rng(0)
         low, high = env.action_space.low, env.action_space.high

@@ -24,7 +24,7 @@ from simoun_agent.losses import (
     total_loss,
     transition_loss,
 )
-from simoun_agent.models.actors import ACTORS, make_actor
+from simoun_agent.models.actors import ACTORS, make_actor, trunk_dim
 from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight_init
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Critic
@@ -82,7 +82,9 @@ class SimounAgent:
 
         self.encoder = make_encoder(config, self.frame_shape).to(self.device)
         repr_dim = self.encoder.repr_dim
-        self.critic = Critic(repr_dim, action_dim, config.hidden_dim).to(self.device)
+        self.critic = Critic(repr_dim, action_dim, config.hidden_dim, trunk_dim(config)).to(
+            self.device
+        )
         self.actor = make_actor(config, repr_dim, action_dim).to(self.device)
         self.motion_path = ENCODERS[config.encoder].motion_path
         # L_tran predicts f^m of a dual encoder, or the whole state of a single-path one (whose
@@ -98,7 +100,7 @@ class SimounAgent:
             else None
         )
         self.similarity = (
-            BilinearSimilarity(config.feature_dim).to(self.device)
+            BilinearSimilarity(config.feature_dim, config.similarity_init).to(self.device)
             if config.contrastive_weight
             else None
         )
@@ -118,12 +120,27 @@ class SimounAgent:
         """log of SAC's temperature; None for an actor without one"""
         self.target_entropy = -float(action_dim)
 
-        heads = (self.critic, self.reward_model, self.similarity, self.transition)
+        # L_con in its own step trains W there alone (CURL's cpc_optimizer)
+        similarity = None if config.contrastive_step else self.similarity
+        heads = (self.critic, self.reward_model, similarity, self.transition)
         representation = [self.encoder, *(net for net in heads if net is not None)]
         # fused Adam: one kernel per tensor, measured ~7x faster than foreach on our CPU
         self.critic_optimizer = torch.optim.Adam(
             [p for m in representation for p in m.parameters()], lr=config.lr, fused=True
         )
+        self.contrastive_optimizers = (
+            tuple(
+                torch.optim.Adam(params, lr=config.lr, fused=True)
+                for params in (
+                    list(self.encoder.parameters()),
+                    [*self.encoder.parameters(), *self.similarity.parameters()],
+                )
+            )
+            if config.contrastive_step and self.similarity is not None
+            else ()
+        )
+        """with ``contrastive_step``: CURL's encoder_optimizer (the encoder) and cpc_optimizer
+        (the encoder and W), both stepped by L_con's one gradient"""
         self.actor_optimizer = torch.optim.Adam(self.actor.parameters(), lr=config.lr, fused=True)
         self.alpha_optimizer = (
             torch.optim.Adam(
@@ -138,6 +155,11 @@ class SimounAgent:
         self.env_step = 0
         """global env step of the latest update; :meth:`act`'s default for the exploration
         schedule of an actor that has one"""
+        self.reads_encoder_target = config.next_state_encoder == "target" or bool(
+            config.contrastive_weight
+        )
+        """whether anything reads the EMA encoder (the TD target, the contrastive keys); when
+        nothing does, :meth:`update_targets` leaves it"""
 
     @property
     def alpha(self) -> torch.Tensor | None:
@@ -250,7 +272,8 @@ class SimounAgent:
         :meth:`encode`, :meth:`td_target` (averaged over ``target_augmentations`` views),
         :meth:`update_critic` (L_Q averaged over ``critic_augmentations`` views and the
         auxiliary losses), :meth:`update_actor` every ``actor_update_every`` and
-        :meth:`update_targets` every ``target_update_every`` gradient steps.
+        :meth:`update_targets` every ``target_update_every`` gradient steps, then, with
+        ``contrastive_step`` (CURL), :meth:`update_contrastive`.
         """
         cfg = self.config
         self.env_step = step
@@ -273,6 +296,8 @@ class SimounAgent:
             metrics.update(self.update_actor(enc.state[: len(action)].detach(), step))
         if self.num_updates % cfg.target_update_every == 0:
             self.update_targets()
+        if self.contrastive_optimizers:
+            metrics.update(self.update_contrastive(views))
         self.num_updates += 1
         return metrics
 
@@ -280,16 +305,26 @@ class SimounAgent:
         """The augmented inputs of one update, in this order of random draws: the
         max(critic_augmentations, target_augmentations) RL views, each the window and the
         bootstrap triplet under one random shift per sample (or unchanged with augmentation
-        "none"), then the contrastive key's view."""
+        "none"); with ``independent_next_shift``, the window alone, then the target views'
+        bootstrap triplets each under a shift of its own; then the contrastive key's view."""
         cfg = self.config
         k, length = cfg.num_frames, window.shape[1]
         count = max(cfg.critic_augmentations, cfg.target_augmentations)
-        frames = window if bootstrap_obs is None else torch.cat([window, bootstrap_obs], dim=1)
+        independent = cfg.augmentation == "shift" and cfg.independent_next_shift
+        frames = window
+        if bootstrap_obs is not None and not independent:
+            frames = torch.cat([window, bootstrap_obs], dim=1)
         if cfg.augmentation == "shift":
             views = [random_shift(frames, self.shift_pad) for _ in range(count)]
         else:
             views = [frames] * count
-        next_obs = [v[:, length:] if bootstrap_obs is not None else v[:, 1 : k + 1] for v in views]
+        if independent:
+            following = window[:, 1 : k + 1] if bootstrap_obs is None else bootstrap_obs
+            next_obs = [random_shift(following, self.shift_pad) for _ in range(count)]
+        else:
+            next_obs = [
+                v[:, length:] if bootstrap_obs is not None else v[:, 1 : k + 1] for v in views
+            ]
         windows = [v[:, :length] for v in views]
         key = None
         if self.similarity is not None:
@@ -301,7 +336,7 @@ class SimounAgent:
                 )
         shared = (
             0
-            if bootstrap_obs is not None
+            if bootstrap_obs is not None or independent
             else min(cfg.target_augmentations, cfg.critic_augmentations)
         )
         return Views(windows, next_obs[: cfg.target_augmentations], shared, key)
@@ -435,7 +470,7 @@ class SimounAgent:
             else None
         )
         l_con = None
-        if views.key is not None:
+        if views.key is not None and not self.contrastive_optimizers:
             with torch.no_grad():
                 key = self.encoder_target.encode_key(views.key)
             l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity)
@@ -467,6 +502,22 @@ class SimounAgent:
                 metrics[name] = term.detach()
         return metrics
 
+    def update_contrastive(self, views: Views) -> dict[str, torch.Tensor]:
+        """L_con (Eq. 3) in a step of its own, after the critic, actor and EMA updates (CURL's
+        update_cpc in curl_sac.py): the anchor encoded again by the updated online encoder from
+        the first view's triplet at t, the key by the updated EMA encoder; one gradient, then
+        CURL's two Adam steps (the encoder alone, then the encoder and W)."""
+        anchor = self.encoder(views.windows[0][:, : self.config.num_frames]).anchor
+        with torch.no_grad():
+            key = self.encoder_target.encode_key(views.key)
+        loss = contrastive_loss(anchor, key, self.similarity)
+        for optimizer in self.contrastive_optimizers:
+            optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        for optimizer in self.contrastive_optimizers:
+            optimizer.step()
+        return {"contrastive_loss": loss.detach()}
+
     def dynamics(self, enc: Encoding) -> torch.Tensor:
         """What L_tran predicts the next value of: f^m with a motion path, else the state."""
         return enc.motion if self.motion_path else enc.state
@@ -492,12 +543,14 @@ class SimounAgent:
         return {**metrics, **extra}
 
     def update_targets(self) -> None:
-        """EMA: target <- target + tau (online - target), encoder and Q heads at their own tau."""
+        """EMA: target <- target + tau (online - target), the encoder (when anything reads its
+        target) and the critic (Q heads and, with ``separate_trunks``, its trunk) at their own
+        tau."""
+        pairs = [(self.critic, self.critic_target, self.config.critic_tau)]
+        if self.reads_encoder_target:
+            pairs.append((self.encoder, self.encoder_target, self.config.encoder_tau))
         with torch.no_grad():
-            for online, target, tau in (
-                (self.encoder, self.encoder_target, self.config.encoder_tau),
-                (self.critic, self.critic_target, self.config.critic_tau),
-            ):
+            for online, target, tau in pairs:
                 torch._foreach_lerp_(list(target.parameters()), list(online.parameters()), tau)
 
     # -- checkpoints ---------------------------------------------------------------------------
@@ -533,6 +586,8 @@ class SimounAgent:
                 log_alpha=self.log_alpha.detach().clone(),
                 alpha_optimizer=self.alpha_optimizer.state_dict(),
             )
+        if self.contrastive_optimizers:
+            state["contrastive_optimizers"] = [o.state_dict() for o in self.contrastive_optimizers]
         return state
 
     def load_state_dict(self, state: dict) -> None:
@@ -545,6 +600,10 @@ class SimounAgent:
             self.alpha_optimizer.load_state_dict(state["alpha_optimizer"])
         self.critic_optimizer.load_state_dict(state["critic_optimizer"])
         self.actor_optimizer.load_state_dict(state["actor_optimizer"])
+        for optimizer, saved in zip(
+            self.contrastive_optimizers, state.get("contrastive_optimizers", ()), strict=True
+        ):
+            optimizer.load_state_dict(saved)
         self.running_max.load_state_dict(state["running_max"])
         self.num_updates = int(state["num_updates"])
         # saved since the deterministic actor; older checkpoints hold only Gaussian actors,

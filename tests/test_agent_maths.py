@@ -83,6 +83,7 @@ def test_critic_loss_is_eq9_with_the_eq10_target_on_terminal_and_non_terminal_ro
     r_i = intrinsic_by_hand(agent, obs, reward)
     with torch.no_grad():
         state, next_state = agent.encoder(obs).state, agent.encoder(next_obs).state
+        ema_next_state = agent.encoder_target(next_obs).state
         r_hat = np64(agent.reward_model(state, action))
     target_q, actor, online_q = Calls(agent.critic_target), Calls(agent.actor), Calls(agent.critic)
     metrics = agent.update_window(window, action, reward, 1 - TERMINATED, STEP)
@@ -91,8 +92,9 @@ def test_critic_loss_is_eq9_with_the_eq10_target_on_terminal_and_non_terminal_ro
     [((target_in, target_action), (q1_bar, q2_bar))] = target_q.with_grad(False)
     [((actor_in,), (next_action, next_log_prob))] = actor.with_grad(False)
     (state_in, action_in), (q1, q2) = online_q.with_grad(True)[0]
-    # the target reads o_{t+1} through the online encoder (no gradient) and a fresh a_{t+1} ~ pi
-    torch.testing.assert_close(target_in, next_state)
+    # the target Q heads read o_{t+1} through the EMA encoder, a fresh a_{t+1} ~ pi is drawn
+    # from the online encoder's state (no gradient)
+    torch.testing.assert_close(target_in, ema_next_state)
     torch.testing.assert_close(actor_in, next_state)
     torch.testing.assert_close(target_action.double(), next_action)
     torch.testing.assert_close(state_in, state)
@@ -122,7 +124,7 @@ def perturb(module: torch.nn.Module, seed: int) -> None:
     ("network", "changes"),
     [
         ("critic_target", {"critic_loss", "target_q"}),
-        ("encoder_target", {"contrastive_loss"}),
+        ("encoder_target", {"critic_loss", "target_q", "contrastive_loss"}),
         ("critic", {"critic_loss", "q"}),
         ("actor", {"critic_loss", "target_q"}),
         (
@@ -135,8 +137,9 @@ def perturb(module: torch.nn.Module, seed: int) -> None:
 )
 def test_each_term_reads_the_online_or_target_network_it_should(network, changes):
     """Perturb one network: exactly the terms that read it change. The TD target reads the
-    target Q heads (never the online ones) and the actor; the contrastive keys read the momentum
-    encoder, which nothing else does; L_re and L_tran read their own heads only."""
+    target Q heads (never the online ones) on the momentum encoder's next state, and the actor;
+    the contrastive keys read the momentum encoder too; L_re and L_tran read their own heads
+    only."""
     agent = agent_for_targets()
     window, action, reward, _ = random_window()
     batch = (window, action, reward, 1 - TERMINATED, STEP)

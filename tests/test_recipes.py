@@ -81,61 +81,43 @@ def test_single_path_encoders_train_l_tran_on_their_state():
     assert any(not torch.equal(b, p) for b, p in zip(before, after, strict=True))
 
 
-class Spy:
-    """Records the uint8 windows the encoder is given (and the contrastive key views)."""
-
-    def __init__(self, agent: SimounAgent) -> None:
-        self.windows, self.keys = [], []
-        encode, key = agent.encoder.encode_transition, agent.encoder_target.encode_key
-
-        def spy_transition(w: torch.Tensor, **kwargs):
-            self.windows.append(w)
-            return encode(w, **kwargs)
-
-        def spy_key(view: torch.Tensor) -> torch.Tensor:
-            self.keys.append(view)
-            return key(view)
-
-        agent.encoder.encode_transition = spy_transition
-        agent.encoder_target.encode_key = spy_key
-
-
-def test_sac_sees_unshifted_frames_and_rad_shifted_ones():
-    frames, *rest = window()
+def test_sac_sees_unshifted_frames_and_rad_shifted_ones_with_the_next_obs_shifted_apart():
+    frames, *_ = window()
     sac, rad = recipe_agent("sac"), recipe_agent("rad")
-    seen = {}
-    for name, agent in (("sac", sac), ("rad", rad)):
-        spy = Spy(agent)
-        agent.update_window(frames, *rest, step=0)
-        seen[name] = spy.windows[0]
-    assert torch.equal(seen["sac"], frames)
-    assert not torch.equal(seen["rad"], frames)
+    plain, shifted = sac.augment(frames, None), rad.augment(frames, None)
+    assert torch.equal(plain.windows[0], frames)
+    assert torch.equal(plain.next_obs[0], frames[:, 1:4]) and plain.shared == 1
+    assert not torch.equal(shifted.windows[0], frames)
     assert rad.shift_pad == shift_pad(FRAME[1]) == 1
-    # one view of the critic and one of the target, the online encoder for the next state
-    assert len(spy.windows) == 1 and spy.windows[0].shape == frames.shape
+    # RAD's curl_sac.py crops obs and next_obs by separate calls: the next triplet has its own
+    # offset, so the critic's encoder pass cannot give it (shared 0)
+    assert shifted.shared == 0 and shifted.next_obs[0].shape == frames[:, 1:4].shape
+    assert not torch.equal(shifted.next_obs[0], shifted.windows[0][:, 1:4])
+    assert torch.equal(random_shift(frames[:, 1:4], 0), frames[:, 1:4])
 
 
-def test_rad_is_what_drq_meant_before_it_followed_drq_s_k_m_averaging():
-    """The values the 'drq' recipe had until it followed DrQ as published."""
-    before = {"encoder": "stacked", "augmentation": "shift", "transition_weight": 0.0}
-    before.update(contrastive_weight=0.0, reward_weight=0.0, curiosity=False)
-    before.update(alpha_lr=1e-3, alpha_beta=0.9)
-    assert RECIPES["rad"].values == before
+def test_rad_is_rad_s_published_sac():
+    """RadSacAgent of RAD's curl_sac.py with train.py's values: the defaults' SAC (temperature
+    init 0.1, lr 1e-4, beta1 0.5; critic tau 0.01, EMA target encoder 0.05 read by the TD
+    target), delta-orthogonal conv init, obs and next_obs augmented independently."""
+    expected = {"encoder": "stacked", "augmentation": "shift", "transition_weight": 0.0}
+    expected.update(contrastive_weight=0.0, reward_weight=0.0, curiosity=False)
+    expected.update(conv_init="delta_orthogonal", independent_next_shift=True)
+    assert RECIPES["rad"].values == expected
     rad = resolve(None, {"agent.recipe": "rad"}).agent
-    defaults = AgentConfig()
     assert (rad.critic_augmentations, rad.target_augmentations) == (1, 1)
-    assert (rad.next_state_encoder, rad.actor, rad.n_step) == ("online", "gaussian", 1)
-    assert (rad.init_temperature, rad.critic_tau, rad.encoder_tau, rad.lr) == (
-        defaults.init_temperature, defaults.critic_tau, defaults.encoder_tau, defaults.lr,
-    )  # fmt: skip
+    assert (rad.next_state_encoder, rad.actor, rad.n_step) == ("target", "gaussian", 1)
+    assert (rad.init_temperature, rad.alpha_lr, rad.alpha_beta) == (0.1, 1e-4, 0.5)
+    assert (rad.critic_tau, rad.encoder_tau) == (0.01, 0.05)
 
 
 @pytest.mark.parametrize("name", ["drq", "drqv2", "rad", "curl", "sac"])
 def test_each_baseline_cites_its_paper_and_names_its_deviations(name):
     recipe = RECIPES[name]
-    assert re.search(r"\([A-Z][^()]* (et al\. |& [A-Z]\w+ )?(19|20)\d\d\)", recipe.description)
-    if name != "sac":
-        assert recipe.deviations and all(len(item) > 20 for item in recipe.deviations)
+    assert re.search(r"\([A-Z][^()]* (et al\. |& [A-Z]\w+ )?(19|20)\d\d[;)]", recipe.description)
+    assert recipe.deviations and all(len(item) > 20 for item in recipe.deviations)
+    # the published file and function it follows
+    assert re.search(r"\w+\.py", recipe.description) and "hidden" in " ".join(recipe.deviations)
     if name in ("rad", "curl"):  # the crop of 100x100 renders the papers use
         assert any("random crop of 100x100" in item for item in recipe.deviations)
 
@@ -148,15 +130,17 @@ def perturb(module: torch.nn.Module, seed: int) -> None:
 
 
 def drq_critic_loss_by_hand(agent, frames, action, reward, discount, seed, value_encoder):
-    """DrQ's critic loss written out: K = 2 shifted next states, each through ``value_encoder``
-    for the target Q heads and the online encoder for the actor, their targets averaged; M = 2
-    shifted current states, each against that target, the losses averaged."""
+    """DrQ's critic loss written out: K = 2 next states, each shifted by an offset of its own
+    (drq.py's next_obs and next_obs_aug), each through ``value_encoder`` for the target Q heads
+    and the online encoder for the actor, their targets averaged; M = 2 shifted current states,
+    each against that target, the losses averaged."""
     agent = copy.deepcopy(agent)
     torch.manual_seed(seed)
     views = [random_shift(frames, agent.shift_pad) for _ in range(2)]  # the update's draws
+    next_views = [random_shift(frames[:, 1:], agent.shift_pad) for _ in range(2)]
     gamma, alpha = agent.config.discount, float(agent.alpha.detach())
     with torch.no_grad():
-        next_obs = torch.cat([v[:, 1:] for v in views])
+        next_obs = torch.cat(next_views)
         next_action, log_prob = agent.actor(agent.encoder(next_obs).state)
         q1_bar, q2_bar = agent.critic_target(value_encoder(agent)(next_obs).state, next_action)
         value = (torch.min(q1_bar, q2_bar) - alpha * log_prob)[:, 0].view(2, -1)
@@ -223,8 +207,9 @@ def test_drqv2_noise_std_follows_the_linear_schedule_of_the_env_step():
     agent = recipe_agent("drqv2")
     config = agent.config
     assert (config.exploration_std_start, config.exploration_std_end) == (1.0, 0.1)
-    assert (config.exploration_steps, config.noise_clip) == (1_000_000, 0.3)
-    schedule = {0: 1.0, 250_000: 0.775, 500_000: 0.55, 1_000_000: 0.1, 3_000_000: 0.1}
+    # cartpole-swingup is one of DrQ-v2's easy tasks (cfgs/task/cartpole_swingup.yaml)
+    assert (config.exploration_steps, config.noise_clip) == (200_000, 0.3)
+    schedule = {0: 1.0, 50_000: 0.775, 100_000: 0.55, 200_000: 0.1, 3_000_000: 0.1}
     for step, std in schedule.items():
         assert agent.actor.std(step) == pytest.approx(std)
     with torch.no_grad():  # mu = 0, so the action is the clamped noise itself
@@ -232,12 +217,12 @@ def test_drqv2_noise_std_follows_the_linear_schedule_of_the_env_step():
         agent.actor.trunk[-1].bias.zero_()
     state = torch.zeros(20_000, agent.encoder.repr_dim)
     torch.manual_seed(0)
-    for step in (800_000, 1_000_000):  # stds 0.28 and 0.1: the clamp at +-1 hardly matters
+    for step in (160_000, 200_000):  # stds 0.28 and 0.1: the clamp at +-1 hardly matters
         noise = agent.actor.act(state, deterministic=False, step=step)
         assert float(noise.detach().std()) == pytest.approx(agent.actor.std(step), rel=0.02)
     # act() without a step uses the step of the latest update; the trainer passes its own
     frames, action, reward, discount = window()
-    agent.update_window(frames, action, reward, discount, step=1_000_000)
+    agent.update_window(frames, action, reward, discount, step=200_000)
     obs = frames[0, :3].numpy()
     samples = np.stack([agent.act(obs) for _ in range(400)])
     assert samples.std() == pytest.approx(0.1, rel=0.15)
@@ -246,9 +231,21 @@ def test_drqv2_noise_std_follows_the_linear_schedule_of_the_env_step():
 
 
 def test_drqv2_easy_is_drqv2_with_the_schedule_of_drqv2s_easy_tasks_alone():
-    drqv2 = to_dict(resolve("cpu", {"agent.recipe": "drqv2"}))["agent"]
-    easy = to_dict(resolve("cpu", {"agent.recipe": "drqv2_easy"}))["agent"]
-    assert {key for key in drqv2 if drqv2[key] != easy[key]} == {"recipe", "exploration_steps"}
+    """drqv2 takes each task's schedule from DrQ-v2's cfgs/task/*.yaml: the easy one (that of
+    drqv2_easy) on cartpole-swingup, the medium one on cheetah-run; drqv2_easy the easy one
+    everywhere."""
+    differ = {}
+    for task in ("cartpole-swingup", "cheetah-run"):
+        env = {"env": f"dm_control/{task}-v0"}
+        drqv2 = to_dict(resolve("cpu", {**env, "agent.recipe": "drqv2"}))["agent"]
+        easy = to_dict(resolve("cpu", {**env, "agent.recipe": "drqv2_easy"}))["agent"]
+        differ[task] = {key for key in drqv2 if drqv2[key] != easy[key]}
+        assert easy["exploration_steps"] == 200_000
+        assert drqv2["exploration_steps"] == {"cartpole-swingup": 200_000}.get(task, 1_000_000)
+    assert differ == {
+        "cartpole-swingup": {"recipe"},
+        "cheetah-run": {"recipe", "exploration_steps"},
+    }
     agent = recipe_agent("drqv2_easy")
     schedule = {0: 1.0, 100_000: 0.55, 200_000: 0.1, 1_000_000: 0.1}
     for step, std in schedule.items():
@@ -257,18 +254,20 @@ def test_drqv2_easy_is_drqv2_with_the_schedule_of_drqv2s_easy_tasks_alone():
 
 def test_drqv2_target_and_actor_loss_read_min_q_at_the_clipped_noisy_action():
     """TD target r + gamma d min(Qbar)(s', clamp(mu(s') + clip(std eps, +-0.3))) through the
-    online encoder, no entropy term; actor loss -min Q(s, clamp(mu(s) + clip(std eps)))."""
+    online encoder on o_{t+1} under a shift of its own, no entropy term (Qbar: the critic
+    target with its own EMA trunk); actor loss -min Q(s, clamp(mu(s) + clip(std eps)))."""
     agent = recipe_agent("drqv2")
     perturb(agent.encoder_target, seed=1)  # never read: DrQ-v2's target uses the online one
+    perturb(agent.critic_target.trunk, seed=2)  # the target's trunk is its own
     frames, action, reward, discount = window()
     discount[1] = 0.0
-    step, gamma = 300_000, agent.config.discount
+    step, gamma = 100_000, agent.config.discount
     std = agent.actor.std(step)
     by_hand = copy.deepcopy(agent)
     torch.manual_seed(5)
     with torch.no_grad():
         shifted = random_shift(frames, by_hand.shift_pad)
-        next_state = by_hand.encoder(shifted[:, 1:]).state
+        next_state = by_hand.encoder(random_shift(frames[:, 1:], by_hand.shift_pad)).state
         mu = by_hand.actor(next_state)
         noise = (std * torch.randn_like(mu)).clamp(-0.3, 0.3)
         q1_bar, q2_bar = by_hand.critic_target(next_state, (mu + noise).clamp(-1, 1))
@@ -295,9 +294,12 @@ def test_drqv2_target_and_actor_loss_read_min_q_at_the_clipped_noisy_action():
     )
 
 
-def test_drqv2_trains_the_actor_every_step_and_the_targets_every_second_on_3_step_returns():
+def test_drqv2_steps_critic_actor_and_targets_together_on_3_step_returns_every_2nd_decision():
+    """DrQV2Agent.update: one critic, one actor and one EMA step per gradient step, which the
+    training loop takes at every 2nd agent step (update_every_steps)."""
     agent = recipe_agent("drqv2")
     assert agent.config.n_step == 3 and agent.config.lr == 1e-4
+    assert agent.config.update_every_steps == 2
     rng = np.random.default_rng(0)
     replay = FrameReplay(100, FRAME, 2, seed=0)
     replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
@@ -320,7 +322,7 @@ def test_drqv2_trains_the_actor_every_step_and_the_targets_every_second_on_3_ste
                 )
             }
         )
-    assert moved == [{"actor", "critic_target"}, {"actor"}] * 2
+    assert moved == [{"actor", "critic_target"}] * 4
 
 
 def test_a_run_saved_as_the_old_drq_loads_with_this_version_s_defaults():
@@ -347,10 +349,9 @@ def test_a_run_saved_as_the_old_drq_loads_with_this_version_s_defaults():
 def test_curl_key_is_an_independent_shift_of_the_unshifted_stack():
     torch.manual_seed(0)
     agent = recipe_agent("curl", shift_pad=3)
-    spy = Spy(agent)
-    frames, *rest = window()
-    agent.update_window(frames, *rest, step=0)
-    anchor_input, key = spy.windows[0][:, :-1], spy.keys[0]
+    frames, *_ = window()
+    views = agent.augment(frames, None)
+    anchor_input, key = views.windows[0][:, :-1], views.key
     assert key.shape == (6, 3, *FRAME)  # the whole stack, as floats in [0, 1]
     assert not torch.equal(key, anchor_input.float() / 255)  # its own offsets
     # every sample's key is the stack itself under one of the (2 pad + 1)^2 shifts

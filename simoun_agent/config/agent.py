@@ -23,6 +23,8 @@ from simoun_agent.config.shapes import ENCODER_SHAPES
 AUGMENTATIONS = ("none", "shift")
 CONTRASTIVE_VIEWS = ("random_conv", "shift")
 NEXT_STATE_ENCODERS = ("online", "target")
+CONV_INITS = ("orthogonal", "delta_orthogonal")
+SIMILARITY_INITS = ("identity", "uniform")
 ACTOR_NAMES = ("gaussian", "deterministic")
 """The actors of :data:`simoun_agent.models.actors.ACTORS` (the same names: a test holds them
 equal)."""
@@ -53,13 +55,42 @@ class AgentConfig:
     """K of DrQ: augmented views of the next state whose TD targets are averaged; view k shares
     the offsets of critic view k (views beyond M get their own). More than 1 needs augmentation
     "shift" """
-    next_state_encoder: str = "online"
-    """encoder of the next state read by the target Q heads: "online" (no gradient; DrQ-v2,
-    CURL-style agents), or "target", the EMA encoder (DrQ, whose target critic holds its own
-    encoder, EMA rate encoder_tau). The next action is drawn from the online encoder's state"""
+    next_state_encoder: str = "target"
+    """encoder of the next state read by the target Q heads: "target", the EMA encoder (rate
+    encoder_tau), as the critic target of CURL, RAD and SAC-AE holds its own encoder
+    (update_critic in curl_sac.py / sac_ae.py: encoder tau 0.05, Q heads critic_tau 0.01) and DrQ's
+    (drq.py, tau 0.01 for both); or "online", the online encoder without gradient (DrQ-v2:
+    DrQV2Agent.update in drqv2.py). The next action is drawn from the online encoder's state.
+    Configs saved before this field defaulted to "target" hold "online" explicitly"""
+    independent_next_shift: bool = False
+    """augmentation "shift": True shifts the triplet the TD target bootstraps from by an offset of
+    its own (DrQ-v2, DrQ, RAD and CURL augment obs and next_obs by separate calls); False: it
+    moves with the offset of its view's window (frames t-2 .. t+1 alike), which lets the encoder
+    pass of the critic's views give the next state (the shared-frame trick)"""
+    separate_trunks: bool = False
+    """False: the encoder ends in FC + LayerNorm, whose state the critic reads and the actor reads
+    detached. True (DrQ-v2: Actor and Critic in drqv2.py): the encoder ends at its flattened convs
+    and the actor and the critic each put their own trunk Linear -> LayerNorm -> Tanh
+    (feature_dim) on them; the critic's trunk belongs to the critic and so to its EMA target
+    (critic_tau), the actor's is trained by the actor loss. Stacked-frame encoders without
+    auxiliary losses only"""
+    pixel_offset: float = 0.0
+    """subtracted from the pixels after x / 255 before the convs (DrQ-v2's Encoder: 0.5)"""
+    conv_init: str = "orthogonal"
+    """initialisation of the conv weights: "orthogonal" (relu gain; DrQ and DrQ-v2's
+    utils.weight_init) or "delta_orthogonal" (zero but an orthogonal centre tap, relu gain; the
+    weight_init of CURL's and RAD's curl_sac.py and SAC-AE's sac_ae.py)"""
     contrastive_view: str = "random_conv"
     """positive view of L_con: "random_conv" (Eq. 3, a random convolution of the same frames)
     or "shift" (CURL: an independently shifted view of the same input)"""
+    contrastive_step: bool = False
+    """False: L_con is added to the critic's loss and stepped with it (Eq. 14). True (CURL:
+    CurlSacAgent.update_cpc in curl_sac.py): L_con gets its own step after the critic, actor and
+    EMA updates, its anchor encoded again by the updated encoder, and, as in that code, the
+    encoder is stepped twice by it (CURL's encoder_optimizer, then cpc_optimizer with W)"""
+    similarity_init: str = "identity"
+    """initial W of L_con's bilinear score: "identity" (Eq. 3's inner product) or "uniform"
+    (CURL: torch.rand, uniform on [0, 1))"""
     feature_dim: int = 50
     """size of each path's feature vector (f_m and f_a); single-path encoders output this size"""
     num_filters: int = 32
@@ -89,6 +120,10 @@ class AgentConfig:
     """update the actor and temperature every this many gradient steps"""
     target_update_every: int = 2
     """update the EMA targets every this many gradient steps"""
+    update_every_steps: int = 1
+    """the agent's gradient step(s) come at every this-many-th agent step once learning has
+    started (DrQ-v2's update_every_steps 2: one critic, actor and target update every 2 agent
+    steps)"""
     actor: str = "gaussian"
     """the policy: "gaussian" (SAC, learned temperature) or "deterministic" (DrQ-v2: tanh(mu),
     scheduled exploration noise, no entropy term); the registry simoun_agent.models.actors.ACTORS"""
@@ -163,7 +198,13 @@ AGENT_RULES: dict[str, Rule] = {
     "critic_augmentations": _POSITIVE,
     "target_augmentations": _POSITIVE,
     "next_state_encoder": one_of(NEXT_STATE_ENCODERS),
+    "independent_next_shift": boolean(),
+    "separate_trunks": boolean(),
+    "pixel_offset": finite(),
+    "conv_init": one_of(CONV_INITS),
     "contrastive_view": one_of(CONTRASTIVE_VIEWS),
+    "contrastive_step": boolean(),
+    "similarity_init": one_of(SIMILARITY_INITS),
     "feature_dim": _POSITIVE,
     "num_filters": _POSITIVE,
     "hidden_dim": _POSITIVE,
@@ -178,6 +219,7 @@ AGENT_RULES: dict[str, Rule] = {
     "encoder_tau": _RATE,
     "actor_update_every": _POSITIVE,
     "target_update_every": _POSITIVE,
+    "update_every_steps": _POSITIVE,
     "actor": one_of(ACTOR_NAMES),
     "exploration_std_start": real(0.0),
     "exploration_std_end": real(0.0),
@@ -224,6 +266,8 @@ def check_agent_config(config: Any) -> None:
                 f"'none' (every view would be the same); set --agent.augmentation shift or "
                 f"--agent.{name.replace('_', '-')} 1",
             )
+    if config.separate_trunks:
+        check_separate_trunks(config)
     motion_path = ENCODER_SHAPES[config.encoder].motion_path
     if config.num_frames != 3 and motion_path:
         raise fail(
@@ -242,3 +286,28 @@ def check_agent_config(config: Any) -> None:
             f"{config.encoder!r} does not have; set --agent.curiosity false "
             "(AgentConfig(curiosity=False)) or use a dual encoder",
         )
+
+
+def check_separate_trunks(config: Any) -> None:
+    """Trunks on the flat conv maps need an encoder that ends at its convs, and no auxiliary
+    loss reading the state (it would read the 10^4-wide maps)."""
+    if not ENCODER_SHAPES[config.encoder].conv_state:
+        usable = [name for name, shape in ENCODER_SHAPES.items() if shape.conv_state]
+        raise fail(
+            AGENT,
+            "separate_trunks",
+            True,
+            f"the actor's and critic's own trunks need an encoder that ends at its convs, and "
+            f"{config.encoder!r} does not; use --agent.encoder {' or '.join(usable)}, or "
+            "--agent.separate-trunks false",
+        )
+    for name in ("transition_weight", "contrastive_weight", "reward_weight"):
+        if getattr(config, name):
+            raise fail(
+                AGENT,
+                name,
+                getattr(config, name),
+                "the auxiliary losses read the encoder's state, which with separate trunks is "
+                f"the flat conv maps; set --agent.{name.replace('_', '-')} 0 or "
+                "--agent.separate-trunks false",
+            )

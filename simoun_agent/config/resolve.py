@@ -2,11 +2,11 @@
 
 The dataclass defaults (the paper's DrQ-style setup), then a named preset
 (:mod:`simoun_agent.config.presets`), then a named agent recipe (``--agent.recipe drq``,
-:mod:`simoun_agent.config.recipes`), then the user's overrides (``--agent.batch-size 64`` or
-``--set agent.batch_size=64``). Every layer's keys pass :func:`~simoun_agent.config.keys.
-check_keys`, so a misspelled key is refused with its close match wherever it comes from. The
-resolved config is saved as ``config.json`` in the run directory and checked again when the run
-is resumed.
+:mod:`simoun_agent.config.recipes`, with its values for the run's DMC task), then the user's
+overrides (``--agent.batch-size 64`` or ``--set agent.batch_size=64``). Every layer's keys
+pass :func:`~simoun_agent.config.keys.check_keys`, so a misspelled key is refused with its
+close match wherever it comes from. The resolved config is saved as ``config.json`` in the run
+directory and checked again when the run is resumed.
 
 Example:
     >>> config = resolve("cpu", {"agent.recipe": "drq", "seed": 3})
@@ -24,7 +24,7 @@ import json
 import typing
 from typing import Any
 
-from simoun_agent.config.envs import split_env_id
+from simoun_agent.config.envs import dmc_task, split_env_id
 from simoun_agent.config.errors import SetupError
 from simoun_agent.config.keys import check_keys, config_fields, config_sections
 from simoun_agent.config.presets import PRESETS
@@ -56,7 +56,8 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
             )
     recipe = overrides.get("agent.recipe", values.get("agent.recipe"))
     if recipe is not None:
-        values.update(recipe_values(recipe))
+        env_id = split_env_id(overrides.get("env", values.get("env", TrainConfig.env)))[1]
+        values.update(recipe_values(recipe, dmc_task(env_id)))
     values.update(overrides)
     return from_flat(values)
 
@@ -76,9 +77,10 @@ def preset_values(name: str) -> dict[str, Any]:
     return {**values, "preset": name}
 
 
-def recipe_values(name: str) -> dict[str, Any]:
-    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name``;
-    SetupError for an unknown recipe or a recipe entry with an unknown key."""
+def recipe_values(name: str, task: str | None = None) -> dict[str, Any]:
+    """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name`` on the
+    DMC ``task`` (its ``per_task`` values there; None: any other env); SetupError for an unknown
+    recipe or a recipe entry with an unknown key."""
     if name not in RECIPES:
         hint = difflib.get_close_matches(name, RECIPES, n=1)
         raise SetupError(
@@ -86,7 +88,7 @@ def recipe_values(name: str) -> dict[str, Any]:
             + (f" (did you mean {hint[0]!r}?)" if hint else "")
             + f"; choose one of {', '.join(RECIPES)}"
         )
-    values = {"agent." + key: value for key, value in RECIPES[name].values.items()}
+    values = {"agent." + key: value for key, value in RECIPES[name].values_for(task).items()}
     check_keys(values, f"recipe {name!r}", "fix its entry in simoun_agent.config.recipes.RECIPES")
     return values
 
@@ -130,9 +132,16 @@ def to_dict(config: TrainConfig) -> dict[str, Any]:
     return json.loads(json.dumps(dataclasses.asdict(config)))
 
 
+SAVED_BEFORE = {"agent.next_state_encoder": "online"}
+"""What a saved config that lacks a key ran with, where that differs from today's default: the
+key was added with this value as its default, which the default has since left."""
+
+
 def from_dict(data: dict[str, Any]) -> TrainConfig:
-    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know."""
-    flat = flatten(data)
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know. A key
+    the config predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did),
+    else this version's default."""
+    flat = {**SAVED_BEFORE, **flatten(data)}
     check_keys(
         flat,
         "saved config",

@@ -59,12 +59,15 @@ class EncoderShape:
     interactive: bool = False
     """the structural interactive module reduces the trunk's maps with one conv of kernel
     ``reduce_kernel`` and stride ``reduce_stride`` (Eq. 4), which needs an output too"""
+    conv_state: bool = False
+    """one conv path on a stack of frames, whose flattened maps can be the state that the actor
+    and the critic put their own trunks on (``AgentConfig.separate_trunks``, DrQ-v2)"""
 
 
 ENCODER_SHAPES: dict[str, EncoderShape] = {
-    "single": EncoderShape(motion_path=False),
-    "stacked": EncoderShape(motion_path=False),
-    "stacked_wide": EncoderShape(motion_path=False),
+    "single": EncoderShape(motion_path=False, conv_state=True),
+    "stacked": EncoderShape(motion_path=False, conv_state=True),
+    "stacked_wide": EncoderShape(motion_path=False, conv_state=True),
     "flare": EncoderShape(motion_path=False),
     "dual": EncoderShape(motion_path=True),
     "dual_interactive": EncoderShape(motion_path=True, interactive=True),

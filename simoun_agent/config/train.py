@@ -59,7 +59,8 @@ class TrainConfig:
     warmup_agent_steps: int = 1000
     """agent decisions taken uniformly at random before learning starts"""
     updates_per_step: int = 1
-    """gradient updates per agent decision once learning has started"""
+    """gradient updates per agent decision once learning has started (at every
+    ``agent.update_every_steps``-th decision)"""
     replay_capacity: int = 100_000
     """transitions kept in the replay buffer"""
     eval_every: int = 10_000

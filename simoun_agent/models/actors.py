@@ -34,7 +34,7 @@ from torch import nn
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.losses import deterministic_actor_loss, deterministic_value
-from simoun_agent.models.networks import mlp
+from simoun_agent.models.networks import mlp, state_trunk
 from simoun_agent.models.sac import Actor, Critic
 
 
@@ -51,7 +51,8 @@ class DeterministicActor(nn.Module):
     It explores with Gaussian noise whose std follows :func:`exploration_std` of the global env
     step; the TD target and the policy loss read the critic at ``mu + clip(noise, +-noise_clip)``
     (target policy smoothing, Fujimoto et al. 2018), the action kept in [-1, 1] by a clamp whose
-    gradient is the identity (DrQ-v2's TruncatedNormal).
+    gradient is the identity (DrQ-v2's TruncatedNormal). ``trunk_dim``: its own trunk on the
+    state (DrQ-v2's Actor.trunk; :func:`~simoun_agent.models.networks.state_trunk`), or None.
     """
 
     def __init__(
@@ -63,15 +64,17 @@ class DeterministicActor(nn.Module):
         std_end: float,
         std_steps: int,
         noise_clip: float,
+        trunk_dim: int | None = None,
     ) -> None:
         super().__init__()
-        self.trunk = mlp(repr_dim, hidden_dim, action_dim)
+        self.state_trunk, in_dim = state_trunk(repr_dim, trunk_dim)
+        self.trunk = mlp(in_dim, hidden_dim, action_dim)
         self.schedule = (std_start, std_end, std_steps)
         self.noise_clip = noise_clip
 
     def forward(self, state: torch.Tensor) -> torch.Tensor:
         """The deterministic action mu(f_t) in [-1, 1]."""
-        return torch.tanh(self.trunk(state))
+        return torch.tanh(self.trunk(self.state_trunk(state)))
 
     def std(self, step: int) -> float:
         """The exploration noise std at global env step ``step``."""
@@ -109,6 +112,12 @@ class DeterministicActor(nn.Module):
         return loss, None, {"exploration_std": torch.tensor(self.std(step))}
 
 
+def trunk_dim(config: AgentConfig) -> int | None:
+    """The size of the actor's and the critic's own trunks, None without them
+    (``AgentConfig.separate_trunks``)."""
+    return config.feature_dim if config.separate_trunks else None
+
+
 @dataclass(frozen=True)
 class ActorEntry:
     """How to build one registered actor, and what the agent trains beside it."""
@@ -125,7 +134,7 @@ class ActorEntry:
 ACTORS: dict[str, ActorEntry] = {
     "gaussian": ActorEntry(
         lambda c, repr_dim, action_dim: Actor(
-            repr_dim, action_dim, c.hidden_dim, c.log_std_min, c.log_std_max
+            repr_dim, action_dim, c.hidden_dim, c.log_std_min, c.log_std_max, trunk_dim(c)
         ),
         temperature=True,
         description="SAC's tanh-squashed Gaussian policy with a learned temperature",
@@ -139,6 +148,7 @@ ACTORS: dict[str, ActorEntry] = {
             c.exploration_std_end,
             c.exploration_steps,
             c.noise_clip,
+            trunk_dim(c),
         ),
         temperature=False,
         description="DrQ-v2's deterministic policy with scheduled, clipped exploration noise",

@@ -1,7 +1,8 @@
 """Pixel encoders: the dual-path encoder (Sec. 3.2) and the ablation variants of Fig. 6.
 
 Every encoder maps a uint8 observation ``(B, k, C, H, W)`` (k frames, oldest first) to an
-:class:`Encoding`. Frames become float (x / 255) on the device inside the encoder, so the replay
+:class:`Encoding`. Frames become float (x / 255 - ``AgentConfig.pixel_offset``) on the device
+inside the encoder, so the replay
 and the environment only ever hold uint8. ``encode_transition`` encodes the states at t and t+1
 from one window of k+1 frames, sharing frames; ``encode_key`` encodes an augmented float view
 (the contrastive positive, run through the momentum copy of the encoder).
@@ -22,6 +23,7 @@ Ablations (Fig. 6), registered in :data:`ENCODERS` and built by :func:`make_enco
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -61,11 +63,22 @@ def conv_trunk(in_channels: int, num_filters: int) -> nn.Sequential:
     return nn.Sequential(*layers)
 
 
-class Head(nn.Module):
-    """FC + LayerNorm from a feature map ``(N, c, h, w)`` to a vector (Alg. 1, lines 11-12).
+def flatten_maps(maps: torch.Tensor) -> torch.Tensor:
+    """Feature maps ``(N, c, h, w)`` -> ``(N, h * w * c)``, in (h, w, c) order: a free view of a
+    channels-last map."""
+    return maps.permute(0, 2, 3, 1).flatten(1)
 
-    The map is flattened in (h, w, c) order, a free view of a channels-last map.
-    """
+
+class FlatMaps(nn.Module):
+    """The flattened conv maps as the state (DrQ-v2's Encoder, whose output the actor's and the
+    critic's own trunks read)."""
+
+    def forward(self, maps: torch.Tensor) -> torch.Tensor:
+        return flatten_maps(maps)
+
+
+class Head(nn.Module):
+    """FC + LayerNorm from a feature map ``(N, c, h, w)`` to a vector (Alg. 1, lines 11-12)."""
 
     def __init__(self, in_features: int, feature_dim: int) -> None:
         super().__init__()
@@ -74,7 +87,7 @@ class Head(nn.Module):
 
     def linear(self, maps: torch.Tensor) -> torch.Tensor:
         """The FC layer alone."""
-        return self.fc(maps.permute(0, 2, 3, 1).flatten(1))
+        return self.fc(flatten_maps(maps))
 
     def modulation(self, mask: torch.Tensor, size: tuple[int, int]) -> torch.Tensor:
         """FC weights (no bias) applied to ``mask`` resized bilinearly to ``size``."""
@@ -84,12 +97,24 @@ class Head(nn.Module):
         return self.norm(self.linear(maps))
 
 
-def weight_init(module: nn.Module) -> None:
-    """Orthogonal weights and zero biases for linear and conv layers (DrQ / SAC-AE practice)."""
-    if isinstance(module, (nn.Linear, nn.Conv2d)):
-        gain = nn.init.calculate_gain("relu") if isinstance(module, nn.Conv2d) else 1.0
-        nn.init.orthogonal_(module.weight, gain)
+def weight_init(module: nn.Module, conv: str = "orthogonal") -> None:
+    """Orthogonal weights and zero biases for linear layers; conv layers by ``conv``
+    (``AgentConfig.conv_init``): "orthogonal" with relu gain (DrQ, DrQ-v2), or "delta_orthogonal"
+    (Xiao et al. 2018: every tap zero but the centre one, an orthogonal matrix with relu gain; CURL,
+    RAD, SAC-AE)."""
+    if isinstance(module, nn.Linear):
+        nn.init.orthogonal_(module.weight)
         nn.init.zeros_(module.bias)
+    elif isinstance(module, nn.Conv2d):
+        gain = nn.init.calculate_gain("relu")
+        nn.init.zeros_(module.bias)
+        if conv == "orthogonal":
+            nn.init.orthogonal_(module.weight, gain)
+            return
+        kernel_h, kernel_w = module.weight.shape[-2:]
+        with torch.no_grad():
+            module.weight.zero_()
+            nn.init.orthogonal_(module.weight[:, :, kernel_h // 2, kernel_w // 2], gain)
 
 
 class PixelEncoder(nn.Module):
@@ -102,24 +127,26 @@ class PixelEncoder(nn.Module):
     repr_dim: int
     key_is_frame: bool
     """True: the contrastive view is frame t ``(B, C, H, W)``; False: the whole stack"""
+    pixel_offset: float = 0.0
+    """subtracted from x / 255 (``AgentConfig.pixel_offset``; set by :func:`make_encoder`)"""
 
     def __init__(self, channels_last: bool = True) -> None:
         super().__init__()
         self.memory_format = torch.channels_last if channels_last else torch.contiguous_format
 
-    @staticmethod
-    def to_float(obs: torch.Tensor) -> torch.Tensor:
-        """uint8 -> float in [0, 1]."""
-        return obs.float().div_(255.0)
+    def to_float(self, obs: torch.Tensor) -> torch.Tensor:
+        """uint8 -> float x / 255 - pixel_offset."""
+        x = obs.float().div_(255.0)
+        return x.sub_(self.pixel_offset) if self.pixel_offset else x
 
     def frame_stack(self, obs: torch.Tensor) -> torch.Tensor:
-        """uint8 ``(B, n, C, H, W)`` -> float ``(n, B, C, H, W)`` in [0, 1] whose frames ``[j]``
-        are already in the conv memory format (one uint8 transpose instead of a float copy per
-        frame)."""
+        """uint8 ``(B, n, C, H, W)`` -> float ``(n, B, C, H, W)`` (x / 255 - pixel_offset) whose
+        frames ``[j]`` are already in the conv memory format (one uint8 transpose instead of a
+        float copy per frame)."""
         if self.memory_format == torch.channels_last:
-            x = obs.permute(1, 0, 3, 4, 2).contiguous().float().div_(255.0)
+            x = self.to_float(obs.permute(1, 0, 3, 4, 2).contiguous())
             return x.permute(0, 1, 4, 2, 3)
-        return obs.transpose(0, 1).contiguous().float().div_(255.0)
+        return self.to_float(obs.transpose(0, 1).contiguous())
 
     def trunk_input(self, x: torch.Tensor) -> torch.Tensor:
         return x.contiguous(memory_format=self.memory_format)
@@ -149,7 +176,8 @@ class PixelEncoder(nn.Module):
 
 class StackedEncoder(PixelEncoder):
     """Ablations "stacked" / "stacked_wide": one conv path on the k frames folded into kC
-    channels (CURL / DrQ's encoder)."""
+    channels (CURL / DrQ's encoder). With ``head=False`` the state is the flattened conv maps
+    (DrQ-v2's Encoder), on which the actor and the critic put their own trunks."""
 
     key_is_frame = False
 
@@ -160,12 +188,14 @@ class StackedEncoder(PixelEncoder):
         num_filters: int,
         feature_dim: int,
         channels_last: bool = True,
+        head: bool = True,
     ) -> None:
         super().__init__(channels_last)
         c, h, w = frame_shape
         self.convs = conv_trunk(num_frames * c, num_filters)
-        self.head = Head(num_filters * conv_output_size(h) * conv_output_size(w), feature_dim)
-        self.repr_dim = feature_dim
+        flat = num_filters * conv_output_size(h) * conv_output_size(w)
+        self.head = Head(flat, feature_dim) if head else FlatMaps()
+        self.repr_dim = feature_dim if head else flat
 
     def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         stack = view if view.ndim == 4 else view.flatten(1, 2)
@@ -187,8 +217,9 @@ class SingleFrameEncoder(StackedEncoder):
         num_filters: int,
         feature_dim: int,
         channels_last: bool = True,
+        head: bool = True,
     ) -> None:
-        super().__init__(frame_shape, 1, num_filters, feature_dim, channels_last)
+        super().__init__(frame_shape, 1, num_filters, feature_dim, channels_last, head)
 
     def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         return super().forward(obs[:, -1:], frame_features)
@@ -407,20 +438,32 @@ def _dual(name: str) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncod
 
 ENCODERS: dict[str, EncoderEntry] = {
     "single": EncoderEntry(
-        lambda c, shape: SingleFrameEncoder(shape, c.num_filters, c.feature_dim, c.channels_last),
+        lambda c, shape: SingleFrameEncoder(
+            shape, c.num_filters, c.feature_dim, c.channels_last, not c.separate_trunks
+        ),
         shape=ENCODER_SHAPES["single"],
         description="one conv path on frame t only",
     ),
     "stacked": EncoderEntry(
         lambda c, shape: StackedEncoder(
-            shape, c.num_frames, c.num_filters, c.feature_dim, c.channels_last
+            shape,
+            c.num_frames,
+            c.num_filters,
+            c.feature_dim,
+            c.channels_last,
+            not c.separate_trunks,
         ),
         shape=ENCODER_SHAPES["stacked"],
         description="one conv path on the frames folded into channels (CURL, DrQ)",
     ),
     "stacked_wide": EncoderEntry(
         lambda c, shape: StackedEncoder(
-            shape, c.num_frames, 2 * c.num_filters, c.feature_dim, c.channels_last
+            shape,
+            c.num_frames,
+            2 * c.num_filters,
+            c.feature_dim,
+            c.channels_last,
+            not c.separate_trunks,
         ),
         shape=ENCODER_SHAPES["stacked_wide"],
         description="stacked with twice the filters (about the dual path's parameter count)",
@@ -449,7 +492,9 @@ one in :data:`simoun_agent.config.shapes.ENCODER_SHAPES` (its paths and convs)."
 
 def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:
     """Build the encoder named by ``config.encoder`` (the variants of Fig. 6) from
-    :data:`ENCODERS`, with orthogonal initialisation, in its conv memory format."""
+    :data:`ENCODERS`, initialised by ``config.conv_init``, reading x / 255 - ``pixel_offset``, in
+    its conv memory format."""
     encoder = ENCODERS[config.encoder].build(config, tuple(frame_shape))
-    encoder.apply(weight_init)
+    encoder.apply(functools.partial(weight_init, conv=config.conv_init))
+    encoder.pixel_offset = config.pixel_offset
     return encoder.to(memory_format=encoder.memory_format)

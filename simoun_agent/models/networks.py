@@ -15,6 +15,16 @@ def mlp(in_dim: int, hidden_dim: int, out_dim: int, hidden_layers: int = 2) -> n
     return nn.Sequential(*layers)
 
 
+def state_trunk(repr_dim: int, trunk_dim: int | None) -> tuple[nn.Module, int]:
+    """The trunk an actor or a critic puts on the encoder's state, and its output size: DrQ-v2's
+    Linear -> LayerNorm -> Tanh of ``trunk_dim`` units (the trunk of Actor and Critic in
+    drqv2.py), or, for ``None``, none (the identity on the ``repr_dim`` state)."""
+    if trunk_dim is None:
+        return nn.Identity(), repr_dim
+    layers = nn.Sequential(nn.Linear(repr_dim, trunk_dim), nn.LayerNorm(trunk_dim), nn.Tanh())
+    return layers, trunk_dim
+
+
 class TransitionModel(nn.Module):
     """G(f^m_t, a_t): two FC layers predicting the next motion feature f^m_{t+1} (Eq. 2)."""
 
@@ -38,12 +48,15 @@ class RewardModel(nn.Module):
 
 
 class BilinearSimilarity(nn.Module):
-    """Score q W k^T between anchors and keys; W starts as the identity, i.e. Eq. 3's plain inner
-    product, and is learned as in CURL."""
+    """Score q W k^T between anchors and keys, W learned as in CURL. W starts as the identity
+    (``init="identity"``: Eq. 3's plain inner product) or uniform on [0, 1) (``"uniform"``: CURL's
+    ``torch.rand`` in curl_sac.py's CURL module)."""
 
-    def __init__(self, feature_dim: int) -> None:
+    def __init__(self, feature_dim: int, init: str = "identity") -> None:
         super().__init__()
-        self.weight = nn.Parameter(torch.eye(feature_dim))
+        identity = init == "identity"
+        start = torch.eye(feature_dim) if identity else torch.rand(feature_dim, feature_dim)
+        self.weight = nn.Parameter(start)
 
     def forward(self, anchor: torch.Tensor, key: torch.Tensor) -> torch.Tensor:
         return anchor @ self.weight @ key.T

@@ -8,7 +8,7 @@ import torch
 from torch import nn
 
 from simoun_agent.losses import actor_loss, soft_value
-from simoun_agent.models.networks import mlp
+from simoun_agent.models.networks import mlp, state_trunk
 
 
 class Actor(nn.Module):
@@ -16,7 +16,8 @@ class Actor(nn.Module):
 
     The ``"gaussian"`` entry of :data:`simoun_agent.models.actors.ACTORS`: it explores by
     sampling, and its TD target and loss carry SAC's entropy term with the learned temperature
-    alpha. ``step`` (the exploration schedule of other actors) is unused.
+    alpha. ``step`` (the exploration schedule of other actors) is unused. ``trunk_dim``: its own
+    trunk on the state (:func:`~simoun_agent.models.networks.state_trunk`), or None.
     """
 
     def __init__(
@@ -26,9 +27,11 @@ class Actor(nn.Module):
         hidden_dim: int,
         log_std_min: float,
         log_std_max: float,
+        trunk_dim: int | None = None,
     ) -> None:
         super().__init__()
-        self.trunk = mlp(repr_dim, hidden_dim, 2 * action_dim)
+        self.state_trunk, in_dim = state_trunk(repr_dim, trunk_dim)
+        self.trunk = mlp(in_dim, hidden_dim, 2 * action_dim)
         self.log_std_min = log_std_min
         self.log_std_max = log_std_max
 
@@ -36,7 +39,7 @@ class Actor(nn.Module):
         self, state: torch.Tensor, deterministic: bool = False
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """Return a squashed action and its log-probability ``(B, 1)`` (of the sampled action)."""
-        mu, log_std = self.trunk(state).chunk(2, dim=-1)
+        mu, log_std = self.trunk(self.state_trunk(state)).chunk(2, dim=-1)
         log_std = torch.tanh(log_std)
         log_std = self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
         noise = torch.zeros_like(mu) if deterministic else torch.randn_like(mu)
@@ -73,15 +76,20 @@ class Actor(nn.Module):
 
 
 class Critic(nn.Module):
-    """Twin Q heads Q1, Q2 on ``[f_t, a_t]`` (clipped double-Q)."""
+    """Twin Q heads Q1, Q2 on ``[f_t, a_t]`` (clipped double-Q). ``trunk_dim``: the critic's own
+    trunk on the state, shared by both heads and part of the critic's EMA target (DrQ-v2's
+    Critic; :func:`~simoun_agent.models.networks.state_trunk`), or None."""
 
-    def __init__(self, repr_dim: int, action_dim: int, hidden_dim: int) -> None:
+    def __init__(
+        self, repr_dim: int, action_dim: int, hidden_dim: int, trunk_dim: int | None = None
+    ) -> None:
         super().__init__()
-        self.q1 = mlp(repr_dim + action_dim, hidden_dim, 1)
-        self.q2 = mlp(repr_dim + action_dim, hidden_dim, 1)
+        self.trunk, in_dim = state_trunk(repr_dim, trunk_dim)
+        self.q1 = mlp(in_dim + action_dim, hidden_dim, 1)
+        self.q2 = mlp(in_dim + action_dim, hidden_dim, 1)
 
     def forward(
         self, state: torch.Tensor, action: torch.Tensor
     ) -> tuple[torch.Tensor, torch.Tensor]:
-        x = torch.cat([state, action], dim=-1)
+        x = torch.cat([self.trunk(state), action], dim=-1)
         return self.q1(x), self.q2(x)

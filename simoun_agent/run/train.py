@@ -398,7 +398,8 @@ class Trainer:
             # the environment steps (in a background process with env_process) while the agent
             # updates on the transitions before this one; both runners give the same results
             env.step_async(action)
-            if counters.agent_step >= learning_starts:
+            due = counters.agent_step % config.agent.update_every_steps == 0
+            if counters.agent_step >= learning_starts and due:
                 for _ in range(config.updates_per_step):
                     # Actor metrics come every actor_update_every updates: keep the latest of each.
                     update_metrics.update(agent.update(replay, counters.env_step + repeat))

@@ -170,7 +170,8 @@ def run_cpu_seconds(config: TrainConfig, cost: Cost) -> float:
     episodes (and video episode), and set-up."""
     decisions = math.ceil(config.total_env_steps / config.resolved_action_repeat())
     learning_starts = max(config.warmup_agent_steps, config.agent.batch_size)
-    updates = max(0, decisions - learning_starts) * config.updates_per_step
+    updating = max(0, decisions - learning_starts)
+    updates = math.ceil(updating / config.agent.update_every_steps) * config.updates_per_step
     acting = max(0, decisions - config.warmup_agent_steps)
     episodes = evaluations(config) * config.eval_episodes + (1 if config.video else 0)
     played = episodes * cost.episode_decisions * (cost.eval_step_s + cost.act_s)
