@@ -21,13 +21,21 @@ times the updates themselves, every recipe in the same process on the same repla
     python benchmarks/recipe_update.py                                   # cheetah-run
     python benchmarks/recipe_update.py --task dm_control/cartpole-swingup-v0 --action-repeat 8
     python benchmarks/recipe_update.py --ablations
+    python benchmarks/recipe_update.py --selection runs/studies/NAME/selection.json \
+        --json runs/studies/NAME/update_cost.json     # the ratios a study's report draws with
+
+``--json`` also writes the ratios with where they were measured (the command, the commit, the
+machine), in the form ``simoun-study report`` reads
+(:data:`simoun_agent.study.report.UPDATE_COST_JSON`).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -36,7 +44,10 @@ import torch
 
 from simoun_agent.config import resolve
 from simoun_agent.config.recipes import SIMOUN_PARTS
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.train import build
+from simoun_agent.study.probe import machine
+from simoun_agent.study.provenance import code_version
 
 SELECTION = Path(__file__).resolve().parent.parent / "docs/studies/dmc100k/selection.json"
 BASELINE = "drq"
@@ -101,6 +112,7 @@ def main() -> None:
     parser.add_argument(
         "--ablations", action="store_true", help="also time each simoun_no_<part> recipe"
     )
+    parser.add_argument("--json", type=Path, help="also write the ratios here, for a study report")
     args = parser.parse_args()
     if args.updates < 2 or args.updates % 2:
         parser.error(f"--updates must be even and at least 2, got {args.updates}")
@@ -135,6 +147,21 @@ def main() -> None:
         ratio = medians[name] / medians[BASELINE]
         run_s = medians[name] * built[name][2] / 1000
         print(f"| {name} | {setting} | {medians[name]:.1f} | {ratio:.2f} | {run_s:.0f} |")
+    if args.json is not None:
+        code = code_version()
+        record = {
+            "baseline": BASELINE,
+            "ratio": {name: medians[name] / medians[BASELINE] for name in names},
+            "ms_per_update": medians,
+            "task": args.task,
+            "action_repeat": args.action_repeat,
+            "command": shlex.join(["python", "benchmarks/recipe_update.py", *sys.argv[1:]]),
+            "commit": f"{code['commit'] or code['version']}"
+            + (" with uncommitted changes" if code["dirty"] else ""),
+            "machine": machine(),
+        }
+        text = json.dumps(record, indent=2) + "\n"
+        atomic_write(args.json, lambda tmp: tmp.write_text(text))
 
 
 if __name__ == "__main__":

@@ -247,6 +247,37 @@ def probability_of_improvement_ci(
     return probability_of_improvement(x, y), float(low), float(high)
 
 
+def difference_ci(
+    x: Scores,
+    y: Scores,
+    statistic: Callable[[Scores], float] = aggregate_iqm,
+    reps: int = 2000,
+    confidence: float = 0.95,
+    seed: int = 0,
+) -> tuple[float, float, float]:
+    """(point, low, high): ``statistic(x) - statistic(y)`` and its percentile interval, the runs
+    of X and of Y resampled independently within each task, drawn as
+    :func:`probability_of_improvement_ci` draws them (rliable's
+    ``StratifiedIndependentBootstrap`` of the difference).
+
+    >>> difference_ci({"t": np.array([3.0, 3.0])}, {"t": np.array([1.0, 1.0])})
+    (2.0, 2.0, 2.0)
+    """
+    _same_tasks(x, y)
+    y = {task: y[task] for task in x}
+    rng = np.random.RandomState(seed)
+    counts = [[len(runs) for runs in x.values()], [len(runs) for runs in y.values()]]
+    draws_x, draws_y = _draw_indices(rng, counts, reps)
+    replicates = np.array(
+        [
+            statistic(_take(x, indices_x)) - statistic(_take(y, indices_y))
+            for indices_x, indices_y in zip(draws_x, draws_y, strict=True)
+        ]
+    )
+    low, high = percentile_interval(replicates, confidence)
+    return float(statistic(x) - statistic(y)), float(low), float(high)
+
+
 def performance_profile(scores: Scores, taus: np.ndarray) -> np.ndarray:
     """For each threshold tau, the fraction of all runs (of all tasks) whose normalized score
     exceeds it (rliable's run-score distribution).

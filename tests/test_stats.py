@@ -105,6 +105,22 @@ def test_probability_of_improvement_and_its_interval_equal_rliable():
     np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
 
 
+def test_difference_of_iqms_and_its_interval_equal_rliable():
+    rng = np.random.default_rng(4)
+    x, y = rng.uniform(size=(5, 2)), rng.uniform(size=(4, 2))
+    seed_rliable(7)
+    point, interval = rly.get_interval_estimates(
+        {"x,y": [x, y]},
+        lambda a, b: np.array([metrics.aggregate_iqm(a) - metrics.aggregate_iqm(b)]),
+        reps=300,
+    )
+    ours = stats.difference_ci(as_tasks(x), as_tasks(y), reps=300, seed=7)
+    theirs = (float(np.ravel(point["x,y"])[0]), *np.ravel(interval["x,y"]))
+    np.testing.assert_allclose(ours, theirs, rtol=0, atol=1e-12)
+    # by hand: IQM of 5 runs x 2 tasks cuts 2 of 10 at each end, of 4 x 2 cuts 2 of 8
+    assert ours[0] == pytest.approx(np.sort(x.ravel())[2:8].mean() - np.sort(y.ravel())[2:6].mean())
+
+
 def test_performance_profile_and_its_band_equal_rliable():
     matrix = np.random.default_rng(5).uniform(size=(6, 2))
     taus = np.linspace(0.0, 1.0, 21)

@@ -2,13 +2,16 @@
 2-value grid x 2 tuning + 2 evaluation seeds), its plan, resume from the archive, the commit
 check, and the bad specs it refuses before Ray starts, each naming its line."""
 
+import csv
 import json
 import math
 import re
 import shutil
 import sys
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
 
@@ -16,8 +19,8 @@ from simoun_agent.cli import study as cli
 from simoun_agent.config import RECIPES, SetupError
 from simoun_agent.study.plan import evaluation_runs, tuning_runs
 from simoun_agent.study.provenance import code_version
-from simoun_agent.study.report import RunResult, mean_cpu
-from simoun_agent.study.runner import StudyOptions, open_study
+from simoun_agent.study.report import RunResult, cost_curves, mean_cpu, read_result
+from simoun_agent.study.runner import StudyOptions, check_same_spec, open_study
 from simoun_agent.study.spec import load_spec
 from simoun_agent.study.toml_lines import key_line
 
@@ -307,6 +310,9 @@ def test_plan_without_a_probe_lists_the_runs_only(tmp_path, capsys):
     assert "runs: 8 tuning + 4 evaluation = 12" in out and "estimated" not in out
 
 
+MAX = "max_concurrent_trials = 2\n"
+"""The spec's last line, after which a bad spec adds an optional table."""
+
 BAD_SPECS = [
     ('recipes = ["simoun", "sac"]', 'recipe = ["simoun", "sac"]',
      "unknown key 'recipe' (did you mean 'recipes'"),
@@ -358,6 +364,18 @@ BAD_SPECS = [
      "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
      "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["simoun_no_auxx"]',
+     "unknown recipe 'simoun_no_auxx' (did you mean 'simoun_no_aux'?)"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\ndrq = ["simoun_no_aux"]',
+     "'drq' is not one of the study's recipes (simoun, sac)"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["sac"]',
+     "'sac' is one of the study's recipes, tuned and compared on its own"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["colour_easy"]',
+     "unknown distraction 'colour_easy' in modes; did you mean 'color_easy'?"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["train"]',
+     "the train mode is always played"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["color_easy"]',
+     "the evaluation task simoun/PointReach-v0 is no dm_control task"),
 ]  # fmt: skip
 """(text of the good spec, its replacement, what the error says[, the text of the line it
 names]): by default the error names the line where the replacement ends."""
@@ -480,3 +498,187 @@ def test_without_ray_a_study_plans_and_says_how_to_install_ray_to_run(
     assert exit_info.value.code == 2
     assert "pip install 'simoun[sweep]'" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
+
+
+DMC_SPEC = """\
+description = "a tiny study with diagnostics and generalization"
+recipes = ["simoun", "sac"]
+
+[base]
+env_kwargs = { task_kwargs = { time_limit = 1 } }
+image_size = 32
+warmup_agent_steps = 10
+replay_capacity = 1000
+eval_every = 1000
+eval_episodes = 1
+checkpoint_every = 1000
+video = false
+device = "cpu"
+agent.batch_size = 8
+agent.num_filters = 8
+agent.feature_dim = 16
+agent.hidden_dim = 32
+agent.aux_hidden_dim = 32
+
+[grid]
+agent.n_step = [1]
+
+[tuning]
+tasks = ["dm_control/cartpole-swingup-v0"]
+seeds = [101]
+env_steps = 60
+
+[evaluation]
+tasks = ["dm_control/cartpole-swingup-v0"]
+seeds = [1]
+env_steps = 60
+
+[diagnostics]
+simoun = ["simoun_no_aux"]
+
+[generalization]
+modes = ["color_easy", "video_hard"]
+episodes = 1
+
+[resources]
+max_concurrent_trials = 2
+"""
+"""A 1 s cartpole-swingup episode (13 decisions at its action repeat of 8, a reward above 0 at
+every step): one tuning and one evaluation seed, simoun's aux-loss ablation as a diagnostic and
+two distraction modes."""
+
+
+@pytest.fixture(scope="module")
+def dmc_study(ray_address, tmp_path_factory):
+    """The tiny DMC study, run once with an archive: (spec, study dir, archive)."""
+    root = tmp_path_factory.mktemp("dmc_study")
+    spec = write_spec(root / "dmc.toml", DMC_SPEC)
+    argv = ["run", str(spec), "--study-dir", str(root / "s"), "--archive", str(root / "a")]
+    assert cli.main([*argv, "--verbose", "0"]) == 0
+    return spec, root / "s", root / "a"
+
+
+def test_a_diagnostic_runs_at_its_methods_selected_setting_and_is_reported_apart(dmc_study):
+    _, study_dir, archive = dmc_study
+    ablation = study_dir / "evaluation/simoun_no_aux/cartpole-swingup/s1"
+    config = json.loads((ablation / "config.json").read_text())
+    assert config["agent"]["recipe"] == "simoun_no_aux" and config["agent"]["n_step"] == 1
+    assert (archive / "evaluation/simoun_no_aux/cartpole-swingup/s1/summary.json").is_file()
+    report = (study_dir / "report/report.md").read_text()
+    assert "## Diagnostics of simoun: what each part adds" in report
+    assert "P(simoun > ablation) [95 % CI]" in report
+    results = report[report.index("## Results") : report.index("## Diagnostics")]
+    assert "simoun_no_aux" not in results  # not among the compared recipes' tables
+    # one run each on one task: the interval of a difference collapses onto it
+    scores = {
+        name: json.loads((study_dir / f"evaluation/{name}/cartpole-swingup/s1/summary.json")
+                         .read_text())["final_eval"]["return_mean"] / 1000
+        for name in ("simoun", "simoun_no_aux")
+    }  # fmt: skip
+    difference = scores["simoun"] - scores["simoun_no_aux"]
+    p = 1.0 if difference > 0 else 0.0 if difference < 0 else 0.5
+    row = next(line for line in report.splitlines() if line.startswith("| simoun_no_aux |"))
+    cells = [cell.strip() for cell in row.split("|")[1:-1]]
+    no_aux = f"{scores['simoun_no_aux']:.3f}"
+    assert cells[2:] == [
+        "1",
+        f"{no_aux} [{no_aux}, {no_aux}]",
+        f"{difference:.3f} [{difference:.3f}, {difference:.3f}]",
+        f"{p:.3f} [{p:.3f}, {p:.3f}]",
+    ]
+
+
+def test_generalization_plays_each_final_agent_on_the_train_mode_and_each_distraction(dmc_study):
+    _, study_dir, archive = dmc_study
+    report = (study_dir / "report/report.md").read_text()
+    ratios = {}
+    for recipe in ("simoun", "sac", "simoun_no_aux"):
+        name = f"evaluation/{recipe}/cartpole-swingup/s1"
+        with (study_dir / name / "generalization.csv").open(newline="") as f:
+            rows = list(csv.DictReader(f))
+        assert [row["mode"] for row in rows] == ["train", "color_easy", "video_hard"]
+        summary = json.loads((study_dir / name / "summary.json").read_text())
+        assert {row["episodes"] for row in rows} == {"1"}
+        assert {row["env_step"] for row in rows} == {str(summary["env_step"])}  # the final agent
+        # the train mode is the run's own final evaluation: same agent, seeds and episodes
+        assert float(rows[0]["return_mean"]) == pytest.approx(summary["final_eval"]["return_mean"])
+        assert (archive / name / "generalization.csv").read_bytes() == (
+            study_dir / name / "generalization.csv"
+        ).read_bytes()
+        train = float(rows[0]["return_mean"])
+        assert train > 0
+        ratios[recipe] = [float(row["return_mean"]) / train for row in rows[1:]]
+    section = report[report.index("## Generalization under distraction") :]
+    for recipe, values in ratios.items():
+        row = next(line for line in section.splitlines() if line.startswith(f"| {recipe} | 1 |"))
+        # one run: each interval is the run's own ratio
+        assert row.endswith(" | ".join(f"{v:.3f} [{v:.3f}, {v:.3f}]" for v in values) + " |")
+    p = 1.0 if ratios["simoun"][1] > ratios["sac"][1] else 0.0  # P(simoun > sac), video_hard
+    if ratios["simoun"][1] == ratios["sac"][1]:
+        p = 0.5
+    against = section[section.index("P(simoun > Y) of that ratio") :]
+    row = next(line for line in against.splitlines() if line.startswith("| sac |"))
+    assert row.endswith(f"| {p:.3f} [{p:.3f}, {p:.3f}] |")
+    assert "No `update_cost.json` in the study directory" in report
+
+
+def test_update_cost_ratios_place_each_run_on_the_baselines_clock(dmc_study, tmp_path):
+    spec_path, _, archive = dmc_study
+    copy = tmp_path / "archive"
+    shutil.copytree(archive, copy)
+    costs = {
+        "baseline": "sac",
+        "ratio": {"sac": 1.0, "simoun": 1.5},
+        "ms_per_update": {"sac": 2.0, "simoun": 3.0},
+        "task": "dm_control/cartpole-swingup-v0",
+        "action_repeat": 4,
+        "command": "python benchmarks/recipe_update.py --json update_cost.json",
+        "commit": "0" * 40,
+        "machine": "a test machine",
+    }
+    (copy / "update_cost.json").write_text(json.dumps(costs))
+    assert cli.main(["report", str(spec_path), "--study-dir", str(copy)]) == 0
+    report = (copy / "report/report.md").read_text()
+    assert "`python benchmarks/recipe_update.py --json update_cost.json` at commit" in report
+    assert "| simoun | 3.0 | 1.50 |" in report and "| sac | 2.0 | 1.00 |" in report
+    assert "Not drawn (no ratio in the file): simoun_no_aux." in report
+    assert (copy / "report/iqm_wall_time_update_cost.png").stat().st_size > 1000
+    spec = load_spec(spec_path)
+    chosen = {"simoun": {"agent.n_step": 1}, "sac": {"agent.n_step": 1}}
+    results = [read_result(copy, run) for run in evaluation_runs(spec, chosen)]
+    placed, left_out = cost_curves(results, costs)
+    assert left_out == ["simoun_no_aux"]
+    by_recipe = {r.run.recipe: r.curve for r in placed}
+    np.testing.assert_allclose(by_recipe["sac"]["cost_time_s"], by_recipe["sac"]["wall_time_s"])
+    np.testing.assert_allclose(  # one sac run: its clock is its own wall time
+        by_recipe["simoun"]["cost_time_s"], 1.5 * by_recipe["sac"]["wall_time_s"]
+    )
+
+
+def test_the_dmc100k_v2_spec_reruns_the_protocol_on_five_seeds_per_task_with_diagnostics():
+    first = cli.spec_from("docs/studies/dmc100k.toml")
+    spec = cli.spec_from("docs/studies/dmc100k-v2.toml")
+    for key in ("recipes", "selection", "preset", "base", "grid", "grid_overrides", "tuning"):
+        assert getattr(spec, key) == getattr(first, key), key
+    assert spec.task_config == first.task_config
+    assert spec.evaluation.seeds == {task: [1, 2, 3, 4, 5] for task in spec.evaluation.tasks}
+    assert spec.evaluation.tasks == ["dm_control/cartpole-swingup-v0", "dm_control/cheetah-run-v0"]
+    assert spec.diagnostics == {
+        "simoun": ["simoun_no_curiosity", "simoun_no_interaction", "simoun_no_aux"]
+    }
+    assert spec.generalization == ["color_easy", "color_hard", "video_easy", "video_hard"]
+    assert spec.generalization_episodes == 10
+    runs = evaluation_runs(spec, {recipe: {"agent.n_step": 3} for recipe in spec.recipes})
+    assert len(tuning_runs(spec)) == 20 and len(runs) == (5 + 3) * 2 * 5
+    ablations = [run for run in runs if run.of is not None]
+    assert {run.of for run in ablations} == {"simoun"} and len(ablations) == 30
+    assert all(run.setting == {"agent.n_step": 3} for run in ablations)
+
+
+def test_a_study_record_saved_before_diagnostics_existed_reads_as_its_spec():
+    record = json.loads(Path("docs/studies/dmc100k/study.json").read_text())
+    assert "diagnostics" not in record["spec"]
+    spec = cli.spec_from("docs/studies/dmc100k.toml")
+    check_same_spec(record, spec, "not the same", "fix it")  # raises when they differ
+    with pytest.raises(SetupError, match="diagnostics differ"):
+        check_same_spec(record, replace(spec, diagnostics={"simoun": ["simoun_no_aux"]}), "", "")

@@ -11,11 +11,13 @@ Modules, each with one job: :mod:`~simoun_agent.study.spec` (read and check the 
 (the runs of each phase), :mod:`~simoun_agent.study.probe` (the CPU-time estimate),
 :mod:`~simoun_agent.study.selection` (the rules) and :mod:`~simoun_agent.study.choice` (the
 chosen settings), :mod:`~simoun_agent.study.archive` (what survives the study),
-:mod:`~simoun_agent.study.provenance` (the commit it ran), :mod:`~simoun_agent.study.report`
-and :mod:`~simoun_agent.study.runner` (the command: :mod:`simoun_agent.cli.study`).
+:mod:`~simoun_agent.study.provenance` (the commit it ran), :mod:`~simoun_agent.study.generalization`
+(each evaluation run's final agent under distraction), :mod:`~simoun_agent.study.report` and
+:mod:`~simoun_agent.study.runner` (the command: :mod:`simoun_agent.cli.study`).
 
 A study directory holds ``study.json`` (the spec and the commits it ran from),
 ``tuning/<recipe>/<setting>/<task>/s<seed>`` and ``evaluation/<recipe>/<task>/s<seed>`` (run
-directories as ``simoun-train`` writes them), ``selection.json``, ``tune/`` (Ray Tune's
-records) and ``report/``.
+directories as ``simoun-train`` writes them; diagnostic recipes' runs among the evaluation's),
+``selection.json``, ``tune/`` (Ray Tune's records), ``report/`` and, once measured,
+``update_cost.json``.
 """

@@ -35,11 +35,13 @@ fixed spec may change them for finished runs."""
 
 
 def configs(spec: StudySpec) -> list[tuple[str, str, dict[str, Any], TrainConfig]]:
-    """(phase, recipe, setting, config) of each recipe x task x setting of both phases."""
+    """(phase, recipe, setting, config) of each recipe x task x setting of both phases (the
+    diagnostic recipes with every setting their method may select)."""
     found = []
     for phase in (spec.tuning, spec.evaluation):
+        recipes = spec.recipes + (list(spec.ablations()) if phase is spec.evaluation else [])
         for task in phase.tasks:
-            for recipe in spec.recipes:
+            for recipe in recipes:
                 for setting in spec.settings():
                     seed, steps = phase.seeds[task][0], phase.env_steps[task]
                     overrides = spec.overrides(recipe, task, setting, seed, steps)
@@ -141,7 +143,7 @@ def check_fixed_spec(
     now be trained otherwise, or an evaluation run whose recipe would be selected from other
     tuning runs or by another rule."""
     saved = StudySpec.from_json(record["spec"])
-    old, new = record["spec"], spec.to_json()
+    old, new = saved.to_json(), spec.to_json()  # a key added since the record: its default
     changed = [key for key in {**old, **new} if old.get(key) != new.get(key)]
     if not changed:
         return []
@@ -156,14 +158,16 @@ def check_fixed_spec(
         if config is None:
             continue
         if run.phase != TUNING:
-            evaluated.add(run.recipe)
+            evaluated.add(run.of or run.recipe)  # a diagnostic ran at its method's selection
             # the setting it ran with: the one its tuning selected
             agent = config.get("agent", {})
             setting = {
                 key: agent[key[6:]] if key.startswith("agent.") else config[key]
                 for key in spec.grid
             }
-            run = StudyRun(run.phase, run.recipe, run.task, run.seed, run.env_steps, setting)
+            run = StudyRun(
+                run.phase, run.recipe, run.task, run.seed, run.env_steps, setting, run.of
+            )
         wanted = to_dict(resolve(spec.preset, run.trial(spec, Path(".")).overrides))
         differences = changes(config, wanted)
         if differences:

@@ -3,9 +3,11 @@
 Tuning: every recipe x grid setting x tuning task x tuning seed, at
 ``<study>/tuning/<recipe>/<setting>/<task>/s<seed>``. Evaluation: every recipe with the setting
 its tuning selected x evaluation task x held-out seed, at
-``<study>/evaluation/<recipe>/<task>/s<seed>``. A run's path under the study directory is its
-name, in Ray Tune's tables and in the archive. :func:`describe` is ``simoun-study plan``'s
-listing of them, with the CPU time each should take (:mod:`simoun_agent.study.probe`).
+``<study>/evaluation/<recipe>/<task>/s<seed>``; the spec's diagnostic recipes (ablations of one
+method) run there too, each at its method's selected setting. A run's path under the study
+directory is its name, in Ray Tune's tables and in the archive. :func:`describe` is
+``simoun-study plan``'s listing of them, with the CPU time each should take
+(:mod:`simoun_agent.study.probe`).
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ class StudyRun:
     """the run's budget (total_env_steps)"""
     setting: dict | None
     """grid values; None for an evaluation run before its recipe's setting is selected"""
+    of: str | None = None
+    """for a diagnostic run: the method whose selected setting it runs at"""
 
     @property
     def variant(self) -> str:
@@ -86,9 +90,11 @@ def tuning_runs(spec: StudySpec) -> list[StudyRun]:
 
 
 def evaluation_runs(spec: StudySpec, selected: dict[str, dict] | None = None) -> list[StudyRun]:
-    """Evaluation runs, by task, recipe and seed, with each recipe's ``selected`` setting (None
-    before the tuning phase has chosen)."""
+    """Evaluation runs, by task, recipe (the compared ones, then the diagnostic ones) and seed,
+    with each recipe's ``selected`` setting, a diagnostic recipe with its method's (None before
+    the tuning phase has chosen)."""
     phase = spec.evaluation
+    of = {recipe: None for recipe in spec.recipes} | spec.ablations()
     return [
         StudyRun(
             EVALUATION,
@@ -96,10 +102,11 @@ def evaluation_runs(spec: StudySpec, selected: dict[str, dict] | None = None) ->
             task,
             seed,
             phase.env_steps[task],
-            None if selected is None else selected[recipe],
+            None if selected is None else selected[method or recipe],
+            method,
         )
         for task in phase.tasks
-        for recipe in spec.recipes
+        for recipe, method in of.items()
         for seed in phase.seeds[task]
     ]
 
@@ -130,8 +137,8 @@ def cost_identity(run: StudyRun, setting: dict[str, Any]) -> tuple:
 
 def estimate_runs(spec: StudySpec, runs: list[StudyRun], updates: int) -> dict[str, float]:
     """Each run's estimated CPU seconds, by run name, from a probe measured now with
-    ``updates`` timed updates per configuration; an evaluation run before the selection gets
-    its recipe's slowest grid setting."""
+    ``updates`` timed updates per configuration, an evaluation run's generalization episodes
+    included; an evaluation run before the selection gets its recipe's slowest grid setting."""
     configs = {}
     for run in runs:
         for setting in settings_of(spec, run):
@@ -144,10 +151,32 @@ def estimate_runs(spec: StudySpec, runs: list[StudyRun], updates: int) -> dict[s
         key: probe.run_cpu_seconds(config, costs[probe.cost_key(config)])
         for key, config in configs.items()
     }
+    episodes = generalization_episodes(spec)
+    played = {
+        key: episodes * probe.episode_cpu_seconds(costs[probe.cost_key(config)])
+        for key, config in configs.items()
+    }
     return {
-        run.name: max(seconds[cost_identity(run, setting)] for setting in settings_of(spec, run))
+        run.name: max(
+            seconds[cost_identity(run, setting)]
+            + (played[cost_identity(run, setting)] if run.phase == EVALUATION else 0.0)
+            for setting in settings_of(spec, run)
+        )
         for run in runs
     }
+
+
+def generalization_episodes(spec: StudySpec) -> int:
+    """Episodes each evaluation run's final agent plays after training: every distraction mode
+    and the train mode, ``generalization_episodes`` each (0 when the spec asks for none)."""
+    if not spec.generalization:
+        return 0
+    return (len(spec.generalization) + 1) * spec.generalization_episodes
+
+
+def selected_by(run: StudyRun) -> str:
+    """The setting column of a run whose setting the tuning phase has not selected yet."""
+    return "(selected)" if run.of is None else f"({run.of}'s)"
 
 
 def duration(seconds: float) -> str:
@@ -169,7 +198,7 @@ def describe(spec: StudySpec, spec_path: str, updates: int) -> str:
             run.phase,
             env_label(run.task),
             run.recipe,
-            setting_label(run.setting) if run.setting is not None else "(selected)",
+            setting_label(run.setting) if run.setting is not None else selected_by(run),
             str(run.seed),
             str(run.env_steps),
             duration(estimates[run.name]) if estimates else "",
@@ -190,7 +219,18 @@ def describe(spec: StudySpec, spec_path: str, updates: int) -> str:
             for i, (cell, width) in enumerate(zip(row, widths, strict=True))
         ]
         lines.append("  ".join(cells).rstrip())
-    lines += ["", f"runs: {len(tuning)} tuning + {len(evaluation)} evaluation = {len(runs)}"]
+    diagnostic = sum(run.of is not None for run in evaluation)
+    lines += [
+        "",
+        f"runs: {len(tuning)} tuning + {len(evaluation)} evaluation = {len(runs)}"
+        + (f" ({diagnostic} of the evaluation runs are diagnostics)" if diagnostic else ""),
+    ]
+    if spec.generalization:
+        lines.append(
+            "after training, each evaluation run's final agent plays "
+            f"{spec.generalization_episodes} episodes of each of train, "
+            f"{', '.join(spec.generalization)} ({generalization_episodes(spec)} episodes a run)"
+        )
     if not estimates:
         return "\n".join(lines)
     tuning_s = sum(estimates[run.name] for run in tuning)
@@ -207,6 +247,7 @@ def describe(spec: StudySpec, spec_path: str, updates: int) -> str:
         f"budget), {probe.ACTIONS} actions and {updates} agent updates (after "
         f"{probe.WARMUP_UPDATES} untimed); for each environment, 2 x batch + 20 random env "
         "decisions and one evaluation episode. Evaluation runs are counted with their recipe's "
-        "slowest grid setting; checkpoints and logging are not counted.",
+        "slowest grid setting (a diagnostic run with its method's), generalization episodes as "
+        "evaluation episodes of the undistracted env; checkpoints and logging are not counted.",
     ]
     return "\n".join(lines)

@@ -184,6 +184,12 @@ def run_cpu_seconds(config: TrainConfig, cost: Cost) -> float:
     )
 
 
+def episode_cpu_seconds(cost: Cost) -> float:
+    """One evaluation episode's CPU seconds: its decisions' env steps and actions (as
+    :func:`run_cpu_seconds` counts an evaluation's)."""
+    return cost.episode_decisions * (cost.eval_step_s + cost.act_s)
+
+
 def machine() -> str:
     """Where the probe ran: host, CPUs and the 1-minute load average."""
     load = os.getloadavg()[0]

@@ -12,7 +12,14 @@ Written into ``<study>/report/`` (and the archive's ``report/``):
   recipe improves on each other one (read from ``evaluation/``), the IQM curves over all tasks
   against env steps and wall time (``iqm_curves.png``), and the wall and CPU time of the runs;
 - ``scores.csv``: one row per finished run of both phases (final return, score, wall and CPU
-  time, machine load at its start).
+  time, machine load at its start);
+- with ``[diagnostics]`` in the spec: each ablation's IQM, its difference to its method and
+  P(method > ablation), with CIs (the ablations stay out of the compared recipes' tables);
+- with ``[generalization]``: per recipe, the return under each distraction mode over the train
+  mode's return, IQM over runs with CIs, and P(first recipe > Y) of that ratio;
+- with ``update_cost.json`` in the study directory (``benchmarks/recipe_update.py --json``, each
+  recipe's update time over the baseline's, measured side by side): the IQM curves against wall
+  time on the baseline's clock stretched by each recipe's ratio (``iqm_wall_time_update_cost.png``).
 
 Scores follow Agarwal et al. 2021 (:mod:`simoun_agent.stats`): the last evaluation's mean
 return divided by the task's maximum (1000 for dm_control; raw returns for tasks without a
@@ -39,7 +46,8 @@ from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.study.choice import Choice
+from simoun_agent.study.choice import SELECTION_FILE, Choice
+from simoun_agent.study.generalization import read_modes
 from simoun_agent.study.plan import (
     EVALUATION,
     TUNING,
@@ -61,6 +69,14 @@ CURVES_PNG = "iqm_curves.png"
 CURVE_POINTS = 50
 """Points of the common wall-time grid the IQM curve is drawn on."""
 
+UPDATE_COST_JSON = "update_cost.json"
+"""Per-recipe update-cost ratios measured side by side, in the study directory:
+``benchmarks/recipe_update.py --json`` writes ``baseline`` (the recipe the ratios divide by),
+``ratio`` (recipe -> its update time over the baseline's), ``ms_per_update``, ``task``,
+``action_repeat``, ``command``, ``commit`` and ``machine``."""
+
+COST_CURVES_PNG = "iqm_wall_time_update_cost.png"
+
 
 @dataclass
 class RunResult:
@@ -78,6 +94,9 @@ class RunResult:
     """CPU seconds over the trial's parts (trial.json; NaN without it)"""
     load: float
     """1-minute load average per CPU at the trial's first start (NaN without it)"""
+    modes: dict | None = None
+    """mode -> mean return of the final agent (``generalization.csv``, ``train`` included);
+    None when it was not played"""
 
 
 def read_result(study_dir: Path, run: StudyRun) -> RunResult | None:
@@ -97,7 +116,8 @@ def read_result(study_dir: Path, run: StudyRun) -> RunResult | None:
     cpu = sum(part.get("cpu_s", math.nan) for part in parts) if parts else math.nan
     load = parts[0]["loadavg"][0] / parts[0]["cpu_count"] if parts else math.nan
     score = float(stats.normalize(run.task, [final])[0])
-    return RunResult(run, final, score, curve, float(summary["wall_time_s"]), cpu, load)
+    modes = read_modes(run_dir, int(summary["env_step"]))
+    return RunResult(run, final, score, curve, float(summary["wall_time_s"]), cpu, load, modes)
 
 
 def _interval(point: float, low: float, high: float) -> str:
@@ -200,6 +220,20 @@ def protocol(spec: StudySpec, record: dict[str, Any], choices: dict[str, Choice]
             f"- Tuned on {', '.join(env_label(t) for t in tuning.tasks)} only: each recipe's "
             "selected setting is used on every evaluation task, "
             f"{', '.join(env_label(t) for t in untuned)} included, untuned there."
+        )
+    for method, ablations in spec.diagnostics.items():
+        lines.append(
+            f"- Diagnostics of `{method}` (not compared recipes, not tuned): "
+            + ", ".join(f"`{a}`" for a in ablations)
+            + f", each at `{method}`'s selected setting "
+            f"(`{setting_label(choices[method].setting)}`) on the evaluation tasks and seeds."
+        )
+    if spec.generalization:
+        lines.append(
+            "- Generalization: each evaluation run's final agent played "
+            f"{spec.generalization_episodes} episodes of the train mode and of each of "
+            f"{', '.join(spec.generalization)} (`simoun_agent/generalization/`), on the run's "
+            "evaluation seeds; nothing trained again."
         )
     lines += [
         "",
@@ -312,6 +346,10 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
         "| task | recipe | n | return (mean ± std) | IQM score [95 % CI] |",
         "|---|---|---:|---:|---:|",
     ]
+    # the diagnostic recipes run under evaluation/ too: their own section compares them
+    per_task = [r for r in per_task if recipe_of(r) in order]
+    aggregate = [r for r in aggregate if recipe_of(r) in order]
+    improvement = [r for r in improvement if recipe_of(r, "y") in order]
     per_task.sort(key=lambda r: (tasks.index(r["env"]), order.get(recipe_of(r), 0)))
     for row in per_task:
         spread = "" if math.isnan(row["final_return_std"]) else f" ± {row['final_return_std']:.0f}"
@@ -361,6 +399,251 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
         f"[evaluation/{sweep_report.REPORT_MD}](evaluation/{sweep_report.REPORT_MD}); the "
         f"tuning runs: [tuning/{sweep_report.REPORT_MD}](tuning/{sweep_report.REPORT_MD}).",
     ]
+    return lines
+
+
+def scores_by_task(results: list[RunResult], recipe: str) -> dict[str, np.ndarray]:
+    """Task -> the normalized final scores of ``recipe``'s runs among ``results``."""
+    scores: dict[str, list[float]] = {}
+    for result in results:
+        if result.run.recipe == recipe:
+            scores.setdefault(result.run.task, []).append(result.score)
+    return {task: np.array(values) for task, values in scores.items()}
+
+
+def _bootstrap(scores: stats.Scores) -> tuple[float, float, float]:
+    return stats.stratified_bootstrap_ci(
+        scores,
+        stats.aggregate_iqm,
+        sweep_report.BOOTSTRAP_REPS,
+        sweep_report.CONFIDENCE,
+        sweep_report.BOOTSTRAP_SEED,
+    )
+
+
+def _pair(method: stats.Scores, other: stats.Scores) -> tuple[dict, dict]:
+    """Both score sets on the tasks both have runs of."""
+    tasks = [task for task in method if task in other]
+    return {t: method[t] for t in tasks}, {t: other[t] for t in tasks}
+
+
+def diagnostics_section(spec: StudySpec, results: list[RunResult]) -> list[str]:
+    """Each method's ablations against it: IQM, the IQM difference and P(method > ablation),
+    each with its 95 % stratified bootstrap interval (method and ablation resampled apart)."""
+    lines: list[str] = []
+    args = (sweep_report.BOOTSTRAP_REPS, sweep_report.CONFIDENCE, sweep_report.BOOTSTRAP_SEED)
+    for method, ablations in spec.diagnostics.items():
+        mine = scores_by_task(results, method)
+        rows = []
+        for ablation in ablations:
+            x, y = _pair(mine, scores_by_task(results, ablation))
+            if not x:
+                rows.append(f"| {ablation} | {RECIPES[ablation].description} | 0 | – | – | – |")
+                continue
+            difference = stats.difference_ci(x, y, stats.aggregate_iqm, *args)
+            improvement = stats.probability_of_improvement_ci(x, y, *args)
+            runs = sum(len(v) for v in y.values())
+            rows.append(
+                f"| {ablation} | {RECIPES[ablation].description} | {runs} | "
+                f"{_interval(*_bootstrap(y))} | {_interval(*difference)} | "
+                f"{_interval(*improvement)} |"
+            )
+        lines += [
+            "",
+            f"## Diagnostics of {method}: what each part adds",
+            "",
+            f"Ablations of `{method}`, not compared recipes: each ran at `{method}`'s selected "
+            "setting on the same evaluation tasks and seeds, untuned. IQM score: as above, tasks "
+            f"pooled; difference: IQM({method}) - IQM(ablation), positive when the part helps; "
+            f"P({method} > ablation): as above, 0.5 is no difference. Intervals: 95 % stratified "
+            "bootstrap, the runs of both resampled apart within each task.",
+            "",
+            f"`{method}` itself: {sum(len(v) for v in mine.values())} runs, IQM score "
+            + (_interval(*_bootstrap(mine)) if mine else "– (no finished run)")
+            + ".",
+            "",
+            f"| ablation | what it is | runs | IQM score [95 % CI] | IQM({method}) - IQM(ablation) "
+            f"[95 % CI] | P({method} > ablation) [95 % CI] |",
+            "|---|---|---:|---:|---:|---:|",
+            *rows,
+        ]
+    return lines
+
+
+def mode_ratios(results: list[RunResult], recipe: str, mode: str) -> tuple[dict, int]:
+    """Task -> each played run's return under ``mode`` over its train-mode return, for
+    ``recipe``; and how many played runs were left out for a train return of 0 or less (no
+    ratio)."""
+    ratios: dict[str, list[float]] = {}
+    left_out = 0
+    for result in results:
+        if result.run.recipe != recipe or result.modes is None:
+            continue
+        train = result.modes["train"]
+        if train <= 0:
+            left_out += 1
+            continue
+        ratios.setdefault(result.run.task, []).append(result.modes[mode] / train)
+    return {task: np.array(values) for task, values in ratios.items()}, left_out
+
+
+def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[str]:
+    """Per recipe, the return under each distraction mode over the train-mode return of the
+    same final agent on the same seeds: IQM over runs with its interval; then P(first recipe
+    > Y) of that ratio per mode."""
+    recipes = spec.recipes + list(spec.ablations())
+    modes = spec.generalization
+    args = (sweep_report.BOOTSTRAP_REPS, sweep_report.CONFIDENCE, sweep_report.BOOTSTRAP_SEED)
+    lines = [
+        "",
+        "## Generalization under distraction",
+        "",
+        f"Each evaluation run's final agent played {spec.generalization_episodes} episodes of "
+        "the train mode and of each distraction mode on the same reset seeds "
+        "(`generalization.csv` in each run's directory). A cell: the IQM over runs (tasks "
+        "pooled) of the mode's mean return over the train mode's, 1 is no loss, with its 95 % "
+        "stratified bootstrap interval; train score: the IQM of the train mode's normalized "
+        "return. A run whose train return is 0 or less has no ratio and is left out.",
+        "",
+        "| recipe | runs | train score [95 % CI] | " + " | ".join(modes) + " |",
+        "|---|---:|---:|" + "---:|" * len(modes),
+    ]
+    played = [r for r in results if r.modes is not None]
+    for recipe in recipes:
+        mine = [r for r in played if r.run.recipe == recipe]
+        if not mine:
+            continue
+        train: dict[str, list[float]] = {}
+        for r in mine:
+            train.setdefault(r.run.task, []).append(r.modes["train"])
+        train_scores = {t: stats.normalize(t, v) for t, v in train.items()}
+        cells = []
+        for mode in modes:
+            ratios, _ = mode_ratios(played, recipe, mode)
+            cells.append(_interval(*_bootstrap(ratios)) if ratios else "–")
+        _, left_out = mode_ratios(played, recipe, modes[0])
+        count = f"{len(mine)}" + (f" ({left_out} left out)" if left_out else "")
+        lines.append(
+            f"| {recipe} | {count} | {_interval(*_bootstrap(train_scores))} | "
+            + " | ".join(cells)
+            + " |"
+        )
+    first = spec.recipes[0]
+    rows = []
+    for other in recipes[1:]:
+        cells = []
+        for mode in modes:
+            x, y = _pair(mode_ratios(played, first, mode)[0], mode_ratios(played, other, mode)[0])
+            cells.append(_interval(*stats.probability_of_improvement_ci(x, y, *args)) if x else "–")
+        rows.append(f"| {other} | " + " | ".join(cells) + " |")
+    if rows:
+        lines += [
+            "",
+            f"P({first} > Y) of that ratio, per mode: the chance that a run of {first} keeps "
+            "more of its train-mode return than a run of Y on the same task, with its 95 % "
+            "interval.",
+            "",
+            "| Y | " + " | ".join(modes) + " |",
+            "|---|" + "---:|" * len(modes),
+            *rows,
+        ]
+    unplayed = [r.run.name for r in results if r.modes is None]
+    if unplayed:
+        lines += ["", "Finished evaluation runs not played (not counted):", ""]
+        lines += [f"- {name}" for name in unplayed]
+    return lines
+
+
+def read_update_costs(study_dir: Path) -> dict[str, Any] | None:
+    """The study's ``update_cost.json`` (:data:`UPDATE_COST_JSON`), None when there is none."""
+    path = study_dir / UPDATE_COST_JSON
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def baseline_clock(results: list[RunResult], baseline: str) -> dict[str, tuple]:
+    """Task -> (env steps, wall seconds): at each evaluation step, the median over the
+    baseline's runs on that task of the wall time it had taken (their common steps only)."""
+    clocks = {}
+    for task in dict.fromkeys(r.run.task for r in results):
+        runs = [r for r in results if r.run.recipe == baseline and r.run.task == task]
+        if not runs:
+            continue
+        steps = runs[0].curve["env_step"]
+        for run in runs[1:]:
+            steps = np.intersect1d(steps, run.curve["env_step"])
+        walls = [np.interp(steps, r.curve["env_step"], r.curve["wall_time_s"]) for r in runs]
+        clocks[task] = (steps, np.median(walls, axis=0))
+    return clocks
+
+
+def cost_curves(
+    results: list[RunResult], costs: dict[str, Any]
+) -> tuple[list[RunResult], list[str]]:
+    """The runs with ``cost_time_s`` on their curves: the baseline's clock on their task at
+    their evaluation steps, times their recipe's update-cost ratio; and the recipes left out
+    (no ratio in the file)."""
+    clocks = baseline_clock(results, costs["baseline"])
+    placed, left_out = [], []
+    for result in results:
+        ratio = costs["ratio"].get(result.run.recipe)
+        if ratio is None or result.run.task not in clocks:
+            left_out.append(result.run.recipe)
+            continue
+        steps, wall = clocks[result.run.task]
+        curve = dict(result.curve)
+        curve["cost_time_s"] = ratio * np.interp(curve["env_step"], steps, wall)
+        placed.append(RunResult(**{**result.__dict__, "curve": curve}))
+    return placed, list(dict.fromkeys(left_out))
+
+
+def update_cost_section(
+    spec: StudySpec, results: list[RunResult], study_dir: Path, out: Path
+) -> list[str]:
+    """IQM curves against wall time at the measured update costs, with where the ratios came
+    from; without ``update_cost.json``, how to measure them."""
+    costs = read_update_costs(study_dir)
+    lines = ["", "## Wall time at update costs measured side by side", ""]
+    if costs is None:
+        return [
+            *lines,
+            f"No `{UPDATE_COST_JSON}` in the study directory: the wall-time curves above use the "
+            "runs' own wall times, measured while machines ran under different loads. To compare "
+            "at equal wall time, time every recipe's update in one process at the study's "
+            f"commit: `python benchmarks/recipe_update.py --selection DIR/{SELECTION_FILE} "
+            f"--json DIR/{UPDATE_COST_JSON}` (DIR: this study's directory), then write the "
+            "report again (`simoun-study report`).",
+        ]
+    baseline = costs["baseline"]
+    placed, left_out = cost_curves(results, costs)
+    recipes = [r for r in spec.recipes + list(spec.ablations()) if r in costs["ratio"]]
+    lines += [
+        f"Update-cost ratios from `{UPDATE_COST_JSON}`: `{costs['command']}` at commit "
+        f"`{costs['commit']}` on {costs['machine']}, {env_label(costs['task'])} at action "
+        f"repeat {costs['action_repeat']}; every recipe's update timed in one process, "
+        f"interleaved, as the median of its repeats, over {baseline}'s.",
+        "",
+        f"| recipe | ms per update | x {baseline} |",
+        "|---|---:|---:|",
+        *(f"| {r} | {costs['ms_per_update'][r]:.1f} | {costs['ratio'][r]:.2f} |" for r in recipes),
+        "",
+        f"Each run is placed on {baseline}'s clock (at each evaluation step, the median wall "
+        f"time of {baseline}'s evaluation runs on the task) stretched by its recipe's ratio, so "
+        "every recipe's time comes from one machine's measurement. The whole step, env and "
+        "evaluations included, is charged at the update's ratio: where updates take a share u "
+        f"of {baseline}'s step, the true ratio is u x ratio + 1 - u, and the gaps between "
+        "curves are drawn wider than they are, either way.",
+        "",
+        f"![IQM curves at measured update costs]({COST_CURVES_PNG})",
+    ]
+    if left_out:
+        lines += ["", f"Not drawn (no ratio in the file): {', '.join(left_out)}."]
+    if placed:
+        plot_curves(
+            [r for r in recipes if any(p.run.recipe == r for p in placed)],
+            placed,
+            out / COST_CURVES_PNG,
+            [("cost_time_s", f"seconds on {baseline}'s clock x update-cost ratio", CURVE_POINTS)],
+        )
     return lines
 
 
@@ -432,20 +715,28 @@ def curve_scores(
     return grid, {task: np.stack(values) for task, values in curves.items()}
 
 
-def plot_curves(spec: StudySpec, results: list[RunResult], path: Path) -> None:
-    """IQM over all tasks' runs with its band per recipe, against env steps and wall time (each
-    recipe's curve up to its shortest run)."""
+AXES = [
+    ("env_step", "environment steps", None),
+    ("wall_time_s", "wall-clock seconds", CURVE_POINTS),
+]
+"""The IQM curves' x axes: the curve key, its label, the points of its grid (None: the
+evaluation steps)."""
+
+
+def plot_curves(
+    recipes: list[str], results: list[RunResult], path: Path, axes_of: list[tuple] = AXES
+) -> None:
+    """IQM over all tasks' runs with its band per recipe, one panel per x axis of ``axes_of``
+    (each recipe's curve up to its shortest run)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4), dpi=110)
-    for ax, x_key, label, points in (
-        (axes[0], "env_step", "environment steps", None),
-        (axes[1], "wall_time_s", "wall-clock seconds", CURVE_POINTS),
-    ):
-        for recipe in spec.recipes:
+    fig, axes = plt.subplots(1, len(axes_of), figsize=(5.5 * len(axes_of), 4), dpi=110)
+    axes = np.atleast_1d(axes)
+    for ax, (x_key, label, points) in zip(axes, axes_of, strict=True):
+        for recipe in recipes:
             runs = [r for r in results if r.run.recipe == recipe and len(r.curve[x_key])]
             if not runs:
                 continue
@@ -527,7 +818,12 @@ def write_study_report(
     if results:
         recipes = recipe_variants(study_dir / EVALUATION)
         lines += results_section(spec, out / EVALUATION, recipes)
-        plot_curves(spec, results, out / CURVES_PNG)
+        plot_curves(spec.recipes, results, out / CURVES_PNG)
+        if spec.diagnostics:
+            lines += diagnostics_section(spec, results)
+        if spec.generalization:
+            lines += generalization_section(spec, results)
+        lines += update_cost_section(spec, results, study_dir, out)
     if missing:
         lines += ["", "## Evaluation runs not finished (not counted)", ""]
         lines += [f"- {name}" for name in missing]

@@ -14,9 +14,12 @@ from typing import Any, Literal
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CHECKPOINT_NAME
 from simoun_agent.study import archive as archiving
+from simoun_agent.study.archive import GENERALIZATION_CSV
 from simoun_agent.study.checks import check_fixed_spec, check_study
 from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
+from simoun_agent.study.generalization import play_modes, playable, to_play
 from simoun_agent.study.plan import (
     EVALUATION,
     TUNING,
@@ -88,8 +91,9 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
 
 def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: str) -> None:
     """Refuse ``spec`` when it is not the one the study ``record`` was started with: the error
-    says ``problem``, the keys that differ and ``fix``."""
-    saved, wanted = record["spec"], spec.to_json()
+    says ``problem``, the keys that differ and ``fix``. A record saved before a spec key
+    existed has that key's default (read through :meth:`StudySpec.from_json`)."""
+    saved, wanted = StudySpec.from_json(record["spec"]).to_json(), spec.to_json()
     changed = [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
     if changed:
         raise SetupError(
@@ -157,6 +161,51 @@ class Phases:
             f" --archive {options.archive}" if options.archive else ""
         )
 
+    def connect(self) -> None:
+        """Start (or join) Ray, once: only when there is something to run."""
+        if self.gpus is not None:
+            return
+        self.started = launch.connect(self.ray, self.options.address, self.options.num_cpus)
+        device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
+        wanted = str(self.spec.gpus_per_trial)
+        self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
+        launch.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
+
+    def generalize(self, runs: list[StudyRun]) -> list[str]:
+        """Play each finished run's final agent on the spec's distraction modes (Ray tasks with a
+        trial's resources, as many at a time as trials), archiving each ``generalization.csv``
+        as it is written; the runs that could not be played, with why."""
+        names = [run.name for run in runs if run.finished(self.study_dir)]
+        todo = to_play(self.study_dir, self.archive, names)
+        print(f"generalization: {len(todo)} runs to play, {len(names) - len(todo)} played")
+        missing = [n for n in todo if not playable(self.study_dir / n)]
+        todo = [n for n in todo if n not in missing]
+        failed = [f"{name}: no {CHECKPOINT_NAME} (restored from the archive)" for name in missing]
+        if not todo:
+            return failed
+        self.connect()
+        remote = self.ray.remote(num_cpus=self.spec.cpus_per_trial, num_gpus=self.gpus)(play_modes)
+        at_once = self.spec.max_concurrent_trials or len(todo)
+        waiting, running = list(todo), {}
+        while waiting or running:
+            while waiting and len(running) < at_once:
+                name = waiting.pop(0)
+                args = (str(self.study_dir / name), self.spec.generalization)
+                running[remote.remote(*args, self.spec.generalization_episodes)] = name
+            (done,), _ = self.ray.wait(list(running), num_returns=1)
+            name = running.pop(done)
+            try:
+                self.ray.get(done)
+            except self.ray.exceptions.RayTaskError as err:
+                failed.append(f"{name}: {err.cause!r}")
+                continue
+            if self.archive is not None:
+                archiving.copy_file(
+                    self.study_dir / name / GENERALIZATION_CSV,
+                    self.archive / name / GENERALIZATION_CSV,
+                )
+        return failed
+
     def restore(self, runs: list[StudyRun]) -> int:
         """Bring back archived finished runs whose run directories are gone; how many."""
         if self.archive is None:
@@ -182,12 +231,7 @@ class Phases:
         if not todo:
             self.sync(runs)
             return {}
-        if self.gpus is None:  # Ray starts only once there is something to run
-            self.started = launch.connect(self.ray, self.options.address, self.options.num_cpus)
-            device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
-            wanted = str(self.spec.gpus_per_trial)
-            self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
-            launch.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
+        self.connect()
         callbacks = []
         if self.archive is not None:
             from simoun_agent.study.tune_callback import ArchiveOnComplete
@@ -228,7 +272,11 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
                     archiving.copy_file(study_dir / SELECTION_FILE, archive / SELECTION_FILE)
                 say_choices(choices)
                 selected = {recipe: choice.setting for recipe, choice in choices.items()}
-                outcome = phases.run(EVALUATION, evaluation_runs(spec, selected))
+                evaluation = evaluation_runs(spec, selected)
+                outcome = phases.run(EVALUATION, evaluation)
+                if spec.generalization and not (outcome.get("failed") or outcome.get("stopped")):
+                    for problem in phases.generalize(evaluation):
+                        print(f"generalization not played: {problem}", flush=True)
     except KeyboardInterrupt:
         outcome = {"stopped": phases.todo}
     finally:

@@ -34,6 +34,14 @@ printed without a traceback). The layout (``docs/studies/dmc100k.toml`` is a ful
     max_concurrent_trials = 2                  # runs at a time (default: as many as fit)
     gpus_per_trial = "auto"                    # a number, or auto (1 when Ray has GPUs)
 
+    [diagnostics]                              # optional: ablations of one method, each run
+    simoun = ["simoun_no_curiosity"]           # at the method's selected setting on the
+                                               # evaluation tasks and seeds, never tuned
+
+    [generalization]                           # optional: each evaluation run's final agent
+    modes = ["color_hard", "video_hard"]       # played on distraction modes (and ``train``)
+    episodes = 10                              # on the run's evaluation seeds
+
 A grid key that a recipe fixes (drqv2's ``n_step = 3``) is refused, unless the top-level
 ``grid_overrides = ["agent.n_step"]`` names it and the grid offers the recipe's own value: then
 every recipe is tuned over the same values and the recipe as published is one of its settings.
@@ -57,6 +65,7 @@ from simoun_agent.config.keys import (
     parse_value,
 )
 from simoun_agent.config.rules import show
+from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.study.selection import SELECTION_RULES
 from simoun_agent.study.toml_lines import key_line
 from simoun_agent.sweep.grid import parse_seeds
@@ -67,6 +76,10 @@ except ModuleNotFoundError:  # Python 3.10: the same parser from PyPI (the sweep
     import tomli as tomllib
 
 PHASES = ("tuning", "evaluation")
+
+OFFLINE_MODES = [mode for mode, entry in DISTRACTIONS.items() if entry is not None]
+"""The distraction modes a study can play: all but ``train`` (always played, as the reference),
+each built procedurally, with no video files or downloads."""
 
 SCHEMA: dict[tuple[str, ...], dict[str, str]] = {
     (): {
@@ -81,6 +94,9 @@ SCHEMA: dict[tuple[str, ...], dict[str, str]] = {
         "evaluation": "the [evaluation] table: tasks, seeds, env_steps",
         "tasks": 'per-task config keys: [tasks."ENV_ID"]',
         "resources": "the [resources] table: cpus_per_trial, max_concurrent_trials, gpus_per_trial",
+        "diagnostics": "the [diagnostics] table: method recipe = [its ablation recipes], each "
+        'evaluated at the method\'s selected setting, e.g. simoun = ["simoun_no_curiosity"]',
+        "generalization": "the [generalization] table: modes, episodes",
     },
     **{
         (phase,): {
@@ -89,6 +105,11 @@ SCHEMA: dict[tuple[str, ...], dict[str, str]] = {
             "env_steps": "env steps of each run: an integer or a table per task",
         }
         for phase in PHASES
+    },
+    ("generalization",): {
+        "modes": "distraction modes each evaluation run's final agent is played on, e.g. "
+        f'modes = ["color_hard", "video_hard"] (from {", ".join(OFFLINE_MODES)})',
+        "episodes": "episodes of each mode (and of the train mode they are compared with)",
     },
     ("resources",): {
         "cpus_per_trial": "CPUs of each run (it uses as many torch threads)",
@@ -161,6 +182,14 @@ class StudySpec:
     """runs at a time; None: as many as the Ray cluster fits"""
     gpus_per_trial: float | str = "auto"
     """GPUs of each run, or ``auto``"""
+    diagnostics: dict = field(default_factory=dict)
+    """method recipe -> its ablation recipes, evaluated at the method's selected setting on the
+    evaluation tasks and seeds (not tuned); the report compares each with the method"""
+    generalization: list = field(default_factory=list)
+    """distraction modes each finished evaluation run's final agent is played on, beside the
+    train mode; empty: none"""
+    generalization_episodes: int = 10
+    """episodes of each generalization mode, on the run's evaluation seeds"""
 
     def phase(self, name: str) -> Phase:
         return self.tuning if name == "tuning" else self.evaluation
@@ -189,8 +218,14 @@ class StudySpec:
         """The JSON form (tuples as lists), equal for a fresh and a reloaded spec."""
         return json.loads(json.dumps(asdict(self)))
 
+    def ablations(self) -> dict[str, str]:
+        """Each diagnostic recipe -> the method whose selected setting it runs at."""
+        return {a: method for method, ablations in self.diagnostics.items() for a in ablations}
+
     @classmethod
     def from_json(cls, data: dict[str, Any]) -> StudySpec:
+        """The spec saved in ``study.json``; keys added since it was saved take their defaults,
+        so an older study reads as the spec it was (no diagnostics, no generalization)."""
         phases = {name: Phase(**data[name]) for name in PHASES}
         return cls(**{**data, **phases})
 
@@ -278,17 +313,21 @@ class _Reader:
                 + (f" (did you mean {hint[0]!r}?)" if hint else "")
                 + f"; choose one of {', '.join(PRESETS)}",
             )
-        base = self.config_table(base_table, ("base",), recipes)
+        diagnostics = self.diagnostics(data.get("diagnostics", {}), recipes)
+        # a diagnostic recipe runs with the base, task and grid values too: what it fixes counts
+        every = recipes + [a for ablations in diagnostics.values() for a in ablations]
+        base = self.config_table(base_table, ("base",), every)
         self.resolves(preset, base, ("base",))
         overrides = data.get("grid_overrides", [])
         if not isinstance(overrides, list) or not all(isinstance(k, str) for k in overrides):
             raise self.fail(("grid_overrides",), 'give a list of grid keys, e.g. ["agent.n_step"]')
-        grid = self.grid(data["grid"], recipes, preset, base, overrides)
+        grid = self.grid(data["grid"], every, preset, base, overrides)
         tuning = self.phase(data["tuning"], "tuning")
         evaluation = self.phase(data["evaluation"], "evaluation")
         self.disjoint(tuning, evaluation)
-        task_config = self.tasks(data.get("tasks", {}), tuning, evaluation, recipes, preset, base)
+        task_config = self.tasks(data.get("tasks", {}), tuning, evaluation, every, preset, base)
         resources = self.resources(data.get("resources", {}))
+        modes, episodes = self.generalization(data.get("generalization"), evaluation)
         spec = StudySpec(
             name,
             description,
@@ -302,6 +341,9 @@ class _Reader:
             evaluation,
             overrides,
             **resources,
+            diagnostics=diagnostics,
+            generalization=modes,
+            generalization_episodes=episodes,
         )
         self.check_runs(spec)
         return json_round_trip(spec)
@@ -603,13 +645,88 @@ class _Reader:
             out["gpus_per_trial"] = gpus
         return out
 
+    def diagnostics(self, value: Any, recipes: list[str]) -> dict[str, list[str]]:
+        """Method -> its ablation recipes: the method is one of the study's recipes; each
+        ablation is a known recipe, not compared in the study itself, listed once."""
+        table = self.table(value, ("diagnostics",))
+        seen: set[str] = set()
+        out = {}
+        for method, ablations in table.items():
+            where = ("diagnostics", method)
+            if method not in recipes:
+                raise self.fail(
+                    where,
+                    f"{method!r} is not one of the study's recipes ({', '.join(recipes)}); "
+                    "diagnostics run at a compared recipe's selected setting",
+                )
+            if not isinstance(ablations, list) or not ablations:
+                raise self.fail(
+                    where, f'give a non-empty list of recipes, e.g. {method} = ["{method}_no_aux"]'
+                )
+            for ablation in ablations:
+                if ablation not in RECIPES:
+                    hint = difflib.get_close_matches(str(ablation), RECIPES, n=1)
+                    raise self.fail(
+                        where,
+                        f"unknown recipe {ablation!r}"
+                        + (f" (did you mean {hint[0]!r}?)" if hint else "")
+                        + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
+                    )
+                if ablation in recipes:
+                    raise self.fail(
+                        where,
+                        f"{ablation!r} is one of the study's recipes, tuned and compared on its "
+                        "own; a diagnostic runs at another recipe's setting, so list it in one "
+                        "place",
+                    )
+                if ablation in seen:
+                    raise self.fail(where, f"{ablation!r} is listed twice; list each once")
+                seen.add(ablation)
+            out[method] = list(ablations)
+        return out
+
+    def generalization(self, value: Any, evaluation: Phase) -> tuple[list[str], int]:
+        """The distraction modes (checked, each a dm_control evaluation task's) and episodes."""
+        if value is None:
+            return [], StudySpec.generalization_episodes
+        where = ("generalization",)
+        table = self.table(value, where)
+        self.check_keys(table, where)
+        if "modes" not in table:
+            raise self.fail(where, f"no 'modes' ({SCHEMA[where]['modes']})")
+        modes = table["modes"]
+        if not isinstance(modes, list) or not all(isinstance(m, str) for m in modes):
+            raise self.fail((*where, "modes"), f"give a list ({SCHEMA[where]['modes']})")
+        try:
+            modes = parse_distractions(modes, "modes")
+        except SetupError as err:
+            raise self.fail((*where, "modes"), str(err)) from None
+        if "train" in modes:
+            raise self.fail(
+                (*where, "modes"),
+                "the train mode is always played, as the return the others are divided by; "
+                "list distraction modes only",
+            )
+        episodes = table.get("episodes", StudySpec.generalization_episodes)
+        if not isinstance(episodes, int) or isinstance(episodes, bool) or episodes < 1:
+            raise self.fail((*where, "episodes"), f"give a positive integer, not {episodes!r}")
+        other = [task for task in evaluation.tasks if not task.startswith("dm_control/")]
+        if other:
+            raise self.fail(
+                (*where, "modes"),
+                f"the distraction modes recolour or re-render a MuJoCo scene, and the "
+                f"evaluation task {other[0]} is no dm_control task; drop [generalization] or "
+                "evaluate on dm_control tasks only",
+            )
+        return modes, episodes
+
     def check_runs(self, spec: StudySpec) -> None:
-        """Resolve each recipe x task x setting x budget once, before anything runs."""
+        """Resolve each recipe x task x setting x budget once (each diagnostic recipe with
+        every setting its method may select), before anything runs."""
         checked = set()
         for phase in (spec.tuning, spec.evaluation):
-            for task, recipe, setting in itertools.product(
-                phase.tasks, spec.recipes, spec.settings()
-            ):
+            recipes = spec.recipes + (list(spec.ablations()) if phase is spec.evaluation else [])
+            for task, recipe, setting in itertools.product(phase.tasks, recipes, spec.settings()):
                 steps = phase.env_steps[task]
                 overrides = spec.overrides(recipe, task, setting, phase.seeds[task][0], steps)
                 key = json.dumps([recipe, task, steps, show(setting)])
