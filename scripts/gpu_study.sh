@@ -3,7 +3,7 @@
 # 6 settings x 3 seeds of `simoun-train --preset cpu` on dm_control cartpole-swingup, run side
 # by side as plain processes for at most STUDY_SECONDS each, then packed (logs and CSVs, no
 # checkpoints) into $OUT/study.tgz for `simoun-report`.
-# Usage (from the repo root, wheels in .devkit/whl, a trimmed dm_control in .devkit/site):
+# Usage (from the repo root, with simoun and its dmc extra installed):
 #   STUDY_SECONDS=470 bash scripts/gpu_study.sh
 set -u
 seconds=${STUDY_SECONDS:-470}

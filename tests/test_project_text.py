@@ -1,21 +1,17 @@
 """The project's text speaks of the software, never of how it was made.
 
 Every tracked text file (code, comments, docstrings, tests, docs, specs, scripts) is searched for
-words that belong to the making of the project rather than to the project:
-
-- issue or pull-request numbers (``issue 20``, ``#38`` after "issue", ``PR 7``, ``GH-12``);
-- the timeline of the work: "session", "this issue", dates such as ``2026-12`` (a version or a
-  commit says when something changed: CHANGELOG.md is organised by version);
-- who lends which machine ("lent", "lend", "loan");
-- the names of development tools and assistants.
+words that belong to the making of the project rather than to the project: tracker numbers, the
+timeline of the work (calendar months, sittings), who provides which machine, and the names of
+development tools and assistants. The patterns below are the list; a version or a commit says
+when something changed (CHANGELOG.md is organised by version).
 
 Run records are data, not narrative, and are not searched: ``.csv``, ``.json`` and ``.jsonl``
 files (their provenance timestamps are dates on purpose), and binary files. This file is not
 searched either (it spells the patterns).
 
 ``ALLOWED`` lists the exceptions: a (path, word) pair where the word is about the software
-itself, each with its reason. It is empty: the code uses no API named "session" (Ray's
-``ray.train`` sessions are not used), and no legitimate text needs the other words. Add an entry
+itself, each with its reason. It is empty: no legitimate text needs these words. Add an entry
 only for such a case, never for an account of the work.
 """
 
