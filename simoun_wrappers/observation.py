@@ -129,6 +129,12 @@ def _channel_first(obs: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
     return obs.reshape(shape).transpose(2, 0, 1)
 
 
+def _fold(frames: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
+    """``(K, C, H, W)`` frames as one ``(K*C, H, W)`` stack (``np.reshape``'s ``shape`` keyword
+    needs numpy 2.1; the floor is 2.0)."""
+    return frames.reshape(shape)
+
+
 def _frames_dict(frames: np.ndarray) -> dict[str, np.ndarray]:
     return {"frames": frames}
 
@@ -388,7 +394,7 @@ class SimounObservation(ChainWrapper):
         if fold_frames:
             folded = spaces.Box(0, 255, (num_frames * channels, height, width), dtype=np.uint8)
             chain = TransformObservation(
-                chain, functools.partial(np.reshape, shape=folded.shape), folded
+                chain, functools.partial(_fold, shape=folded.shape), folded
             )
         elif motion:
             chain = ResidualMotion(chain)
