@@ -327,6 +327,29 @@ def test_resume_of_a_finished_sweep_runs_nothing(sweep_dir, capsys):
     assert {d: (d / "summary.json").read_bytes() for d in run_dirs(sweep_dir)} == summaries
 
 
+def test_a_finished_sweep_extended_with_total_env_steps_trains_each_run_on(
+    ray_address, tmp_path, capsys
+):
+    sweep_dir = tmp_path / "extended"
+    argv = [*TINY, "--seeds", "0", "--sweep-dir", str(sweep_dir), "--address", ray_address]
+    assert cli.main([*argv, "--verbose", "0"]) == 0
+    run_dir = sweep_dir / "base/simoun-PointReach-v0/s0"
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 120
+    capsys.readouterr()
+
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "60"], capsys)
+    assert "--total-env-steps 60 is below the sweep's 120" in err
+    extend = ["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "240"]
+    assert cli.main([*extend, "--address", ray_address, "--verbose", "0"]) == 0
+    assert "1 trials to run, 0 already finished" in capsys.readouterr().out
+    # went on from the final checkpoint: the evaluations continue the grid, none repeated
+    assert [row["env_step"] for row in read_csv(run_dir / "eval.csv")] == [0, 60, 120, 180, 240]
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 240
+    assert json.loads((sweep_dir / SWEEP_FILE).read_text())["base"]["total_env_steps"] == 240
+    assert cli.main(["--resume", "--sweep-dir", str(sweep_dir)]) == 0
+    assert "0 trials to run, 1 already finished" in capsys.readouterr().out
+
+
 def test_unreachable_address_fails_within_seconds(tmp_path):
     with socket.socket() as sock:  # a port nothing listens on
         sock.bind(("127.0.0.1", 0))

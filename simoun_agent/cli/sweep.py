@@ -2,6 +2,7 @@
 
     simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl --seeds 0-4 --sweep-dir sw
     simoun-sweep --resume --sweep-dir sw              # after Ctrl-C: finish what is unfinished
+    simoun-sweep --resume --sweep-dir sw --total-env-steps 200000   # train every trial further
     simoun-sweep --address auto --preset cheetah-run --grid agent.recipe=simoun,drq --seeds 0-4
 
 The base config is given exactly as to ``simoun-train`` (``--preset``, every config flag,
@@ -53,6 +54,7 @@ examples:
   simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 \\
       --sweep-dir sweeps/baselines
   simoun-sweep --resume --sweep-dir sweeps/baselines
+  simoun-sweep --resume --sweep-dir sweeps/baselines --total-env-steps 1000000
   simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq \\
       --seeds 0-4 --sweep-dir /shared/sweeps/walker
 
@@ -89,7 +91,8 @@ class SweepCommand:
     """CPUs of the local Ray instance (none: this machine's)"""
     resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
     """continue the sweep in --sweep-dir: finished trials are skipped, the others go on from
-    their checkpoints"""
+    their checkpoints; with a larger --total-env-steps every trial, finished ones too, trains on
+    to it"""
     verbose: Literal[0, 1, 2] = 1
     """Tune's output"""
     flags: Annotated[ConfigFlags, tyro.conf.arg(name="")] = field(default_factory=ConfigFlags)
@@ -98,9 +101,9 @@ class SweepCommand:
 
 def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> SweepSpec:
     """The sweep to run: from the flags (``base``: the config overrides they give), or the saved
-    one on ``--resume`` (which the flags, when given, must match)."""
+    one on ``--resume`` (which the flags, when given, must match; ``--total-env-steps`` alone may
+    differ, and extends every trial to the new budget)."""
     preset = args.flags.preset
-    given = bool(args.grid or args.seeds or args.envs or base or preset)
     if not args.resume:
         if (sweep_dir / SWEEP_FILE).exists():
             raise SetupError(
@@ -112,24 +115,28 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
         cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
         return SweepSpec.create(preset, base, list(args.grid), args.seeds, args.envs, cpus)
     saved = SweepSpec.load(sweep_dir)
-    if not given and args.cpus_per_trial in (None, saved.cpus_per_trial):
-        return saved
-    spec = SweepSpec.create(
-        preset,
-        base,
-        list(args.grid),
-        args.seeds,
-        args.envs,
-        saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
-    )
-    differences = spec.describe_differences(saved)
-    if differences:
-        raise SetupError(
-            f"the sweep in {sweep_dir} was started with another grid, so --resume cannot continue "
-            f"it ({'; '.join(differences)}); give the flags it was started with (or only "
-            f"--resume --sweep-dir {sweep_dir}), or start a new sweep in another --sweep-dir"
+    base = dict(base)
+    total = base.pop("total_env_steps", None)
+    given = bool(args.grid or args.seeds or args.envs or base or preset)
+    if given or args.cpus_per_trial not in (None, saved.cpus_per_trial):
+        spec = SweepSpec.create(
+            preset,
+            {**base, **({} if total is None else {"total_env_steps": total})},
+            list(args.grid),
+            args.seeds,
+            args.envs,
+            saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
         )
-    return saved
+        like_saved = saved if total is None else saved.extended(total)
+        differences = spec.describe_differences(like_saved)
+        if differences:
+            raise SetupError(
+                f"the sweep in {sweep_dir} was started with another grid, so --resume cannot "
+                f"continue it ({'; '.join(differences)}); give the flags it was started with (or "
+                f"only --resume --sweep-dir {sweep_dir}), or start a new sweep in another "
+                "--sweep-dir"
+            )
+    return saved if total is None else saved.extended(total)
 
 
 @quiet_pipe
@@ -167,7 +174,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             gpus = gpus_per_trial(ray, args.gpus_per_trial, device)
             check_fits(ray, spec.cpus_per_trial, gpus)
             sweep_dir.mkdir(parents=True, exist_ok=True)
-            if not (sweep_dir / SWEEP_FILE).exists():
+            if not (sweep_dir / SWEEP_FILE).exists() or SweepSpec.load(sweep_dir) != spec:
                 spec.save(sweep_dir)
             (sweep_dir / STOP_FILE).unlink(missing_ok=True)
             with stop_trials_on_sigterm(sweep_dir) as came:

@@ -232,6 +232,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     counters = Counters(**payload["state"]["counters"])
     lock = take_run_dir(run_dir, resume=True)
     remove_leftovers(run_dir, payload["replay_file"])
+    # trained further, the run is whole again only when it reaches its new end
+    (run_dir / SUMMARY_NAME).unlink(missing_ok=True)
     write_config(run_dir, config)
     return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
 

@@ -20,7 +20,7 @@ import json
 import re
 import sys
 import typing
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -261,6 +261,27 @@ class SweepSpec:
             for name, flag in flags.items()
             if mine[name] != saved[name]
         ]
+
+    def total_env_steps(self) -> int:
+        """The env-step budget of every trial (the base flags', else the preset's)."""
+        return resolve(self.preset, self.base).total_env_steps
+
+    def extended(self, total_env_steps: int) -> SweepSpec:
+        """This sweep with every trial trained to ``total_env_steps``: its finished trials go on
+        from their final checkpoints. A sweep can grow, never shrink."""
+        if "total_env_steps" in self.grid:
+            raise SetupError(
+                "--total-env-steps cannot extend this sweep: its --grid sets total_env_steps; "
+                "start a new sweep in another --sweep-dir"
+            )
+        current = self.total_env_steps()
+        if total_env_steps < current:
+            raise SetupError(
+                f"--total-env-steps {total_env_steps} is below the sweep's {current}: a sweep is "
+                f"extended, never shortened; pass a larger value (e.g. --total-env-steps "
+                f"{2 * current}) or start a new sweep in another --sweep-dir"
+            )
+        return replace(self, base={**self.base, "total_env_steps": total_env_steps})
 
     def save(self, sweep_dir: Path) -> None:
         text = json.dumps(asdict(self), indent=2) + "\n"

@@ -8,6 +8,7 @@ Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``; t
 
 from __future__ import annotations
 
+import json
 import signal
 import socket
 import sys
@@ -22,7 +23,13 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.sweep.grid import SweepSpec, Trial
-from simoun_agent.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table
+from simoun_agent.sweep.trainable import (
+    ERROR_FILE,
+    STOP_FILE,
+    run_trial,
+    trial_budget,
+    trial_table,
+)
 
 CONNECT_TIMEOUT_S = 5.0
 """How long ``--address HOST:PORT`` may take to answer before the sweep gives up."""
@@ -126,7 +133,16 @@ def check_fits(ray: ModuleType, cpus: int, gpus: float) -> None:
 
 
 def finished(trial: Trial) -> bool:
-    return (Path(trial.run_dir) / SUMMARY_NAME).is_file()
+    """True once the trial's run has ended at the sweep's budget (a sweep extended with a larger
+    ``--total-env-steps`` makes its finished runs unfinished again)."""
+    path = Path(trial.run_dir) / SUMMARY_NAME
+    if not path.is_file():
+        return False
+    try:
+        done = json.loads(path.read_text())["env_step"]
+    except (json.JSONDecodeError, KeyError, TypeError, UnicodeDecodeError):
+        return True  # damaged: the report names it; training cannot tell how far the run got
+    return done >= trial_budget(trial)
 
 
 def run_sweep(

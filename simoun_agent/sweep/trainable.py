@@ -62,15 +62,22 @@ class TuneReporter(train.TrainCallback):
         tune.report({"env_step": run.counters.env_step, **metrics})
 
 
+def trial_budget(trial: Trial) -> int:
+    """The env steps the trial trains to (its overrides', else its preset's)."""
+    return resolve(trial.preset, trial.overrides).total_env_steps
+
+
 def open_run(trial: Trial) -> train.Run:
-    """The trial's run: continued from its checkpoint, else started afresh.
+    """The trial's run: continued from its checkpoint (to the trial's budget, which an extended
+    sweep raised), else started afresh.
 
     A run directory with ``config.json`` but no checkpoint was stopped before its first
     checkpoint: it holds nothing to continue from, so its files are removed and it starts over.
     """
     run_dir = Path(trial.run_dir)
     if (run_dir / CHECKPOINT_NAME).is_file():
-        return train.resume_run(run_dir, {}, check=check_eval_distractions)
+        budget = {"total_env_steps": trial_budget(trial)}
+        return train.resume_run(run_dir, budget, check=check_eval_distractions)
     if (run_dir / CONFIG_NAME).is_file():
         shutil.rmtree(run_dir)
     config = resolve(trial.preset, trial.overrides)
