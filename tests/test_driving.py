@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 
+import imageio.v2 as imageio
 import numpy as np
 import pytest
 
@@ -49,11 +50,17 @@ def test_three_cameras_give_the_papers_layout_of_three_views_side_by_side():
     assert not any(np.array_equal(a, b) for a, b in itertools.pairwise(views))
 
 
-def test_lane_keeping_beats_the_zero_action_and_does_not_crash():
-    metrics = reference_metrics(resolve("highway-cpu", {}), episodes=3, seed=1000)
+def test_lane_keeping_beats_the_zero_action_and_does_not_crash(tmp_path):
+    video = tmp_path / "lane-keeping.gif"
+    metrics = reference_metrics(resolve("highway-cpu", {}), episodes=3, seed=1000, video=video)
     assert list(metrics) == list(REFERENCES)
     keeper, zero, random = (metrics[name] for name in REFERENCES[::-1])
     assert keeper["crash_rate"] == 0.0 and keeper["length_mean"] >= 150
     assert keeper["return_mean"] > zero["return_mean"] + 20
     assert random["length_mean"] < 20  # random steering leaves the road, which ends the episode
     assert 15 < keeper["mean_speed"] < 31 and keeper["distance_m"] > 450
+    # its first episode as the agent sees it, one frame per decision, enlarged (the GIF encoder
+    # may merge two equal consecutive frames)
+    frames = imageio.mimread(video)
+    assert 140 <= len(frames) <= 151 and frames[0].shape == (256, 256, 3)
+    assert len({frame.tobytes() for frame in frames}) > 100  # the road moves past

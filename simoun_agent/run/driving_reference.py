@@ -12,13 +12,16 @@ environment stack, with the same metric code (:mod:`simoun_agent.run.driving_met
 
     python -m simoun_agent.run.driving_reference --episodes 20 --seed 1000
 
-prints their table on the ``highway-cpu`` preset, one episode per seed from ``--seed`` on.
+prints their table on the ``highway-cpu`` preset, one episode per seed from ``--seed`` on;
+``--video docs/driving/lane-keeping.gif`` also writes the lane-keeping driver's first episode as
+the agent sees it (the frames ``simoun-eval --video`` writes for a learned driver).
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 from typing import Protocol
 
 import gymnasium as gym
@@ -26,7 +29,8 @@ import numpy as np
 
 from simoun_agent.config import TrainConfig, resolve
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
-from simoun_agent.run.make_env import make_env
+from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.video import write_video
 
 
 class Policy(Protocol):
@@ -132,14 +136,21 @@ def reference_policy(name: str, env: gym.Env, seed: int) -> Policy:
     raise ValueError(f"unknown reference driver {name!r}; choose one of {', '.join(REFERENCES)}")
 
 
-def reference_metrics(config: TrainConfig, episodes: int, seed: int) -> dict[str, dict]:
-    """Each reference driver's evaluation metrics on ``episodes`` episodes seeded from ``seed``."""
+def reference_metrics(
+    config: TrainConfig, episodes: int, seed: int, video: Path | None = None
+) -> dict[str, dict]:
+    """Each reference driver's evaluation metrics on ``episodes`` episodes seeded from ``seed``;
+    with ``video``, the lane-keeping driver's first episode is written there (``.gif``/``.mp4``)."""
     env = make_env(config)
     try:
-        return {
-            name: evaluate(reference_policy(name, env, seed), env, episodes, seed)[0]
-            for name in REFERENCES
-        }
+        metrics = {}
+        for name in REFERENCES:
+            record = video is not None and name == "lane-keeping"
+            policy = reference_policy(name, env, seed)
+            metrics[name], frames = evaluate(policy, env, episodes, seed, record=record)
+            if record:
+                write_video(video, frames, video_fps(env, config.resolved_action_repeat()))
+        return metrics
     finally:
         env.close()
 
@@ -173,9 +184,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--seed", type=int, default=1000, help="seed of the first episode")
     parser.add_argument("--preset", default="highway-cpu")
+    parser.add_argument(
+        "--video", type=Path, help="write the lane-keeping driver's first episode here (.gif/.mp4)"
+    )
     args = parser.parse_args(argv)
+    if args.video is not None and not args.video.parent.is_dir():
+        parser.error(f"--video {args.video}: the folder {args.video.parent} does not exist")
     config = resolve(args.preset, {"device": "cpu"})
-    print(markdown_table(reference_metrics(config, args.episodes, args.seed)))
+    print(markdown_table(reference_metrics(config, args.episodes, args.seed, args.video)))
 
 
 if __name__ == "__main__":
