@@ -4,7 +4,7 @@ M. Kowal, M. Siam, M. A. Islam, N. D. B. Bruce, R. P. Wildes, K. G. Derpanis, "A
 What Deep Spatiotemporal Networks Encode: Quantifying Static vs. Dynamic Information", CVPR 2022
 (after Esser et al., CVPR 2020, and Islam et al., ICLR 2021). The estimator only needs a layer's
 per-unit activations on pairs of inputs that share one factor; how simoun builds the pairs from a
-run's own environment is in :mod:`simoun_agent.analysis.pairs`.
+run's own environment is in :mod:`simoun_lab.analysis.pairs`.
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ def feature_layers(encoder: PixelEncoder, obs: torch.Tensor) -> dict[str, torch.
     """``{layer name: (B, units)}`` for uint8 observations ``(B, k, C, H, W)``."""
     raise SetupError(
         f"the information-bias analysis does not know the layers of {type(encoder).__name__}; "
-        "register a function for it with simoun_agent.analysis.layers.feature_layers.register"
+        "register a function for it with simoun_lab.analysis.layers.feature_layers.register"
     )
 
 

@@ -13,7 +13,7 @@ frames are real, not the reset padding). No data is downloaded.
   as Kowal et al.'s stylised copies of a video do.
   With ``--recolour model`` (dm_control tasks) ``recolour(x)`` is instead the same observation
   re-rendered by a twin of the environment that replays the episode's seed and actions under
-  new colours of the skybox, the materials and the geoms (:mod:`simoun_agent.analysis.recolour`).
+  new colours of the skybox, the materials and the geoms (:mod:`simoun_lab.analysis.recolour`).
 - *static pair* ``(x, shuffle(x))``: shares the appearance, differs in motion. ``shuffle`` puts the
   same frames in another order, a permutation drawn uniformly among those that are not the
   identity (one per pair): the same pixels, so the same objects and colours, but the residual
@@ -56,7 +56,7 @@ def make_pairs(
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """``{"dynamic": (x, recolour(x)), "static": (x, shuffle(x))}`` for observations
     ``(N, k, C, H, W)`` uint8, reproducible from ``seed``. ``recoloured`` gives the second
-    member of the dynamic pairs instead (e.g. re-rendered by :mod:`simoun_agent.analysis.recolour`).
+    member of the dynamic pairs instead (e.g. re-rendered by :mod:`simoun_lab.analysis.recolour`).
     """
     generator = torch.Generator().manual_seed(seed)
     rng = np.random.default_rng(seed)

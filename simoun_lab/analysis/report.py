@@ -7,9 +7,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.analysis import pairs
-from simoun_agent.analysis.bias import CATEGORIES, THRESHOLD, BiasEstimate
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.analysis import pairs
+from simoun_lab.analysis.bias import CATEGORIES, THRESHOLD, BiasEstimate
 
 CATEGORY_COLOURS = {
     "static": "#E69F00",
@@ -43,7 +43,7 @@ class RunBias:
 def to_json(results: list[RunBias], seed: int) -> dict[str, Any]:
     """Everything the chart and table show, and the per-factor scores behind them."""
     return {
-        "method": "Kowal et al., CVPR 2022 (simoun_agent.analysis.bias.information_bias)",
+        "method": "Kowal et al., CVPR 2022 (simoun_lab.analysis.bias.information_bias)",
         "threshold": THRESHOLD,
         "seed": seed,
         "pairs_doc": " ".join((pairs.__doc__ or "").split()),

@@ -21,19 +21,19 @@ import torch
 import tyro
 from tyro.constructors import PrimitiveConstructorSpec
 
-from simoun_agent.analysis import masks as mask_pictures
-from simoun_agent.analysis.bias import information_bias
-from simoun_agent.analysis.layers import layer_activations
-from simoun_agent.analysis.pairs import make_pairs, sample_rows, usable_steps
-from simoun_agent.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
-from simoun_agent.analysis.report import RunBias, write_report
-from simoun_agent.analysis.runs import play_episode, prepare_output
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.load import LoadedRun, load_run
 from simoun_agent.run.make_env import video_fps
 from simoun_agent.run.video import write_video
+from simoun_lab.analysis import masks as mask_pictures
+from simoun_lab.analysis.bias import information_bias
+from simoun_lab.analysis.layers import layer_activations
+from simoun_lab.analysis.pairs import make_pairs, sample_rows, usable_steps
+from simoun_lab.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
+from simoun_lab.analysis.report import RunBias, write_report
+from simoun_lab.analysis.runs import play_episode, prepare_output
 
 MAX_BIAS_EPISODES = 200
 """Episodes the bias analysis plays at most to gather its observations."""

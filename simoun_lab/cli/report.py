@@ -1,5 +1,5 @@
 """``simoun-report DIR``: tables and figures of a sweep or of a directory of ``simoun-train``
-runs, per variant and env, over seeds (:mod:`simoun_agent.sweep.report` describes them).
+runs, per variant and env, over seeds (:mod:`simoun_lab.sweep.report` describes them).
 
     simoun-report sweeps/baselines
     simoun-report runs/ --out runs/report
@@ -17,7 +17,7 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.sweep.report import write_report
+from simoun_lab.sweep.report import write_report
 
 PROG = "simoun-report"
 

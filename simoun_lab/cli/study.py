@@ -9,9 +9,9 @@
 ``plan`` lists every run of both phases with a CPU-time estimate measured here; ``run`` tunes
 (every recipe x grid setting x tuning seed), selects each recipe's setting by the spec's rule,
 evaluates the selected settings on the held-out seeds and writes the report
-(:mod:`simoun_agent.study.report`); ``report`` writes it again from the finished runs of a study
+(:mod:`simoun_lab.study.report`); ``report`` writes it again from the finished runs of a study
 directory or its archive (``simoun-study report SPEC --study-dir docs/studies/NAME``). The
-study is run by :mod:`simoun_agent.study.runner`; the runs go through ``simoun-sweep``'s code:
+study is run by :mod:`simoun_lab.study.runner`; the runs go through ``simoun-sweep``'s code:
 the same trial directories, Tune experiments, STOP file on SIGTERM and failure handling.
 """
 
@@ -28,10 +28,10 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.study.checks import check_study
-from simoun_agent.study.plan import describe
-from simoun_agent.study.runner import StudyOptions, report_study, run_study, spec_from
-from simoun_agent.sweep.launch import load_ray
+from simoun_lab.study.checks import check_study
+from simoun_lab.study.plan import describe
+from simoun_lab.study.runner import StudyOptions, report_study, run_study, spec_from
+from simoun_lab.sweep.launch import load_ray
 
 PROG = "simoun-study"
 
@@ -47,7 +47,7 @@ examples:
       --archive docs/studies/dmc100k --resume
   simoun-study report docs/studies/dmc100k.toml --study-dir docs/studies/dmc100k
 
-The spec's layout is documented in simoun_agent/study/spec.py; docs/studies/dmc100k.toml is a
+The spec's layout is documented in simoun_lab/study/spec.py; docs/studies/dmc100k.toml is a
 full example."""
 
 

@@ -6,8 +6,8 @@
 
 The base config is given exactly as to ``simoun-train`` (``--preset``, every config flag,
 ``--set KEY=VALUE``). Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``;
-the report (:mod:`simoun_agent.sweep.report`) is written when the sweep ends. The running is
-:mod:`simoun_agent.sweep.launch`'s.
+the report (:mod:`simoun_lab.sweep.report`) is written when the sweep ends. The running is
+:mod:`simoun_lab.sweep.launch`'s.
 """
 
 from __future__ import annotations
@@ -29,9 +29,9 @@ from simoun_agent.cli.config_flags import (
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
-from simoun_agent.sweep import report
-from simoun_agent.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
-from simoun_agent.sweep.launch import (
+from simoun_lab.sweep import report
+from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
+from simoun_lab.sweep.launch import (
     check_fits,
     connect,
     finished,
@@ -41,7 +41,7 @@ from simoun_agent.sweep.launch import (
     stop_trials_on_sigterm,
     summarize,
 )
-from simoun_agent.sweep.trainable import STOP_FILE
+from simoun_lab.sweep.trainable import STOP_FILE
 
 PROG = "simoun-sweep"
 

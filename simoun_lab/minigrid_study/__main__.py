@@ -1,10 +1,10 @@
-"""``python -m simoun_agent.minigrid_study run|report``: the MiniGrid PPO study's command line.
+"""``python -m simoun_lab.minigrid_study run|report``: the MiniGrid PPO study's command line.
 
-python -m simoun_agent.minigrid_study run                  # every unfinished run, locally
-python -m simoun_agent.minigrid_study run --address auto   # on a running Ray cluster
-python -m simoun_agent.minigrid_study report               # docs/studies/minigrid/report/
-python -m simoun_agent.minigrid_study probe                # docs/studies/minigrid/probe/
-python -m simoun_agent.minigrid_study select --archive A   # a tuning archive's selection
+python -m simoun_lab.minigrid_study run                  # every unfinished run, locally
+python -m simoun_lab.minigrid_study run --address auto   # on a running Ray cluster
+python -m simoun_lab.minigrid_study report               # docs/studies/minigrid/report/
+python -m simoun_lab.minigrid_study probe                # docs/studies/minigrid/probe/
+python -m simoun_lab.minigrid_study select --archive A   # a tuning archive's selection
 """
 
 from __future__ import annotations
@@ -19,12 +19,12 @@ import tyro
 
 from simoun_agent.cli.flags import installed_version, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.minigrid_study.probe import PROBED, ProbeSettings
-from simoun_agent.minigrid_study.spec import StudySpec, load_spec
+from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings
+from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 
 ARCHIVE = Path("docs/studies/minigrid")
 
-PROG = "python -m simoun_agent.minigrid_study"
+PROG = "python -m simoun_lab.minigrid_study"
 
 
 def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
@@ -32,7 +32,7 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     archive that holds them (``archive`` is ARCHIVE, or ``new``: a ``run`` may start a study in
     an empty directory). An archive that is not there is refused rather than made up: a
     mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
-    from simoun_agent.minigrid_study.tune import SPEC_FILE
+    from simoun_lab.minigrid_study.tune import SPEC_FILE
 
     if not archive.is_dir():
         where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
@@ -80,7 +80,7 @@ class Probe:
 
     settings: ProbeSettings = field(default_factory=ProbeSettings)
     probes: list[str] = field(default_factory=lambda: list(PROBED))
-    """probes of ``simoun_agent.minigrid_study.probe.PROBED``"""
+    """probes of ``simoun_lab.minigrid_study.probe.PROBED``"""
     out: Path = ARCHIVE / "probe"
     """where probe.csv and probe.md go"""
 
@@ -112,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args=argv,
     )
     if isinstance(args, Probe):
-        from simoun_agent.minigrid_study.probe import write_probe
+        from simoun_lab.minigrid_study.probe import write_probe
 
         try:
             if not args.out.parent.is_dir():
@@ -128,18 +128,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
         if isinstance(args, Run):
-            from simoun_agent.minigrid_study.tune import run_study
+            from simoun_lab.minigrid_study.tune import run_study
 
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
             print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
             return 1 if outcome["failed"] else 0
         if isinstance(args, Select):
-            from simoun_agent.minigrid_study.select import write_selection
+            from simoun_lab.minigrid_study.select import write_selection
 
             print(write_selection(spec, args.archive))
             return 0
-        from simoun_agent.minigrid_study.report import write_report
-        from simoun_agent.minigrid_study.tune import finished_runs
+        from simoun_lab.minigrid_study.report import write_report
+        from simoun_lab.minigrid_study.tune import finished_runs
 
         if not finished_runs(spec, args.archive):
             raise SetupError(

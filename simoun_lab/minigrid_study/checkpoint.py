@@ -23,8 +23,8 @@ import numpy as np
 import torch
 from stable_baselines3.common.callbacks import BaseCallback
 
-from simoun_agent.minigrid_study.training import Training
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.minigrid_study.training import Training
 
 __all__ = ["CHECKPOINT", "RunCheckpoint", "intrinsic_state", "load_intrinsic_state", "restore"]
 
@@ -50,7 +50,7 @@ def load_intrinsic_state(envs: Any, state: dict[str, Any] | None) -> None:
 
 class RunCheckpoint(BaseCallback):
     """Writes ``path`` at the first rollout after each evaluation of the run ``training``
-    (a :class:`~simoun_agent.minigrid_study.training.Training`), then calls ``on_save`` with
+    (a :class:`~simoun_lab.minigrid_study.training.Training`), then calls ``on_save`` with
     it (the study hands it to Ray Tune, which keeps it beyond the run directory)."""
 
     def __init__(

@@ -29,9 +29,9 @@ import numpy as np
 import torch
 from gymnasium.vector import VectorEnv
 
-from simoun_agent.minigrid_study.arms import ARMS, consistency
-from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.minigrid_study.arms import ARMS, consistency
+from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
 
 __all__ = ["PROBED", "ProbeSettings", "probe", "write_probe"]
 

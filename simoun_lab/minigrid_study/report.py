@@ -1,5 +1,5 @@
 """The study's report from its archive: per task and arm the IQM of the final success rate and
-extrinsic return with 95 % stratified bootstrap CIs (Agarwal et al. 2021, ``simoun_agent.stats``),
+extrinsic return with 95 % stratified bootstrap CIs (Agarwal et al. 2021, ``simoun_lab.stats``),
 the probability that an intrinsic arm beats plain PPO, curves against env steps and wall time,
 each arm's step-time cost, and what the intrinsic rewards look like during training.
 
@@ -21,10 +21,10 @@ import numpy as np
 from matplotlib.figure import Figure  # no pyplot: no backend or global figure state
 from matplotlib.ticker import EngFormatter
 
-from simoun_agent import stats
-from simoun_agent.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
-from simoun_agent.minigrid_study.spec import Run, StudySpec
 from simoun_agent.run.checkpoint import atomic_write
+from simoun_lab import stats
+from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
+from simoun_lab.minigrid_study.spec import Run, StudySpec
 
 __all__ = ["REPORT", "write_report"]
 
@@ -385,7 +385,7 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "(mean^2 / (mean^2 + std^2), 1 for a constant), the discounted value of the mean reward "
         f"to a policy that never ends its episode (mean / (1 - gamma), gamma {spec.ppo.gamma}), "
         "and the share of rollouts whose reward correlated negatively with novelty. "
-        "`python -m simoun_agent.minigrid_study probe` measures the correlation without PPO "
+        "`python -m simoun_lab.minigrid_study probe` measures the correlation without PPO "
         "(`probe/`).",
         "",
         *survival_table(records),

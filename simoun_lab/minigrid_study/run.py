@@ -17,10 +17,10 @@ from typing import Any
 
 from stable_baselines3.common.callbacks import CallbackList
 
-from simoun_agent.minigrid_study.checkpoint import CHECKPOINT, RunCheckpoint, restore
-from simoun_agent.minigrid_study.spec import Run, StudySpec
-from simoun_agent.minigrid_study.training import CONFIG, set_up, write_json
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, RunCheckpoint, restore
+from simoun_lab.minigrid_study.spec import Run, StudySpec
+from simoun_lab.minigrid_study.training import CONFIG, set_up, write_json
 
 __all__ = ["EVAL_CSV", "RUN_FILES", "SUMMARY", "TRAIN_CSV", "train_run"]
 
@@ -50,7 +50,7 @@ def train_run(
 ) -> dict[str, Any]:
     """Train and evaluate ``run`` (set up by :func:`set_up`), writing its files into
     ``run_dir``; returns the summary. A ``checkpoint.pt`` left in ``run_dir`` by an ended
-    process is gone on from (:mod:`~simoun_agent.minigrid_study.checkpoint`); each new one is
+    process is gone on from (:mod:`~simoun_lab.minigrid_study.checkpoint`); each new one is
     passed to ``on_checkpoint``; the finished run removes it."""
     training = set_up(spec, run, run_dir, commit)
     ppo, clock, log = training.ppo, training.clock, training.log

@@ -18,11 +18,11 @@ from typing import Any
 
 import numpy as np
 
-from simoun_agent.minigrid_study.arms import parse_arm
-from simoun_agent.minigrid_study.report import read_rows
-from simoun_agent.minigrid_study.run import EVAL_CSV, SUMMARY
-from simoun_agent.minigrid_study.spec import StudySpec
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.minigrid_study.arms import parse_arm
+from simoun_lab.minigrid_study.report import read_rows
+from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY
+from simoun_lab.minigrid_study.spec import StudySpec
 
 __all__ = ["SELECTION", "run_auc", "select", "write_selection"]
 

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
-from simoun_agent.minigrid_study.arms import ARMS, parse_arm
+from simoun_lab.minigrid_study.arms import ARMS, parse_arm
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -78,7 +78,7 @@ class StudySpec:
     tasks: tuple[Task, ...] = field(default_factory=default_tasks)
     """the tasks with their budgets and seeds"""
     arms: tuple[str, ...] = ("ppo", "consistency", "rnd")
-    """arms: entries of ``simoun_agent.minigrid_study.arms.ARMS``, each optionally with settings
+    """arms: entries of ``simoun_lab.minigrid_study.arms.ARMS``, each optionally with settings
     (``"rnd,normalization=return_std,scale=0.01"``)"""
     ppo: PPOSettings = field(default_factory=PPOSettings)
     """PPO's settings, shared by every arm"""

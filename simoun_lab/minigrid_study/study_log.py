@@ -12,9 +12,9 @@ import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
 
-from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv
-from simoun_agent.minigrid_study.spec import Run, StudySpec
-from simoun_agent.minigrid_study.timing import RolloutClock
+from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv
+from simoun_lab.minigrid_study.spec import Run, StudySpec
+from simoun_lab.minigrid_study.timing import RolloutClock
 
 __all__ = ["StudyLog", "evaluate"]
 

@@ -11,12 +11,12 @@ import numpy as np
 import torch
 from stable_baselines3 import PPO
 
-from simoun_agent.minigrid_study.arms import build_arm
-from simoun_agent.minigrid_study.envs import SB3VecEnv, pixel_vector_env
-from simoun_agent.minigrid_study.spec import Run, StudySpec
-from simoun_agent.minigrid_study.study_log import StudyLog
-from simoun_agent.minigrid_study.timing import RolloutClock, TimedVecEnv
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.minigrid_study.arms import build_arm
+from simoun_lab.minigrid_study.envs import SB3VecEnv, pixel_vector_env
+from simoun_lab.minigrid_study.spec import Run, StudySpec
+from simoun_lab.minigrid_study.study_log import StudyLog
+from simoun_lab.minigrid_study.timing import RolloutClock, TimedVecEnv
 
 __all__ = ["CONFIG", "Training", "set_up", "write_json"]
 

@@ -24,13 +24,13 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
-from simoun_agent.minigrid_study.checkpoint import CHECKPOINT
-from simoun_agent.minigrid_study.run import RUN_FILES, SUMMARY, train_run
-from simoun_agent.minigrid_study.spec import StudySpec, spec_from_dict
-from simoun_agent.minigrid_study.training import write_json
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.study.provenance import code_version
-from simoun_agent.sweep.launch import connect, load_ray
+from simoun_lab.minigrid_study.checkpoint import CHECKPOINT
+from simoun_lab.minigrid_study.run import RUN_FILES, SUMMARY, train_run
+from simoun_lab.minigrid_study.spec import StudySpec, spec_from_dict
+from simoun_lab.minigrid_study.training import write_json
+from simoun_lab.study.provenance import code_version
+from simoun_lab.sweep.launch import connect, load_ray
 
 __all__ = ["SPEC_FILE", "finished_runs", "run_study"]
 

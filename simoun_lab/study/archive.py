@@ -14,11 +14,11 @@ from pathlib import Path
 
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME, TRAIN_CSV
-from simoun_agent.sweep.trainable import TRIAL_FILE
+from simoun_lab.sweep.trainable import TRIAL_FILE
 
 GENERALIZATION_CSV = "generalization.csv"
 """A finished evaluation run's returns under the distraction modes
-(:mod:`simoun_agent.study.generalization`), written after the run."""
+(:mod:`simoun_lab.study.generalization`), written after the run."""
 
 RUN_FILES = (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, TRIAL_FILE, GENERALIZATION_CSV, SUMMARY_NAME)
 """What the archive keeps of a finished run, ``summary.json`` last (its mark of a whole copy)."""

@@ -4,7 +4,7 @@
 that ``simoun-study plan`` (and ``run``, before any trial) refuses a task the agent cannot
 train on (discrete or unbounded actions, no pixels) or a setting the machine cannot hold, naming
 the spec's file and line. The frame size against each recipe's encoder is checked as the spec
-is read (:meth:`~simoun_agent.study.spec._Reader.check_runs`).
+is read (:meth:`~simoun_lab.study.spec._Reader.check_runs`).
 
 :func:`check_fixed_spec` lets a study resume under a spec fixed after a failure (a task that
 cannot run replaced, seeds added, a budget raised for runs not finished yet), as long as every
@@ -23,8 +23,8 @@ from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
-from simoun_agent.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
-from simoun_agent.study.spec import Source, StudySpec
+from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
+from simoun_lab.study.spec import Source, StudySpec
 
 MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
 """The keys a memory refusal asks to change, looked up in the spec to name their line."""

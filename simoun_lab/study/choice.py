@@ -1,5 +1,5 @@
 """The tuning phase's outcome: every setting's score and the one chosen for each recipe, by the
-spec's selection rule (:mod:`simoun_agent.study.selection`), saved as ``selection.json``."""
+spec's selection rule (:mod:`simoun_lab.study.selection`), saved as ``selection.json``."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ import numpy as np
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.study.plan import StudyRun, tuning_runs
-from simoun_agent.study.selection import SELECTION_RULES, TIE_RULE, best_setting
-from simoun_agent.study.spec import StudySpec
+from simoun_lab.study.plan import StudyRun, tuning_runs
+from simoun_lab.study.selection import SELECTION_RULES, TIE_RULE, best_setting
+from simoun_lab.study.spec import StudySpec
 
 SELECTION_FILE = "selection.json"
 

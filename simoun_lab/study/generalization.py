@@ -16,7 +16,7 @@ from pathlib import Path
 from simoun_agent.generalization.evaluation import evaluate_runs
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME
-from simoun_agent.study.archive import GENERALIZATION_CSV, copy_file
+from simoun_lab.study.archive import GENERALIZATION_CSV, copy_file
 
 COLUMNS = ("mode", "return_mean", "return_std", "episodes", "first_seed", "env_step")
 """The columns of ``generalization.csv``: one row per mode, ``train`` first."""

@@ -7,7 +7,7 @@ its tuning selected x evaluation task x held-out seed, at
 method) run there too, each at its method's selected setting. A run's path under the study
 directory is its name, in Ray Tune's tables and in the archive. :func:`describe` is
 ``simoun-study plan``'s listing of them, with the CPU time each should take
-(:mod:`simoun_agent.study.probe`).
+(:mod:`simoun_lab.study.probe`).
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.rules import show
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.study import probe
-from simoun_agent.study.spec import StudySpec
-from simoun_agent.sweep.grid import Trial, path_part, typed
+from simoun_lab.study import probe
+from simoun_lab.study.spec import StudySpec
+from simoun_lab.sweep.grid import Trial, path_part, typed
 
 TUNING, EVALUATION = "tuning", "evaluation"
 

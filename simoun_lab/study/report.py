@@ -3,7 +3,7 @@
 Written into ``<study>/report/`` (and the archive's ``report/``):
 
 - ``tuning/`` and ``evaluation/``: ``simoun-report`` of each phase's runs
-  (:func:`simoun_agent.sweep.report.write_report`: per recipe and task the IQM of the normalized
+  (:func:`simoun_lab.sweep.report.write_report`: per recipe and task the IQM of the normalized
   final return with its 95 % stratified bootstrap CI, the aggregate over tasks, the probability
   of improvement of each pair, per-task curves and the performance profile);
 - ``report.md``: the protocol (code commit, recipes and what each was given, grid, seeds of each
@@ -21,7 +21,7 @@ Written into ``<study>/report/`` (and the archive's ``report/``):
   recipe's update time over the baseline's, measured side by side): the IQM curves against wall
   time on the baseline's clock stretched by each recipe's ratio (``iqm_wall_time_update_cost.png``).
 
-Scores follow Agarwal et al. 2021 (:mod:`simoun_agent.stats`): the last evaluation's mean
+Scores follow Agarwal et al. 2021 (:mod:`simoun_lab.stats`): the last evaluation's mean
 return divided by the task's maximum (1000 for dm_control; raw returns for tasks without a
 known maximum).
 """
@@ -38,7 +38,6 @@ from typing import Any
 
 import numpy as np
 
-from simoun_agent import stats
 from simoun_agent.config import RECIPES, resolve, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
@@ -46,9 +45,10 @@ from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
-from simoun_agent.study.choice import SELECTION_FILE, Choice
-from simoun_agent.study.generalization import read_modes
-from simoun_agent.study.plan import (
+from simoun_lab import stats
+from simoun_lab.study.choice import SELECTION_FILE, Choice
+from simoun_lab.study.generalization import read_modes
+from simoun_lab.study.plan import (
     EVALUATION,
     TUNING,
     StudyRun,
@@ -56,10 +56,10 @@ from simoun_agent.study.plan import (
     setting_label,
     tuning_runs,
 )
-from simoun_agent.study.selection import SELECTION_RULES, TIE_RULE
-from simoun_agent.study.spec import StudySpec, fixed_by
-from simoun_agent.sweep import report as sweep_report
-from simoun_agent.sweep.trainable import read_trial_parts
+from simoun_lab.study.selection import SELECTION_RULES, TIE_RULE
+from simoun_lab.study.spec import StudySpec, fixed_by
+from simoun_lab.sweep import report as sweep_report
+from simoun_lab.sweep.trainable import read_trial_parts
 
 REPORT_DIR = "report"
 REPORT_MD = "report.md"
@@ -340,7 +340,7 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
             maxima + ([f"raw returns on {', '.join(raw)}: no known maximum"] if raw else [])
         )
         + "). IQM: the 25 % trimmed mean over runs; [low, high]: the 95 % stratified bootstrap "
-        "interval (Agarwal et al. 2021; `simoun_agent/stats.py`). With a few seeds per task the "
+        "interval (Agarwal et al. 2021; `simoun_lab/stats.py`). With a few seeds per task the "
         "intervals are wide: overlapping intervals are no evidence of a difference.",
         "",
         "| task | recipe | n | return (mean ± std) | IQM score [95 % CI] |",

@@ -1,6 +1,6 @@
 """Running a study from its spec (the library under ``simoun-study``,
-:mod:`simoun_agent.cli.study`): the study record, both phases on Ray Tune through
-:mod:`simoun_agent.sweep.launch`, the selection between them and the report at the end.
+:mod:`simoun_lab.cli.study`): the study record, both phases on Ray Tune through
+:mod:`simoun_lab.sweep.launch`, the selection between them and the report at the end.
 """
 
 from __future__ import annotations
@@ -15,12 +15,12 @@ from typing import Any, Literal
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME
-from simoun_agent.study import archive as archiving
-from simoun_agent.study.archive import GENERALIZATION_CSV
-from simoun_agent.study.checks import check_fixed_spec, check_study
-from simoun_agent.study.choice import SELECTION_FILE, Choice, choose, save_choices
-from simoun_agent.study.generalization import play_modes, playable, to_play
-from simoun_agent.study.plan import (
+from simoun_lab.study import archive as archiving
+from simoun_lab.study.archive import GENERALIZATION_CSV
+from simoun_lab.study.checks import check_fixed_spec, check_study
+from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
+from simoun_lab.study.generalization import play_modes, playable, to_play
+from simoun_lab.study.plan import (
     EVALUATION,
     TUNING,
     StudyRun,
@@ -29,10 +29,10 @@ from simoun_agent.study.plan import (
     setting_label,
     tuning_runs,
 )
-from simoun_agent.study.provenance import code_version, same_code
-from simoun_agent.study.report import REPORT_DIR, REPORT_MD, write_study_report
-from simoun_agent.study.spec import StudySpec, load_spec
-from simoun_agent.sweep import launch
+from simoun_lab.study.provenance import code_version, same_code
+from simoun_lab.study.report import REPORT_DIR, REPORT_MD, write_study_report
+from simoun_lab.study.spec import StudySpec, load_spec
+from simoun_lab.sweep import launch
 
 STUDY_FILE = "study.json"
 """The study record, in the study directory and the archive: the spec (its file, text and
@@ -234,7 +234,7 @@ class Phases:
         self.connect()
         callbacks = []
         if self.archive is not None:
-            from simoun_agent.study.tune_callback import ArchiveOnComplete
+            from simoun_lab.study.tune_callback import ArchiveOnComplete
 
             names = {run.trial(self.spec, self.study_dir).name: run.name for run in todo}
             callbacks.append(ArchiveOnComplete(self.study_dir, self.archive, names))

@@ -3,7 +3,7 @@
 A rule scores one run from its evaluation curve; a setting's score is the mean over the tuning
 tasks of the mean over each task's seeds (so every task weighs the same), and each recipe gets
 its best setting. Returns are normalized by the task's maximum first
-(:func:`simoun_agent.stats.normalize`: 1000 for dm_control), so tasks of different scales
+(:func:`simoun_lab.stats.normalize`: 1000 for dm_control), so tasks of different scales
 compare. A new rule is one entry of :data:`SELECTION_RULES`.
 
 Example:
@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from simoun_agent.stats import normalize
-from simoun_agent.sweep.report import area_under_curve
+from simoun_lab.stats import normalize
+from simoun_lab.sweep.report import area_under_curve
 
 
 @dataclass(frozen=True)

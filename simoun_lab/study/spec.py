@@ -66,13 +66,13 @@ from simoun_agent.config.keys import (
 )
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
-from simoun_agent.study.selection import SELECTION_RULES
-from simoun_agent.study.toml_lines import key_line
-from simoun_agent.sweep.grid import parse_seeds
+from simoun_lab.study.selection import SELECTION_RULES
+from simoun_lab.study.toml_lines import key_line
+from simoun_lab.sweep.grid import parse_seeds
 
 try:
     import tomllib
-except ModuleNotFoundError:  # Python 3.10: the same parser from PyPI (the sweep extra has it)
+except ModuleNotFoundError:  # Python 3.10: the same parser from PyPI (the lab extra has it)
     import tomli as tomllib
 
 PHASES = ("tuning", "evaluation")
@@ -163,7 +163,7 @@ class StudySpec:
     recipes: list
     """recipe names; the first is compared with each of the others"""
     selection: str
-    """the selection rule (:data:`~simoun_agent.study.selection.SELECTION_RULES`)"""
+    """the selection rule (:data:`~simoun_lab.study.selection.SELECTION_RULES`)"""
     preset: str | None
     """the preset every run starts from"""
     base: dict

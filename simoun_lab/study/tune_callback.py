@@ -8,12 +8,12 @@ from typing import Any
 
 from ray import tune
 
-from simoun_agent.study.archive import archive_run
+from simoun_lab.study.archive import archive_run
 
 
 class ArchiveOnComplete(tune.Callback):
     """Copy a completed trial's run into the archive (a trial stopped on SIGTERM completes
-    too, unfinished: :func:`~simoun_agent.study.archive.archive_run` then copies nothing)."""
+    too, unfinished: :func:`~simoun_lab.study.archive.archive_run` then copies nothing)."""
 
     def __init__(self, study_dir: Path, archive: Path, names: dict[str, str]) -> None:
         self.study_dir, self.archive = study_dir, archive

@@ -1,9 +1,9 @@
 """Sweeps: a grid of ordinary training runs on Ray Tune (``simoun-sweep``), and their report
 (``simoun-report``).
 
-Ray is an optional extra (``pip install 'simoun[sweep]'``) imported only by
-:mod:`simoun_agent.sweep.trainable` and :mod:`simoun_agent.sweep.launch`; the grid
-(:mod:`simoun_agent.sweep.grid`) and the report (:mod:`simoun_agent.sweep.report`) work without
+Ray is an optional extra (``pip install 'simoun[lab]'``) imported only by
+:mod:`simoun_lab.sweep.trainable` and :mod:`simoun_lab.sweep.launch`; the grid
+(:mod:`simoun_lab.sweep.grid`) and the report (:mod:`simoun_lab.sweep.report`) work without
 it, and the rest of ``simoun_agent`` never imports this package.
 
 A sweep directory holds ``sweep.json`` (the grid and the base config), one run directory per

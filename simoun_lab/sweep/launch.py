@@ -1,9 +1,9 @@
 """Running a grid of training runs on Ray Tune (the library under ``simoun-sweep``,
-:mod:`simoun_agent.cli.sweep`, and ``simoun-study``): Ray's start, the trials as one Tune
+:mod:`simoun_lab.cli.sweep`, and ``simoun-study``): Ray's start, the trials as one Tune
 experiment, the STOP file on SIGTERM and the summary of what happened.
 
 Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``; the report
-(:mod:`simoun_agent.sweep.report`) is written when the sweep ends.
+(:mod:`simoun_lab.sweep.report`) is written when the sweep ends.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from typing import Any
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.sweep.grid import SweepSpec, Trial
-from simoun_agent.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table
+from simoun_lab.sweep.grid import SweepSpec, Trial
+from simoun_lab.sweep.trainable import ERROR_FILE, STOP_FILE, run_trial, trial_table
 
 CONNECT_TIMEOUT_S = 5.0
 """How long ``--address HOST:PORT`` may take to answer before the sweep gives up."""
@@ -36,7 +36,7 @@ def load_ray() -> ModuleType:
     except ImportError:
         raise SetupError(
             "simoun-sweep runs on Ray Tune, which is not installed; install it with: "
-            "pip install 'simoun[sweep]'"
+            "pip install 'simoun[lab]'"
         ) from None
     return ray
 

@@ -1,7 +1,7 @@
-"""The report behind ``simoun-report DIR`` (:mod:`simoun_agent.cli.report`): compare the runs
+"""The report behind ``simoun-report DIR`` (:mod:`simoun_lab.cli.report`): compare the runs
 of a sweep, or of any directory of ``simoun-train`` runs, per variant and env, over seeds (the
 paper's Table 1 and Fig. 6), with the statistics of Agarwal et al. 2021 (rliable;
-:mod:`simoun_agent.stats`). Needs no Ray.
+:mod:`simoun_lab.stats`). Needs no Ray.
 
     simoun-report sweeps/baselines
     simoun-report runs/ --out runs/report
@@ -17,7 +17,7 @@ one evaluation grid (:func:`one_evaluation_grid`). Writes:
 - ``report.md`` and ``report.csv``: per variant x env, the number of seeds n and mean ± std
   over seeds (sample std, ddof=1) of the final evaluation return, of the area under the
   learning curve, of the wall time and of the env steps per second; and on the final returns
-  normalized by the task's maximum (:func:`simoun_agent.stats.normalize`), the IQM and the mean
+  normalized by the task's maximum (:func:`simoun_lab.stats.normalize`), the IQM and the mean
   with their 95 % stratified-bootstrap confidence intervals (columns ``iqm``, ``iqm_low``,
   ``iqm_high``, ``norm_mean``, ``norm_mean_low``, ``norm_mean_high``, ``score_max``);
 - ``aggregate.csv``: per variant, the IQM and mean over all runs of all its tasks, with CIs;
@@ -46,7 +46,6 @@ from typing import Any
 
 import numpy as np
 
-from simoun_agent import stats
 from simoun_agent.config import SetupError, from_dict, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
@@ -55,8 +54,9 @@ from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
-from simoun_agent.sweep.grid import BASE_VARIANT, SWEEP_FILE
-from simoun_agent.sweep.report_plots import Band, plot_panels
+from simoun_lab import stats
+from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE
+from simoun_lab.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
 REPORT_CSV = "report.csv"
@@ -67,7 +67,7 @@ CURVES_TIME_PNG = "curves_wall_time.png"
 IQM_STEPS_PNG = "iqm_env_steps.png"
 PROFILE_PNG = "performance_profile.png"
 ERROR_FILE = "error.txt"
-"""Written by a failed sweep trial into its run directory (:mod:`simoun_agent.sweep.trainable`)."""
+"""Written by a failed sweep trial into its run directory (:mod:`simoun_lab.sweep.trainable`)."""
 
 NOT_VARIANT = {
     "seed",

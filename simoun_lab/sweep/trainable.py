@@ -28,8 +28,8 @@ from simoun_agent.run import train
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
 from simoun_agent.run.signals import Stopped
-from simoun_agent.sweep.grid import Trial
-from simoun_agent.sweep.report import ERROR_FILE
+from simoun_lab.sweep.grid import Trial
+from simoun_lab.sweep.report import ERROR_FILE
 
 TRIAL_FILE = "trial.json"
 """Written by each trial into its run directory: one entry per part it ran (a resumed trial has
