@@ -4,7 +4,7 @@
 Ray is an optional extra (``pip install 'simoun[lab]'``) imported only by
 :mod:`simoun_lab.sweep.trainable` and :mod:`simoun_lab.sweep.launch`; the grid
 (:mod:`simoun_lab.sweep.grid`) and the report (:mod:`simoun_lab.sweep.report`) work without
-it, and the rest of ``simoun_agent`` never imports this package.
+it, and ``simoun_agent`` never imports this package.
 
 A sweep directory holds ``sweep.json`` (the grid and the base config), one run directory per
 trial at ``<variant>/<env>/s<seed>`` (the same files as ``simoun-train`` writes, so each can be
