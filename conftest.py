@@ -1,10 +1,10 @@
-"""Suite-wide pytest set-up: headless defaults, one torch thread, doctests of both packages.
+"""Suite-wide pytest set-up: headless defaults, one torch thread, doctests of the packages.
 
-``--doctest-modules`` (pyproject's ``addopts``) runs every ``>>>`` example of ``simoun_wrappers``
-and ``simoun_agent``, as Gymnasium does. A module that imports an optional dependency which is
-not installed (pettingzoo without the ``multiagent`` extra, say) cannot be imported to collect
-its examples: it is left out of collection, and the report header names it and the missing
-package, so nothing is skipped silently.
+``--doctest-modules`` (pyproject's ``addopts``) runs every ``>>>`` example of ``simoun_wrappers``,
+``simoun_agent`` and ``simoun_lab``, as Gymnasium does. A module that imports an optional
+dependency which is not installed (pettingzoo without the ``multiagent`` extra, say) cannot be
+imported to collect its examples: it is left out of collection, and the report header names it
+and the missing package, so nothing is skipped silently.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import pytest
 import simoun_wrappers  # noqa: F401  (headless rendering defaults, before dm_control/pygame load)
 
 ROOT = Path(__file__).parent
-PACKAGES = (ROOT / "simoun_wrappers", ROOT / "simoun_agent")
+PACKAGES = (ROOT / "simoun_wrappers", ROOT / "simoun_agent", ROOT / "simoun_lab")
 
 
 @pytest.fixture(autouse=True)

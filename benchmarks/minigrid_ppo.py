@@ -1,6 +1,6 @@
 """Is env stepping the bottleneck of SB3 PPO on MiniGrid pixels? And what will the study cost?
 
-For each arm of the MiniGrid study (``simoun_agent.minigrid_study``), PPO with the study's
+For each arm of the MiniGrid study (``simoun_lab.minigrid_study``), PPO with the study's
 settings (rl-zoo's MiniGrid entry: 8 sub-envs x 128 steps, 10 epochs of minibatch 64,
 ``CnnPolicy`` on the folded 56x56 triplet) trains for a few rollouts on one torch thread. Per
 rollout it times ``env.step`` of the wrapped vector env (pixels, triplets and the arm's
@@ -29,10 +29,10 @@ import time
 import torch
 from stable_baselines3 import PPO
 
-from simoun_agent.minigrid_study.arms import ARMS
-from simoun_agent.minigrid_study.envs import SB3VecEnv, pixel_vector_env
-from simoun_agent.minigrid_study.spec import StudySpec
-from simoun_agent.minigrid_study.timing import RolloutClock, TimedVecEnv
+from simoun_lab.minigrid_study.arms import ARMS
+from simoun_lab.minigrid_study.envs import SB3VecEnv, pixel_vector_env
+from simoun_lab.minigrid_study.spec import StudySpec
+from simoun_lab.minigrid_study.timing import RolloutClock, TimedVecEnv
 
 
 def measure(env_id: str, arm: str, rollouts: int, spec: StudySpec) -> dict[str, float]:

@@ -26,7 +26,7 @@ times the updates themselves, every recipe in the same process on the same repla
 
 ``--json`` also writes the ratios with where they were measured (the command, the commit, the
 machine), in the form ``simoun-study report`` reads
-(:data:`simoun_agent.study.report.UPDATE_COST_JSON`).
+(:data:`simoun_lab.study.report.UPDATE_COST_JSON`).
 """
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ from simoun_agent.config import resolve
 from simoun_agent.config.recipes import SIMOUN_PARTS
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.train import build
-from simoun_agent.study.probe import machine
-from simoun_agent.study.provenance import code_version
+from simoun_lab.study.probe import machine
+from simoun_lab.study.provenance import code_version
 
 SELECTION = Path(__file__).resolve().parent.parent / "docs/studies/dmc100k/selection.json"
 BASELINE = "drq"

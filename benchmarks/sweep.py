@@ -72,7 +72,7 @@ def sequential(out: Path, flags: list[str]) -> float:
 def sweep(out: Path, flags: list[str], num_cpus: int) -> float:
     """The 4 trials as one ``simoun-sweep``, a fresh local Ray instance of ``num_cpus``."""
     grid = ["--grid", "agent.recipe=" + ",".join(RECIPES), "--seeds", f"{SEEDS[0]}-{SEEDS[-1]}"]
-    command = [sys.executable, "-m", "simoun_agent.cli.sweep", *flags, *grid]
+    command = [sys.executable, "-m", "simoun_lab.cli.sweep", *flags, *grid]
     command += ["--cpus-per-trial", "1", "--num-cpus", str(num_cpus), "--verbose", "0"]
     return timed([*command, "--sweep-dir", str(out / "sweep")])
 

@@ -8,7 +8,7 @@ set -u
 steps=${STUDY_STEPS:-16000}
 root=${STUDY_DIR:-/tmp/bias-study}
 out=${OUT:-/tmp/out}
-analyze="python3 -m simoun_agent.cli.analyze"
+analyze="python3 -m simoun_lab.cli.analyze"
 mkdir -p "$root" "$out"
 for encoder in stacked flare dual_interactive; do
   for seed in ${SEEDS:-1 2 3}; do

@@ -2,14 +2,17 @@
 
 The torch parts load on first use (``simoun_agent.SimounAgent``, PEP 562), so importing the
 torch-free configuration (:mod:`simoun_agent.config`) or the run directories' readers does not
-import torch.
+import torch. The lab that used to live here is :mod:`simoun_lab` (:mod:`simoun_agent.moved`).
 """
 
 import importlib
 from typing import Any
 
 import simoun_wrappers  # noqa: F401  (headless rendering defaults)
+from simoun_agent import moved
 from simoun_agent.config import AgentConfig
+
+moved.install()  # the lab's former names (simoun_agent.study, ...) for one release
 
 _LAZY = {
     "DualPathEncoder": "simoun_agent.models.encoder",

@@ -10,16 +10,16 @@ import pytest
 import torch
 from test_train_resume import TINY as RESUME_TINY
 
-from simoun_agent.analysis import masks as mask_pictures
-from simoun_agent.analysis.bias import information_bias
-from simoun_agent.analysis.layers import layer_activations
-from simoun_agent.analysis.pairs import make_pairs
-from simoun_agent.analysis.recolour import dm_control_physics, replay_recoloured
-from simoun_agent.cli.analyze import main
 from simoun_agent.config import AgentConfig, resolve
 from simoun_agent.models.encoder import ENCODERS, DualPathEncoder, make_encoder
 from simoun_agent.run import train
 from simoun_agent.run.make_env import make_env
+from simoun_lab.analysis import masks as mask_pictures
+from simoun_lab.analysis.bias import information_bias
+from simoun_lab.analysis.layers import layer_activations
+from simoun_lab.analysis.pairs import make_pairs
+from simoun_lab.analysis.recolour import dm_control_physics, replay_recoloured
+from simoun_lab.cli.analyze import main
 from simoun_wrappers import SimounObservation
 
 TINY = {**RESUME_TINY, "total_env_steps": 60}

@@ -17,7 +17,7 @@ from simoun_agent.cli import train as train_cli
 from simoun_agent.run.logger import CURVE_PNG
 
 EXTRAS = ("dmc", "highway", "minigrid", "multiagent", "sb3")
-"""The extras scripts/test_floors.sh installs at their floors (sweep pins ray exactly)."""
+"""The extras scripts/test_floors.sh installs at their floors (lab pins ray exactly)."""
 
 
 def floors(kind: str) -> dict[str, Version]:

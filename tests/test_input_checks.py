@@ -18,14 +18,14 @@ import pytest
 from gymnasium.wrappers import TransformReward
 from test_cli_conventions import TINY
 
-from simoun_agent.cli import report as report_cli
 from simoun_agent.cli import train as train_cli
 from simoun_agent.cli.config_flags import check_given_once, overrides_from
 from simoun_agent.config import resolve, to_dict
-from simoun_agent.minigrid_study import __main__ as minigrid_cli
 from simoun_agent.run import memory
 from simoun_agent.run.logger import read_csv
-from simoun_agent.sweep.report import write_report
+from simoun_lab.cli import report as report_cli
+from simoun_lab.minigrid_study import __main__ as minigrid_cli
+from simoun_lab.sweep.report import write_report
 from simoun_wrappers import (
     ActionRepeat,
     FrameTriplet,
@@ -123,10 +123,10 @@ def test_a_misspelled_sb3_policy_is_not_reported_as_fitting():
 
 def test_the_minigrid_study_answers_version(capsys):
     assert minigrid_cli.main(["--version"]) == 0
-    assert capsys.readouterr().out.startswith("python -m simoun_agent.minigrid_study ")
+    assert capsys.readouterr().out.startswith("python -m simoun_lab.minigrid_study ")
 
 
-@pytest.mark.parametrize("module", ["simoun_agent.cli.report", "simoun_agent.minigrid_study"])
+@pytest.mark.parametrize("module", ["simoun_lab.cli.report", "simoun_lab.minigrid_study"])
 def test_a_pipe_closed_early_ends_quietly(module):
     # help is longer than a pipe's buffer only with many lines: read one byte and close
     with subprocess.Popen(
@@ -299,7 +299,7 @@ def test_a_damaged_run_is_named_and_left_out(tmp_path):
 
 
 def test_a_study_report_of_a_missing_directory_gives_the_report_advice(tmp_path, capsys):
-    from simoun_agent.cli import study as study_cli
+    from simoun_lab.cli import study as study_cli
 
     spec = str(ROOT / "docs" / "studies" / "dmc100k.toml")
     err = refused(capsys, study_cli.main, ["report", spec, "--study-dir", str(tmp_path / "x")])

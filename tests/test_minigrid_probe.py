@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from gymnasium.vector import VectorWrapper
 
-from simoun_agent.minigrid_study.envs import STATE_KEY
-from simoun_agent.minigrid_study.probe import PROBED, ProbeSettings, pearson, probe, write_probe
+from simoun_lab.minigrid_study.envs import STATE_KEY
+from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings, pearson, probe, write_probe
 
 
 def test_pearson_by_hand():
@@ -69,7 +69,7 @@ def test_the_command_line_probes_the_consistency_model(tmp_path):
     command = [
         sys.executable,
         "-m",
-        "simoun_agent.minigrid_study",
+        "simoun_lab.minigrid_study",
         "probe",
         "--probes",
         "consistency",

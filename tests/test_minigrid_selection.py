@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from simoun_agent.config import SetupError
-from simoun_agent.minigrid_study.arms import arm_name, parse_arm
-from simoun_agent.minigrid_study.report import read_rows
-from simoun_agent.minigrid_study.select import run_auc, select, write_selection
-from simoun_agent.minigrid_study.spec import load_spec, spec_from_dict
+from simoun_lab.minigrid_study.arms import arm_name, parse_arm
+from simoun_lab.minigrid_study.report import read_rows
+from simoun_lab.minigrid_study.select import run_auc, select, write_selection
+from simoun_lab.minigrid_study.spec import load_spec, spec_from_dict
 
 V1 = Path(__file__).parent.parent / "docs" / "studies" / "minigrid"
 TASK = "MiniGrid-DoorKey-6x6-v0"

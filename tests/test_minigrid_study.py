@@ -17,11 +17,11 @@ import pytest
 import torch
 from gymnasium.vector import AutoresetMode
 
-from simoun_agent.minigrid_study.checkpoint import CHECKPOINT, restore
-from simoun_agent.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
-from simoun_agent.minigrid_study.run import train_run
-from simoun_agent.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
-from simoun_agent.minigrid_study.training import set_up
+from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, restore
+from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
+from simoun_lab.minigrid_study.run import train_run
+from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
+from simoun_lab.minigrid_study.training import set_up
 
 TINY = {
     "tasks": [{"env_id": "MiniGrid-DoorKey-5x5-v0", "steps": 2048, "seeds": [0]}],
@@ -32,7 +32,7 @@ TINY = {
 
 
 def study(*args: str) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "simoun_agent.minigrid_study", *args]
+    command = [sys.executable, "-m", "simoun_lab.minigrid_study", *args]
     return subprocess.run(command, capture_output=True, text=True, timeout=600)
 
 
@@ -90,7 +90,7 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
 
 
 def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_pooled_score(tmp_path):
-    from simoun_agent.minigrid_study.report import Records, improvement_lines, score_table
+    from simoun_lab.minigrid_study.report import Records, improvement_lines, score_table
 
     study_dir = Path(__file__).parent.parent / "docs" / "studies" / "minigrid"
     small, large = "MiniGrid-DoorKey-6x6-v0", "MiniGrid-DoorKey-8x8-v0"
@@ -164,8 +164,8 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     run_dir = tmp_path / "run"
     code = (
         "import sys, json; from pathlib import Path\n"
-        "from simoun_agent.minigrid_study.spec import spec_from_dict\n"
-        "from simoun_agent.minigrid_study.run import train_run\n"
+        "from simoun_lab.minigrid_study.spec import spec_from_dict\n"
+        "from simoun_lab.minigrid_study.run import train_run\n"
         "spec = spec_from_dict(json.loads(sys.argv[1]), 'test')\n"
         "run = [r for r in spec.runs() if r.arm == 'consistency'][0]\n"
         "train_run(spec, run, Path(sys.argv[2]))\n"
@@ -219,7 +219,7 @@ def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_go
     archive.mkdir()  # a study's archive is never created by default
     paths = ["--archive", str(archive), "--spec", str(spec_file), "--work-dir", str(work)]
     archived = archive / "MiniGrid-DoorKey-5x5-v0" / "ppo" / "s0" / CHECKPOINT
-    command = [sys.executable, "-m", "simoun_agent.minigrid_study", "run", *paths]
+    command = [sys.executable, "-m", "simoun_lab.minigrid_study", "run", *paths]
     process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL)
     deadline = time.monotonic() + 600  # generous: the suite may share a loaded machine
     while not archived.is_file():
@@ -244,7 +244,7 @@ def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_go
 
 
 def test_survival_row_by_hand():
-    from simoun_agent.minigrid_study.report import survival_row
+    from simoun_lab.minigrid_study.report import survival_row
 
     row = {"intrinsic_mean": 0.3, "intrinsic_std": 0.4, "novelty_corr": -0.1}
     # 0.09 / (0.09 + 0.16); 0.3 / (1 - 0.9); a negative correlation
@@ -260,7 +260,7 @@ def test_survival_row_by_hand():
 def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path):
     import shutil
 
-    from simoun_agent.minigrid_study.report import Records
+    from simoun_lab.minigrid_study.report import Records
 
     study_dir = Path(__file__).parent.parent / "docs" / "studies" / "minigrid"
     task = "MiniGrid-DoorKey-6x6-v0"
@@ -273,7 +273,7 @@ def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path
     ]
     assert len(records.final(task, "ppo", "success_rate")) == 1
     # the exploration column: distinct states reached, averaged over the bracket's rollouts
-    from simoun_agent.minigrid_study.report import intrinsic_table
+    from simoun_lab.minigrid_study.report import intrinsic_table
 
     rows = records.train[f"{task}/ppo/s0"]
     last_tenth = rows[int(0.9 * len(rows)) :]

@@ -21,7 +21,7 @@ from simoun_agent.config.keys import config_sections
 from simoun_agent.models.actors import DeterministicActor
 from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.run import train
-from simoun_agent.sweep.report import with_defaults
+from simoun_lab.sweep.report import with_defaults
 from simoun_wrappers.augment import random_shift, shift_pad
 
 FRAME = (3, 24, 24)

@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 from test_train_resume import TINY as RESUME_TINY
 
-from simoun_agent import stats
-from simoun_agent.cli import report as report_cli
 from simoun_agent.config import resolve, to_dict
 from simoun_agent.run import train
 from simoun_agent.run.logger import read_csv
-from simoun_agent.sweep import report
-from simoun_agent.sweep.grid import SweepSpec
+from simoun_lab import stats
+from simoun_lab.cli import report as report_cli
+from simoun_lab.sweep import report
+from simoun_lab.sweep.grid import SweepSpec
 
 TINY = {key: value for key, value in RESUME_TINY.items() if key != "seed"}
 """The tiny run of tests/test_train_resume.py, each run choosing its own seed."""
@@ -384,7 +384,7 @@ def test_a_read_only_directory_is_refused_naming_it_and_the_out_flag(runs_dir, t
     mount in a user and mount namespace of its own (as a read-only share would be); as any
     other user its write bits are taken away."""
     root = copy_runs(runs_dir, ("a-s0",), tmp_path / "runs")
-    command = [sys.executable, "-m", "simoun_agent.cli.report", str(root)]
+    command = [sys.executable, "-m", "simoun_lab.cli.report", str(root)]
     if os.geteuid() == 0:
         mount = f"mount --bind {root} {root} && mount -o remount,bind,ro {root} {root}"
         command = ["unshare", "-rm", "sh", "-c", f"{mount} && exec {shlex.join(command)}"]

@@ -7,7 +7,6 @@ import pytest
 import torch
 from test_train_resume import TINY
 
-from simoun_agent.cli import analyze as analyze_cli
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.models.encoder import ENCODERS
@@ -15,6 +14,7 @@ from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
 from simoun_agent.run.load import load_run
+from simoun_lab.cli import analyze as analyze_cli
 
 TRAINED_ON = "cuda:0"
 """The device string the run's checkpoint is made to say it trained on."""

@@ -1,4 +1,4 @@
-"""simoun_agent.stats against hand-worked examples and against the rliable package itself
+"""simoun_lab.stats against hand-worked examples and against the rliable package itself
 (Agarwal et al. 2021) on the same scores: the same point estimates and, since the resampling
 draws rliable's indices from the same seeded stream, the same bootstrap intervals."""
 
@@ -7,7 +7,7 @@ import pytest
 from rliable import library as rly
 from rliable import metrics
 
-from simoun_agent import stats
+from simoun_lab import stats
 
 
 def as_tasks(matrix):

@@ -13,16 +13,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
+import ray  # the lab extra, which CI installs: a missing install fails instead of skipping
 
-from simoun_agent.cli import study as cli
 from simoun_agent.config import RECIPES, SetupError
-from simoun_agent.study.plan import evaluation_runs, tuning_runs
-from simoun_agent.study.provenance import code_version
-from simoun_agent.study.report import RunResult, cost_curves, mean_cpu, read_result
-from simoun_agent.study.runner import StudyOptions, check_same_spec, open_study
-from simoun_agent.study.spec import load_spec
-from simoun_agent.study.toml_lines import key_line
+from simoun_lab.cli import study as cli
+from simoun_lab.study.plan import evaluation_runs, tuning_runs
+from simoun_lab.study.provenance import code_version
+from simoun_lab.study.report import RunResult, cost_curves, mean_cpu, read_result
+from simoun_lab.study.runner import StudyOptions, check_same_spec, open_study
+from simoun_lab.study.spec import load_spec
+from simoun_lab.study.toml_lines import key_line
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
 
@@ -496,7 +496,7 @@ def test_without_ray_a_study_plans_and_says_how_to_install_ray_to_run(
     with pytest.raises(SystemExit) as exit_info:
         cli.main(["run", str(spec), "--study-dir", str(tmp_path / "s")])
     assert exit_info.value.code == 2
-    assert "pip install 'simoun[sweep]'" in capsys.readouterr().err
+    assert "pip install 'simoun[lab]'" in capsys.readouterr().err
     assert not (tmp_path / "s").exists()
 
 

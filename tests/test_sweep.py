@@ -12,12 +12,12 @@ import time
 from pathlib import Path
 
 import pytest
-import ray  # the sweep extra, which CI installs: a missing install fails instead of skipping
+import ray  # the lab extra, which CI installs: a missing install fails instead of skipping
 
-from simoun_agent.cli import sweep as cli
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
-from simoun_agent.sweep.grid import SWEEP_FILE, parse_seeds, split_values
+from simoun_lab.cli import sweep as cli
+from simoun_lab.sweep.grid import SWEEP_FILE, parse_seeds, split_values
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
 
@@ -149,7 +149,7 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=120,360"]
     argv += ["--seeds", "0-1", "--sweep-dir"]
     argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
-    command = [sys.executable, "-m", "simoun_agent.cli.sweep", *argv]
+    command = [sys.executable, "-m", "simoun_lab.cli.sweep", *argv]
     log = tmp_path / "sweep.log"  # a file, not a pipe nobody reads until the end
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
@@ -180,7 +180,7 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
 
     resumed = [*argv, "--resume"]
     result = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.cli.sweep", *resumed],
+        [sys.executable, "-m", "simoun_lab.cli.sweep", *resumed],
         capture_output=True,
         text=True,
         timeout=600,  # generous: a loaded CI machine must not fail the test
@@ -206,7 +206,7 @@ def test_sigterm_stops_every_trial_with_a_checkpoint_and_resume_finishes(ray_add
     argv[at + 1] = "1000000000"
     argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir), "--address", ray_address]
     argv += ["--verbose", "0"]
-    command = [sys.executable, "-m", "simoun_agent.cli.sweep", *argv]
+    command = [sys.executable, "-m", "simoun_lab.cli.sweep", *argv]
     log = tmp_path / "sweep.log"
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
@@ -357,7 +357,7 @@ def test_unreachable_address_fails_within_seconds(tmp_path):
     argv = [*TINY, "--seeds", "0", "--sweep-dir", str(tmp_path / "s")]
     start = time.monotonic()
     result = subprocess.run(
-        [sys.executable, "-m", "simoun_agent.cli.sweep", *argv, "--address", f"127.0.0.1:{port}"],
+        [sys.executable, "-m", "simoun_lab.cli.sweep", *argv, "--address", f"127.0.0.1:{port}"],
         capture_output=True,
         text=True,
         timeout=300,
@@ -374,7 +374,7 @@ def test_unreachable_address_fails_within_seconds(tmp_path):
 def test_without_ray_the_sweep_says_how_to_install_it(monkeypatch, tmp_path, capsys):
     monkeypatch.setitem(sys.modules, "ray", None)  # what `import ray` meets when not installed
     err = error_of([*TINY, "--seeds", "0", "--sweep-dir", str(tmp_path / "s")], capsys)
-    assert "pip install 'simoun[sweep]'" in err
+    assert "pip install 'simoun[lab]'" in err
 
 
 def test_seeds_and_grid_values_parse():

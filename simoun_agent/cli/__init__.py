@@ -1,7 +1,8 @@
 """The command lines, one thin module each: argument parsing and ``main()`` over the library.
 
-``train`` (``simoun-train``), ``eval`` (``simoun-eval``), ``sweep`` (``simoun-sweep``),
-``report`` (``simoun-report``), ``analyze`` (``simoun-analyze``) and ``study``
-(``simoun-study``); each also runs as ``python -m simoun_agent.cli.<name>``. The layers below
-(:mod:`simoun_agent.run` and the optional parts) never import this package.
+``train`` (``simoun-train``) and ``eval`` (``simoun-eval``); each also runs as
+``python -m simoun_agent.cli.<name>``. :mod:`~simoun_agent.cli.flags` and
+:mod:`~simoun_agent.cli.config_flags` hold the conventions every command shares, the lab's
+(:mod:`simoun_lab.cli`) included. The layers below (:mod:`simoun_agent.run` and the optional
+parts) never import this package.
 """

@@ -1,4 +1,5 @@
-"""Command-line conventions shared by the commands of :mod:`simoun_agent.cli`, parsed with tyro.
+"""Command-line conventions shared by the commands of :mod:`simoun_agent.cli` and
+:mod:`simoun_lab.cli`, parsed with tyro.
 
 Every command is a dataclass whose field docstrings are its help text; :func:`parse` hands it
 to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not have:
@@ -55,6 +56,10 @@ REGISTRY = ConstructorRegistry()
 CONFIG_SECTIONS = (TrainConfig, AgentConfig)
 """Dataclasses filled without their checks (those run once, in ``resolve``)."""
 
+COMMAND_PACKAGES = ("simoun_agent.", "simoun_lab.")
+"""Where the dataclasses these conventions apply to are defined (the lab's commands share
+them; the lab is named here as a string, never imported)."""
+
 PIPED_HELP_COLUMNS = "160"
 """Width of help written to a pipe (grep, less, a log): a field's doc stays on one line."""
 
@@ -65,7 +70,7 @@ def _dataclass(info: StructTypeInfo) -> StructConstructorSpec | None:
     # ours only: tyro wraps a union of commands in a generic dataclass of its own
     if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
         return None
-    if not cls.__module__.startswith("simoun_agent."):
+    if not cls.__module__.startswith(COMMAND_PACKAGES):
         return None
     hints = typing.get_type_hints(cls, include_extras=True)
     if cls in CONFIG_SECTIONS:  # a list of the config is given by repeating its flag

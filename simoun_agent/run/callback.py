@@ -13,7 +13,7 @@ class TrainCallback:
     """Hooks into the loop (:func:`simoun_agent.run.train.train`); subclass and override what
     you need (all do nothing here).
 
-    Ray Tune's reporter (``simoun_agent.sweep``) and extra evaluation environments plug in here
+    Ray Tune's reporter (``simoun_lab.sweep``) and extra evaluation environments plug in here
     instead of editing the loop; whoever wants one passes it to the loop.
     """
 

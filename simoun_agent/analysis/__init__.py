@@ -1,9 +1,0 @@
-"""The paper's analyses for trained runs: structure masks (Fig. 7) and information bias (Fig. 5).
-
-The command ``simoun-analyze`` (:mod:`simoun_agent.cli.analyze`) runs both; the estimator
-(:func:`simoun_agent.analysis.bias.information_bias`) works on any features.
-"""
-
-from simoun_agent.analysis.bias import BiasEstimate, information_bias
-
-__all__ = ["BiasEstimate", "information_bias"]

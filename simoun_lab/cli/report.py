@@ -1,0 +1,78 @@
+"""``simoun-report DIR``: tables and figures of a sweep or of a directory of ``simoun-train``
+runs, per variant and env, over seeds (:mod:`simoun_lab.sweep.report` describes them).
+
+    simoun-report sweeps/baselines
+    simoun-report runs/ --out runs/report
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated
+
+import tyro
+
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.config import SetupError
+from simoun_lab.sweep.report import write_report
+
+PROG = "simoun-report"
+
+DESCRIPTION = (
+    "Tables (Markdown, CSV) and figures (PNG) of a sweep or of a directory of simoun-train "
+    "runs, per variant and env, over seeds: mean ± std, and on returns normalized by the "
+    "task's maximum the IQM and mean with 95 % stratified-bootstrap confidence intervals, "
+    "probabilities of improvement, performance profiles and IQM curves (Agarwal et al. 2021). "
+    "A row counts each seed once (the run that finished, or reached the budget, then the most "
+    "recent; the others are listed) and runs of one evaluation grid (eval_every: runs on "
+    "another grid than most of their row are listed and left out)."
+)
+
+
+BUDGET = tyro.conf.create_mutex_group(required=False, title="equal budget (one of)")
+
+
+@dataclass
+class ReportCommand:
+    """What ``simoun-report`` is asked."""
+
+    root: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="DIR")]
+    """a sweep directory or a directory of runs"""
+    out: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    """where to write the report (none: DIR; for a single run directory, report-<name> beside
+    it, so the run directory is left as simoun-train wrote it)"""
+    at_step: Annotated[int | None, BUDGET, tyro.conf.arg(metavar="N")] = None
+    """compare at an equal budget of N env steps: a run counts, finished or not, only with an
+    evaluation at N, or the nearest within half its eval_every (listed in the report; runs
+    evaluated elsewhere are listed as short)"""
+    at_wall_time: Annotated[float | None, BUDGET, tyro.conf.arg(metavar="SECONDS")] = None
+    """compare at an equal wall-time budget: a run counts, finished or not, if it trained past
+    SECONDS (an evaluation at or after it), with its last evaluation at or before SECONDS (runs
+    that stopped earlier are listed as short)"""
+
+
+@quiet_pipe
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``simoun-report``."""
+    args = parse(ReportCommand, argv, PROG, DESCRIPTION)
+    budget = None
+    if args.at_step is not None:
+        budget = ("env_step", args.at_step)
+    elif args.at_wall_time is not None:
+        budget = ("wall_time_s", args.at_wall_time)
+    if budget is not None and budget[1] <= 0:
+        fail(PROG, "--at-step / --at-wall-time must be positive")
+    try:
+        written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
+    except SetupError as err:
+        fail(PROG, err)
+    print((Path(written[0])).read_text(), end="")
+    print(f"written: {', '.join(map(str, written))}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,128 @@
+"""``simoun-study``: one protocol for every method, from a spec file, on Ray Tune.
+
+    simoun-study plan docs/studies/dmc100k.toml
+    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+        --archive docs/studies/dmc100k
+    simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+        --archive docs/studies/dmc100k --resume
+
+``plan`` lists every run of both phases with a CPU-time estimate measured here; ``run`` tunes
+(every recipe x grid setting x tuning seed), selects each recipe's setting by the spec's rule,
+evaluates the selected settings on the held-out seeds and writes the report
+(:mod:`simoun_lab.study.report`); ``report`` writes it again from the finished runs of a study
+directory or its archive (``simoun-study report SPEC --study-dir docs/studies/NAME``). The
+study is run by :mod:`simoun_lab.study.runner`; the runs go through ``simoun-sweep``'s code:
+the same trial directories, Tune experiments, STOP file on SIGTERM and failure handling.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Union
+
+import tyro
+
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.config import SetupError
+from simoun_lab.study.checks import check_study
+from simoun_lab.study.plan import describe
+from simoun_lab.study.runner import StudyOptions, report_study, run_study, spec_from
+from simoun_lab.sweep.launch import load_ray
+
+PROG = "simoun-study"
+
+DESCRIPTION = """Run a study from its spec file: tune every recipe on one shared grid, select
+each recipe's setting by one rule, evaluate the selected settings on held-out seeds, and report
+IQM with confidence intervals (Agarwal et al. 2021).
+
+examples:
+  simoun-study plan docs/studies/dmc100k.toml
+  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+      --archive docs/studies/dmc100k
+  simoun-study run docs/studies/dmc100k.toml --study-dir runs/studies/dmc100k \\
+      --archive docs/studies/dmc100k --resume
+  simoun-study report docs/studies/dmc100k.toml --study-dir docs/studies/dmc100k
+
+The spec's layout is documented in simoun_lab/study/spec.py; docs/studies/dmc100k.toml is a
+full example."""
+
+
+@dataclass
+class Plan:
+    """List every run of both phases (phase, task, recipe, grid values, seed, env steps) and
+    estimate the CPU time of each from a short probe measured here, running nothing."""
+
+    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    """the study's TOML file"""
+    probe_updates: Annotated[int, tyro.conf.arg(metavar="N")] = 20
+    """agent updates timed per configuration (0: no estimate)"""
+
+
+@dataclass(kw_only=True)
+class Run(StudyOptions):
+    """Run the tuning phase, select each recipe's setting, run the evaluation phase on the
+    held-out seeds and write the report into STUDY_DIR/report (on Ray Tune)."""
+
+    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    """the study's TOML file"""
+    # the library's options, with the command line's metavars (their docs are StudyOptions')
+    study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
+    archive: Annotated[Path | None, tyro.conf.arg(metavar="DIR")] = None
+    resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    allow_other_commit: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    address: Annotated[str | None, tyro.conf.arg(metavar="auto|HOST:PORT|ray://HOST:PORT")] = None
+    num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
+
+
+@dataclass(kw_only=True)
+class Report:
+    """Write the report of a study's finished runs again, with this code, from its study
+    directory or its archive (no Ray, nothing trained): into DIR/report."""
+
+    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    """the study's TOML file"""
+    study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
+    """the study directory or its archive (e.g. docs/studies/NAME)"""
+
+
+Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
+    Annotated[Plan, tyro.conf.subcommand("plan")],
+    Annotated[Run, tyro.conf.subcommand("run")],
+    Annotated[Report, tyro.conf.subcommand("report")],
+]
+"""The command line: plan a study, run it, or write its report again."""
+
+
+@quiet_pipe
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``simoun-study``."""
+    args = parse(Command, argv, PROG, DESCRIPTION)
+    try:
+        spec = spec_from(args.spec)
+        if isinstance(args, Plan):
+            if args.probe_updates < 0:
+                raise SetupError("--probe-updates must be 0 or more")
+            check_study(spec, args.spec)
+            print(describe(spec, args.spec, args.probe_updates))
+            return 0
+        if isinstance(args, Report):
+            print(f"report: {report_study(spec, args.study_dir)}")
+            return 0
+        # absolute: Tune runs each trial in a working directory of its own
+        options = dataclasses.replace(
+            args,
+            study_dir=args.study_dir.absolute(),
+            archive=args.archive.absolute() if args.archive else None,
+        )
+        ray = load_ray()
+        return run_study(spec, args.spec, options, ray)
+    except SetupError as err:
+        fail(PROG, err)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

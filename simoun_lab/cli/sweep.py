@@ -1,0 +1,200 @@
+"""``simoun-sweep``: a grid of training runs on Ray Tune, on this machine or a Ray cluster.
+
+    simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl --seeds 0-4 --sweep-dir sw
+    simoun-sweep --resume --sweep-dir sw              # after Ctrl-C: finish what is unfinished
+    simoun-sweep --resume --sweep-dir sw --total-env-steps 200000   # train every trial further
+    simoun-sweep --address auto --preset cheetah-run --grid agent.recipe=simoun,drq --seeds 0-4
+
+The base config is given exactly as to ``simoun-train`` (``--preset``, every config flag,
+``--set KEY=VALUE``). Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``;
+the report (:mod:`simoun_lab.sweep.report`) is written when the sweep ends. The running is
+:mod:`simoun_lab.sweep.launch`'s.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import tyro
+
+from simoun_agent.cli.config_flags import (
+    ConfigFlags,
+    config_default,
+    config_switches,
+    overrides_from,
+)
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_lab.sweep import report
+from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
+from simoun_lab.sweep.launch import (
+    check_fits,
+    connect,
+    finished,
+    gpus_per_trial,
+    load_ray,
+    run_sweep,
+    stop_trials_on_sigterm,
+    summarize,
+)
+from simoun_lab.sweep.trainable import STOP_FILE
+
+PROG = "simoun-sweep"
+
+DESCRIPTION = f"""Run a grid of simoun-train runs (variants x envs x seeds) on Ray Tune, on this
+machine or a Ray cluster, then write the report (simoun-report). The base config is given
+exactly as to simoun-train (--preset, every config flag, --set KEY=VALUE).
+
+examples:
+  simoun-sweep --preset cpu --grid agent.recipe=simoun,drq,curl,sac --seeds 0-4 \\
+      --sweep-dir sweeps/baselines
+  simoun-sweep --resume --sweep-dir sweeps/baselines
+  simoun-sweep --resume --sweep-dir sweeps/baselines --total-env-steps 1000000
+  simoun-sweep --address auto --preset walker-walk --grid agent.recipe=simoun,drq \\
+      --seeds 0-4 --sweep-dir /shared/sweeps/walker
+
+agent recipes (--grid agent.recipe=A,B): {", ".join(RECIPES)}
+
+Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory."""
+
+
+@dataclass
+class SweepCommand:
+    """What ``simoun-sweep`` is asked: the grid, where and how to run it, and the base config."""
+
+    sweep_dir: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    """where the runs and the report go (none: sweeps/<UTC time>; required with --resume); on a
+    cluster, a directory every machine sees"""
+    grid: Annotated[
+        tuple[str, ...], tyro.conf.UseAppendAction, tyro.conf.arg(metavar="KEY=V1,V2")
+    ] = ()
+    """a config key and the values to try (the variants are the product), e.g. --grid
+    agent.recipe=simoun,drq"""
+    seeds: Annotated[str | None, tyro.conf.arg(metavar="SEEDS")] = None
+    """seeds of each variant, e.g. 0-4 or 0,2,5 (none: --seed)"""
+    envs: Annotated[str | None, tyro.conf.arg(metavar="ID,ID")] = None
+    """Gymnasium ids to run every variant on (none: --env)"""
+    cpus_per_trial: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
+    """CPUs per trial; the trial uses as many torch threads (none: 1)"""
+    gpus_per_trial: Annotated[str, tyro.conf.arg(metavar="N|auto")] = "auto"
+    """GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device is not
+    cpu, else 0"""
+    address: Annotated[str | None, tyro.conf.arg(metavar="auto|HOST:PORT|ray://HOST:PORT")] = None
+    """run on a Ray cluster (auto: the one `ray start` made on this machine); none: a local Ray
+    instance"""
+    num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
+    """CPUs of the local Ray instance (none: this machine's)"""
+    resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
+    """continue the sweep in --sweep-dir: finished trials are skipped, the others go on from
+    their checkpoints; with a larger --total-env-steps every trial, finished ones too, trains on
+    to it"""
+    verbose: Literal[0, 1, 2] = 1
+    """Tune's output"""
+    flags: Annotated[ConfigFlags, tyro.conf.arg(name="")] = field(default_factory=ConfigFlags)
+    """the base config of every trial"""
+
+
+def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> SweepSpec:
+    """The sweep to run: from the flags (``base``: the config overrides they give), or the saved
+    one on ``--resume`` (which the flags, when given, must match; ``--total-env-steps`` alone may
+    differ, and extends every trial to the new budget)."""
+    preset = args.flags.preset
+    if not args.resume:
+        if (sweep_dir / SWEEP_FILE).exists():
+            raise SetupError(
+                f"{sweep_dir} already holds a sweep; continue it with --resume, or pass another "
+                "--sweep-dir"
+            )
+        if sweep_dir.exists() and any(sweep_dir.iterdir()):
+            raise SetupError(f"{sweep_dir} is not empty; pass a new --sweep-dir")
+        cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
+        return SweepSpec.create(preset, base, list(args.grid), args.seeds, args.envs, cpus)
+    saved = SweepSpec.load(sweep_dir)
+    base = dict(base)
+    total = base.pop("total_env_steps", None)
+    given = bool(args.grid or args.seeds or args.envs or base or preset)
+    if given or args.cpus_per_trial not in (None, saved.cpus_per_trial):
+        spec = SweepSpec.create(
+            preset,
+            {**base, **({} if total is None else {"total_env_steps": total})},
+            list(args.grid),
+            args.seeds,
+            args.envs,
+            saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
+        )
+        like_saved = saved if total is None else saved.extended(total)
+        differences = spec.describe_differences(like_saved)
+        if differences:
+            raise SetupError(
+                f"the sweep in {sweep_dir} was started with another grid, so --resume cannot "
+                f"continue it ({'; '.join(differences)}); give the flags it was started with (or "
+                f"only --resume --sweep-dir {sweep_dir}), or start a new sweep in another "
+                "--sweep-dir"
+            )
+    return saved if total is None else saved.extended(total)
+
+
+@quiet_pipe
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``simoun-sweep``."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        default = SweepCommand(flags=ConfigFlags(config=config_default(argv)))
+    except SetupError as err:
+        fail(PROG, err)
+    args = parse(SweepCommand, argv, PROG, DESCRIPTION, default, config_switches())
+    if args.resume and not args.sweep_dir:
+        fail(PROG, "--resume needs the --sweep-dir of the sweep")
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    # absolute: Tune runs each trial in a working directory of its own
+    sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
+    try:
+        ray = load_ray()
+        spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+    except SetupError as err:
+        fail(PROG, err)
+    todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
+    done = len(spec.trials(sweep_dir)) - len(todo)
+    try:
+        check_runnable(todo, "--envs" if args.envs or len(spec.envs) > 1 else "--env")
+    except SetupError as err:
+        fail(PROG, err)
+    print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)
+    terminated: list[bool] = []
+    if todo:
+        started = False
+        try:
+            started = connect(ray, args.address, args.num_cpus)
+            device = spec.base.get("device", resolve(spec.preset, {}).device)
+            gpus = gpus_per_trial(ray, args.gpus_per_trial, device)
+            check_fits(ray, spec.cpus_per_trial, gpus)
+            sweep_dir.mkdir(parents=True, exist_ok=True)
+            if not (sweep_dir / SWEEP_FILE).exists() or SweepSpec.load(sweep_dir) != spec:
+                spec.save(sweep_dir)
+            (sweep_dir / STOP_FILE).unlink(missing_ok=True)
+            with stop_trials_on_sigterm(sweep_dir) as came:
+                terminated = came
+                outcome = run_sweep(ray, spec, sweep_dir, gpus, args.verbose)
+        except SetupError as err:
+            fail(PROG, err)
+        except KeyboardInterrupt:
+            outcome = {"stopped": todo}
+        finally:
+            if started:
+                ray.shutdown()
+    else:
+        outcome = {}
+    try:
+        written = report.write_report(sweep_dir)
+    except SetupError:  # no trial got as far as writing its config.json
+        written = []
+    return summarize(outcome, sweep_dir, written, bool(terminated))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

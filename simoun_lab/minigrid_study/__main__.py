@@ -1,0 +1,157 @@
+"""``python -m simoun_lab.minigrid_study run|report``: the MiniGrid PPO study's command line.
+
+python -m simoun_lab.minigrid_study run                  # every unfinished run, locally
+python -m simoun_lab.minigrid_study run --address auto   # on a running Ray cluster
+python -m simoun_lab.minigrid_study report               # docs/studies/minigrid/report/
+python -m simoun_lab.minigrid_study probe                # docs/studies/minigrid/probe/
+python -m simoun_lab.minigrid_study select --archive A   # a tuning archive's selection
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Union
+
+import tyro
+
+from simoun_agent.cli.flags import installed_version, quiet_pipe
+from simoun_agent.config import SetupError
+from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings
+from simoun_lab.minigrid_study.spec import StudySpec, load_spec
+
+ARCHIVE = Path("docs/studies/minigrid")
+
+PROG = "python -m simoun_lab.minigrid_study"
+
+
+def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
+    """``spec``, else the archive's spec, else the defaults (the study as designed) for the
+    archive that holds them (``archive`` is ARCHIVE, or ``new``: a ``run`` may start a study in
+    an empty directory). An archive that is not there is refused rather than made up: a
+    mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
+    from simoun_lab.minigrid_study.tune import SPEC_FILE
+
+    if not archive.is_dir():
+        where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
+        in_clone = " (run it from the root of a clone of simoun)" if archive == ARCHIVE else ""
+        start = "; to start a new study, create the directory first" if new else ""
+        raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
+    if spec is not None:
+        return load_spec(spec)
+    if (archive / SPEC_FILE).is_file():
+        return load_spec(archive / SPEC_FILE)
+    if new and (archive == ARCHIVE or not any(archive.iterdir())):
+        return StudySpec()
+    raise SetupError(
+        f"--archive {archive} holds no {SPEC_FILE}, so it is not a study's archive; pass the "
+        "archive a run wrote, or --spec FILE for the spec its runs were trained with"
+    )
+
+
+@dataclass
+class Report:
+    """Write the report."""
+
+    archive: Path = ARCHIVE
+    """the study's records"""
+    spec: Path | None = None
+    """a JSON spec (None: the archive's spec.json)"""
+
+
+@dataclass
+class Run(Report):
+    """Train every unfinished run."""
+
+    work_dir: Path = Path("runs/minigrid_study")
+    """Ray Tune's records and the run directories (a run in progress keeps its checkpoint
+    there, and a rerun goes on from it)"""
+    address: str | None = None
+    """a Ray cluster (auto, HOST:PORT); None: local"""
+    concurrent: int = 2
+    """runs at a time"""
+
+
+@dataclass
+class Probe:
+    """Correlate each probed intrinsic reward with novelty under a random policy (no PPO)."""
+
+    settings: ProbeSettings = field(default_factory=ProbeSettings)
+    probes: list[str] = field(default_factory=lambda: list(PROBED))
+    """probes of ``simoun_lab.minigrid_study.probe.PROBED``"""
+    out: Path = ARCHIVE / "probe"
+    """where probe.csv and probe.md go"""
+
+
+@dataclass
+class Select(Report):
+    """Apply the tuning phase's selection rule to a tuning archive (selection.md, .json)."""
+
+
+Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotated types)
+    Annotated[Run, tyro.conf.subcommand("run")],
+    Annotated[Report, tyro.conf.subcommand("report")],
+    Annotated[Select, tyro.conf.subcommand("select")],
+    Annotated[Probe, tyro.conf.subcommand("probe")],
+]
+
+
+@quiet_pipe
+def main(argv: Sequence[str] | None = None) -> int:
+    if "--version" in (sys.argv[1:] if argv is None else argv):
+        print(f"{PROG} {installed_version()}")
+        return 0
+    args = tyro.cli(
+        Command,
+        prog=PROG,
+        description="SB3 PPO on MiniGrid pixels with no intrinsic reward, consistency curiosity "
+        "or RND: train the runs on Ray Tune (resumable), then report; probe an intrinsic reward's "
+        "link to novelty without PPO.",
+        args=argv,
+    )
+    if isinstance(args, Probe):
+        from simoun_lab.minigrid_study.probe import write_probe
+
+        try:
+            if not args.out.parent.is_dir():
+                raise SetupError(
+                    f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "
+                    "run from the root of a clone of simoun, or pass an --out whose folder exists"
+                )
+            print(write_probe(args.settings, args.probes, args.out))
+        except ValueError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 2
+        return 0
+    try:
+        spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
+        if isinstance(args, Run):
+            from simoun_lab.minigrid_study.tune import run_study
+
+            outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
+            print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
+            return 1 if outcome["failed"] else 0
+        if isinstance(args, Select):
+            from simoun_lab.minigrid_study.select import write_selection
+
+            print(write_selection(spec, args.archive))
+            return 0
+        from simoun_lab.minigrid_study.report import write_report
+        from simoun_lab.minigrid_study.tune import finished_runs
+
+        if not finished_runs(spec, args.archive):
+            raise SetupError(
+                f"--archive {args.archive} holds no finished run of its spec: nothing to report "
+                f"yet; train them with: {PROG} run --archive {args.archive}"
+            )
+        print(write_report(spec, args.archive))
+    except SetupError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,187 @@
+"""What a study checks before it spends compute, and what a resumed study lets its spec change.
+
+:func:`check_study` makes each task once and estimates the memory of each configuration, so
+that ``simoun-study plan`` (and ``run``, before any trial) refuses a task the agent cannot
+train on (discrete or unbounded actions, no pixels) or a setting the machine cannot hold, naming
+the spec's file and line. The frame size against each recipe's encoder is checked as the spec
+is read (:meth:`~simoun_lab.study.spec._Reader.check_runs`).
+
+:func:`check_fixed_spec` lets a study resume under a spec fixed after a failure (a task that
+cannot run replaced, seeds added, a budget raised for runs not finished yet), as long as every
+finished run would be trained the same way under the fixed spec, and no recipe whose
+evaluation started would select another setting.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
+from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
+from simoun_agent.run.make_env import check_task
+from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
+from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
+from simoun_lab.study.spec import Source, StudySpec
+
+MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
+"""The keys a memory refusal asks to change, looked up in the spec to name their line."""
+
+NOT_TRAINING = ("run_dir", "torch_threads", "progress")
+"""Config keys that change where a run writes and how fast it goes, not what it learns: a
+fixed spec may change them for finished runs."""
+
+
+def configs(spec: StudySpec) -> list[tuple[str, str, dict[str, Any], TrainConfig]]:
+    """(phase, recipe, setting, config) of each recipe x task x setting of both phases (the
+    diagnostic recipes with every setting their method may select)."""
+    found = []
+    for phase in (spec.tuning, spec.evaluation):
+        recipes = spec.recipes + (list(spec.ablations()) if phase is spec.evaluation else [])
+        for task in phase.tasks:
+            for recipe in recipes:
+                for setting in spec.settings():
+                    seed, steps = phase.seeds[task][0], phase.env_steps[task]
+                    overrides = spec.overrides(recipe, task, setting, seed, steps)
+                    found.append((phase.name, recipe, setting, resolve(spec.preset, overrides)))
+    return found
+
+
+def memory_line(spec: StudySpec, task: str) -> tuple[str, ...]:
+    """Where a memory refusal points: the first memory key the spec sets (grid, the task's
+    table, base), else the [base] table."""
+    for key in MEMORY_KEYS:
+        if key in spec.grid:
+            return ("grid", *key.split("."))
+        if key in spec.task_config.get(task, {}):
+            return ("tasks", task, *key.split("."))
+        if key in spec.base:
+            return ("base", *key.split("."))
+    return ("base",)
+
+
+def check_study(spec: StudySpec, spec_path: str) -> None:
+    """Make each task once, check that the replay holds a batch of its episodes and estimate
+    each configuration's memory; SetupError naming the spec's line, the task and the fix for
+    the first that cannot run (the tasks first: they take a second each, a memory estimate
+    several)."""
+    source = Source(Path(spec_path), Path(spec_path).read_text())
+    made: dict[str, int | None] = {}
+    found = configs(spec)
+    for phase, recipe, _, config in found:
+        env = json.dumps([config.env, config.env_kwargs, config.env_module], sort_keys=True)
+        if env not in made:
+            try:
+                made[env] = check_task(config)
+            except SetupError as err:
+                raise source.error(
+                    (phase, "tasks"),
+                    f"{config.env} cannot be trained by the recipes: {err} Replace it in "
+                    f"[{phase}] tasks (the spec is read before anything runs).",
+                ) from None
+        try:
+            check_replay(config, made[env], SPEC_KEYS)
+        except SetupError as err:
+            raise source.error(
+                memory_line(spec, config.env), f"{recipe} on {config.env}: {err}"
+            ) from None
+    measured: set[str] = set()
+    for _, recipe, setting, config in found:
+        memory = {**to_dict(config), "env": None, "seed": None, "total_env_steps": None}
+        key = json.dumps(memory, sort_keys=True)
+        if key in measured:
+            continue
+        measured.add(key)
+        shown = ", ".join(f"{k} = {v!r}" for k, v in setting.items())
+        try:
+            warning = check_memory(config, SPEC_KEYS)
+        except SetupError as err:
+            raise source.error(
+                memory_line(spec, config.env), f"{recipe} on {config.env} with {shown}: {err}"
+            ) from None
+        if warning:
+            print(f"{spec_path}: warning: {recipe} with {shown}: {warning}", file=sys.stderr)
+
+
+def finished_config(name: str, places: list[Path]) -> dict[str, Any] | None:
+    """The saved config of the run ``name`` if it finished in one of ``places``, else None."""
+    for where in places:
+        run_dir = where / name
+        if (run_dir / SUMMARY_NAME).is_file() and (run_dir / CONFIG_NAME).is_file():
+            return json.loads((run_dir / CONFIG_NAME).read_text())
+    return None
+
+
+def flat(config: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``{"agent": {"lr": 1}}`` -> ``{"agent.lr": 1}``."""
+    out: dict[str, Any] = {}
+    for key, value in config.items():
+        if isinstance(value, dict) and key == "agent":
+            out.update(flat(value, prefix + key + "."))
+        else:
+            out[prefix + key] = value
+    return out
+
+
+def changes(saved: dict[str, Any], wanted: dict[str, Any]) -> list[str]:
+    """``agent.lr: 0.001 when it ran, 0.0003 now`` for each training key that differs."""
+    old, new = flat(saved), flat(wanted)
+    return [
+        f"{key}: {old.get(key)!r} when it ran, {new.get(key)!r} now"
+        for key in sorted(set(old) | set(new))
+        if key not in NOT_TRAINING and old.get(key) != new.get(key)
+    ]
+
+
+def check_fixed_spec(
+    record: dict[str, Any], spec: StudySpec, spec_path: str, places: list[Path]
+) -> list[str]:
+    """The spec keys that differ from the study ``record``'s; SetupError when the change
+    touches a run finished in ``places`` (the study directory, the archive): a run that would
+    now be trained otherwise, or an evaluation run whose recipe would be selected from other
+    tuning runs or by another rule."""
+    saved = StudySpec.from_json(record["spec"])
+    old, new = saved.to_json(), spec.to_json()  # a key added since the record: its default
+    changed = [key for key in {**old, **new} if old.get(key) != new.get(key)]
+    if not changed:
+        return []
+    advice = (
+        f"so {spec_path} cannot continue this study. Undo that change, delete the run (in the "
+        "study directory and the archive) to train it again, or start a new study in another "
+        "--study-dir"
+    )
+    evaluated = set()
+    for run in tuning_runs(spec) + evaluation_runs(spec):
+        config = finished_config(run.name, places)
+        if config is None:
+            continue
+        if run.phase != TUNING:
+            evaluated.add(run.of or run.recipe)  # a diagnostic ran at its method's selection
+            # the setting it ran with: the one its tuning selected
+            agent = config.get("agent", {})
+            setting = {
+                key: agent[key[6:]] if key.startswith("agent.") else config[key]
+                for key in spec.grid
+            }
+            run = StudyRun(
+                run.phase, run.recipe, run.task, run.seed, run.env_steps, setting, run.of
+            )
+        wanted = to_dict(resolve(spec.preset, run.trial(spec, Path(".")).overrides))
+        differences = changes(config, wanted)
+        if differences:
+            raise SetupError(
+                f"the finished run {run.name} would be trained otherwise under the changed "
+                f"spec ({'; '.join(differences)}), {advice}"
+            )
+    for recipe in sorted(evaluated):
+        before = [r.name for r in tuning_runs(saved) if r.recipe == recipe]
+        after = [r.name for r in tuning_runs(spec) if r.recipe == recipe]
+        if before != after or saved.selection != spec.selection:
+            raise SetupError(
+                f"the evaluation of {recipe} has started with the setting its tuning selected, "
+                f"and the changed spec would select again (its tuning runs or selection rule "
+                f"differ), {advice}"
+            )
+    return changed

@@ -1,0 +1,85 @@
+"""The tuning phase's outcome: every setting's score and the one chosen for each recipe, by the
+spec's selection rule (:mod:`simoun_lab.study.selection`), saved as ``selection.json``."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from simoun_agent.config import SetupError
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.logger import EVAL_CSV, read_csv
+from simoun_lab.study.plan import StudyRun, tuning_runs
+from simoun_lab.study.selection import SELECTION_RULES, TIE_RULE, best_setting
+from simoun_lab.study.spec import StudySpec
+
+SELECTION_FILE = "selection.json"
+
+
+@dataclass
+class Candidate:
+    """One grid setting of one recipe, scored on its tuning runs."""
+
+    setting: dict
+    score: float
+    """mean over tuning tasks of the mean over each task's seeds"""
+    runs: dict
+    """task -> each seed's score, in seed order"""
+
+
+@dataclass
+class Choice:
+    """A recipe's selected setting and every setting it was chosen from."""
+
+    recipe: str
+    setting: dict
+    score: float
+    candidates: list
+
+
+def run_score(spec: StudySpec, study_dir: Path, run: StudyRun) -> float:
+    """The selection rule's score of one finished tuning run, from its ``eval.csv``."""
+    run_dir = Path(study_dir, run.name)
+    if not run.finished(study_dir):
+        raise SetupError(
+            f"the tuning run {run.name} has not finished, so no setting can be selected yet; "
+            "resume the study to finish it"
+        )
+    rows = read_csv(run_dir / EVAL_CSV)
+    steps = np.array([row["env_step"] for row in rows])
+    returns = np.array([row["return_mean"] for row in rows])
+    return SELECTION_RULES[spec.selection].score(run.task, steps, returns)
+
+
+def choose(spec: StudySpec, study_dir: Path) -> dict[str, Choice]:
+    """Each recipe's setting, chosen from its finished tuning runs."""
+    runs = tuning_runs(spec)
+    choices = {}
+    for recipe in spec.recipes:
+        candidates = []
+        for setting in spec.settings():
+            mine = [r for r in runs if r.recipe == recipe and r.setting == setting]
+            by_task = {
+                task: [run_score(spec, study_dir, r) for r in mine if r.task == task]
+                for task in spec.tuning.tasks
+            }
+            score = float(np.mean([np.mean(scores) for scores in by_task.values()]))
+            candidates.append(Candidate(setting, score, by_task))
+        chosen = best_setting([(c.setting, c.score) for c in candidates])
+        score = next(c.score for c in candidates if c.setting == chosen)
+        choices[recipe] = Choice(recipe, chosen, score, candidates)
+    return choices
+
+
+def save_choices(choices: dict[str, Choice], spec: StudySpec, path: Path) -> None:
+    data = {
+        "rule": spec.selection,
+        "description": SELECTION_RULES[spec.selection].description,
+        "ties": TIE_RULE,
+        "recipes": {recipe: asdict(choice) for recipe, choice in choices.items()},
+    }
+    text = json.dumps(data, indent=2) + "\n"
+    atomic_write(path, lambda tmp: tmp.write_text(text))

@@ -1,0 +1,312 @@
+"""Running a study from its spec (the library under ``simoun-study``,
+:mod:`simoun_lab.cli.study`): the study record, both phases on Ray Tune through
+:mod:`simoun_lab.sweep.launch`, the selection between them and the report at the end.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from types import ModuleType
+from typing import Any, Literal
+
+from simoun_agent.config import SetupError, resolve
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CHECKPOINT_NAME
+from simoun_lab.study import archive as archiving
+from simoun_lab.study.archive import GENERALIZATION_CSV
+from simoun_lab.study.checks import check_fixed_spec, check_study
+from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
+from simoun_lab.study.generalization import play_modes, playable, to_play
+from simoun_lab.study.plan import (
+    EVALUATION,
+    TUNING,
+    StudyRun,
+    check_layout,
+    evaluation_runs,
+    setting_label,
+    tuning_runs,
+)
+from simoun_lab.study.provenance import code_version, same_code
+from simoun_lab.study.report import REPORT_DIR, REPORT_MD, write_study_report
+from simoun_lab.study.spec import StudySpec, load_spec
+from simoun_lab.sweep import launch
+
+STUDY_FILE = "study.json"
+"""The study record, in the study directory and the archive: the spec (its file, text and
+parsed form) and each part's code version."""
+
+
+@dataclass
+class StudyOptions:
+    """Where and how :func:`run_study` runs a study (the options of ``simoun-study run``)."""
+
+    study_dir: Path
+    """where the runs and the report go; on a cluster, a directory every machine sees"""
+    archive: Path | None = None
+    """copy each finished run's CSVs, config.json and summary.json (no checkpoints, replays,
+    videos or tb/) here as it completes, with the study record, the selection and the report,
+    e.g. docs/studies/NAME; a resumed study counts archived runs as done"""
+    resume: bool = False
+    """continue the study: finished runs (in --study-dir, else in --archive) are kept, the
+    others go on from their checkpoints or start"""
+    allow_other_commit: bool = False
+    """resume even though the code is at another commit than the study started from"""
+    address: str | None = None
+    """run on a Ray cluster: auto (the one `ray start` made here), HOST:PORT or
+    ray://HOST:PORT; none: a local Ray instance"""
+    num_cpus: int | None = None
+    """CPUs of the local Ray instance (none: all)"""
+    verbose: Literal[0, 1, 2] = 1
+    """Tune's output"""
+
+
+def spec_from(path: str) -> StudySpec:
+    spec = load_spec(path)
+    check_layout(spec)
+    return spec
+
+
+def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) -> dict[str, Any]:
+    """The saved study record, from the study directory, else from the archive; SetupError
+    with the advice of the command asked (``run --resume``, or ``report``: ``resuming``
+    False) when neither holds one."""
+    for where in (study_dir, archive):
+        if where is not None and (where / STUDY_FILE).is_file():
+            return json.loads((where / STUDY_FILE).read_text())
+    places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
+    missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
+    if not resuming:
+        raise SetupError(
+            f"no study to report: {places} holds no {STUDY_FILE}{missing}; pass the "
+            "--study-dir of a study that ran (or its archive, e.g. docs/studies/NAME)"
+        )
+    raise SetupError(
+        f"no study to resume: {places} holds no {STUDY_FILE}{missing}; drop --resume to start "
+        "the study, or pass the --study-dir (or --archive) of the study to continue"
+    )
+
+
+def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: str) -> None:
+    """Refuse ``spec`` when it is not the one the study ``record`` was started with: the error
+    says ``problem``, the keys that differ and ``fix``. A record saved before a spec key
+    existed has that key's default (read through :meth:`StudySpec.from_json`)."""
+    saved, wanted = StudySpec.from_json(record["spec"]).to_json(), spec.to_json()
+    changed = [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
+    if changed:
+        raise SetupError(
+            f"{problem} ({', '.join(changed)} differ from the saved {STUDY_FILE}); {fix}"
+        )
+
+
+def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[str, Any]:
+    """The study record, new or resumed (same spec and, unless allowed, same commit)."""
+    study_dir, archive = options.study_dir, options.archive
+    code = code_version()
+    part = {"started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"), **code}
+    if not options.resume:
+        for where, flag in ((study_dir, "--study-dir"), (archive, "--archive")):
+            if where is not None and (where / STUDY_FILE).is_file():
+                raise SetupError(
+                    f"{where} already holds a study; continue it with --resume, or pass another "
+                    f"{flag}"
+                )
+        if study_dir.exists() and any(study_dir.iterdir()):
+            raise SetupError(f"{study_dir} is not empty; pass a new --study-dir")
+        text = Path(spec_path).read_text()
+        return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
+    record = load_record(study_dir, archive)
+    changed = check_fixed_spec(record, spec, spec_path, [p for p in (study_dir, archive) if p])
+    if changed:  # a fix that leaves every finished run as it ran: the study goes on under it
+        part["spec_changed"] = {"keys": changed, "before": record["spec_text"]}
+        record.update(spec_file=spec_path, spec_text=Path(spec_path).read_text())
+        record["spec"] = spec.to_json()
+    first = record["parts"][0]
+    if not same_code(first, code) and not options.allow_other_commit:
+        raise SetupError(
+            f"this study ran from commit {first['commit'] or first['version']}, and the code is "
+            f"now at {code['commit'] or code['version']}: the code under study must not change "
+            "within a study, or its runs would compare two versions of the methods. Check out "
+            f"{first['commit'] or first['version']} to resume, start a new study, or pass "
+            "--allow-other-commit if the change cannot affect the runs (the report lists every "
+            "commit)"
+        )
+    record["parts"].append({**part, "allowed_other_commit": not same_code(first, code)})
+    return record
+
+
+def save_record(record: dict[str, Any], places: list[Path]) -> None:
+    text = json.dumps(record, indent=2) + "\n"
+    for where in places:
+        where.mkdir(parents=True, exist_ok=True)
+        atomic_write(where / STUDY_FILE, lambda tmp: tmp.write_text(text))
+
+
+class Phases:
+    """Runs the study's phases on Ray Tune through simoun-sweep's trial code."""
+
+    def __init__(
+        self, spec: StudySpec, spec_path: str, options: StudyOptions, ray: ModuleType
+    ) -> None:
+        self.spec, self.options, self.ray = spec, options, ray
+        self.study_dir, self.archive = options.study_dir, options.archive
+        self.gpus: float | None = None
+        self.started = False
+        """whether Ray was started here (then the study shuts it down)"""
+        self.todo: list = []
+        """the trials of the phase running now"""
+        self.resume = f"simoun-study run {spec_path} --study-dir {options.study_dir} --resume" + (
+            f" --archive {options.archive}" if options.archive else ""
+        )
+
+    def connect(self) -> None:
+        """Start (or join) Ray, once: only when there is something to run."""
+        if self.gpus is not None:
+            return
+        self.started = launch.connect(self.ray, self.options.address, self.options.num_cpus)
+        device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
+        wanted = str(self.spec.gpus_per_trial)
+        self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
+        launch.check_fits(self.ray, self.spec.cpus_per_trial, self.gpus)
+
+    def generalize(self, runs: list[StudyRun]) -> list[str]:
+        """Play each finished run's final agent on the spec's distraction modes (Ray tasks with a
+        trial's resources, as many at a time as trials), archiving each ``generalization.csv``
+        as it is written; the runs that could not be played, with why."""
+        names = [run.name for run in runs if run.finished(self.study_dir)]
+        todo = to_play(self.study_dir, self.archive, names)
+        print(f"generalization: {len(todo)} runs to play, {len(names) - len(todo)} played")
+        missing = [n for n in todo if not playable(self.study_dir / n)]
+        todo = [n for n in todo if n not in missing]
+        failed = [f"{name}: no {CHECKPOINT_NAME} (restored from the archive)" for name in missing]
+        if not todo:
+            return failed
+        self.connect()
+        remote = self.ray.remote(num_cpus=self.spec.cpus_per_trial, num_gpus=self.gpus)(play_modes)
+        at_once = self.spec.max_concurrent_trials or len(todo)
+        waiting, running = list(todo), {}
+        while waiting or running:
+            while waiting and len(running) < at_once:
+                name = waiting.pop(0)
+                args = (str(self.study_dir / name), self.spec.generalization)
+                running[remote.remote(*args, self.spec.generalization_episodes)] = name
+            (done,), _ = self.ray.wait(list(running), num_returns=1)
+            name = running.pop(done)
+            try:
+                self.ray.get(done)
+            except self.ray.exceptions.RayTaskError as err:
+                failed.append(f"{name}: {err.cause!r}")
+                continue
+            if self.archive is not None:
+                archiving.copy_file(
+                    self.study_dir / name / GENERALIZATION_CSV,
+                    self.archive / name / GENERALIZATION_CSV,
+                )
+        return failed
+
+    def restore(self, runs: list[StudyRun]) -> int:
+        """Bring back archived finished runs whose run directories are gone; how many."""
+        if self.archive is None:
+            return 0
+        return sum(archiving.restore_run(self.study_dir, self.archive, r.name) for r in runs)
+
+    def sync(self, runs: list[StudyRun]) -> None:
+        """Archive every finished run not archived yet (those the live callback missed)."""
+        if self.archive is not None:
+            for run in runs:
+                archiving.archive_run(self.study_dir, self.archive, run.name)
+
+    def run(self, phase: str, runs: list[StudyRun]) -> dict[str, list]:
+        """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
+        restored = self.restore(runs)
+        todo = [run for run in runs if not run.finished(self.study_dir)]
+        self.todo = [run.trial(self.spec, self.study_dir) for run in todo]
+        print(
+            f"{phase}: {len(todo)} runs to run, {len(runs) - len(todo)} already finished"
+            + (f" ({restored} restored from {self.archive})" if restored else ""),
+            flush=True,
+        )
+        if not todo:
+            self.sync(runs)
+            return {}
+        self.connect()
+        callbacks = []
+        if self.archive is not None:
+            from simoun_lab.study.tune_callback import ArchiveOnComplete
+
+            names = {run.trial(self.spec, self.study_dir).name: run.name for run in todo}
+            callbacks.append(ArchiveOnComplete(self.study_dir, self.archive, names))
+        outcome = launch.run_trials(
+            self.todo,
+            self.study_dir,
+            self.spec.cpus_per_trial,
+            self.gpus,
+            self.options.verbose,
+            callbacks,
+            self.spec.max_concurrent_trials,
+            name=f"{phase}-",
+        )
+        self.sync(runs)
+        return outcome
+
+
+def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: ModuleType) -> int:
+    """Tune, select, evaluate, report the study of ``spec`` (read from ``spec_path``); the exit
+    status (the sweep's: 130/143 stopped, 1 failed)."""
+    study_dir, archive = options.study_dir, options.archive
+    check_study(spec, spec_path)
+    record = open_study(spec, spec_path, options)
+    save_record(record, [study_dir] + ([archive] if archive is not None else []))
+    phases = Phases(spec, spec_path, options, ray)
+    choices: dict[str, Choice] | None = None
+    terminated: list[bool] = []
+    try:
+        with launch.stop_trials_on_sigterm(study_dir) as terminated:
+            outcome = phases.run(TUNING, tuning_runs(spec))
+            if not (outcome.get("failed") or outcome.get("stopped")):
+                choices = choose(spec, study_dir)
+                save_choices(choices, spec, study_dir / SELECTION_FILE)
+                if archive is not None:
+                    archiving.copy_file(study_dir / SELECTION_FILE, archive / SELECTION_FILE)
+                say_choices(choices)
+                selected = {recipe: choice.setting for recipe, choice in choices.items()}
+                evaluation = evaluation_runs(spec, selected)
+                outcome = phases.run(EVALUATION, evaluation)
+                if spec.generalization and not (outcome.get("failed") or outcome.get("stopped")):
+                    for problem in phases.generalize(evaluation):
+                        print(f"generalization not played: {problem}", flush=True)
+    except KeyboardInterrupt:
+        outcome = {"stopped": phases.todo}
+    finally:
+        if phases.started:
+            ray.shutdown()
+    written = []
+    if choices is not None:
+        write_study_report(spec, study_dir, record, choices)
+        written = [study_dir / REPORT_DIR / REPORT_MD]
+        if archive is not None:
+            archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
+    return launch.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
+
+
+def report_study(spec: StudySpec, study_dir: Path) -> Path:
+    """Write the report of the finished runs in ``study_dir`` (a study directory or its
+    archive) again, with this code, into ``study_dir/report``; returns its ``report.md``."""
+    record = load_record(study_dir, None, resuming=False)
+    check_same_spec(
+        record,
+        spec,
+        f"{study_dir} holds a study of another spec",
+        f"pass the spec it was run with ({record['spec_file']})",
+    )
+    code = code_version()
+    commit = f"{code['commit']}{' with uncommitted changes' if code['dirty'] else ''}"
+    write_study_report(spec, study_dir, record, choose(spec, study_dir), rewritten_by=commit)
+    return study_dir / REPORT_DIR / REPORT_MD
+
+
+def say_choices(choices: dict[str, Choice]) -> None:
+    for recipe, choice in choices.items():
+        print(f"selected for {recipe}: {setting_label(choice.setting)} (score {choice.score:.4g})")

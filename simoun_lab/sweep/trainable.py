@@ -1,0 +1,167 @@
+"""Ray Tune's trainable: each trial is one ordinary ``simoun-train`` run in its own run directory,
+reporting every evaluation to Tune through a :class:`~simoun_agent.run.callback.TrainCallback`.
+
+A trial continues from its run directory's checkpoint when there is one (a resumed sweep), and
+writes ``error.txt`` (the traceback) into its run directory when it fails, so the failure stays
+visible beside the run, to ``simoun-report`` too, without Ray. ``trial.json`` records where,
+under what machine load and with how much CPU time each part of the trial ran.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import shutil
+import signal
+import socket
+import time
+import traceback
+from dataclasses import asdict
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+from simoun_agent.config import resolve
+from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
+from simoun_agent.run import train
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
+from simoun_agent.run.signals import Stopped
+from simoun_lab.sweep.grid import Trial
+from simoun_lab.sweep.report import ERROR_FILE
+
+TRIAL_FILE = "trial.json"
+"""Written by each trial into its run directory: one entry per part it ran (a resumed trial has
+several), with the start time, host, CPU count, load average at the start, env steps, wall and
+CPU seconds (:func:`start_part`, :func:`end_part`)."""
+
+STOP_FILE = "STOP"
+"""Written into the sweep directory by ``simoun-sweep`` on SIGTERM: every trial then stops at
+its next step with a checkpoint (a Ray trial runs in a worker thread, where no signal reaches
+it), and ``simoun-sweep --resume`` goes on from there."""
+
+
+class StopFile(train.TrainCallback):
+    """Ask the trial's training loop to stop, as on SIGTERM, once ``path`` exists."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def stop_requested(self, run: train.Run) -> int | None:
+        return signal.SIGTERM if self.path.exists() else None
+
+
+class TuneReporter(train.TrainCallback):
+    """Report each logged evaluation (``env_step``, ``return_mean``, ``wall_time_s``, ...) to Tune,
+    so its progress table and TensorBoard show live curves."""
+
+    def on_logged(self, run: train.Run, metrics: dict[str, float]) -> None:
+        from ray import tune
+
+        tune.report({"env_step": run.counters.env_step, **metrics})
+
+
+def trial_budget(trial: Trial) -> int:
+    """The env steps the trial trains to (its overrides', else its preset's)."""
+    return resolve(trial.preset, trial.overrides).total_env_steps
+
+
+def open_run(trial: Trial) -> train.Run:
+    """The trial's run: continued from its checkpoint (to the trial's budget, which an extended
+    sweep raised), else started afresh.
+
+    A run directory with ``config.json`` but no checkpoint was stopped before its first
+    checkpoint: it holds nothing to continue from, so its files are removed and it starts over.
+    """
+    run_dir = Path(trial.run_dir)
+    if (run_dir / CHECKPOINT_NAME).is_file():
+        budget = {"total_env_steps": trial_budget(trial)}
+        return train.resume_run(run_dir, budget, check=check_eval_distractions)
+    if (run_dir / CONFIG_NAME).is_file():
+        shutil.rmtree(run_dir)
+    config = resolve(trial.preset, trial.overrides)
+    return train.create_run(config, check=check_eval_distractions)
+
+
+def run_trial(
+    config: dict[str, Any], trials: dict[str, dict[str, Any]], stop_file: str | None = None
+) -> None:
+    """Tune's function trainable: train the trial named ``config["trial"]`` to the end, or until
+    ``stop_file`` appears (then it ends unfinished, with a checkpoint to resume from)."""
+    trial = Trial(**trials[config["trial"]])
+    run_dir = Path(trial.run_dir)
+    callbacks: list[train.TrainCallback] = [TuneReporter()]
+    if stop_file is not None:
+        callbacks.append(StopFile(Path(stop_file)))
+    try:
+        run = open_run(trial)
+        part = start_part(run)
+        try:
+            train.train(run, callbacks=[*distraction_callbacks(run.config), *callbacks])
+        except Stopped:
+            return
+        finally:
+            run.env.close()
+            run.eval_env.close()
+            end_part(run, part)
+    except Exception:
+        text = traceback.format_exc()
+        run_dir.mkdir(parents=True, exist_ok=True)
+        atomic_write(run_dir / ERROR_FILE, lambda tmp: tmp.write_text(text))
+        raise
+    (run_dir / ERROR_FILE).unlink(missing_ok=True)
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process (all its threads: the trial, and Ray's own in its worker) and of
+    its finished children (a background env process once closed), user + system."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def start_part(run: train.Run) -> dict[str, Any]:
+    """Append this part of the trial (a resumed trial has several) to its ``trial.json``: when
+    and where it started and how loaded the machine was then (``os.getloadavg``: processes
+    running or waiting for a CPU, averaged over 1, 5 and 15 minutes)."""
+    part = {
+        "started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "host": socket.gethostname(),
+        "cpu_count": os.cpu_count(),
+        "loadavg": list(os.getloadavg()),
+        "env_step_start": run.counters.env_step,
+        "_cpu_start": cpu_seconds(),
+        "_wall_start": time.perf_counter(),
+    }
+    _write_part(run.run_dir, part)
+    return part
+
+
+def end_part(run: train.Run, part: dict[str, Any]) -> None:
+    """Complete this part's entry in ``trial.json`` with its env steps, wall and CPU time."""
+    part["env_step_end"] = run.counters.env_step
+    part["wall_s"] = time.perf_counter() - part["_wall_start"]
+    part["cpu_s"] = cpu_seconds() - part["_cpu_start"]
+    _write_part(run.run_dir, part, replace_last=True)
+
+
+def _write_part(run_dir: Path, part: dict[str, Any], replace_last: bool = False) -> None:
+    """Append ``part`` to ``trial.json`` (or replace its last entry), leaving out the private
+    ``_`` entries."""
+    parts = read_trial_parts(run_dir)[: -1 if replace_last else None]
+    parts.append({key: value for key, value in part.items() if not key.startswith("_")})
+    text = json.dumps({"parts": parts}, indent=2) + "\n"
+    atomic_write(run_dir / TRIAL_FILE, lambda tmp: tmp.write_text(text))
+
+
+def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
+    """The parts recorded in a run directory's ``trial.json`` (none without one)."""
+    path = Path(run_dir) / TRIAL_FILE
+    return json.loads(path.read_text())["parts"] if path.is_file() else []
+
+
+def trial_table(trials: list[Trial]) -> dict[str, dict[str, Any]]:
+    """``{trial name: its fields}``, the lookup :func:`run_trial` is given (Tune's config then
+    holds only the short name, which its progress table shows)."""
+    return {trial.name: asdict(trial) for trial in trials}
