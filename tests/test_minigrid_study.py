@@ -117,7 +117,7 @@ def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_poole
     assert rnd_row.endswith("| — |")
 
 
-def test_the_default_spec_is_the_issue_s_design():
+def test_the_default_spec_is_the_v1_design():
     spec = StudySpec()
     assert [(t.env_id, t.steps, len(t.seeds)) for t in spec.tasks] == [
         ("MiniGrid-DoorKey-6x6-v0", 400_000, 5),

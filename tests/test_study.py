@@ -452,7 +452,7 @@ def test_help_runs_for_the_command_and_each_subcommand(capsys):
     assert "--probe-updates N" in out and "--allow-other-commit" in out and "--archive DIR" in out
 
 
-def test_the_dmc100k_spec_of_issue_20_plans_its_runs():
+def test_the_dmc100k_spec_plans_its_runs():
     spec = cli.spec_from("docs/studies/dmc100k.toml")
     assert spec.recipes == ["simoun", "drq", "drqv2", "rad", "curl"]
     assert spec.preset == "cpu" and spec.grid == {"agent.n_step": [1, 3]}
