@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from simoun_agent import table
 from simoun_agent.config import resolve
 from simoun_agent.config.recipes import SIMOUN_PARTS
 from simoun_agent.run.atomic import atomic_write
@@ -140,13 +141,14 @@ def main() -> None:
         f"{args.task}, action repeat {args.action_repeat}: median of {args.repeats} repeats of "
         f"{args.updates} updates"
     )
-    print(f"| recipe | setting | ms / update | x {BASELINE} | update time of a run (s) |")
-    print("|---|---|---:|---:|---:|")
+    rows = []
     for name in names:
         setting = ", ".join(f"{key}={value}" for key, value in settings[name].items())
         ratio = medians[name] / medians[BASELINE]
         run_s = medians[name] * built[name][2] / 1000
-        print(f"| {name} | {setting} | {medians[name]:.1f} | {ratio:.2f} | {run_s:.0f} |")
+        rows.append([name, setting, f"{medians[name]:.1f}", f"{ratio:.2f}", f"{run_s:.0f}"])
+    headers = ["recipe", "setting", "ms / update", f"x {BASELINE}", "update time of a run (s)"]
+    print(table.markdown_table(headers, rows, align="llrrr"))
     if args.json is not None:
         code = code_version()
         record = {

@@ -99,7 +99,9 @@ def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_poole
             shutil.copytree(study_dir / name, tmp_path / name)
         shutil.copytree(study_dir / large / arm / "s0", tmp_path / large / arm / "s0")
     records = Records(load_spec(study_dir / "spec.json"), tmp_path)
-    row = next(x for x in score_table(records, "success_rate") if x.startswith("| rnd |"))
+    row = next(
+        x for x in score_table(records, "success_rate").splitlines() if x.startswith("| rnd |")
+    )
     small_cell, large_cell, pooled = row.strip("| ").split(" | ")[1:]
     assert small_cell.endswith("(n=3)") and "[" in small_cell
     large_score = records.final(large, "rnd", "success_rate")[0]
@@ -113,7 +115,9 @@ def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_poole
     records = Records(load_spec(study_dir / "spec.json"), tmp_path)
     [_, rnd_line] = improvement_lines(records)
     assert rnd_line == "- P(rnd > ppo) on success rate: no task has 3 seeds yet"
-    rnd_row = next(x for x in score_table(records, "success_rate") if x.startswith("| rnd |"))
+    rnd_row = next(
+        x for x in score_table(records, "success_rate").splitlines() if x.startswith("| rnd |")
+    )
     assert rnd_row.endswith("| — |")
 
 
@@ -278,5 +282,9 @@ def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path
     rows = records.train[f"{task}/ppo/s0"]
     last_tenth = rows[int(0.9 * len(rows)) :]
     visited = np.mean([row["states_visited"] for row in last_tenth])
-    line = next(x for x in intrinsic_table(records) if x.startswith(f"| {task} | ppo | 90-100 % |"))
+    line = next(
+        x
+        for x in intrinsic_table(records).splitlines()
+        if x.startswith(f"| {task} | ppo | 90-100 % |")
+    )
     assert line.endswith(f"| {visited:.0f} |") and 100 < visited < 400

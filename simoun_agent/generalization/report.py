@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import csv
 import os
 from collections.abc import Sequence
 from dataclasses import asdict, fields
 from pathlib import Path
 
+from simoun_agent import table
 from simoun_agent.generalization.evaluation import ModeResult
 from simoun_agent.run.atomic import atomic_write
 
@@ -33,31 +33,20 @@ def markdown_table(results: Sequence[ModeResult]) -> str:
     """One row per run, one column per mode, cells ``mean ± std`` of the episode return."""
     runs, modes = _order(results)
     cell = {(r.run, r.mode): f"{r.return_mean:.1f} ± {r.return_std:.1f}" for r in results}
-    lines = [
-        "| run | " + " | ".join(modes) + " |",
-        "|---|" + "---:|" * len(modes),
-    ]
-    lines += [
-        f"| {run} | " + " | ".join(cell.get((run, m), "") for m in modes) + " |" for run in runs
-    ]
+    rows = [[run] + [cell.get((run, m), "") for m in modes] for run in runs]
+    text = table.markdown_table(["run", *modes], rows, align="l" + "r" * len(modes))
     first = results[0]
     note = (
         f"\nEpisode return, mean ± std over {first.episodes} deterministic episodes per mode "
         f"(reset seeds from {first.first_seed} for the first run; every mode plays the same ones)."
     )
-    return "\n".join(lines) + "\n" + note + "\n"
+    return text + "\n" + note + "\n"
 
 
 def write_csv(results: Sequence[ModeResult], path: Path) -> None:
     """One row per run and mode, with every ``ModeResult`` field."""
 
-    def write(tmp: Path) -> None:
-        with tmp.open("w", newline="") as f:
-            writer = csv.DictWriter(f, [field.name for field in fields(ModeResult)])
-            writer.writeheader()
-            writer.writerows(asdict(result) for result in results)
-
-    atomic_write(path, write)
+    table.write_csv(path, [field.name for field in fields(ModeResult)], map(asdict, results))
 
 
 def plot_bars(results: Sequence[ModeResult], path: Path, title: str) -> None:

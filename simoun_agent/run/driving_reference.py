@@ -27,6 +27,7 @@ from typing import Protocol
 import gymnasium as gym
 import numpy as np
 
+from simoun_agent import table
 from simoun_agent.config import TrainConfig, resolve
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
 from simoun_agent.run.make_env import make_env, video_fps
@@ -169,14 +170,11 @@ COLUMNS = (
 
 def markdown_table(metrics: dict[str, dict]) -> str:
     """One row per driver, the columns of :data:`COLUMNS`."""
-    lines = [
-        "| driver | " + " | ".join(header for header, _, _ in COLUMNS) + " |",
-        "|---" * (len(COLUMNS) + 1) + "|",
+    headers = ["driver"] + [header for header, _, _ in COLUMNS]
+    rows = [
+        [name] + [fmt.format(row[key]) for _, key, fmt in COLUMNS] for name, row in metrics.items()
     ]
-    for name, row in metrics.items():
-        cells = [fmt.format(row[key]) for _, key, fmt in COLUMNS]
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+    return table.markdown_table(headers, rows)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.analysis import pairs
 from simoun_lab.analysis.bias import CATEGORIES, THRESHOLD, BiasEstimate
@@ -77,26 +78,26 @@ def to_json(results: list[RunBias], seed: int) -> dict[str, Any]:
 
 def to_markdown(results: list[RunBias]) -> str:
     """A table: one row per run and layer, percent of units per category and per factor."""
-    lines = [
-        f"Percent of units per category (threshold {THRESHOLD} on the per-unit scores) and per "
-        "factor (softmax of the layer scores), Kowal et al. (CVPR 2022).",
-        "",
-        "| encoder | layer | units | static | dynamic | joint | residual | factors s / d / r "
-        "| pairs | env step | run |",
-        "|---|---|---:|---:|---:|---:|---:|---|---|---:|---|",
-    ]
+    headers = ["encoder", "layer", "units", *CATEGORIES, "factors s / d / r", "pairs"]
+    headers += ["env step", "run"]
+    rows = []
     for result in results:
         for name, estimate in result.layers.items():
             cats = estimate.category_percent()
             factors = estimate.factor_percent()
             shares = " / ".join(f"{factors[f]:.0f}" for f in ("static", "dynamic", "residual"))
-            lines.append(
-                f"| {result.encoder} | {name} | {estimate.units} | "
-                + " | ".join(f"{cats[c]:.1f}" for c in CATEGORIES)
-                + f" | {shares} | {result.pairs} ({result.recolour}) | {result.env_step} | "
-                f"{Path(result.run_dir).name} |"
+            rows.append(
+                [result.encoder, name, estimate.units]
+                + [f"{cats[c]:.1f}" for c in CATEGORIES]
+                + [shares, f"{result.pairs} ({result.recolour})", result.env_step]
+                + [Path(result.run_dir).name]
             )
-    return "\n".join(lines) + "\n"
+    intro = (
+        f"Percent of units per category (threshold {THRESHOLD} on the per-unit scores) and per "
+        "factor (softmax of the layer scores), Kowal et al. (CVPR 2022)."
+    )
+    align = "llr" + "r" * len(CATEGORIES) + "llrl"
+    return intro + "\n\n" + table.markdown_table(headers, rows, align) + "\n"
 
 
 def draw_chart(path: Path, results: list[RunBias]) -> Path:

@@ -17,7 +17,6 @@ control: a probe that cannot find RND's novelty signal would say nothing about t
 
 from __future__ import annotations
 
-import csv
 import functools
 import warnings
 from collections import Counter
@@ -29,6 +28,7 @@ import numpy as np
 import torch
 from gymnasium.vector import VectorEnv
 
+from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import ARMS, consistency
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
@@ -141,13 +141,7 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     rows = [row for name in names for row in probe(name, settings)]
     out.mkdir(parents=True, exist_ok=True)
 
-    def write_csv(tmp: Path) -> None:
-        with tmp.open("w", newline="") as file:
-            writer = csv.DictWriter(file, COLUMNS)
-            writer.writeheader()
-            writer.writerows(rows)
-
-    atomic_write(out / "probe.csv", write_csv)
+    table.write_csv(out / "probe.csv", COLUMNS, rows)
     lines = [
         f"# Intrinsic rewards against novelty under a random policy ({settings.env_id})",
         "",
@@ -159,10 +153,8 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
         "equal frames, re-visits the state it stands in, so a reward that pays still triplets "
         "more correlates negatively with novelty for that reason alone); block means.",
         "",
-        "| probe | corr | blocks with corr > 0 | corr, moving only | std / mean | "
-        "still / moving mean | still share |",
-        "|---|---|---|---|---|---|---|",
     ]
+    summary = []
     for name in names:
         blocks = [r for r in rows if r["probe"] == name][1:]
 
@@ -174,10 +166,19 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
             warnings.simplefilter("ignore", RuntimeWarning)
             cv = np.nanmean(np.where(mean > 0, column("intrinsic_std") / mean, np.nan))
             ratio = np.nanmean(column("still_mean") / column("moving_mean"))
-        lines.append(
-            f"| {name} | {np.nanmean(corr):+.3f} | {int(np.sum(corr > 0))} of {len(corr)} | "
-            f"{np.nanmean(column('novelty_corr_moving')):+.3f} | {cv:.3f} | {ratio:.2f} | "
-            f"{np.mean(column('still_fraction')):.2f} |"
+        summary.append(
+            [
+                name,
+                f"{np.nanmean(corr):+.3f}",
+                f"{int(np.sum(corr > 0))} of {len(corr)}",
+                f"{np.nanmean(column('novelty_corr_moving')):+.3f}",
+                f"{cv:.3f}",
+                f"{ratio:.2f}",
+                f"{np.mean(column('still_fraction')):.2f}",
+            ]
         )
+    headers = ["probe", "corr", "blocks with corr > 0", "corr, moving only", "std / mean"]
+    headers += ["still / moving mean", "still share"]
+    lines.append(table.markdown_table(headers, summary))
     atomic_write(out / "probe.md", lambda tmp: tmp.write_text("\n".join(lines) + "\n"))
     return out / "probe.md"

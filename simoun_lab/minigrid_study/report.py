@@ -21,6 +21,7 @@ import numpy as np
 from matplotlib.figure import Figure  # no pyplot: no backend or global figure state
 from matplotlib.ticker import EngFormatter
 
+from simoun_agent import table
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_lab import stats
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
@@ -81,13 +82,12 @@ def ci_text(point: float, low: float, high: float) -> str:
     return f"{point:.2f} [{low:.2f}, {high:.2f}]"
 
 
-def score_table(records: Records, key: str) -> list[str]:
-    """Markdown rows: IQM of the final ``key`` with its 95 % CI, per task and arm, and over
+def score_table(records: Records, key: str) -> str:
+    """A Markdown table: IQM of the final ``key`` with its 95 % CI, per task and arm, and over
     the tasks with ``MIN_SEEDS`` seeds; a task with fewer shows its runs' values alone."""
     spec = records.spec
     tasks = [t.env_id for t in spec.tasks]
-    head = "| arm | " + " | ".join(tasks) + f" | tasks with {MIN_SEEDS}+ seeds |"
-    lines = [head, "|---" * (len(tasks) + 2) + "|"]
+    rows = []
     for arm in spec.arms:
         cells, pooled = [], {}
         for env_id in tasks:
@@ -103,8 +103,8 @@ def score_table(records: Records, key: str) -> list[str]:
                 cells.append(f"{ci_text(*ci)} (n={len(scores)})")
         whole = stats.stratified_bootstrap_ci(pooled, stats.aggregate_iqm, REPS) if pooled else None
         cells.append(ci_text(*whole) if whole else "—")
-        lines.append(f"| {arm} | " + " | ".join(cells) + " |")
-    return lines
+        rows.append([arm, *cells])
+    return table.markdown_table(["arm", *tasks, f"tasks with {MIN_SEEDS}+ seeds"], rows)
 
 
 def improvement_lines(records: Records) -> list[str]:
@@ -126,13 +126,10 @@ def improvement_lines(records: Records) -> list[str]:
     return lines
 
 
-def cost_table(records: Records) -> list[str]:
+def cost_table(records: Records) -> str:
     """Seconds per 1000 env steps in env stepping (intrinsic reward included) and in PPO's
     updates, env steps per second of training, and the arm's wall time over plain PPO's."""
-    lines = [
-        "| task | arm | env s / 1k steps | update s / 1k steps | steps / s | wall vs ppo |",
-        "|---|---|---|---|---|---|",
-    ]
+    rows = []
     for task in records.spec.tasks:
         base = None
         for arm in records.spec.arms:
@@ -145,10 +142,9 @@ def cost_table(records: Records) -> list[str]:
             rate = np.mean([s["steps_per_s"] for s in summaries])
             base = rate if arm == "ppo" else base
             ratio = f"{base / rate:.2f}x" if base else "—"
-            lines.append(
-                f"| {task.env_id} | {arm} | {env:.2f} | {update:.2f} | {rate:.1f} | {ratio} |"
-            )
-    return lines
+            rows.append([task.env_id, arm, f"{env:.2f}", f"{update:.2f}", f"{rate:.1f}", ratio])
+    headers = ["task", "arm", "env s / 1k steps", "update s / 1k steps", "steps / s"]
+    return table.markdown_table([*headers, "wall vs ppo"], rows)
 
 
 INTRINSIC_KEYS = (
@@ -190,14 +186,11 @@ def bracket_means(
         return np.nanmean(per_run, axis=0)
 
 
-def intrinsic_table(records: Records) -> list[str]:
+def intrinsic_table(records: Records) -> str:
     """The intrinsic reward per rollout, averaged over each tenth-of-training bracket's rollouts
     and over seeds, in the brackets of :data:`PARTS`. Plain PPO's rows (no
     intrinsic reward) give the share of still triplets its policy makes, for comparison."""
-    lines = [
-        "| task | arm | part | " + " | ".join(INTRINSIC_KEYS) + " |",
-        "|---" * (len(INTRINSIC_KEYS) + 3) + "|",
-    ]
+    rows = []
     for task in records.spec.tasks:
         for arm in records.spec.arms:
             runs = records.runs(task.env_id, arm)
@@ -205,12 +198,12 @@ def intrinsic_table(records: Records) -> list[str]:
                 means = bracket_means(
                     records, runs, bracket, lambda r: [r[k] for k in INTRINSIC_KEYS]
                 )
-                cells = " | ".join(
+                cells = [
                     f"{v:.0f}" if key == "states_visited" else f"{v:.3f}"
                     for key, v in zip(INTRINSIC_KEYS, means, strict=True)
-                )
-                lines.append(f"| {task.env_id} | {arm} | {part} | {cells} |")
-    return lines
+                ]
+                rows.append([task.env_id, arm, part, *cells])
+    return table.markdown_table(["task", "arm", "part", *INTRINSIC_KEYS], rows)
 
 
 def survival_row(row: dict[str, float], gamma: float) -> list[float]:
@@ -228,13 +221,10 @@ def survival_row(row: dict[str, float], gamma: float) -> list[float]:
     ]
 
 
-def survival_table(records: Records) -> list[str]:
+def survival_table(records: Records) -> str:
     """:func:`survival_row` averaged over each bracket of training and over seeds."""
     gamma = records.spec.ppo.gamma
-    lines = [
-        "| task | arm | part | constant share | bonus value mean/(1-gamma) | rollouts corr < 0 |",
-        "|---|---|---|---|---|---|",
-    ]
+    rows = []
     for task in records.spec.tasks:
         for arm in [a for a in records.spec.arms if a != "ppo"]:
             runs = records.runs(task.env_id, arm)
@@ -242,11 +232,10 @@ def survival_table(records: Records) -> list[str]:
                 share, value, negative = bracket_means(
                     records, runs, bracket, lambda r: survival_row(r, gamma)
                 )
-                lines.append(
-                    f"| {task.env_id} | {arm} | {part} | {share:.3f} | {value:.3f} | "
-                    f"{negative:.2f} |"
-                )
-    return lines
+                cells = [f"{share:.3f}", f"{value:.3f}", f"{negative:.2f}"]
+                rows.append([task.env_id, arm, part, *cells])
+    headers = ["task", "arm", "part", "constant share", "bonus value mean/(1-gamma)"]
+    return table.markdown_table([*headers, "rollouts corr < 0"], rows)
 
 
 def plot_curves(records: Records, out: Path) -> list[str]:
@@ -355,17 +344,17 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "",
         "## Final success rate",
         "",
-        *score_table(records, "success_rate"),
+        score_table(records, "success_rate"),
         "",
         *improvement_lines(records),
         "",
         "## Final extrinsic return",
         "",
-        *score_table(records, "return_mean"),
+        score_table(records, "return_mean"),
         "",
         "## Step-time cost",
         "",
-        *cost_table(records),
+        cost_table(records),
         "",
         "## The intrinsic rewards during training",
         "",
@@ -375,7 +364,7 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "still triplets, and the number of distinct symbolic states reached since the run began "
         "(the exploration each arm's policy achieved; plain PPO's rows for comparison).",
         "",
-        *intrinsic_table(records),
+        intrinsic_table(records),
         "",
         "## Is it a survival bonus?",
         "",
@@ -388,7 +377,7 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
         "`python -m simoun_lab.minigrid_study probe` measures the correlation without PPO "
         "(`probe/`).",
         "",
-        *survival_table(records),
+        survival_table(records),
         "",
         *[f"![{name}]({name})" for name in plot_training(records, out)],
         "",

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import parse_arm
 from simoun_lab.minigrid_study.report import read_rows
@@ -83,14 +84,14 @@ def write_selection(spec: StudySpec, archive: Path) -> Path:
         "over env steps / budget) over the tuning seeds; ties to the smaller scale. An entry is",
         "selected only when all its settings have finished on every tuning seed.",
         "",
-        "| arm | mean area | areas per run | finished |",
-        "|---|---|---|---|",
     ]
+    rows = []
     for arm, record in result["arms"].items():
         mean = "-" if record["mean_area"] is None else f"{record['mean_area']:.3f}"
         areas = ", ".join(f"{a:.3f}" for a in record["areas"].values()) or "-"
         done = f"{len(record['areas'])} of {len([r for r in spec.runs() if r.arm == arm])}"
-        lines.append(f"| {arm} | {mean} | {areas} | {done} |")
+        rows.append([arm, mean, areas, done])
+    lines += [table.markdown_table(["arm", "mean area", "areas per run", "finished"], rows)]
     lines += ["", "Selected:", ""]
     for entry, name in result["selected"].items():
         lines.append(f"- {entry}: {name or 'not yet (settings still running)'}")

@@ -9,12 +9,11 @@ be played and is reported as missing.
 from __future__ import annotations
 
 import csv
-import io
 from dataclasses import asdict
 from pathlib import Path
 
+from simoun_agent import table
 from simoun_agent.generalization.evaluation import evaluate_runs
-from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME
 from simoun_lab.study.archive import GENERALIZATION_CSV, copy_file
 
@@ -26,12 +25,8 @@ def play_modes(run_dir: str, modes: list[str], episodes: int) -> str:
     """Play the final agent of the finished run at ``run_dir`` on the train mode and ``modes``,
     ``episodes`` each, and write its ``generalization.csv``; returns the file's path."""
     results = evaluate_runs([Path(run_dir)], ["train", *modes], episodes)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, COLUMNS, extrasaction="ignore")
-    writer.writeheader()
-    writer.writerows(asdict(result) for result in results)
     path = Path(run_dir, GENERALIZATION_CSV)
-    atomic_write(path, lambda tmp: tmp.write_text(buffer.getvalue()))
+    table.write_csv(path, COLUMNS, map(asdict, results))
     return str(path)
 
 

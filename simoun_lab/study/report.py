@@ -29,7 +29,6 @@ known maximum).
 from __future__ import annotations
 
 import csv
-import io
 import json
 import math
 from dataclasses import dataclass
@@ -38,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from simoun_agent import table
 from simoun_agent.config import RECIPES, resolve, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
@@ -242,27 +242,31 @@ def protocol(spec: StudySpec, record: dict[str, Any], choices: dict[str, Choice]
         "Each recipe got the same base config, grid, seeds and budgets; its own values are its "
         "recipe's (`simoun_agent/config/recipes.py`) and the grid setting its tuning selected.",
         "",
-        "| recipe | what it is | selected setting | tuning score |",
-        "|---|---|---|---:|",
+        table.markdown_table(
+            ["recipe", "what it is", "selected setting", "tuning score"],
+            [
+                [
+                    recipe,
+                    RECIPES[recipe].description,
+                    f"`{setting_label(choices[recipe].setting)}`",
+                    f"{choices[recipe].score:.4g}",
+                ]
+                for recipe in spec.recipes
+            ],
+            align="lllr",
+        ),
     ]
-    for recipe in spec.recipes:
-        choice = choices[recipe]
-        lines.append(
-            f"| {recipe} | {RECIPES[recipe].description} | `{setting_label(choice.setting)}` | "
-            f"{choice.score:.4g} |"
-        )
     keys, values = recipe_differences(spec, choices)
     if keys:
         lines += [
             "",
             "The resolved configs of the evaluation runs differ only in these keys:",
             "",
-            "| recipe | " + " | ".join(keys) + " |",
-            "|---|" + "---|" * len(keys),
+            table.markdown_table(
+                ["recipe", *keys],
+                [[recipe] + [show(values[recipe][key]) for key in keys] for recipe in spec.recipes],
+            ),
         ]
-        for recipe in spec.recipes:
-            cells = [show(values[recipe][key]) for key in keys]
-            lines.append(f"| {recipe} | " + " | ".join(cells) + " |")
     lines += [
         "",
         "### Tuning scores",
@@ -270,9 +274,8 @@ def protocol(spec: StudySpec, record: dict[str, Any], choices: dict[str, Choice]
         "Each setting's score by the selection rule: the mean over tasks of the mean over seeds "
         "(each seed's score in brackets); **bold** is the selected one.",
         "",
-        "| recipe | setting | score | " + " | ".join(env_label(t) for t in tuning.tasks) + " |",
-        "|---|---|---:|" + "---|" * len(tuning.tasks),
     ]
+    rows = []
     for recipe in spec.recipes:
         for candidate in choices[recipe].candidates:
             chosen = candidate.setting == choices[recipe].setting
@@ -283,8 +286,9 @@ def protocol(spec: StudySpec, record: dict[str, Any], choices: dict[str, Choice]
             per_task = [
                 "[" + ", ".join(f"{s:.3g}" for s in candidate.runs[t]) + "]" for t in tuning.tasks
             ]
-            lines.append(f"| {recipe} | {label} | {score} | " + " | ".join(per_task) + " |")
-    return lines
+            rows.append([recipe, label, score, *per_task])
+    headers = ["recipe", "setting", "score", *(env_label(t) for t in tuning.tasks)]
+    return [*lines, table.markdown_table(headers, rows, align="llr")]
 
 
 def read_rows(path: Path) -> list[dict[str, Any]]:
@@ -343,32 +347,39 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
         "interval (Agarwal et al. 2021; `simoun_lab/stats.py`). With a few seeds per task the "
         "intervals are wide: overlapping intervals are no evidence of a difference.",
         "",
-        "| task | recipe | n | return (mean ± std) | IQM score [95 % CI] |",
-        "|---|---|---:|---:|---:|",
     ]
     # the diagnostic recipes run under evaluation/ too: their own section compares them
     per_task = [r for r in per_task if recipe_of(r) in order]
     aggregate = [r for r in aggregate if recipe_of(r) in order]
     improvement = [r for r in improvement if recipe_of(r, "y") in order]
     per_task.sort(key=lambda r: (tasks.index(r["env"]), order.get(recipe_of(r), 0)))
+    rows = []
     for row in per_task:
         spread = "" if math.isnan(row["final_return_std"]) else f" ± {row['final_return_std']:.0f}"
-        lines.append(
-            f"| {row['env']} | {recipe_of(row)} | {row['n']:.0f} | "
-            f"{row['final_return_mean']:.1f}{spread} | "
-            f"{_interval(row['iqm'], row['iqm_low'], row['iqm_high'])} |"
+        rows.append(
+            [
+                row["env"],
+                recipe_of(row),
+                f"{row['n']:.0f}",
+                f"{row['final_return_mean']:.1f}{spread}",
+                _interval(row["iqm"], row["iqm_low"], row["iqm_high"]),
+            ]
         )
+    headers = ["task", "recipe", "n", "return (mean ± std)", "IQM score [95 % CI]"]
+    lines.append(table.markdown_table(headers, rows, align="llrrr"))
     aggregate.sort(key=lambda r: order.get(recipe_of(r), 0))
     lines += [
         "",
         "Over all evaluation tasks (IQM of every run's score, tasks pooled):",
         "",
-        "| recipe | runs | IQM score [95 % CI] |",
-        "|---|---:|---:|",
-    ]
-    lines += [
-        f"| {recipe_of(r)} | {r['runs']:.0f} | {_interval(r['iqm'], r['iqm_low'], r['iqm_high'])} |"
-        for r in aggregate
+        table.markdown_table(
+            ["recipe", "runs", "IQM score [95 % CI]"],
+            [
+                [recipe_of(r), f"{r['runs']:.0f}", _interval(r["iqm"], r["iqm_low"], r["iqm_high"])]
+                for r in aggregate
+            ],
+            align="lrr",
+        ),
     ]
     first = spec.recipes[0]
     mine = [r for r in improvement if recipe_of(r, "x") == first]
@@ -380,12 +391,14 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
             "scores above a run of Y on the same task (ties count one half), averaged over the "
             "tasks both ran, with its 95 % stratified bootstrap interval; 0.5 is no difference.",
             "",
-            "| Y | tasks | P(X > Y) [95 % CI] |",
-            "|---|---|---:|",
-        ]
-        lines += [
-            f"| {recipe_of(r, 'y')} | {r['tasks']} | {_interval(r['p'], r['low'], r['high'])} |"
-            for r in mine
+            table.markdown_table(
+                ["Y", "tasks", "P(X > Y) [95 % CI]"],
+                [
+                    [recipe_of(r, "y"), r["tasks"], _interval(r["p"], r["low"], r["high"])]
+                    for r in mine
+                ],
+                align="llr",
+            ),
         ]
     lines += [
         "",
@@ -438,15 +451,20 @@ def diagnostics_section(spec: StudySpec, results: list[RunResult]) -> list[str]:
         for ablation in ablations:
             x, y = _pair(mine, scores_by_task(results, ablation))
             if not x:
-                rows.append(f"| {ablation} | {RECIPES[ablation].description} | 0 | – | – | – |")
+                rows.append([ablation, RECIPES[ablation].description, 0, "–", "–", "–"])
                 continue
             difference = stats.difference_ci(x, y, stats.aggregate_iqm, *args)
             improvement = stats.probability_of_improvement_ci(x, y, *args)
             runs = sum(len(v) for v in y.values())
             rows.append(
-                f"| {ablation} | {RECIPES[ablation].description} | {runs} | "
-                f"{_interval(*_bootstrap(y))} | {_interval(*difference)} | "
-                f"{_interval(*improvement)} |"
+                [
+                    ablation,
+                    RECIPES[ablation].description,
+                    runs,
+                    _interval(*_bootstrap(y)),
+                    _interval(*difference),
+                    _interval(*improvement),
+                ]
             )
         lines += [
             "",
@@ -462,10 +480,18 @@ def diagnostics_section(spec: StudySpec, results: list[RunResult]) -> list[str]:
             + (_interval(*_bootstrap(mine)) if mine else "– (no finished run)")
             + ".",
             "",
-            f"| ablation | what it is | runs | IQM score [95 % CI] | IQM({method}) - IQM(ablation) "
-            f"[95 % CI] | P({method} > ablation) [95 % CI] |",
-            "|---|---|---:|---:|---:|---:|",
-            *rows,
+            table.markdown_table(
+                [
+                    "ablation",
+                    "what it is",
+                    "runs",
+                    "IQM score [95 % CI]",
+                    f"IQM({method}) - IQM(ablation) [95 % CI]",
+                    f"P({method} > ablation) [95 % CI]",
+                ],
+                rows,
+                align="llrrrr",
+            ),
         ]
     return lines
 
@@ -505,9 +531,8 @@ def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[st
         "stratified bootstrap interval; train score: the IQM of the train mode's normalized "
         "return. A run whose train return is 0 or less has no ratio and is left out.",
         "",
-        "| recipe | runs | train score [95 % CI] | " + " | ".join(modes) + " |",
-        "|---|---:|---:|" + "---:|" * len(modes),
     ]
+    scored = []
     played = [r for r in results if r.modes is not None]
     for recipe in recipes:
         mine = [r for r in played if r.run.recipe == recipe]
@@ -523,11 +548,9 @@ def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[st
             cells.append(_interval(*_bootstrap(ratios)) if ratios else "–")
         _, left_out = mode_ratios(played, recipe, modes[0])
         count = f"{len(mine)}" + (f" ({left_out} left out)" if left_out else "")
-        lines.append(
-            f"| {recipe} | {count} | {_interval(*_bootstrap(train_scores))} | "
-            + " | ".join(cells)
-            + " |"
-        )
+        scored.append([recipe, count, _interval(*_bootstrap(train_scores)), *cells])
+    headers = ["recipe", "runs", "train score [95 % CI]", *modes]
+    lines.append(table.markdown_table(headers, scored, align="lrr" + "r" * len(modes)))
     first = spec.recipes[0]
     rows = []
     for other in recipes[1:]:
@@ -535,7 +558,7 @@ def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[st
         for mode in modes:
             x, y = _pair(mode_ratios(played, first, mode)[0], mode_ratios(played, other, mode)[0])
             cells.append(_interval(*stats.probability_of_improvement_ci(x, y, *args)) if x else "–")
-        rows.append(f"| {other} | " + " | ".join(cells) + " |")
+        rows.append([other, *cells])
     if rows:
         lines += [
             "",
@@ -543,9 +566,7 @@ def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[st
             "more of its train-mode return than a run of Y on the same task, with its 95 % "
             "interval.",
             "",
-            "| Y | " + " | ".join(modes) + " |",
-            "|---|" + "---:|" * len(modes),
-            *rows,
+            table.markdown_table(["Y", *modes], rows, align="l" + "r" * len(modes)),
         ]
     unplayed = [r.run.name for r in results if r.modes is None]
     if unplayed:
@@ -622,9 +643,11 @@ def update_cost_section(
         f"repeat {costs['action_repeat']}; every recipe's update timed in one process, "
         f"interleaved, as the median of its repeats, over {baseline}'s.",
         "",
-        f"| recipe | ms per update | x {baseline} |",
-        "|---|---:|---:|",
-        *(f"| {r} | {costs['ms_per_update'][r]:.1f} | {costs['ratio'][r]:.2f} |" for r in recipes),
+        table.markdown_table(
+            ["recipe", "ms per update", f"x {baseline}"],
+            [[r, f"{costs['ms_per_update'][r]:.1f}", f"{costs['ratio'][r]:.2f}"] for r in recipes],
+            align="lrr",
+        ),
         "",
         f"Each run is placed on {baseline}'s clock (at each evaluation step, the median wall "
         f"time of {baseline}'s evaluation runs on the task) stretched by its recipe's ratio, so "
@@ -659,10 +682,8 @@ def time_section(results: list[RunResult]) -> list[str]:
         "the 1-minute load average per CPU when the trial started (above 1, runs waited for a "
         "CPU and their wall times are inflated).",
         "",
-        "| phase | recipe | runs | env steps | wall time per run (s) | CPU time per run (s) | "
-        "env steps per wall second | load at start (max) |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
     ]
+    rows = []
     groups: dict[tuple[str, str], list[RunResult]] = {}
     for result in results:
         groups.setdefault((result.run.phase, result.run.recipe), []).append(result)
@@ -671,10 +692,21 @@ def time_section(results: list[RunResult]) -> list[str]:
         wall = np.mean([r.wall_s for r in group])
         loads = [r.load for r in group if not math.isnan(r.load)]
         load = f"{max(loads):.2f}" if loads else "–"
-        lines.append(
-            f"| {phase} | {recipe} | {len(group)} | {steps:.0f} | {wall:.0f} | "
-            f"{mean_cpu(group)} | {steps / wall:.1f} | {load} |"
+        rows.append(
+            [
+                phase,
+                recipe,
+                len(group),
+                f"{steps:.0f}",
+                f"{wall:.0f}",
+                mean_cpu(group),
+                f"{steps / wall:.1f}",
+                load,
+            ]
         )
+    headers = ["phase", "recipe", "runs", "env steps", "wall time per run (s)"]
+    headers += ["CPU time per run (s)", "env steps per wall second", "load at start (max)"]
+    lines.append(table.markdown_table(headers, rows, align="llrrrrrr"))
     total_cpu = np.nansum([r.cpu_s for r in results])
     unrecorded = sum(math.isnan(r.cpu_s) for r in results)
     lines += [
@@ -760,13 +792,8 @@ def plot_curves(
 
 
 def _write_csv(path: Path, rows: list[dict[str, Any]]) -> None:
-    if not rows:
-        return
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, list(rows[0]))
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write(path, lambda tmp: tmp.write_text(buffer.getvalue()))
+    if rows:
+        table.write_csv(path, list(rows[0]), rows)
 
 
 def score_rows(results: list[RunResult]) -> list[dict[str, Any]]:

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import csv
 import functools
-import io
 import itertools
 import json
 import math
@@ -46,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from simoun_agent import table
 from simoun_agent.config import SetupError, from_dict, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
@@ -748,21 +748,33 @@ def markdown(
         "span: the run's average evaluation return). Wall time: seconds in the training loop, "
         "evaluations included. Each seed counts once per row.",
         "",
-        "| variant | env | n | final return | AUC | wall time (s) | env steps/s | env steps |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
+        table.markdown_table(
+            [
+                "variant",
+                "env",
+                "n",
+                "final return",
+                "AUC",
+                "wall time (s)",
+                "env steps/s",
+                "env steps",
+            ],
+            [
+                [
+                    row["variant"],
+                    row["env"],
+                    row["n"],
+                    _pm(row["final_return_mean"], row["final_return_std"]),
+                    _pm(row["auc_mean"], row["auc_std"]),
+                    _pm(row["wall_time_s_mean"], row["wall_time_s_std"]),
+                    _pm(row["env_steps_per_s_mean"], row["env_steps_per_s_std"]),
+                    row["env_steps"],
+                ]
+                for row in rows
+            ],
+            align="llrrrrrr",
+        ),
     ]
-    for row in rows:
-        cells = [
-            row["variant"],
-            row["env"],
-            str(row["n"]),
-            _pm(row["final_return_mean"], row["final_return_std"]),
-            _pm(row["auc_mean"], row["auc_std"]),
-            _pm(row["wall_time_s_mean"], row["wall_time_s_std"]),
-            _pm(row["env_steps_per_s_mean"], row["env_steps_per_s_std"]),
-            str(row["env_steps"]),
-        ]
-        lines.append("| " + " | ".join(cells) + " |")
     lines += [
         "",
         "## Normalized scores, IQM and 95 % confidence intervals",
@@ -774,13 +786,21 @@ def markdown(
         f"{BOOTSTRAP_REPS} stratified bootstrap resamples of the seeds (seed {BOOTSTRAP_SEED}; "
         "Agarwal et al. 2021). A wide interval says the seeds disagree: more seeds narrow it.",
         "",
-        "| variant | env | n | IQM [95 % CI] | mean [95 % CI] |",
-        "|---|---|---:|---:|---:|",
+        table.markdown_table(
+            ["variant", "env", "n", "IQM [95 % CI]", "mean [95 % CI]"],
+            [
+                [
+                    row["variant"],
+                    row["env"],
+                    row["n"],
+                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
+                    _ci(row["norm_mean"], row["norm_mean_low"], row["norm_mean_high"]),
+                ]
+                for row in rows
+            ],
+            align="llrrr",
+        ),
     ]
-    for row in rows:
-        iqm = _ci(row["iqm"], row["iqm_low"], row["iqm_high"])
-        mean = _ci(row["norm_mean"], row["norm_mean_low"], row["norm_mean_high"])
-        lines.append(f"| {row['variant']} | {row['env']} | {row['n']} | {iqm} | {mean} |")
     lines += [
         "",
         "### Across tasks",
@@ -794,13 +814,21 @@ def markdown(
             else ""
         ),
         "",
-        "| variant | tasks | runs | IQM [95 % CI] | mean [95 % CI] |",
-        "|---|---|---:|---:|---:|",
+        table.markdown_table(
+            ["variant", "tasks", "runs", "IQM [95 % CI]", "mean [95 % CI]"],
+            [
+                [
+                    row["variant"],
+                    row["tasks"],
+                    row["runs"],
+                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
+                    _ci(row["mean"], row["mean_low"], row["mean_high"]),
+                ]
+                for row in aggregates
+            ],
+            align="llrrr",
+        ),
     ]
-    for row in aggregates:
-        iqm = _ci(row["iqm"], row["iqm_low"], row["iqm_high"])
-        mean = _ci(row["mean"], row["mean_low"], row["mean_high"])
-        lines.append(f"| {row['variant']} | {row['tasks']} | {row['runs']} | {iqm} | {mean} |")
     if improvements:
         lines += _improvement_table(improvements)
     lines += [
@@ -867,21 +895,14 @@ def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
         "with its 95 % CI (the two variants' seeds resampled independently). Above 0.5 the row "
         "tends to win; an interval that excludes 0.5 is a difference these seeds support.",
         "",
-        "| P(row > column) | " + " | ".join(numbers) + " |",
-        "|---|" + "---:|" * len(variants),
     ]
-    for number, x in zip(numbers, variants, strict=True):
-        cells = ["–" if x == y else cell.get((x, y), "no common task") for y in variants]
-        lines.append(f"| {number} {x} | " + " | ".join(cells) + " |")
-    return lines
-
-
-def _csv_text(rows: list[dict[str, Any]], columns: list[str]) -> str:
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, columns)
-    writer.writeheader()
-    writer.writerows(rows)
-    return buffer.getvalue()
+    rows = [
+        [f"{number} {x}"]
+        + ["–" if x == y else cell.get((x, y), "no common task") for y in variants]
+        for number, x in zip(numbers, variants, strict=True)
+    ]
+    align = "l" + "r" * len(variants)
+    return [*lines, table.markdown_table(["P(row > column)", *numbers], rows, align)]
 
 
 AGGREGATE_COLUMNS = ["variant", "tasks", "runs", "iqm", "iqm_low", "iqm_high", "mean", "mean_low"]
@@ -921,12 +942,9 @@ def write_report(
     improvements = improvement_rows(scores)
     text = markdown(comparison, rows, aggregates, improvements)
     atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
-    report_csv = _csv_text(rows, list(rows[0]))
-    atomic_write(out / REPORT_CSV, lambda tmp: tmp.write_text(report_csv))
-    aggregate_csv = _csv_text(aggregates, AGGREGATE_COLUMNS)
-    atomic_write(out / AGGREGATE_CSV, lambda tmp: tmp.write_text(aggregate_csv))
-    improvement_csv = _csv_text(improvements, IMPROVEMENT_COLUMNS)
-    atomic_write(out / IMPROVEMENT_CSV, lambda tmp: tmp.write_text(improvement_csv))
+    table.write_csv(out / REPORT_CSV, list(rows[0]), rows)
+    table.write_csv(out / AGGREGATE_CSV, AGGREGATE_COLUMNS, aggregates)
+    table.write_csv(out / IMPROVEMENT_CSV, IMPROVEMENT_COLUMNS, improvements)
     score = "normalized score (final return / task maximum)"
     plot_panels(
         std_bands(groups, "env_step", None),
