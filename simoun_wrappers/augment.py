@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
+from simoun_wrappers._checks import is_int
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
@@ -56,21 +57,22 @@ def random_conv(
     import torch.nn.functional as F
 
     if not isinstance(batch, torch.Tensor) or not batch.is_floating_point():
+        given = batch.dtype if isinstance(batch, torch.Tensor) else described(batch)
         raise TypeError(
-            f"random_conv expects a floating-point torch.Tensor, got "
-            f"{getattr(batch, 'dtype', type(batch))}; convert uint8 frames first, "
-            f"e.g. torch.as_tensor(frames).float() / 255."
+            f"random_conv expects a floating-point torch.Tensor, got {given}; convert frames "
+            f"first, e.g. torch.as_tensor(frames).float() / 255."
         )
     if batch.ndim not in (4, 5):
         raise ValueError(
             f"random_conv expects a (B, C, H, W) or (B, T, C, H, W) batch, got shape "
             f"{tuple(batch.shape)}; add a leading batch axis with batch[None] for one sample."
         )
-    if not isinstance(kernel_size, int) or kernel_size < 1 or kernel_size % 2 == 0:
+    if not is_int(kernel_size) or kernel_size < 1 or kernel_size % 2 == 0:
         raise ValueError(
             f"kernel_size must be a positive odd int so the output keeps its size, got "
             f"{kernel_size!r}; use 3 (Lee et al. 2020) or another odd value."
         )
+    check_kernel_fits(kernel_size, batch.shape[-2], batch.shape[-1])
     shape = batch.shape
     frames = batch if batch.ndim == 5 else batch.unsqueeze(1)
     b, t, c, h, w = frames.shape
@@ -105,6 +107,24 @@ def random_conv(
     if clamp is not None:
         out = out.clamp(clamp[0], clamp[1])
     return out.reshape(shape)
+
+
+def described(value: Any) -> str:
+    """``value``'s type as a user names it, with a numpy array's dtype: ``numpy.ndarray of
+    float32``, ``list``."""
+    if isinstance(value, np.ndarray):
+        return f"numpy.ndarray of {value.dtype}"
+    return type(value).__name__
+
+
+def check_kernel_fits(kernel_size: int, height: int, width: int) -> None:
+    """Refuse a kernel wider than the image: it would only see padding, and its cost grows
+    with its area (a 301-wide kernel over a 256x256 render takes hours)."""
+    if kernel_size > min(height, width):
+        raise ValueError(
+            f"kernel_size {kernel_size} is larger than the {height}x{width} image; use 3 "
+            f"(Lee et al. 2020), or an odd value up to {min(height, width)}."
+        )
 
 
 def shift_pad(image_size: int) -> int:
@@ -191,7 +211,7 @@ class RandomConvolution(ChainWrapper):
         gym.utils.RecordConstructorArgs.__init__(self, kernel_size=kernel_size, source=source)
         import torch
 
-        if not isinstance(kernel_size, int) or kernel_size < 1 or kernel_size % 2 == 0:
+        if not is_int(kernel_size) or kernel_size < 1 or kernel_size % 2 == 0:
             raise ValueError(
                 f"kernel_size must be a positive odd int, got {kernel_size!r}; use 3 as in "
                 f"Lee et al. 2020."
@@ -205,6 +225,7 @@ class RandomConvolution(ChainWrapper):
         )
         chain, from_render = pixel_env(env, source, owner="RandomConvolution")
         self._layout = image_layout(chain.observation_space)
+        check_kernel_fits(kernel_size, *self._layout[:2])
         chain = TransformObservation(chain, self._convolve, chain.observation_space)
         ChainWrapper.__init__(self, chain, env)
         if from_render:

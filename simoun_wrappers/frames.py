@@ -11,6 +11,8 @@ from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
 from gymnasium.wrappers import FrameStackObservation
 
+from simoun_wrappers._checks import is_int
+
 
 class FrameRing:
     """The last ``num_frames`` frames in a preallocated ring buffer, oldest first on read.
@@ -74,7 +76,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
         check_single_env(env, "FrameTriplet")
         gym.utils.RecordConstructorArgs.__init__(self, num_frames=num_frames)
         gym.Wrapper.__init__(self, env)
-        if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
+        if not is_int(num_frames) or num_frames < 1:
             raise ValueError(
                 f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
             )

@@ -22,6 +22,7 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
+from simoun_wrappers._checks import is_int
 from simoun_wrappers.intrinsic_normalization import Normalization, make_normalization
 
 __all__ = [
@@ -66,17 +67,34 @@ def triplet_shape(space: spaces.Space) -> tuple[int, int, int, int]:
     )
 
 
+class TripletReader:
+    """Takes a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``; a class, not a
+    closure, so that the wrappers holding one pickle."""
+
+    def __init__(self, space: spaces.Space) -> None:
+        self.shape = triplet_shape(space)
+        self.use_key = isinstance(space, spaces.Dict)
+
+    def __call__(self, batch: Any) -> np.ndarray:
+        # A copy: the wrappers keep the previous triplet, and the caller owns the observation.
+        array = np.array(batch["frames"] if self.use_key else batch, dtype=np.uint8)
+        return array.reshape(-1, *self.shape)
+
+
 def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
     """A function taking a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``."""
-    shape = triplet_shape(space)
-    use_key = isinstance(space, spaces.Dict)
+    return TripletReader(space)
 
-    def read(batch: Any) -> np.ndarray:
-        # A copy: the wrappers keep the previous triplet, and the caller owns the observation.
-        array = np.array(batch["frames"] if use_key else batch, dtype=np.uint8)
-        return array.reshape(-1, *shape)
 
-    return read
+LARGEST = np.finfo(np.float64).max
+
+
+def finite_sum(extrinsic: np.ndarray, intrinsic: np.ndarray) -> np.ndarray:
+    """``extrinsic + intrinsic``, at most the largest float in size: finite rewards whose sum
+    overflows give that float, not an inf that a learner would take for a broken env."""
+    with np.errstate(over="ignore"):
+        total = np.add(extrinsic, intrinsic, dtype=np.float64)
+    return np.clip(total, -LARGEST, LARGEST)
 
 
 class SharedSource:
@@ -162,7 +180,7 @@ def check_weighting(decay: float, warmup: int, progress: float | None) -> None:
             f"decay must be a finite number >= 0 (lambda of exp(-lambda * t), per env step), got "
             f"{decay!r}; use the paper's decay=2e-5, or decay=0 for a weight that never fades."
         )
-    if not (isinstance(warmup, (int, np.integer)) and warmup >= 0):
+    if not (is_int(warmup) and warmup >= 0):
         raise ValueError(
             f"warmup must be an int >= 0 (transitions that get no reward while the statistics "
             f"settle), got {warmup!r}; e.g. warmup=1024."
@@ -342,7 +360,7 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
         )
         self._last_triplet = triplet
         info = {**info, "reward_extrinsic": extrinsic, "reward_intrinsic": intrinsic}
-        return obs, extrinsic + intrinsic, terminated, truncated, info
+        return obs, float(finite_sum(extrinsic, intrinsic)), terminated, truncated, info
 
 
 ONE_ENV = np.zeros(1, dtype=np.int64)
@@ -426,7 +444,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
             "reward_intrinsic": intrinsic,
             "_reward_intrinsic": everywhere,
         }
-        return obs, extrinsic + intrinsic, terminated, truncated, info
+        return obs, finite_sum(extrinsic, intrinsic), terminated, truncated, info
 
 
 class ConstantBonusArguments:

@@ -17,6 +17,7 @@ from gymnasium.wrappers import (
     TransformObservation,
 )
 
+from simoun_wrappers._checks import is_int
 from simoun_wrappers.frames import FrameTriplet, check_single_env, frame_stack_in
 from simoun_wrappers.motion import ResidualMotion
 
@@ -41,11 +42,11 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     """``size`` as ``(H, W)``; an int means a square; None stays None (keep the image's size)."""
     if size is None:
         return None
-    if isinstance(size, (int, np.integer)):
+    if is_int(size):
         pair = (size, size)
     else:
         pair = tuple(size) if isinstance(size, (tuple, list)) else (size,)
-    if len(pair) != 2 or not all(isinstance(v, (int, np.integer)) and v > 0 for v in pair):
+    if len(pair) != 2 or not all(is_int(v) and v > 0 for v in pair):
         raise ValueError(
             f"size must be a positive int or an (H, W) pair of positive ints, got {size!r}; "
             f"e.g. size=84 or size=(84, 252), or None to keep the image's size."
@@ -64,7 +65,7 @@ def check_stack_options(
             raise TypeError(f"{name} must be True or False, got {value!r}.")
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
-    if not isinstance(num_frames, (int, np.integer)) or num_frames < 1:
+    if not is_int(num_frames) or num_frames < 1:
         raise ValueError(
             f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
         )

@@ -18,6 +18,7 @@ import pytest
 from gymnasium.wrappers import TransformReward
 from test_cli_conventions import TINY
 
+from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
 from simoun_agent.cli.config_flags import check_given_once, overrides_from
 from simoun_agent.config import resolve, to_dict
@@ -89,6 +90,10 @@ def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys
         (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
         (["--agent.encoder", "duall"], "must be a known name (did you mean 'dual'?)"),
         (["--video=maybe"], "--video is a switch: it takes true or false"),
+        (["--learning-rate", "1e-3"], "unknown flag --learning-rate (did you mean --agent.lr?)"),
+        (["--agent.gamma=0.9"], "unknown flag --agent.gamma (did you mean --agent.discount?)"),
+        (["--frame-skip", "4"], "unknown flag --frame-skip (did you mean --action-repeat?)"),
+        (["--xyzzy"], "unknown flag --xyzzy; `simoun-train --help` lists every flag"),
     ],
 )
 def test_the_command_line_refuses_with_the_fix(flags, said, tmp_path, capsys):
@@ -362,3 +367,39 @@ def test_at_step_counts_a_resumed_run_at_its_nearest_evaluation_and_says_so(tmp_
     with (tmp_path / "report.csv").open() as f:
         (row,) = csv.DictReader(f)
     assert row["n"] == "4"
+
+
+# every command refuses an option given twice with different values
+
+
+@pytest.mark.parametrize(
+    ("main", "flags", "said"),
+    [
+        (eval_cli.main, ["--episodes", "1", "--episodes", "2"], "(--episodes 1 and --episodes 2)"),
+        (eval_cli.main, ["--video", "--no-video"], "(--video and --no-video)"),
+        (eval_cli.main, ["--seed=1", "--seed", "2"], "--seed is given twice"),
+        (report_cli.main, ["--at-step", "5", "--at-step", "6"], "--at-step is given twice"),
+    ],
+)
+def test_every_command_refuses_an_option_given_twice(main, flags, said, tmp_path, capsys):
+    err = refused(capsys, main, [str(tmp_path), *flags])
+    assert said in err and "give it once" in err
+
+
+# paths: one that does not exist, or a file where a directory is expected, is named as such
+
+
+def test_a_missing_or_wrong_kind_of_path_is_named_as_such(tmp_path, capsys):
+    absent, text = tmp_path / "absent", tmp_path / "notes.txt"
+    text.write_text("not a run")
+    err = refused(capsys, eval_cli.main, [str(absent)])
+    assert f"{absent} does not exist" in err
+    err = refused(capsys, eval_cli.main, [str(text)])
+    assert "is a file that is not a checkpoint (.pt)" in err and "Delete" not in err
+    err = refused(capsys, train_cli.main, ["--resume", str(absent)])
+    assert f"--resume {absent} does not exist" in err
+    err = refused(capsys, train_cli.main, ["--resume", str(text)])
+    assert f"--resume {text} is a file, not a directory" in err
+    err = refused(capsys, train_cli.main, [*TINY, "--run-dir", str(text)])
+    assert f"the output directory {text} is a file, not a directory" in err
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["notes.txt"]

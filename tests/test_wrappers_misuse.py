@@ -2,17 +2,30 @@
 silently wrong observation. Headless import order and SDL's signal handlers."""
 
 import os
+import pickle
 import signal
 import subprocess
 import sys
 import threading
 
 import gymnasium as gym
+import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
+import numpy as np
 import pytest
 import shimmy
+import torch
 from gymnasium.error import ResetNeeded
+from gymnasium.wrappers import TransformReward
 
-from simoun_wrappers import FrameTriplet, RandomConvolution, SimounObservation
+from simoun_wrappers import (
+    ActionRepeat,
+    ConstantBonusReward,
+    ConstantBonusVectorReward,
+    FrameTriplet,
+    RandomConvolution,
+    SimounObservation,
+    random_conv,
+)
 
 gym.register_envs(shimmy)
 
@@ -132,3 +145,78 @@ def test_sdl_leaves_sigterm_to_python_after_highway_env_renders():
 def test_switches_given_as_strings_are_refused(option):
     with pytest.raises(TypeError, match=f"{option} must be True or False, got 'false'"):
         SimounObservation(cartpole_pixels(), size=32, **{option: "false"})
+
+
+def minigrid_pixels() -> gym.Env:
+    return gym.make("MiniGrid-Empty-5x5-v0", render_mode="rgb_array")
+
+
+@pytest.mark.parametrize(
+    ("build", "said"),
+    [
+        (lambda: SimounObservation(minigrid_pixels(), size=True), "size must be a positive int"),
+        (lambda: SimounObservation(minigrid_pixels(), size=(32, False)), "got (32, False)"),
+        (lambda: FrameTriplet(minigrid_pixels(), True), "num_frames must be a positive int"),
+        (lambda: ActionRepeat(minigrid_pixels(), True), "repeat must be a positive int"),
+        (lambda: RandomConvolution(minigrid_pixels(), True), "kernel_size must be a positive"),
+    ],
+)
+def test_a_bool_is_not_taken_for_an_int(build, said):
+    with pytest.raises(ValueError) as error:
+        build()
+    assert said in str(error.value)
+
+
+def test_numpy_ints_are_ints_to_every_wrapper():
+    env = SimounObservation(
+        RandomConvolution(ActionRepeat(minigrid_pixels(), np.int64(2)), np.int64(3)),
+        size=np.int32(24),
+        num_frames=np.int64(3),
+    )
+    obs, _ = env.reset(seed=0)
+    assert obs["frames"].shape == (3, 3, 24, 24)
+    kernel = random_conv(torch.rand(1, 3, 8, 8), np.int64(3))
+    assert kernel.shape == (1, 3, 8, 8)
+
+
+def test_a_kernel_wider_than_the_image_is_refused_before_any_convolution():
+    frozen_lake = gym.make("FrozenLake-v1", render_mode="rgb_array")  # 256x256 renders
+    with pytest.raises(ValueError, match=r"kernel_size 301 is larger than the 256x256 image"):
+        RandomConvolution(frozen_lake, kernel_size=301)
+    with pytest.raises(ValueError, match=r"larger than the 8x8 image; .* up to 8"):
+        random_conv(torch.rand(1, 3, 8, 8), 9)
+
+
+def test_random_conv_names_a_numpy_array_as_such():
+    with pytest.raises(TypeError, match=r"torch.Tensor, got numpy.ndarray of float32"):
+        random_conv(np.zeros((1, 3, 8, 8), np.float32))
+
+
+def triplets(**options) -> gym.Env:
+    return SimounObservation(minigrid_pixels(), size=16, **options)
+
+
+def paying(extrinsic: float) -> gym.Env:
+    return SimounObservation(TransformReward(minigrid_pixels(), lambda _: extrinsic), size=16)
+
+
+def test_the_intrinsic_bonus_never_turns_finite_rewards_into_inf():
+    single = ConstantBonusReward(paying(1.7e308), scale=1e308)
+    single.reset(seed=0)
+    assert single.step(0)[1] == sys.float_info.max
+    vector = ConstantBonusVectorReward(
+        gym.vector.SyncVectorEnv([lambda: paying(1.7e308), lambda: paying(1.0)]), scale=1e308
+    )
+    vector.reset(seed=0)
+    rewards = vector.step(np.zeros(2, dtype=np.int64))[1]
+    assert rewards[0] == sys.float_info.max and np.isfinite(rewards[1])
+
+
+@pytest.mark.parametrize("fold_frames", [False, True])
+def test_intrinsic_reward_wrappers_pickle_when_the_env_does(fold_frames):
+    env = ConstantBonusReward(triplets(fold_frames=fold_frames), scale=0.1)
+    env.reset(seed=0)
+    env.step(0)
+    copy = pickle.loads(pickle.dumps(env))
+    copy.reset(seed=1)
+    assert copy.step(0)[4]["reward_intrinsic"] == pytest.approx(0.1)

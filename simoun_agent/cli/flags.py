@@ -198,6 +198,56 @@ def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
     return out
 
 
+def single_valued_flags(cls: type) -> dict[str, tuple[str, Any]]:
+    """Flag -> (field, value) for ``cls``'s own fields that take one value: a switch and its
+    negation map to True and False, an option to None (its value follows it). Repeatable
+    tuples, sections and subcommands are left out."""
+    flags: dict[str, tuple[str, Any]] = {}
+    if not dataclasses.is_dataclass(cls):
+        return flags
+    hints = typing.get_type_hints(cls, include_extras=True)
+    for field in dataclasses.fields(cls):
+        kind = hints[field.name]
+        while typing.get_origin(kind) is Annotated:
+            kind = typing.get_args(kind)[0]
+        if typing.get_origin(kind) in (tuple, list) or dataclasses.is_dataclass(kind):
+            continue
+        flag = "--" + field.name.replace("_", "-")
+        flags[flag] = (field.name, True if kind is bool else None)
+        if kind is bool:
+            flags[negated(flag)] = (field.name, False)
+    return flags
+
+
+def refuse_repeated(argv: Sequence[str], cls: type) -> None:
+    """Raise ValueError for an option of ``cls`` given twice with different values
+    (``--episodes 1 --episodes 2``, ``--video --no-video``): tyro would keep the last without a
+    word. Switches come as ``--video`` / ``--no-video`` here (:func:`bool_argv` ran first)."""
+    flags = single_valued_flags(cls)
+    given: dict[str, dict[str, str]] = {}
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        name, eq, text = arg.partition("=")
+        if name not in flags:
+            continue
+        field, switch = flags[name]
+        if switch is not None:
+            value, said = str(switch), arg
+        elif eq or i + 1 < len(argv):
+            value = text if eq else argv[i + 1]
+            said = arg if eq else f"{arg} {value}"
+        else:
+            continue  # tyro says the value is missing
+        given.setdefault(field, {}).setdefault(value, said)
+    for field, values in given.items():
+        if len(values) > 1:
+            raise ValueError(
+                f"--{field.replace('_', '-')} is given twice with different values "
+                f"({' and '.join(values.values())}); give it once"
+            )
+
+
 def negated(flag: str) -> str:
     """tyro's negation of a switch: ``--video`` -> ``--no-video``, ``--agent.curiosity`` ->
     ``--agent.no-curiosity``."""
@@ -230,6 +280,7 @@ def parse(
         sys.exit(0)
     try:
         argv = bool_argv(argv, switches)
+        refuse_repeated(argv, cls)
     except ValueError as err:
         fail(prog, err)
     with _help_unwrapped_in_pipes():

@@ -157,8 +157,19 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
     problem and the fix for a missing, corrupt or foreign file.
     """
     path = Path(path)
+    if not path.exists():
+        raise SetupError(
+            f"{path} does not exist; pass a run directory that simoun-train created, or its "
+            f"{CHECKPOINT_NAME}"
+        )
     if path.is_dir():
         path = path / CHECKPOINT_NAME
+    elif path.suffix != ".pt":
+        # not a checkpoint's name: say so rather than call the file corrupt and advise deleting it
+        raise SetupError(
+            f"{path} is a file that is not a checkpoint (.pt); pass a run directory that "
+            f"simoun-train created, or its {CHECKPOINT_NAME}"
+        )
     if not path.is_file():
         raise SetupError(
             f"no checkpoint at {path}: the run stopped before its first checkpoint, or the path "

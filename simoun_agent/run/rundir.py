@@ -30,6 +30,11 @@ def make_output_dir(path: Path, flag: str = "--out") -> bool:
     it did not exist before, so a caller that stops later can remove what it made; raises
     SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
     created = not path.exists()
+    if path.exists() and not path.is_dir():
+        raise SetupError(
+            f"the output directory {path} is a file, not a directory; pass a new or existing "
+            f"directory to {flag}"
+        )
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / ".write-test"

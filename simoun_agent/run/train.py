@@ -179,6 +179,12 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
     config_path = run_dir / CONFIG_NAME
+    if not run_dir.is_dir():
+        why = "is a file, not a directory" if run_dir.exists() else "does not exist"
+        raise SetupError(
+            f"--resume {run_dir} {why}; pass the directory that simoun-train created (its "
+            "path is printed as 'run directory: ...' when a run starts)"
+        )
     if not config_path.is_file():
         raise SetupError(
             f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "

@@ -7,6 +7,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from simoun_wrappers._checks import is_int
+
 LEVELS = ("easy", "hard")
 
 
@@ -32,7 +34,7 @@ def check_level(level: str, owner: str) -> None:
 
 
 def check_seed(seed: int | None, owner: str) -> None:
-    if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
+    if seed is not None and not (is_int(seed) and seed >= 0):
         raise ValueError(f"{owner} seed must be a non-negative int or None, got {seed!r}.")
 
 
