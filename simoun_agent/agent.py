@@ -461,9 +461,7 @@ class SimounAgent:
         l_q = critic_loss(q1, q2, targets)
         l_tran = (
             transition_loss(
-                self.transition,
-                self.dynamics(enc)[:batch],
-                action,
+                self.transition(self.dynamics(enc)[:batch], action),
                 self.dynamics(following)[:batch],
             )
             if self.transition is not None
@@ -473,9 +471,9 @@ class SimounAgent:
         if views.key is not None and not self.contrastive_optimizers:
             with torch.no_grad():
                 key = self.encoder_target.encode_key(views.key)
-            l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity)
+            l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity.weight)
         l_re = (
-            reward_loss(self.reward_model, enc.state[:batch], action, reward)
+            reward_loss(self.reward_model(enc.state[:batch], action), reward)
             if self.reward_model is not None
             else None
         )
@@ -510,7 +508,7 @@ class SimounAgent:
         anchor = self.encoder(views.windows[0][:, : self.config.num_frames]).anchor
         with torch.no_grad():
             key = self.encoder_target.encode_key(views.key)
-        loss = contrastive_loss(anchor, key, self.similarity)
+        loss = contrastive_loss(anchor, key, self.similarity.weight)
         for optimizer in self.contrastive_optimizers:
             optimizer.zero_grad(set_to_none=True)
         loss.backward()
