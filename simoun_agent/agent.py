@@ -4,6 +4,7 @@ losses, actor, EMA targets."""
 from __future__ import annotations
 
 import copy
+import functools
 import math
 from dataclasses import asdict
 from typing import NamedTuple
@@ -47,6 +48,11 @@ class Views(NamedTuple):
     state the encoder pass of the critic views already gives (the shared-frame trick)"""
     key: torch.Tensor | None
     """the contrastive positive (Eq. 3) as float frames; None without L_con"""
+
+
+def unchanged(frames: torch.Tensor) -> torch.Tensor:
+    """The RL view of augmentation "none": the frames as they are."""
+    return frames
 
 
 class SimounAgent:
@@ -107,11 +113,31 @@ class SimounAgent:
         self.shift_pad = (
             config.shift_pad if config.shift_pad is not None else shift_pad(self.frame_shape[1])
         )
+        # the update's parts, resolved here so that the update path does not read config names
+        shifts = config.augmentation == "shift"
+        self.augment_view = (
+            functools.partial(random_shift, pad=self.shift_pad) if shifts else unchanged
+        )
+        """one RL view of a batch: DrQ's random shift (one offset per sample), or the frames
+        unchanged (augmentation "none")"""
+        self.view_count = max(config.critic_augmentations, config.target_augmentations)
+        """RL views drawn per update: one per critic view (DrQ's M) and per target view (its K)"""
+        self.independent_next_shift = shifts and config.independent_next_shift
+        """whether each target view shifts its bootstrap triplet by an offset of its own"""
+        keys = {"shift": self.shifted_key, "random_conv": self.random_conv_key}
+        self.contrastive_key = (
+            keys[config.contrastive_view] if self.similarity is not None else None
+        )
+        """how the contrastive positive (Eq. 3) is made, :meth:`shifted_key` or
+        :meth:`random_conv_key`; None without L_con"""
         for net in (self.critic, self.actor, self.transition, self.reward_model):
             if net is not None:
                 net.apply(weight_init)
         self.encoder_target = copy.deepcopy(self.encoder).requires_grad_(False)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
+        self.value_encoder = self.encoder_target if config.next_state_encoder == "target" else None
+        """the encoder of the next state the target Q heads read: the EMA encoder, or None for
+        the online state the actor reads"""
         self.log_alpha = (
             torch.tensor(math.log(config.init_temperature), device=self.device, requires_grad=True)
             if ACTORS[config.actor].temperature
@@ -155,9 +181,7 @@ class SimounAgent:
         self.env_step = 0
         """global env step of the latest update; :meth:`act`'s default for the exploration
         schedule of an actor that has one"""
-        self.reads_encoder_target = config.next_state_encoder == "target" or bool(
-            config.contrastive_weight
-        )
+        self.reads_encoder_target = self.value_encoder is not None or self.similarity is not None
         """whether anything reads the EMA encoder (the TD target, the contrastive keys); when
         nothing does, :meth:`update_targets` leaves it"""
 
@@ -278,12 +302,7 @@ class SimounAgent:
         cfg = self.config
         self.env_step = step
         steps = 1 if return_mask is None else return_mask.shape[1]
-        if window.shape[1] != cfg.num_frames + steps:
-            raise ValueError(
-                f"window holds {window.shape[1]} frames; with {steps} return step(s) it must hold "
-                f"{cfg.num_frames + steps} (frames t-{cfg.num_frames - 1} .. t+{steps}): pass "
-                "FrameReplay.sample's 'window', or its 'n_step_window' with 'return_mask'"
-            )
+        self.check_window(window, steps)
         bootstrap_obs, n_return = bootstrap if bootstrap is not None else (None, reward)
         views = self.augment(window, bootstrap_obs)
         per_step = cfg.curiosity and steps > 1
@@ -301,6 +320,16 @@ class SimounAgent:
         self.num_updates += 1
         return metrics
 
+    def check_window(self, window: torch.Tensor, steps: int) -> None:
+        """ValueError unless ``window`` holds the frames of a triplet and ``steps`` more."""
+        k = self.config.num_frames
+        if window.shape[1] != k + steps:
+            raise ValueError(
+                f"window holds {window.shape[1]} frames; with {steps} return step(s) it must hold "
+                f"{k + steps} (frames t-{k - 1} .. t+{steps}): pass "
+                "FrameReplay.sample's 'window', or its 'n_step_window' with 'return_mask'"
+            )
+
     def augment(self, window: torch.Tensor, bootstrap_obs: torch.Tensor | None) -> Views:
         """The augmented inputs of one update, in this order of random draws: the
         max(critic_augmentations, target_augmentations) RL views, each the window and the
@@ -309,37 +338,39 @@ class SimounAgent:
         bootstrap triplets each under a shift of its own; then the contrastive key's view."""
         cfg = self.config
         k, length = cfg.num_frames, window.shape[1]
-        count = max(cfg.critic_augmentations, cfg.target_augmentations)
-        independent = cfg.augmentation == "shift" and cfg.independent_next_shift
+        independent = self.independent_next_shift
         frames = window
         if bootstrap_obs is not None and not independent:
             frames = torch.cat([window, bootstrap_obs], dim=1)
-        if cfg.augmentation == "shift":
-            views = [random_shift(frames, self.shift_pad) for _ in range(count)]
-        else:
-            views = [frames] * count
+        views = [self.augment_view(frames) for _ in range(self.view_count)]
         if independent:
             following = window[:, 1 : k + 1] if bootstrap_obs is None else bootstrap_obs
-            next_obs = [random_shift(following, self.shift_pad) for _ in range(count)]
+            next_obs = [self.augment_view(following) for _ in range(self.view_count)]
         else:
             next_obs = [
                 v[:, length:] if bootstrap_obs is not None else v[:, 1 : k + 1] for v in views
             ]
         windows = [v[:, :length] for v in views]
-        key = None
-        if self.similarity is not None:
-            if cfg.contrastive_view == "shift":
-                key = self.encoder.key_frames(random_shift(window[:, :k], self.shift_pad))
-            else:
-                key = random_conv(
-                    self.encoder.key_frames(windows[0][:, :k]), cfg.random_conv_kernel
-                )
+        key = (
+            self.contrastive_key(window[:, :k], windows[0][:, :k])
+            if self.contrastive_key is not None
+            else None
+        )
         shared = (
             0
             if bootstrap_obs is not None or independent
             else min(cfg.target_augmentations, cfg.critic_augmentations)
         )
         return Views(windows, next_obs[: cfg.target_augmentations], shared, key)
+
+    def shifted_key(self, triplet: torch.Tensor, first_view: torch.Tensor) -> torch.Tensor:
+        """CURL's contrastive positive: the unshifted triplet at t under a shift of its own."""
+        return self.encoder.key_frames(random_shift(triplet, self.shift_pad))
+
+    def random_conv_key(self, triplet: torch.Tensor, first_view: torch.Tensor) -> torch.Tensor:
+        """Eq. 3's contrastive positive: a random convolution of the first RL view's triplet
+        at t."""
+        return random_conv(self.encoder.key_frames(first_view), self.config.random_conv_kernel)
 
     def encode(self, views: Views, next_features: bool = False) -> tuple[Encoding, Encoding | None]:
         """The online encoder on the critic views stacked into one batch of M*B: the state at t
@@ -390,15 +421,14 @@ class SimounAgent:
         """The next state of each target view, stacked ``(K*B, D)``: as the actor sees it (the
         online encoder; the critic views' t+1 states are reused where they are the same frames)
         and as the target Q heads read it (``next_state_encoder``)."""
-        cfg = self.config
         rows = views.shared * len(views.windows[0])
         parts = [following.state[:rows]] if views.shared else []
         if len(views.next_obs) > views.shared:
             parts.append(self.encoder(torch.cat(views.next_obs[views.shared :])).state)
         policy_state = parts[0] if len(parts) == 1 else torch.cat(parts)
-        if cfg.next_state_encoder == "target":
-            return policy_state, self.encoder_target(torch.cat(views.next_obs)).state
-        return policy_state, policy_state
+        if self.value_encoder is None:
+            return policy_state, policy_state
+        return policy_state, self.value_encoder(torch.cat(views.next_obs)).state
 
     def intrinsic_reward(
         self,
@@ -461,9 +491,7 @@ class SimounAgent:
         l_q = critic_loss(q1, q2, targets)
         l_tran = (
             transition_loss(
-                self.transition,
-                self.dynamics(enc)[:batch],
-                action,
+                self.transition(self.dynamics(enc)[:batch], action),
                 self.dynamics(following)[:batch],
             )
             if self.transition is not None
@@ -473,9 +501,9 @@ class SimounAgent:
         if views.key is not None and not self.contrastive_optimizers:
             with torch.no_grad():
                 key = self.encoder_target.encode_key(views.key)
-            l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity)
+            l_con = contrastive_loss(enc.anchor[:batch], key, self.similarity.weight)
         l_re = (
-            reward_loss(self.reward_model, enc.state[:batch], action, reward)
+            reward_loss(self.reward_model(enc.state[:batch], action), reward)
             if self.reward_model is not None
             else None
         )
@@ -510,7 +538,7 @@ class SimounAgent:
         anchor = self.encoder(views.windows[0][:, : self.config.num_frames]).anchor
         with torch.no_grad():
             key = self.encoder_target.encode_key(views.key)
-        loss = contrastive_loss(anchor, key, self.similarity)
+        loss = contrastive_loss(anchor, key, self.similarity.weight)
         for optimizer in self.contrastive_optimizers:
             optimizer.zero_grad(set_to_none=True)
         loss.backward()

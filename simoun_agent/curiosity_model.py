@@ -267,8 +267,8 @@ class CuriosityModel(OnlineModel):
                 self.encoder.to_float(window[:, 2]), cfg.random_conv_kernel, self.generator
             )
             key = self.momentum.encode_key(view)
-        l_tran = transition_loss(self.transition, enc.motion, action, following.motion)
-        l_con = contrastive_loss(enc.anchor, key, self.similarity)
+        l_tran = transition_loss(self.transition(enc.motion, action), following.motion)
+        l_con = contrastive_loss(enc.anchor, key, self.similarity.weight)
         # Eq. 2 in InfoNCE form: G's prediction must pick its own f_m_{t+1} out of the batch.
         # Without it the motion path can collapse to a constant that G predicts exactly.
         l_motion = contrastive_loss(self.transition(enc.motion, action), following.motion)

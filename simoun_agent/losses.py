@@ -1,42 +1,40 @@
-"""Every loss of Simoun, one function per equation of the paper (Sec. 3)."""
+"""Every loss of Simoun, one function per equation of the paper (Sec. 3).
+
+Each takes tensors only: the caller runs the networks (G, R, the critic, the policy) and
+passes their outputs, so a function here holds its equation's arithmetic and nothing else.
+"""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import torch
 import torch.nn.functional as F
 
-if TYPE_CHECKING:  # annotations only: the actor heads (models/sac.py) import these losses
-    from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 
-
-def transition_loss(
-    model: TransitionModel, motion: torch.Tensor, action: torch.Tensor, next_motion: torch.Tensor
-) -> torch.Tensor:
-    """Eq. 2: || G(f^m_t, a_t) - f^m_{t+1} ||_2^2, batch mean; the target f^m_{t+1} is detached."""
-    return (model(motion, action) - next_motion.detach()).pow(2).sum(-1).mean()
+def transition_loss(predicted_next_motion: torch.Tensor, next_motion: torch.Tensor) -> torch.Tensor:
+    """Eq. 2: || G(f^m_t, a_t) - f^m_{t+1} ||_2^2, batch mean, given G's prediction
+    ``(B, D)``; the target f^m_{t+1} is detached."""
+    return (predicted_next_motion - next_motion.detach()).pow(2).sum(-1).mean()
 
 
 def contrastive_loss(
-    anchor: torch.Tensor, key: torch.Tensor, similarity: BilinearSimilarity | None = None
+    anchor: torch.Tensor, key: torch.Tensor, weight: torch.Tensor | None = None
 ) -> torch.Tensor:
     """Eq. 3: InfoNCE over the batch. Row i scores anchor i against every key; key i (the
     augmented view of the same frame, from the momentum encoder, detached) is the positive and
-    the other K-1 keys of the batch are the negatives. ``similarity`` is a bilinear score
-    (identity = Eq. 3's inner product); ``None`` uses the plain inner product."""
+    the other K-1 keys of the batch are the negatives. ``weight`` is the ``(D, D)`` matrix W of
+    CURL's bilinear score anchor W key^T (the identity = Eq. 3's inner product); ``None`` uses
+    the plain inner product."""
     key = key.detach()
-    logits = similarity(anchor, key) if similarity is not None else anchor @ key.T
+    logits = anchor @ weight @ key.T if weight is not None else anchor @ key.T
     logits = logits - logits.amax(dim=1, keepdim=True).detach()
     labels = torch.arange(anchor.shape[0], device=anchor.device)
     return F.cross_entropy(logits, labels)
 
 
-def reward_loss(
-    model: RewardModel, state: torch.Tensor, action: torch.Tensor, reward: torch.Tensor
-) -> torch.Tensor:
-    """Eq. 7: (R(f_t, a_t) - r^e_{t+1})^2, batch mean, against the extrinsic reward only."""
-    return F.mse_loss(model(state, action), reward)
+def reward_loss(predicted_reward: torch.Tensor, reward: torch.Tensor) -> torch.Tensor:
+    """Eq. 7: (R(f_t, a_t) - r^e_{t+1})^2, batch mean, given R's prediction ``(B,)``, against
+    the extrinsic reward only."""
+    return F.mse_loss(predicted_reward, reward)
 
 
 def soft_value(

@@ -1,13 +1,15 @@
 """Every config value is checked when the config is built: the error names the flag, the value
 and the fix. One bad value per field, and every field has a row."""
 
+import dataclasses
 import math
 
 import pytest
 import torch
 
-from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, resolve
+from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import config_fields
+from simoun_agent.config.rules import Rule, check_fields, integer, rules_of, setting
 
 BAD = {
     "env": "",
@@ -122,6 +124,27 @@ def test_messages_give_the_value_and_the_fix(overrides, words):
 def test_device_cuda_without_a_gpu_names_the_flag_and_cpu():
     with pytest.raises(SetupError, match=r"--device cuda: .*no CUDA GPU.*--device cpu"):
         resolve(None, {"device": "cuda"})
+
+
+@pytest.mark.parametrize("cls", [AgentConfig, TrainConfig])
+def test_each_field_carries_its_rule_in_its_own_definition(cls):
+    rules = rules_of(cls)
+    assert list(rules) == [f.name for f in dataclasses.fields(cls)]
+    assert all(isinstance(rule, Rule) for rule in rules.values())
+    assert rules_of(cls()) == rules
+
+
+def test_a_field_without_a_rule_is_refused_when_the_config_is_built():
+    @dataclasses.dataclass
+    class Partial:
+        ruled: int = setting(1, integer(1))
+        bare: int = 2
+
+        def __post_init__(self) -> None:
+            check_fields(self, "")
+
+    with pytest.raises(TypeError, match="Partial fields without a rule: bare"):
+        Partial()
 
 
 def test_agent_config_in_python_names_the_field_too():

@@ -8,12 +8,15 @@ flipped sign, a max for a min, a dropped discount or a missing detach changes a 
 here. The gradient checks say which inputs each loss trains and which it must hold fixed.
 """
 
+import ast
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
+from simoun_agent import losses
 from simoun_agent.losses import (
     actor_loss,
     contrastive_loss,
@@ -67,7 +70,7 @@ def test_transition_loss_is_eq2_squared_l2_per_sample_then_batch_mean():
     model = TransitionModel(D, A, hidden_dim=8)
     motion, action = rand(B, D, seed=1, grad=True), rand(B, A, seed=2)
     next_motion = rand(B, D, seed=3, grad=True)
-    loss = transition_loss(model, motion, action, next_motion)
+    loss = transition_loss(model(motion, action), next_motion)
     predicted = mlp_by_hand(model.net, np.concatenate([np64(motion), np64(action)], 1))
     expected = ((predicted - np64(next_motion)) ** 2).sum(1).mean()
     assert float(loss.detach()) == pytest.approx(expected, rel=1e-5)
@@ -75,6 +78,25 @@ def test_transition_loss_is_eq2_squared_l2_per_sample_then_batch_mean():
     assert next_motion.grad is None  # the target f^m_{t+1} is detached
     assert motion.grad.abs().sum() > 0
     assert all(p.grad is not None and p.grad.abs().sum() > 0 for p in model.parameters())
+
+
+def imported_modules(source: str) -> list[str]:
+    """Every module an ``import`` or ``from ... import`` of ``source`` names, anywhere in it
+    (``TYPE_CHECKING`` blocks included); a relative import counts as ``simoun_agent``'s."""
+    names = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            names += [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            names.append("simoun_agent" if node.level else node.module)
+    return names
+
+
+def test_losses_import_nothing_from_simoun_agent():
+    """The losses take tensors, so the networks can import them and not the other way round."""
+    names = imported_modules(Path(losses.__file__).read_text())
+    assert "torch" in names  # the walk sees the module's imports
+    assert not [name for name in names if name.split(".")[0] == "simoun_agent"], names
 
 
 def test_transition_model_reads_motion_then_action():
@@ -95,7 +117,7 @@ def test_contrastive_loss_is_eq3_infonce_with_the_diagonal_as_positives(bilinear
         with torch.no_grad():  # an asymmetric W: a transposed score would change the value
             similarity.weight.add_(rand(D, D, seed=3, scale=0.5))
         weight = np64(similarity.weight)
-    loss = contrastive_loss(anchor, key, similarity)
+    loss = contrastive_loss(anchor, key, similarity.weight if bilinear else None)
     logits = np64(anchor) @ weight @ np64(key).T
     log_sum_exp = np.log(np.exp(logits).sum(1))
     expected = (log_sum_exp - np.diag(logits)).mean()
@@ -123,7 +145,7 @@ def test_reward_loss_is_eq7_mean_squared_error_against_the_given_reward():
     model = RewardModel(D, A, hidden_dim=8)
     state, action = rand(B, D, seed=1, grad=True), rand(B, A, seed=2)
     reward = rand(B, seed=3, scale=3.0)
-    loss = reward_loss(model, state, action, reward)
+    loss = reward_loss(model(state, action), reward)
     predicted = mlp_by_hand(model.net, np.concatenate([np64(state), np64(action)], 1))[:, 0]
     assert float(loss.detach()) == pytest.approx(((predicted - np64(reward)) ** 2).mean(), rel=1e-5)
     loss.backward()

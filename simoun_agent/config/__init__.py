@@ -9,7 +9,7 @@ the agent, the models, the run layer or the command lines.
 ``resolve``             defaults -> preset -> recipe -> overrides; ``config.json`` round trip
 ``keys``                flat keys (``agent.lr``), typed ``--set`` values, unknown-key refusal
 ``key_match``           close matches of a misspelled key, by words and docstrings
-``rules``               :class:`~simoun_agent.config.rules.Rule` and the field check
+``rules``               :class:`~simoun_agent.config.rules.Rule`, ``setting`` and the field check
 ``shapes``              encoder geometry and the smallest frame, in closed form
 ``envs``                environment ids: MODULE:ID, the paper's DMC tasks, highway-env
 ``device``              whether a ``--device`` is on this machine

@@ -1,5 +1,6 @@
 """Hyperparameters of the Simoun SAC agent (defaults: the paper's, i.e. DrQ's setup, and CURL's),
-each field checked by its rule when the config is built."""
+each field a :func:`~simoun_agent.config.rules.setting` whose rule checks it when the config is
+built."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from simoun_agent.config.rules import (
     is_real,
     one_of,
     real,
+    setting,
 )
 from simoun_agent.config.shapes import ENCODER_SHAPES
 
@@ -30,159 +32,6 @@ ACTOR_NAMES = ("gaussian", "deterministic")
 equal)."""
 
 
-@dataclass
-class AgentConfig:
-    """Everything the agent needs besides the frame shape and the action size."""
-
-    recipe: str | None = None
-    """name of the agent recipe these values started from (simoun_agent.config.recipes: simoun, drq,
-    drqv2, rad, curl, sac and the Fig. 6 encoders); applied before the user's overrides. None:
-    these dataclass defaults"""
-    encoder: str = "dual_interactive"
-    """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6;
-    the registry simoun_agent.models.encoder.ENCODERS, whose geometry is
-    simoun_agent.config.shapes.ENCODER_SHAPES)"""
-    augmentation: str = "none"
-    """augmentation of the frames the critic and actor see: "none", or "shift" (DrQ's random
-    shift: replicate-pad, random crop back, one offset per sample for its whole window)"""
-    shift_pad: int | None = None
-    """padding of the "shift" augmentation in pixels; None: 4 px per 84 px of image height"""
-    critic_augmentations: int = 1
-    """M of DrQ: augmented views of each sample whose critic losses are averaged (each view one
-    shift offset per sample for its whole window); the auxiliary losses, curiosity and the actor
-    use the first. More than 1 needs augmentation "shift" """
-    target_augmentations: int = 1
-    """K of DrQ: augmented views of the next state whose TD targets are averaged; view k shares
-    the offsets of critic view k (views beyond M get their own). More than 1 needs augmentation
-    "shift" """
-    next_state_encoder: str = "target"
-    """encoder of the next state read by the target Q heads: "target", the EMA encoder (rate
-    encoder_tau), as the critic target of CURL, RAD and SAC-AE holds its own encoder
-    (update_critic in curl_sac.py / sac_ae.py: encoder tau 0.05, Q heads critic_tau 0.01) and DrQ's
-    (drq.py, tau 0.01 for both); or "online", the online encoder without gradient (DrQ-v2:
-    DrQV2Agent.update in drqv2.py). The next action is drawn from the online encoder's state.
-    Configs saved before this field defaulted to "target" hold "online" explicitly"""
-    independent_next_shift: bool = False
-    """augmentation "shift": True shifts the triplet the TD target bootstraps from by an offset of
-    its own (DrQ-v2, DrQ, RAD and CURL augment obs and next_obs by separate calls); False: it
-    moves with the offset of its view's window (frames t-2 .. t+1 alike), which lets the encoder
-    pass of the critic's views give the next state (the shared-frame trick)"""
-    separate_trunks: bool = False
-    """False: the encoder ends in FC + LayerNorm, whose state the critic reads and the actor reads
-    detached. True (DrQ-v2: Actor and Critic in drqv2.py): the encoder ends at its flattened convs
-    and the actor and the critic each put their own trunk Linear -> LayerNorm -> Tanh
-    (feature_dim) on them; the critic's trunk belongs to the critic and so to its EMA target
-    (critic_tau), the actor's is trained by the actor loss. Stacked-frame encoders without
-    auxiliary losses only"""
-    pixel_offset: float = 0.0
-    """subtracted from the pixels after x / 255 before the convs (DrQ-v2's Encoder: 0.5)"""
-    conv_init: str = "orthogonal"
-    """initialisation of the conv weights: "orthogonal" (relu gain; DrQ and DrQ-v2's
-    utils.weight_init) or "delta_orthogonal" (zero but an orthogonal centre tap, relu gain; the
-    weight_init of CURL's and RAD's curl_sac.py and SAC-AE's sac_ae.py)"""
-    contrastive_view: str = "random_conv"
-    """positive view of L_con: "random_conv" (Eq. 3, a random convolution of the same frames)
-    or "shift" (CURL: an independently shifted view of the same input)"""
-    contrastive_step: bool = False
-    """False: L_con is added to the critic's loss and stepped with it (Eq. 14). True (CURL:
-    CurlSacAgent.update_cpc in curl_sac.py): L_con gets its own step after the critic, actor and
-    EMA updates, its anchor encoded again by the updated encoder, and, as in that code, the
-    encoder is stepped twice by it (CURL's encoder_optimizer, then cpc_optimizer with W)"""
-    similarity_init: str = "identity"
-    """initial W of L_con's bilinear score: "identity" (Eq. 3's inner product) or "uniform"
-    (CURL: torch.rand, uniform on [0, 1))"""
-    feature_dim: int = 50
-    """size of each path's feature vector (f_m and f_a); single-path encoders output this size"""
-    num_filters: int = 32
-    """filters of every conv layer ("stacked_wide" doubles it)"""
-    hidden_dim: int = 1024
-    """hidden units of the actor and critic MLPs"""
-    aux_hidden_dim: int = 256
-    """hidden units of the two-layer transition model G (Eq. 2) and reward model R (Eq. 7)"""
-    batch_size: int = 512
-    """transitions per gradient step"""
-    lr: float = 1e-3
-    """Adam learning rate of the encoder, critic, actor and auxiliary heads"""
-    alpha_lr: float = 1e-4
-    """Adam learning rate of the temperature (CURL / SAC-AE value)"""
-    alpha_beta: float = 0.5
-    """Adam beta1 of the temperature optimiser (CURL / SAC-AE value)"""
-    discount: float = 0.99
-    """gamma of the TD target (Eq. 9)"""
-    n_step: int = 1
-    """steps of reward summed before bootstrapping in the TD target (DrQ-v2 uses 3); cut at
-    episode ends, bootstrapped across truncation, never across an episode boundary"""
-    critic_tau: float = 0.01
-    """EMA rate of the target Q heads"""
-    encoder_tau: float = 0.05
-    """EMA rate of the target (momentum) encoder"""
-    actor_update_every: int = 2
-    """update the actor and temperature every this many gradient steps"""
-    target_update_every: int = 2
-    """update the EMA targets every this many gradient steps"""
-    update_every_steps: int = 1
-    """the agent's gradient step(s) come at every this-many-th agent step once learning has
-    started (DrQ-v2's update_every_steps 2: one critic, actor and target update every 2 agent
-    steps)"""
-    actor: str = "gaussian"
-    """the policy: "gaussian" (SAC, learned temperature) or "deterministic" (DrQ-v2: tanh(mu),
-    scheduled exploration noise, no entropy term); the registry simoun_agent.models.actors.ACTORS"""
-    exploration_std_start: float = 1.0
-    """deterministic actor: exploration noise std at env step 0 (DrQ-v2)"""
-    exploration_std_end: float = 0.1
-    """deterministic actor: exploration noise std from exploration_steps on (DrQ-v2)"""
-    exploration_steps: int = 1_000_000
-    """deterministic actor: env steps over which the std falls linearly from start to end.
-    DrQ-v2's "medium" schedule is 500k of its agent steps, i.e. 1M env steps (frames) at its
-    action repeat 2"""
-    noise_clip: float = 0.3
-    """deterministic actor: the noise of the TD target's and the policy loss's action is clipped
-    to +- this (DrQ-v2's stddev_clip)"""
-    init_temperature: float = 0.1
-    """initial SAC temperature alpha"""
-    log_std_min: float = -10.0
-    """lower bound of the policy's log standard deviation"""
-    log_std_max: float = 2.0
-    """upper bound of the policy's log standard deviation"""
-    curiosity: bool = True
-    """add the consistency-guided intrinsic reward (Eq. 13) to the TD target (dual encoders only)"""
-    curiosity_scale: float = 0.2
-    """C of Eq. 13"""
-    curiosity_decay: float = 2e-5
-    """lambda of Eq. 13, per environment step"""
-    r_e_max_init: float = 1.0
-    """initial running maximum of the extrinsic reward (Eq. 13)"""
-    r_i_max_init: float = 1.0
-    """initial running maximum of the raw consistency distance (Eq. 13)"""
-    transition_weight: float = 1.0
-    """weight of L_tran in Eq. 14 (encoders with a motion path)"""
-    contrastive_weight: float = 1.0
-    """weight of L_con in Eq. 14"""
-    reward_weight: float = 1.0
-    """weight of L_re in Eq. 14"""
-    num_frames: int = 3
-    """frames per observation (the paper uses 3: o_{t-2}, o_{t-1}, o_t)"""
-    reduce_kernel: int = 3
-    """kernel of the reducing convs of the interactive module (35x35 -> 11x11 with stride 3)"""
-    reduce_stride: int = 3
-    """stride of the reducing convs of the interactive module"""
-    random_conv_kernel: int = 3
-    """kernel size of the random convolution that makes contrastive positives (Eq. 3). Expect
-    L_con to sit at log(batch_size) for the first 100-300 updates while f_a collapses (spread
-    across samples ~0.003) and then fall: measured on dm_control cartpole-swingup 48x48, batch 32"""
-    detach_past_frames: bool = True
-    """dual encoders: frames t-2 and t-1 go through the appearance path without gradient (as
-    Flare detaches earlier frames); the interactive module and frame t still get gradients.
-    False backpropagates through all three frames (about 4 more batch-sized conv backward passes
-    per update)"""
-    channels_last: bool = True
-    """run the convs in channels-last memory format (measured ~25% faster conv forward+backward
-    on our AVX-512 CPU; benchmarks/update.py --no-channels-last compares)"""
-
-    def __post_init__(self) -> None:
-        check_agent_config(self)  # every field, then cross-field
-
-
 AGENT = "agent."
 """Flag prefix of AgentConfig's fields (``--agent.batch-size``)."""
 
@@ -190,65 +39,169 @@ _POSITIVE = integer(1)
 _RATE = real(0.0, 1.0, open_low=True)
 _WEIGHT = real(0.0)
 
-AGENT_RULES: dict[str, Rule] = {
-    "recipe": Rule(f"none or one of {', '.join(RECIPES)}", lambda v: v is None or v in RECIPES),
-    "encoder": one_of(list(ENCODER_SHAPES)),
-    "augmentation": one_of(AUGMENTATIONS),
-    "shift_pad": integer(0, optional=True),
-    "critic_augmentations": _POSITIVE,
-    "target_augmentations": _POSITIVE,
-    "next_state_encoder": one_of(NEXT_STATE_ENCODERS),
-    "independent_next_shift": boolean(),
-    "separate_trunks": boolean(),
-    "pixel_offset": finite(),
-    "conv_init": one_of(CONV_INITS),
-    "contrastive_view": one_of(CONTRASTIVE_VIEWS),
-    "contrastive_step": boolean(),
-    "similarity_init": one_of(SIMILARITY_INITS),
-    "feature_dim": _POSITIVE,
-    "num_filters": _POSITIVE,
-    "hidden_dim": _POSITIVE,
-    "aux_hidden_dim": _POSITIVE,
-    "batch_size": _POSITIVE,
-    "lr": real(0.0, open_low=True),
-    "alpha_lr": real(0.0, open_low=True),
-    "alpha_beta": Rule("a number in [0, 1) (Adam's beta1)", lambda v: is_real(v) and 0 <= v < 1),
-    "discount": real(0.0, 1.0),
-    "n_step": _POSITIVE,
-    "critic_tau": _RATE,
-    "encoder_tau": _RATE,
-    "actor_update_every": _POSITIVE,
-    "target_update_every": _POSITIVE,
-    "update_every_steps": _POSITIVE,
-    "actor": one_of(ACTOR_NAMES),
-    "exploration_std_start": real(0.0),
-    "exploration_std_end": real(0.0),
-    "exploration_steps": _POSITIVE,
-    "noise_clip": real(0.0),
-    "init_temperature": real(0.0, open_low=True),
-    "log_std_min": finite(),
-    "log_std_max": finite(),
-    "curiosity": boolean(),
-    "curiosity_scale": _WEIGHT,
-    "curiosity_decay": _WEIGHT,
-    "r_e_max_init": real(0.0, open_low=True),
-    "r_i_max_init": real(0.0, open_low=True),
-    "transition_weight": _WEIGHT,
-    "contrastive_weight": _WEIGHT,
-    "reward_weight": _WEIGHT,
-    "num_frames": _POSITIVE,
-    "reduce_kernel": _POSITIVE,
-    "reduce_stride": _POSITIVE,
-    "random_conv_kernel": integer(1, odd=True, fix="an odd kernel keeps the image size: 3"),
-    "detach_past_frames": boolean(),
-    "channels_last": boolean(),
-}
-"""The rule of every ``AgentConfig`` field."""
+
+@dataclass
+class AgentConfig:
+    """Everything the agent needs besides the frame shape and the action size."""
+
+    recipe: str | None = setting(
+        None, Rule(f"none or one of {', '.join(RECIPES)}", lambda v: v is None or v in RECIPES)
+    )
+    """name of the agent recipe these values started from (simoun_agent.config.recipes: simoun, drq,
+    drqv2, rad, curl, sac and the Fig. 6 encoders); applied before the user's overrides. None:
+    these dataclass defaults"""
+    encoder: str = setting("dual_interactive", one_of(list(ENCODER_SHAPES)))
+    """one of "single", "stacked", "flare", "dual", "dual_interactive", "stacked_wide" (Fig. 6;
+    the registry simoun_agent.models.encoder.ENCODERS, whose geometry is
+    simoun_agent.config.shapes.ENCODER_SHAPES)"""
+    augmentation: str = setting("none", one_of(AUGMENTATIONS))
+    """augmentation of the frames the critic and actor see: "none", or "shift" (DrQ's random
+    shift: replicate-pad, random crop back, one offset per sample for its whole window)"""
+    shift_pad: int | None = setting(None, integer(0, optional=True))
+    """padding of the "shift" augmentation in pixels; None: 4 px per 84 px of image height"""
+    critic_augmentations: int = setting(1, _POSITIVE)
+    """M of DrQ: augmented views of each sample whose critic losses are averaged (each view one
+    shift offset per sample for its whole window); the auxiliary losses, curiosity and the actor
+    use the first. More than 1 needs augmentation "shift" """
+    target_augmentations: int = setting(1, _POSITIVE)
+    """K of DrQ: augmented views of the next state whose TD targets are averaged; view k shares
+    the offsets of critic view k (views beyond M get their own). More than 1 needs augmentation
+    "shift" """
+    next_state_encoder: str = setting("target", one_of(NEXT_STATE_ENCODERS))
+    """encoder of the next state read by the target Q heads: "target", the EMA encoder (rate
+    encoder_tau), as the critic target of CURL, RAD and SAC-AE holds its own encoder
+    (update_critic in curl_sac.py / sac_ae.py: encoder tau 0.05, Q heads critic_tau 0.01) and DrQ's
+    (drq.py, tau 0.01 for both); or "online", the online encoder without gradient (DrQ-v2:
+    DrQV2Agent.update in drqv2.py). The next action is drawn from the online encoder's state.
+    Configs saved before this field defaulted to "target" hold "online" explicitly"""
+    independent_next_shift: bool = setting(False, boolean())
+    """augmentation "shift": True shifts the triplet the TD target bootstraps from by an offset of
+    its own (DrQ-v2, DrQ, RAD and CURL augment obs and next_obs by separate calls); False: it
+    moves with the offset of its view's window (frames t-2 .. t+1 alike), which lets the encoder
+    pass of the critic's views give the next state (the shared-frame trick)"""
+    separate_trunks: bool = setting(False, boolean())
+    """False: the encoder ends in FC + LayerNorm, whose state the critic reads and the actor reads
+    detached. True (DrQ-v2: Actor and Critic in drqv2.py): the encoder ends at its flattened convs
+    and the actor and the critic each put their own trunk Linear -> LayerNorm -> Tanh
+    (feature_dim) on them; the critic's trunk belongs to the critic and so to its EMA target
+    (critic_tau), the actor's is trained by the actor loss. Stacked-frame encoders without
+    auxiliary losses only"""
+    pixel_offset: float = setting(0.0, finite())
+    """subtracted from the pixels after x / 255 before the convs (DrQ-v2's Encoder: 0.5)"""
+    conv_init: str = setting("orthogonal", one_of(CONV_INITS))
+    """initialisation of the conv weights: "orthogonal" (relu gain; DrQ and DrQ-v2's
+    utils.weight_init) or "delta_orthogonal" (zero but an orthogonal centre tap, relu gain; the
+    weight_init of CURL's and RAD's curl_sac.py and SAC-AE's sac_ae.py)"""
+    contrastive_view: str = setting("random_conv", one_of(CONTRASTIVE_VIEWS))
+    """positive view of L_con: "random_conv" (Eq. 3, a random convolution of the same frames)
+    or "shift" (CURL: an independently shifted view of the same input)"""
+    contrastive_step: bool = setting(False, boolean())
+    """False: L_con is added to the critic's loss and stepped with it (Eq. 14). True (CURL:
+    CurlSacAgent.update_cpc in curl_sac.py): L_con gets its own step after the critic, actor and
+    EMA updates, its anchor encoded again by the updated encoder, and, as in that code, the
+    encoder is stepped twice by it (CURL's encoder_optimizer, then cpc_optimizer with W)"""
+    similarity_init: str = setting("identity", one_of(SIMILARITY_INITS))
+    """initial W of L_con's bilinear score: "identity" (Eq. 3's inner product) or "uniform"
+    (CURL: torch.rand, uniform on [0, 1))"""
+    feature_dim: int = setting(50, _POSITIVE)
+    """size of each path's feature vector (f_m and f_a); single-path encoders output this size"""
+    num_filters: int = setting(32, _POSITIVE)
+    """filters of every conv layer ("stacked_wide" doubles it)"""
+    hidden_dim: int = setting(1024, _POSITIVE)
+    """hidden units of the actor and critic MLPs"""
+    aux_hidden_dim: int = setting(256, _POSITIVE)
+    """hidden units of the two-layer transition model G (Eq. 2) and reward model R (Eq. 7)"""
+    batch_size: int = setting(512, _POSITIVE)
+    """transitions per gradient step"""
+    lr: float = setting(1e-3, real(0.0, open_low=True))
+    """Adam learning rate of the encoder, critic, actor and auxiliary heads"""
+    alpha_lr: float = setting(1e-4, real(0.0, open_low=True))
+    """Adam learning rate of the temperature (CURL / SAC-AE value)"""
+    alpha_beta: float = setting(
+        0.5, Rule("a number in [0, 1) (Adam's beta1)", lambda v: is_real(v) and 0 <= v < 1)
+    )
+    """Adam beta1 of the temperature optimiser (CURL / SAC-AE value)"""
+    discount: float = setting(0.99, real(0.0, 1.0))
+    """gamma of the TD target (Eq. 9)"""
+    n_step: int = setting(1, _POSITIVE)
+    """steps of reward summed before bootstrapping in the TD target (DrQ-v2 uses 3); cut at
+    episode ends, bootstrapped across truncation, never across an episode boundary"""
+    critic_tau: float = setting(0.01, _RATE)
+    """EMA rate of the target Q heads"""
+    encoder_tau: float = setting(0.05, _RATE)
+    """EMA rate of the target (momentum) encoder"""
+    actor_update_every: int = setting(2, _POSITIVE)
+    """update the actor and temperature every this many gradient steps"""
+    target_update_every: int = setting(2, _POSITIVE)
+    """update the EMA targets every this many gradient steps"""
+    update_every_steps: int = setting(1, _POSITIVE)
+    """the agent's gradient step(s) come at every this-many-th agent step once learning has
+    started (DrQ-v2's update_every_steps 2: one critic, actor and target update every 2 agent
+    steps)"""
+    actor: str = setting("gaussian", one_of(ACTOR_NAMES))
+    """the policy: "gaussian" (SAC, learned temperature) or "deterministic" (DrQ-v2: tanh(mu),
+    scheduled exploration noise, no entropy term); the registry simoun_agent.models.actors.ACTORS"""
+    exploration_std_start: float = setting(1.0, real(0.0))
+    """deterministic actor: exploration noise std at env step 0 (DrQ-v2)"""
+    exploration_std_end: float = setting(0.1, real(0.0))
+    """deterministic actor: exploration noise std from exploration_steps on (DrQ-v2)"""
+    exploration_steps: int = setting(1_000_000, _POSITIVE)
+    """deterministic actor: env steps over which the std falls linearly from start to end.
+    DrQ-v2's "medium" schedule is 500k of its agent steps, i.e. 1M env steps (frames) at its
+    action repeat 2"""
+    noise_clip: float = setting(0.3, real(0.0))
+    """deterministic actor: the noise of the TD target's and the policy loss's action is clipped
+    to +- this (DrQ-v2's stddev_clip)"""
+    init_temperature: float = setting(0.1, real(0.0, open_low=True))
+    """initial SAC temperature alpha"""
+    log_std_min: float = setting(-10.0, finite())
+    """lower bound of the policy's log standard deviation"""
+    log_std_max: float = setting(2.0, finite())
+    """upper bound of the policy's log standard deviation"""
+    curiosity: bool = setting(True, boolean())
+    """add the consistency-guided intrinsic reward (Eq. 13) to the TD target (dual encoders only)"""
+    curiosity_scale: float = setting(0.2, _WEIGHT)
+    """C of Eq. 13"""
+    curiosity_decay: float = setting(2e-5, _WEIGHT)
+    """lambda of Eq. 13, per environment step"""
+    r_e_max_init: float = setting(1.0, real(0.0, open_low=True))
+    """initial running maximum of the extrinsic reward (Eq. 13)"""
+    r_i_max_init: float = setting(1.0, real(0.0, open_low=True))
+    """initial running maximum of the raw consistency distance (Eq. 13)"""
+    transition_weight: float = setting(1.0, _WEIGHT)
+    """weight of L_tran in Eq. 14 (encoders with a motion path)"""
+    contrastive_weight: float = setting(1.0, _WEIGHT)
+    """weight of L_con in Eq. 14"""
+    reward_weight: float = setting(1.0, _WEIGHT)
+    """weight of L_re in Eq. 14"""
+    num_frames: int = setting(3, _POSITIVE)
+    """frames per observation (the paper uses 3: o_{t-2}, o_{t-1}, o_t)"""
+    reduce_kernel: int = setting(3, _POSITIVE)
+    """kernel of the reducing convs of the interactive module (35x35 -> 11x11 with stride 3)"""
+    reduce_stride: int = setting(3, _POSITIVE)
+    """stride of the reducing convs of the interactive module"""
+    random_conv_kernel: int = setting(
+        3, integer(1, odd=True, fix="an odd kernel keeps the image size: 3")
+    )
+    """kernel size of the random convolution that makes contrastive positives (Eq. 3). Expect
+    L_con to sit at log(batch_size) for the first 100-300 updates while f_a collapses (spread
+    across samples ~0.003) and then fall: measured on dm_control cartpole-swingup 48x48, batch 32"""
+    detach_past_frames: bool = setting(True, boolean())
+    """dual encoders: frames t-2 and t-1 go through the appearance path without gradient (as
+    Flare detaches earlier frames); the interactive module and frame t still get gradients.
+    False backpropagates through all three frames (about 4 more batch-sized conv backward passes
+    per update)"""
+    channels_last: bool = setting(True, boolean())
+    """run the convs in channels-last memory format (measured ~25% faster conv forward+backward
+    on our AVX-512 CPU; benchmarks/update.py --no-channels-last compares)"""
+
+    def __post_init__(self) -> None:
+        check_agent_config(self)  # every field, then cross-field
 
 
 def check_agent_config(config: Any) -> None:
     """Every field of an ``AgentConfig``, then the constraints between fields."""
-    check_fields(config, AGENT_RULES, AGENT)
+    check_fields(config, AGENT)
     if config.log_std_min >= config.log_std_max:
         raise fail(
             AGENT,

@@ -1,10 +1,11 @@
-"""What a config field accepts (:class:`Rule`) and the check every config runs with its table.
+"""What a config field accepts (:class:`Rule`), the field that carries it and the check every
+config runs.
 
-``AgentConfig`` and ``TrainConfig`` call :func:`check_fields` from ``__post_init__`` with a
-table of :class:`Rule` per field, then their cross-field checks, so a bad value fails when the
-config is built (command line, preset, recipe, Python or a saved ``config.json``), not deep
-inside torch later. Errors are ``ValueError``; the command-line tools print them without a
-traceback.
+Each field of ``AgentConfig`` and ``TrainConfig`` is a :func:`setting`: its type, default,
+rule and (in the docstring under it) help text in one place. Both call :func:`check_fields`
+from ``__post_init__``, then their cross-field checks, so a bad value fails when the config is
+built (command line, preset, recipe, Python or a saved ``config.json``), not deep inside torch
+later. Errors are ``ValueError``; the command-line tools print them without a traceback.
 
 Example:
     >>> from simoun_agent.config import AgentConfig
@@ -105,6 +106,42 @@ def json_object(fix: str = "") -> Rule:
     return Rule("a JSON object (a dict)", lambda v: isinstance(v, dict), fix)
 
 
+RULE = "rule"
+"""The key of a field's :class:`Rule` in its ``dataclasses.field`` metadata."""
+
+
+def setting(default: Any, rule: Rule) -> Any:
+    """A config field: ``default`` and the ``rule`` its values must keep.
+
+    Example:
+        >>> @dataclass
+        ... class Example:
+        ...     size: int = setting(8, integer(1))
+        >>> rules_of(Example)["size"].need
+        'an int >= 1'
+    """
+    return dataclasses.field(default=default, metadata=with_rule(rule))
+
+
+def with_rule(rule: Rule) -> dict[str, Rule]:
+    """The metadata that gives a ``dataclasses.field`` its rule, for a field whose default a
+    factory builds afresh for each config (a dict, a nested config), which :func:`setting`
+    does not take: ``field(default_factory=dict, metadata=with_rule(json_object()))``."""
+    return {RULE: rule}
+
+
+def rules_of(config: Any) -> dict[str, Rule]:
+    """The rule of every field of a config dataclass (or of one of its instances), by field
+    name; TypeError for a field made without one (a programming error), so nothing reaches the
+    agent unchecked."""
+    fields = dataclasses.fields(config)
+    unruled = [f.name for f in fields if RULE not in f.metadata]
+    if unruled:
+        name = config.__name__ if isinstance(config, type) else type(config).__name__
+        raise TypeError(f"{name} fields without a rule: {', '.join(unruled)}")
+    return {f.name: f.metadata[RULE] for f in fields}
+
+
 def flag_name(prefix: str, name: str) -> str:
     """``("agent.", "batch_size")`` -> ``"--agent.batch-size"``, the command-line flag."""
     return "--" + prefix + name.replace("_", "-")
@@ -126,16 +163,11 @@ def show(value: Any) -> str:
     return str(value)
 
 
-def check_fields(config: Any, rules: dict[str, Rule], prefix: str) -> None:
-    """Raise ValueError for the first field of ``config`` that breaks its rule.
-
-    Every field must have a rule (a new field without one is a programming error), so nothing
-    reaches the agent unchecked.
-    """
+def check_fields(config: Any, prefix: str) -> None:
+    """Raise ValueError for the first field of ``config`` that breaks its rule (a nested config
+    checks its own fields); ``prefix`` starts the fields' flags (``"agent."``)."""
     cls = type(config).__name__
-    unruled = [f.name for f in dataclasses.fields(config) if f.name not in rules]
-    if unruled:
-        raise TypeError(f"{cls} fields without a rule: {', '.join(unruled)}")
+    rules = rules_of(config)
     for f in dataclasses.fields(config):
         value = getattr(config, f.name)
         if dataclasses.is_dataclass(value):

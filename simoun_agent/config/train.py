@@ -1,4 +1,4 @@
-"""Training configuration: the ``TrainConfig`` dataclass and the rule of each of its fields.
+"""Training configuration: the ``TrainConfig`` dataclass, each field with its rule.
 
 How a run's config is resolved from presets, recipes and the user's overrides:
 :mod:`simoun_agent.config.resolve`.
@@ -21,76 +21,110 @@ from simoun_agent.config.rules import (
     integer,
     is_int,
     json_object,
+    setting,
     text,
+    with_rule,
 )
 from simoun_agent.config.shapes import frame_fits, min_image_size
+
+_POSITIVE = integer(1)
 
 
 @dataclass
 class TrainConfig:
     """Everything a training run needs; saved with the run as ``config.json``."""
 
-    env: str = "dm_control/cartpole-swingup-v0"
+    env: str = setting(
+        "dm_control/cartpole-swingup-v0", text(fix="e.g. --env dm_control/cartpole-swingup-v0")
+    )
     """Gymnasium id: a dm_control task through shimmy, a highway-env id, any pixel/renderable env;
     MODULE:ID (Gymnasium's form, e.g. minigrid:MiniGrid-DoorKey-6x6-v0) imports MODULE first and
     is saved as env ID plus env_module MODULE"""
-    env_module: str | None = None
+    env_module: str | None = setting(
+        None, text(optional=True, fix="e.g. --env-module minigrid, or none")
+    )
     """module imported before the env is made, for ids that a package registers on import (e.g.
     ale_py, minigrid); saved with the run, so --resume and simoun-eval import it too"""
-    env_kwargs: dict = field(default_factory=dict)
+    env_kwargs: dict = field(
+        default_factory=dict,
+        metadata=with_rule(json_object(fix='e.g. --env-kwargs \'{"config": {"lanes_count": 3}}\'')),
+    )
     """extra keyword arguments for gymnasium.make (JSON on the command line)"""
-    preset: str | None = None
+    preset: str | None = setting(
+        None, Rule(f"none or one of {', '.join(PRESETS)}", lambda v: v is None or v in PRESETS)
+    )
     """name of the preset this config started from (informational)"""
-    seed: int = 1
+    seed: int = setting(
+        1, Rule("an int in [0, 2**32)", lambda v: is_int(v) and 0 <= v < 2**32, "e.g. --seed 1")
+    )
     """seed of every random stream (episodes, replay, torch, numpy, python): each is a child of
     numpy's SeedSequence(seed), so runs of different seeds share no episode"""
-    action_repeat: int | None = None
+    action_repeat: int | None = setting(
+        None,
+        integer(
+            1,
+            optional=True,
+            fix="e.g. --action-repeat 8, or none for the paper's value of a DMC task (1 otherwise)",
+        ),
+    )
     """env steps per agent decision (frame skip); None: the paper's value for its six DMC tasks,
     else 1"""
-    image_size: int = 84
+    image_size: int = setting(84, _POSITIVE)
     """height and width of each camera view fed to the agent"""
-    grayscale: bool = False
+    grayscale: bool = setting(False, boolean())
     """feed grayscale frames (1 channel) instead of RGB"""
-    cameras: int = 1
+    cameras: int = setting(1, _POSITIVE)
     """viewports concatenated along the width (dm_control camera ids 0..n-1; highway-env: 3 views
     around the ego vehicle)"""
-    total_env_steps: int = 500_000
+    total_env_steps: int = setting(500_000, _POSITIVE)
     """length of the run in environment steps (agent decisions x action repeat)"""
-    warmup_agent_steps: int = 1000
+    warmup_agent_steps: int = setting(1000, integer(0))
     """agent decisions taken uniformly at random before learning starts"""
-    updates_per_step: int = 1
+    updates_per_step: int = setting(1, _POSITIVE)
     """gradient updates per agent decision once learning has started (at every
     ``agent.update_every_steps``-th decision)"""
-    replay_capacity: int = 100_000
+    replay_capacity: int = setting(100_000, _POSITIVE)
     """transitions kept in the replay buffer"""
-    eval_every: int = 10_000
+    eval_every: int = setting(10_000, _POSITIVE)
     """environment steps between evaluations (run at the next episode end)"""
-    eval_episodes: int = 10
+    eval_episodes: int = setting(10, _POSITIVE)
     """episodes per evaluation (deterministic actions)"""
-    eval_distraction: tuple[str, ...] = ()
+    eval_distraction: tuple[str, ...] = setting(
+        (),
+        Rule(
+            "a list of distraction mode names",
+            lambda v: isinstance(v, (tuple, list)) and all(isinstance(m, str) and m for m in v),
+            "e.g. --eval-distraction video_hard (simoun_agent.generalization.DISTRACTIONS)",
+        ),
+    )
     """distraction modes also evaluated at every evaluation, as test curves beside the training
     env's (dm_control tasks; repeat the flag, e.g. --eval-distraction video_hard; modes in
     simoun_agent.generalization.DISTRACTIONS)"""
-    checkpoint_every: int = 50_000
+    checkpoint_every: int = setting(50_000, _POSITIVE)
     """environment steps between checkpoints (written at the next episode end). One that does
     not fit on the disk keeps the previous one and is tried again at the next; after 3 failures
     in a row, or at a stop or the run's end, the run stops with exit status 75 (free space, then
     --resume)"""
-    video: bool = True
+    video: bool = setting(True, boolean())
     """record one evaluation episode to video.mp4 at the end of the run"""
-    device: str | None = None
+    device: str | None = setting(
+        None, text(optional=True, fix="e.g. --device cpu, cuda, cuda:0 or mps")
+    )
     """torch device; None: cuda when available, else cpu"""
-    torch_threads: int | None = None
+    torch_threads: int | None = setting(None, integer(1, optional=True))
     """torch intra-op threads; None: torch's default"""
-    env_process: bool = False
+    env_process: bool = setting(False, boolean())
     """step the training environment in a background process while the agent updates (a
     second core works on physics and rendering; results are identical either way)"""
-    run_dir: str | None = None
+    run_dir: str | None = setting(None, text(optional=True))
     """output directory; None: runs/<env>-<preset>-s<seed>-<date>"""
-    progress: bool = True
+    progress: bool = setting(True, boolean())
     """true/false: a progress bar on a terminal (false, or no terminal: one line per
     evaluation)"""
-    agent: AgentConfig = field(default_factory=AgentConfig)
+    agent: AgentConfig = field(
+        default_factory=AgentConfig,
+        metadata=with_rule(Rule("an AgentConfig", lambda v: dataclasses.is_dataclass(v))),
+    )
     """the agent's hyperparameters (simoun_agent.config.AgentConfig)"""
 
     def __post_init__(self) -> None:
@@ -125,48 +159,9 @@ RESUMABLE_FIELDS = (
 (torch_threads changes speed only); every other field must match the saved config."""
 
 
-_POSITIVE = integer(1)
-
-TRAIN_RULES: dict[str, Rule] = {
-    "env": text(fix="e.g. --env dm_control/cartpole-swingup-v0"),
-    "env_module": text(optional=True, fix="e.g. --env-module minigrid, or none"),
-    "env_kwargs": json_object(fix='e.g. --env-kwargs \'{"config": {"lanes_count": 3}}\''),
-    "preset": Rule(f"none or one of {', '.join(PRESETS)}", lambda v: v is None or v in PRESETS),
-    "seed": Rule("an int in [0, 2**32)", lambda v: is_int(v) and 0 <= v < 2**32, "e.g. --seed 1"),
-    "action_repeat": integer(
-        1,
-        optional=True,
-        fix="e.g. --action-repeat 8, or none for the paper's value of a DMC task (1 otherwise)",
-    ),
-    "image_size": _POSITIVE,
-    "grayscale": boolean(),
-    "cameras": _POSITIVE,
-    "total_env_steps": _POSITIVE,
-    "warmup_agent_steps": integer(0),
-    "updates_per_step": _POSITIVE,
-    "replay_capacity": _POSITIVE,
-    "eval_every": _POSITIVE,
-    "eval_episodes": _POSITIVE,
-    "eval_distraction": Rule(
-        "a list of distraction mode names",
-        lambda v: isinstance(v, (tuple, list)) and all(isinstance(m, str) and m for m in v),
-        "e.g. --eval-distraction video_hard (simoun_agent.generalization.DISTRACTIONS)",
-    ),
-    "checkpoint_every": _POSITIVE,
-    "video": boolean(),
-    "device": text(optional=True, fix="e.g. --device cpu, cuda, cuda:0 or mps"),
-    "torch_threads": integer(1, optional=True),
-    "env_process": boolean(),
-    "run_dir": text(optional=True),
-    "progress": boolean(),
-    "agent": Rule("an AgentConfig", lambda v: dataclasses.is_dataclass(v)),
-}
-"""The rule of every ``TrainConfig`` field (``agent`` is checked by ``AgentConfig``)."""
-
-
 def check_train_config(config: TrainConfig) -> None:
     """Every field of a ``TrainConfig``, then the constraints between fields."""
-    check_fields(config, TRAIN_RULES, "")
+    check_fields(config, "")
     if config.device is not None and (problem := device_problem(config.device)):
         raise fail("", "device", config.device, problem)
     if config.replay_capacity < config.agent.batch_size:

@@ -48,7 +48,8 @@ class RewardModel(nn.Module):
 
 
 class BilinearSimilarity(nn.Module):
-    """Score q W k^T between anchors and keys, W learned as in CURL. W starts as the identity
+    """The learned W of CURL's score q W k^T between anchors and keys (the score itself is
+    :func:`simoun_agent.losses.contrastive_loss`, given ``weight``). W starts as the identity
     (``init="identity"``: Eq. 3's plain inner product) or uniform on [0, 1) (``"uniform"``: CURL's
     ``torch.rand`` in curl_sac.py's CURL module)."""
 
@@ -57,6 +58,3 @@ class BilinearSimilarity(nn.Module):
         identity = init == "identity"
         start = torch.eye(feature_dim) if identity else torch.rand(feature_dim, feature_dim)
         self.weight = nn.Parameter(start)
-
-    def forward(self, anchor: torch.Tensor, key: torch.Tensor) -> torch.Tensor:
-        return anchor @ self.weight @ key.T
