@@ -48,6 +48,14 @@ def test_a_saved_config_with_a_misspelled_key_is_refused_with_the_close_match():
     )
 
 
+def test_a_section_given_as_a_key_is_answered_with_one_of_its_fields():
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {"agent": 1})
+    assert "unknown config key agent (agent is a section: set one of its fields, e.g. agent." in (
+        str(error.value)
+    )
+
+
 def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
     with pytest.raises(SetupError, match=r"unknown recipe --agent.recipe 'drqv3' \(did you mean "):
         resolve(None, {"agent.recipe": "drqv3"})

@@ -72,8 +72,11 @@ def test_the_minigrid_report_outside_the_clone_writes_nothing(tmp_path, capsys, 
 
 def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys):
     err = refused(capsys, report_cli.main, [str(tmp_path / "nope")])
-    assert "is not a directory" in err
+    assert f"{tmp_path / 'nope'} does not exist; pass a sweep directory" in err
     assert list(tmp_path.iterdir()) == []
+    (tmp_path / "eval.csv").write_text("env_step,return_mean\n")
+    err = refused(capsys, report_cli.main, [str(tmp_path / "eval.csv")])
+    assert "eval.csv is a file, not a directory" in err
 
 
 # every name a user types is checked; a key given twice is refused

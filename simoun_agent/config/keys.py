@@ -137,7 +137,11 @@ HELP_FIX = "`simoun-train --help` lists every key"
 
 def close_match(key: str) -> str:
     """``" (did you mean agent.lr?)"`` for an unknown ``key``, or an empty string when no config
-    key is close (:func:`simoun_agent.config.key_match.did_you_mean` over every field)."""
+    key is close (:func:`simoun_agent.config.key_match.did_you_mean` over every field); a section
+    (``agent``) is answered with one of its fields."""
+    fields = [known for known in config_fields() if known.startswith(key + ".")]
+    if fields:
+        return f" ({key} is a section: set one of its fields, e.g. {fields[0]})"
     return did_you_mean(key, {known: doc for known, (_, _, doc) in config_fields().items()})
 
 

@@ -505,8 +505,16 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
     keep one evaluation grid per row (:func:`one_evaluation_grid`) and one run per seed
     (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run."""
     root = Path(root)
+    if not root.exists():
+        raise SetupError(
+            f"{root} does not exist; pass a sweep directory (simoun-sweep --sweep-dir) or the "
+            "parent of run directories"
+        )
     if not root.is_dir():
-        raise SetupError(f"{root} is not a directory; pass a sweep directory or a run's parent")
+        raise SetupError(
+            f"{root} is a file, not a directory; pass a sweep directory (simoun-sweep "
+            "--sweep-dir) or the parent of run directories"
+        )
     damaged: list[str] = []
     records = find_runs(root, damaged)
     if not records:
