@@ -38,6 +38,11 @@ def image_layout(space: gym.Space) -> tuple[int, int, int] | None:
     return None
 
 
+MAX_FRAME_BYTES = 2**28
+"""The largest RGB frame ``size`` may ask for (256 MiB: about 9,459 x 9,459 pixels), far above any
+frame a pixel agent learns from."""
+
+
 def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     """``size`` as ``(H, W)``; an int means a square; None stays None (keep the image's size)."""
     if size is None:
@@ -51,7 +56,15 @@ def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
             f"size must be a positive int or an (H, W) pair of positive ints, got {size!r}; "
             f"e.g. size=84 or size=(84, 252), or None to keep the image's size."
         )
-    return int(pair[0]), int(pair[1])
+    height, width = int(pair[0]), int(pair[1])
+    if height * width * 3 > MAX_FRAME_BYTES:
+        # refused here: the resize would otherwise fail deep in OpenCV or numpy with MemoryError
+        raise ValueError(
+            f"size {size!r} makes RGB frames of {height * width * 3 / 2**30:.1f} GiB each (at "
+            f"most {MAX_FRAME_BYTES // 2**20} MiB); pass a smaller size, e.g. size=84 or "
+            f"size=(84, 252)."
+        )
+    return height, width
 
 
 def check_stack_options(

@@ -167,6 +167,20 @@ def test_a_bool_is_not_taken_for_an_int(build, said):
     assert said in str(error.value)
 
 
+@pytest.mark.parametrize("size", [100_000, (84, 10**8)])
+def test_a_frame_size_no_memory_holds_is_refused_before_any_resize(size):
+    with pytest.raises(ValueError) as error:
+        SimounObservation(minigrid_pixels(), size=size)
+    assert f"size {size!r} makes RGB frames of" in str(error.value)
+    assert "pass a smaller size, e.g. size=84" in str(error.value)
+    from pettingzoo.butterfly import pistonball_v6
+
+    from simoun_wrappers.pettingzoo import SimounParallelObservation
+
+    with pytest.raises(ValueError, match="pass a smaller size"):
+        SimounParallelObservation(pistonball_v6.parallel_env(n_pistons=3), size=size)
+
+
 def test_numpy_ints_are_ints_to_every_wrapper():
     env = SimounObservation(
         RandomConvolution(ActionRepeat(minigrid_pixels(), np.int64(2)), np.int64(3)),
