@@ -115,20 +115,19 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
         cpus = 1 if args.cpus_per_trial is None else args.cpus_per_trial
         return SweepSpec.create(preset, base, list(args.grid), args.seeds, args.envs, cpus)
     saved = SweepSpec.load(sweep_dir)
-    base = dict(base)
-    total = base.pop("total_env_steps", None)
-    given = bool(args.grid or args.seeds or args.envs or base or preset)
+    total = base.get("total_env_steps")
+    wanted = saved if total is None else saved.extended(total)
+    given = bool(args.grid or args.seeds or args.envs or preset or set(base) - {"total_env_steps"})
     if given or args.cpus_per_trial not in (None, saved.cpus_per_trial):
         spec = SweepSpec.create(
             preset,
-            {**base, **({} if total is None else {"total_env_steps": total})},
+            base,
             list(args.grid),
             args.seeds,
             args.envs,
             saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
         )
-        like_saved = saved if total is None else saved.extended(total)
-        differences = spec.describe_differences(like_saved)
+        differences = spec.describe_differences(wanted)
         if differences:
             raise SetupError(
                 f"the sweep in {sweep_dir} was started with another grid, so --resume cannot "
@@ -136,7 +135,7 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
                 f"only --resume --sweep-dir {sweep_dir}), or start a new sweep in another "
                 "--sweep-dir"
             )
-    return saved if total is None else saved.extended(total)
+    return wanted
 
 
 @quiet_pipe
