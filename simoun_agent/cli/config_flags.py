@@ -23,7 +23,6 @@ import tyro
 
 from simoun_agent.cli.flags import negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
-from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import (
     FALSE_WORDS,
     TRUE_WORDS,
@@ -74,25 +73,6 @@ def preset_in(argv: Sequence[str]) -> str | None:
     if len(set(names)) > 1:
         raise SetupError(f"--preset is given twice ({' and '.join(names)}); give it once")
     return names[0] if names else None
-
-
-def check_flags_known(argv: Sequence[str], own: Sequence[str]) -> None:
-    """Raise SetupError for a ``--flag`` of ``argv`` that is neither one of ``own`` (the
-    command's flags) nor a config key's, with the config keys it most likely meant, found by
-    meaning (``--learning-rate``: ``--agent.lr``; ``--agent.gamma``: ``--agent.discount``), as
-    ``--set`` does for a key."""
-    known = config_flags()
-    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
-    for arg in argv:
-        if arg == "--":
-            break
-        name = arg.partition("=")[0]
-        if not name.startswith("--") or name in known or name in own:
-            continue
-        typed = name[2:].replace("-", "_")
-        matches = [key_flag(key) for key in close_keys(typed, docs)]
-        hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
-        raise SetupError(f"unknown flag {name}{hint}; `simoun-train --help` lists every flag")
 
 
 @functools.cache
