@@ -130,7 +130,9 @@ def test_a_misspelled_sb3_policy_is_not_reported_as_fitting():
 
 
 def test_the_minigrid_study_answers_version(capsys):
-    assert minigrid_cli.main(["--version"]) == 0
+    with pytest.raises(SystemExit) as stop:
+        minigrid_cli.main(["--version"])
+    assert stop.value.code == 0
     assert capsys.readouterr().out.startswith("python -m simoun_lab.minigrid_study ")
 
 

@@ -92,6 +92,18 @@ def command_flags(command: Any, argv: Sequence[str]) -> dict[str, Flag]:
     return flags
 
 
+def takes_positional(command: Any, argv: Sequence[str]) -> bool:
+    """Whether the dataclass ``argv`` runs has a positional argument (True when it names no
+    subcommand: nothing is known yet)."""
+    cls = chosen(command, argv)
+    if cls is None:
+        return True
+    hints = typing.get_type_hints(cls, include_extras=True)
+    return any(
+        tyro.conf.Positional in unwrap(hints[field.name])[1] for field in dataclasses.fields(cls)
+    )
+
+
 def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) -> None:
     hints = typing.get_type_hints(cls, include_extras=True)
     docs = field_docs(cls)

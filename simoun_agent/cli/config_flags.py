@@ -119,7 +119,7 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
     for pair in flags.set:
         key, sep, value = pair.partition("=")
         key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
-        if not sep:
+        if not sep or not key:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
         check_keys([key])  # an unknown key fails here, with its close matches
         given[key] = parse_value(key, value, fields[key][0])

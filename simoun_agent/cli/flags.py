@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import itertools
 import json
 import os
 import sys
@@ -45,7 +46,13 @@ from tyro.constructors import (
     UnsupportedTypeAnnotationError,
 )
 
-from simoun_agent.cli.command_flags import CONFIG_SECTIONS, Flag, command_flags, subcommands
+from simoun_agent.cli.command_flags import (
+    CONFIG_SECTIONS,
+    Flag,
+    command_flags,
+    subcommands,
+    takes_positional,
+)
 from simoun_agent.config import TrainConfig
 from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs
@@ -219,6 +226,23 @@ def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, pr
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
 
+def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: bool) -> None:
+    """Raise ValueError for a word after a switch in a command that takes no positional
+    argument (``--progress maybe``): tyro would name only the word, not the switch it was
+    meant for. :func:`bool_argv` already took true/false words."""
+    if positional:
+        return
+    for arg, following in itertools.pairwise(argv):
+        if arg == "--":
+            break
+        flag = flags.get(arg)
+        if flag is not None and flag.switch is not None and not following.startswith("-"):
+            raise ValueError(
+                f"{arg} is a switch: it takes true or false ({arg} true, {arg} false), or give "
+                f"{arg} alone; got {following!r}"
+            )
+
+
 def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
     """Raise ValueError for an option of ``flags`` given twice with different values
     (``--episodes 1 --episodes 2``, ``--video --no-video``, a subcommand's ``--study-dir a
@@ -284,6 +308,7 @@ def parse(
         argv = bool_argv(argv, switches)
         flags = command_flags(cls, argv)
         refuse_unknown(argv, flags, cls, prog)
+        refuse_stray_words(argv, flags, takes_positional(cls, argv))
         refuse_repeated(argv, flags)
     except ValueError as err:
         fail(prog, err)
