@@ -64,6 +64,13 @@ def tiny(*extra: str) -> list[str]:
     return [*out, *extra]
 
 
+def sweep_tiny(*extra: str) -> list[str]:
+    """:func:`tiny` for simoun-sweep, which sets torch_threads itself (--cpus-per-trial)."""
+    flags = tiny(*extra)
+    at = flags.index("--torch-threads")
+    return flags[:at] + flags[at + 2 :]
+
+
 COMMANDS = {
     "train": "simoun_agent.cli.train",
     "eval": "simoun_agent.cli.eval",
@@ -181,28 +188,28 @@ FLAG_CASES = [
     cli("flags", "analyze", ["bias", "{run}", "--episodes", "0"], "--episodes"),
     cli("flags", "analyze", ["mask", "{run}"], "masks"),
     cli("flags", "analyze", ["masks", "{run}", "--device", "tpu"], "device"),
-    cli("flags", "sweep", tiny("--grid", "agent.lr"), "--grid"),
-    cli("flags", "sweep", tiny("--grid", "agent.lrr=1,2"), "agent.lr"),
-    cli("flags", "sweep", tiny("--grid", "agent.lr=1e-3,abc"), "agent.lr"),
-    cli("flags", "sweep", tiny("--grid", "agent.recipe=simoun,drqq"), "drqq"),
-    cli("flags", "sweep", tiny("--seeds", "5-2"), "--seeds"),
-    cli("flags", "sweep", tiny("--seeds", "a-b"), "--seeds"),
-    cli("flags", "sweep", tiny("--seeds", ""), "--seeds"),
-    cli("flags", "sweep", tiny("--seeds", "1,1"), "--seeds"),
-    cli("flags", "sweep", tiny("--envs", "Pendulum-v9"), "Pendulum-v9"),
-    cli("flags", "sweep", tiny("--envs", ","), "--envs"),
-    cli("flags", "sweep", tiny("--cpus-per-trial", "0"), "--cpus-per-trial"),
-    cli("flags", "sweep", tiny("--gpus-per-trial", "lots"), "--gpus-per-trial"),
-    cli("flags", "sweep", tiny("--gpus-per-trial", "-1"), "--gpus-per-trial"),
-    cli("flags", "sweep", tiny("--num-cpus", "0"), "--num-cpus"),
-    cli("flags", "sweep", tiny("--verbose", "3"), "--verbose"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lr"), "--grid"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lrr=1,2"), "agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lr=1e-3,abc"), "agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.recipe=simoun,drqq"), "drqq"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "5-2"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "a-b"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", ""), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "1,1"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--envs", "Pendulum-v9"), "Pendulum-v9"),
+    cli("flags", "sweep", sweep_tiny("--envs", ","), "--envs"),
+    cli("flags", "sweep", sweep_tiny("--cpus-per-trial", "0"), "--cpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--gpus-per-trial", "lots"), "--gpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--gpus-per-trial", "-1"), "--gpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--num-cpus", "0"), "--num-cpus"),
+    cli("flags", "sweep", sweep_tiny("--verbose", "3"), "--verbose"),
     cli("flags", "sweep", ["--resume"], "--sweep-dir"),
     cli("flags", "sweep", ["--resume", "--sweep-dir", "nowhere"], "nowhere"),
-    cli("flags", "sweep", tiny("--sweep-dir", "{run}"), "sweep-dir"),
-    cli("flags", "sweep", tiny("--learning-rate", "3"), "--agent.lr"),
-    cli("flags", "sweep", tiny("--sweep-dir", "a", "--sweep-dir", "b"), "--sweep-dir"),
-    cli("flags", "sweep", tiny("--seeds", "1", "--seeds", "2"), "--seeds"),
-    cli("flags", "sweep", tiny("--address", "nohost:1"), "--address"),
+    cli("flags", "sweep", sweep_tiny("--sweep-dir", "{run}"), "sweep-dir"),
+    cli("flags", "sweep", sweep_tiny("--learning-rate", "3"), "--agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--sweep-dir", "a", "--sweep-dir", "b"), "--sweep-dir"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "1", "--seeds", "2"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--address", "nohost:1"), "--address"),
     cli("flags", "study", ["plan"], "SPEC"),
     cli("flags", "study", ["plann", "spec.toml"], "plan"),
     cli("flags", "study", ["plan", "spec.toml", "--probe-updates", "-1"], "--probe-updates"),

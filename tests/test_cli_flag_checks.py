@@ -36,7 +36,7 @@ def refused(capsys, main, argv) -> str:
         (sweep_cli.main, ["--sweepdir", "x"], "(did you mean --sweep-dir?)"),
         (eval_cli.main, ["RUN", "--num-episodes", "3"], "unknown flag --num-episodes (did you "
          "mean --episodes?); `simoun-eval --help`"),
-        (report_cli.main, ["DIR", "--at-stpe", "5"], "(did you mean --at-step?)"),
+        (report_cli.main, ["DIR", "--at-stpe", "5"], "(did you mean --at-step"),
         (study_cli.main, ["plan", "spec.toml", "--probe-update", "1"], "unknown flag "
          "--probe-update (did you mean --probe-updates?); `simoun-study plan --help`"),
         (analyze_cli.main, ["masks", "RUN", "--step", "2"], "(did you mean --steps?); "

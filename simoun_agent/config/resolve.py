@@ -137,14 +137,20 @@ SAVED_BEFORE = {"agent.next_state_encoder": "online"}
 key was added with this value as its default, which the default has since left."""
 
 
-def from_dict(data: dict[str, Any]) -> TrainConfig:
-    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know. A key
-    the config predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did),
-    else this version's default."""
+def from_dict(data: dict[str, Any], where: str = "saved config") -> TrainConfig:
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know, or
+    for ``data`` that is not a dict (a damaged file, named by ``where``). A key the config
+    predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did), else this
+    version's default."""
+    if not isinstance(data, dict):
+        raise SetupError(
+            f"{where} holds {type(data).__name__} where a JSON object of config keys belongs: "
+            "it is damaged; restore it from a copy, or train the run again"
+        )
     flat = {**SAVED_BEFORE, **flatten(data)}
     check_keys(
         flat,
-        "saved config",
+        where,
         "it was written by another version of simoun; use that version, or train it again",
     )
     known = config_fields()

@@ -200,7 +200,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"a resumed run keeps its config; only {', '.join(RESUMABLE_FIELDS)} may change, "
             f"but {', '.join(fixed)} was given. Start a new run to change it."
         )
-    config = from_dict(saved)
+    config = from_dict(saved, str(config_path))
     for key, value in overrides.items():
         setattr(config, key, value)
     config.run_dir = str(run_dir)
