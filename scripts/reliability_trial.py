@@ -37,6 +37,9 @@ import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+from flag_lists import override  # noqa: E402  (the tests' helper, found through ROOT)
+
 TIMEOUT = 20.0
 SPEC = (ROOT / "docs/studies/dmc100k.toml").read_text()
 
@@ -51,17 +54,7 @@ TINY = [
 
 def tiny(*extra: str) -> list[str]:
     """TINY with ``extra``'s flags in place of TINY's own (a flag given twice is its own case)."""
-    given = {arg for arg in extra if arg.startswith("--")}
-    out, skip = [], False
-    for i, arg in enumerate(TINY):
-        if skip:
-            skip = False
-            continue
-        if arg in given:
-            skip = i + 1 < len(TINY) and not TINY[i + 1].startswith("--")
-            continue
-        out.append(arg)
-    return [*out, *extra]
+    return override(TINY, *extra)
 
 
 def sweep_tiny(*extra: str) -> list[str]:
