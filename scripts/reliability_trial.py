@@ -3,6 +3,7 @@ Python API and the files users keep, each classified by what the user is told.
 
     python scripts/reliability_trial.py                 # every case, a table on stdout
     python scripts/reliability_trial.py --area files    # one area
+    python scripts/reliability_trial.py --area flags --command sweep   # one command's cases
     python scripts/reliability_trial.py --markdown out.md
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
@@ -636,11 +637,19 @@ def describe(case: dict) -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--area", choices=("flags", "files", "specs", "api"), action="append")
+    parser.add_argument(
+        "--command", choices=(*COMMANDS, "api"), action="append", help="only its cases"
+    )
     parser.add_argument("--markdown", type=Path, help="also write the table here")
     args = parser.parse_args()
     for name in COMMANDS.values():  # imported once, before the children fork
         __import__(name)
-    cases = [case for case in CASES if args.area is None or case["area"] in args.area]
+    cases = [
+        case
+        for case in CASES
+        if (args.area is None or case["area"] in args.area)
+        and (args.command is None or case.get("command", "api") in args.command)
+    ]
     counts = {"clear": 0, "unclear": 0, "wrong": 0}
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

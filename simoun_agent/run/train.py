@@ -68,10 +68,12 @@ from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
     CURVE_PNG,
+    EVAL_CSV,
     SUMMARY_NAME,
+    TRAIN_CSV,
     VIDEO_NAME,
 )
-from simoun_agent.run.logger import RunLogger
+from simoun_agent.run.logger import RunLogger, read_log
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
@@ -201,6 +203,9 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"but {', '.join(fixed)} was given. Start a new run to change it."
         )
     config = from_dict(saved, str(config_path))
+    for log in (EVAL_CSV, TRAIN_CSV):  # before anything in the run is changed
+        if (run_dir / log).exists():
+            read_log(run_dir / log)
     for key, value in overrides.items():
         setattr(config, key, value)
     config.run_dir = str(run_dir)
