@@ -35,6 +35,7 @@ import math
 import random
 import signal
 import time
+import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
@@ -231,11 +232,18 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     env, eval_env, agent, _ = build(config, check)
     try:
         agent.load_state_dict(payload["agent"])
-        replay = FrameReplay.load(payload["replay_path"])
-    except (RuntimeError, KeyError, ValueError, OSError) as err:
+    except (RuntimeError, KeyError, ValueError) as err:
         raise SetupError(
             f"the checkpoint in {run_dir} does not fit this agent ({type(err).__name__}: "
             f"{err}); start a new run"
+        ) from None
+    try:
+        replay = FrameReplay.load(payload["replay_path"])
+    except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise SetupError(
+            f"{payload['replay_path']} (the replay of the checkpoint) is damaged "
+            f"({type(err).__name__}: {err}); the run cannot continue exactly. Restore it from a "
+            "copy, or start a new run"
         ) from None
     restore_rng(payload["rng"])
     rng = np.random.default_rng()
