@@ -15,6 +15,7 @@ import gymnasium as gym
 import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
 import numpy as np
 import pytest
+from flag_lists import override
 from gymnasium.wrappers import TransformReward
 from test_cli_conventions import TINY
 
@@ -130,7 +131,9 @@ def test_a_misspelled_sb3_policy_is_not_reported_as_fitting():
 
 
 def test_the_minigrid_study_answers_version(capsys):
-    assert minigrid_cli.main(["--version"]) == 0
+    with pytest.raises(SystemExit) as stop:
+        minigrid_cli.main(["--version"])
+    assert stop.value.code == 0
     assert capsys.readouterr().out.startswith("python -m simoun_lab.minigrid_study ")
 
 
@@ -406,3 +409,13 @@ def test_a_missing_or_wrong_kind_of_path_is_named_as_such(tmp_path, capsys):
     err = refused(capsys, train_cli.main, [*TINY, "--run-dir", str(text)])
     assert f"the output directory {text} is a file, not a directory" in err
     assert sorted(path.name for path in tmp_path.iterdir()) == ["notes.txt"]
+
+
+def test_frames_too_large_for_torch_to_size_are_refused_by_the_memory_check(tmp_path, capsys):
+    # 100,000 pixels a side at a batch of 512: an attention map of more than 2**63 bytes
+    argv = override(TINY, "--image-size", "100000", "--agent.batch-size", "512")
+    argv += ["--run-dir", str(tmp_path / "run")]
+    err = refused(capsys, train_cli.main, argv)
+    assert "--image-size 100000 with --agent.batch-size 512" in err
+    assert "Lower --image-size" in err
+    assert not (tmp_path / "run").exists()

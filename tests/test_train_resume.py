@@ -1,6 +1,7 @@
 """Checkpoints and resume of simoun-train: bit-exact continuation and refused bad inputs."""
 
 import json
+import shutil
 
 import pytest
 import torch
@@ -136,3 +137,25 @@ def test_cli_reports_bad_input_without_a_traceback_and_creates_no_run(tmp_path, 
     assert exit_info.value.code == 2
     assert "did you mean dm_control/cartpole-swingup-v0" in capsys.readouterr().err
     assert not run_dir.exists()
+
+
+def test_a_damaged_replay_is_named_and_kept(finished_run, tmp_path):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    replay = run_dir / "replay-40.npz"
+    replay.write_bytes(replay.read_bytes()[: replay.stat().st_size // 2])
+    before = {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()}
+    with pytest.raises(
+        SetupError, match=r"replay-40.npz \(the replay of the checkpoint\) is damaged"
+    ):
+        train.resume_run(run_dir, {"total_env_steps": 60})
+    assert {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()} == before
+
+
+def test_a_missing_checkpoint_is_named_with_both_fixes(finished_run, tmp_path):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    (run_dir / "checkpoint.pt").unlink()
+    with pytest.raises(SetupError, match=r"has no checkpoint\.pt: .* moved or deleted") as refusal:
+        train.resume_run(run_dir, {"total_env_steps": 60})
+    assert "Restore it from a copy" in str(refusal.value)

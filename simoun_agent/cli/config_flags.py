@@ -23,7 +23,6 @@ import tyro
 
 from simoun_agent.cli.flags import negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
-from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import (
     FALSE_WORDS,
     TRUE_WORDS,
@@ -76,25 +75,6 @@ def preset_in(argv: Sequence[str]) -> str | None:
     return names[0] if names else None
 
 
-def check_flags_known(argv: Sequence[str], own: Sequence[str]) -> None:
-    """Raise SetupError for a ``--flag`` of ``argv`` that is neither one of ``own`` (the
-    command's flags) nor a config key's, with the config keys it most likely meant, found by
-    meaning (``--learning-rate``: ``--agent.lr``; ``--agent.gamma``: ``--agent.discount``), as
-    ``--set`` does for a key."""
-    known = config_flags()
-    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
-    for arg in argv:
-        if arg == "--":
-            break
-        name = arg.partition("=")[0]
-        if not name.startswith("--") or name in known or name in own:
-            continue
-        typed = name[2:].replace("-", "_")
-        matches = [key_flag(key) for key in close_keys(typed, docs)]
-        hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
-        raise SetupError(f"unknown flag {name}{hint}; `simoun-train --help` lists every flag")
-
-
 @functools.cache
 def config_flags() -> dict[str, str]:
     """Every spelling of a config key's flag -> the key: ``--agent.batch-size``, and for a
@@ -139,7 +119,7 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
     for pair in flags.set:
         key, sep, value = pair.partition("=")
         key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
-        if not sep:
+        if not sep or not key:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
         check_keys([key])  # an unknown key fails here, with its close matches
         given[key] = parse_value(key, value, fields[key][0])

@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import itertools
 import json
 import os
 import sys
@@ -45,16 +46,21 @@ from tyro.constructors import (
     UnsupportedTypeAnnotationError,
 )
 
-from simoun_agent.config import AgentConfig, TrainConfig
+from simoun_agent.cli.command_flags import (
+    CONFIG_SECTIONS,
+    Flag,
+    command_flags,
+    subcommands,
+    takes_positional,
+)
+from simoun_agent.config import TrainConfig
+from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs
 
 T = TypeVar("T")
 
 REGISTRY = ConstructorRegistry()
 """The conventions above, for every ``tyro.cli`` call of the commands."""
-
-CONFIG_SECTIONS = (TrainConfig, AgentConfig)
-"""Dataclasses filled without their checks (those run once, in ``resolve``)."""
 
 COMMAND_PACKAGES = ("simoun_agent.", "simoun_lab.")
 """Where the dataclasses these conventions apply to are defined (the lab's commands share
@@ -198,52 +204,72 @@ def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
     return out
 
 
-def single_valued_flags(cls: type) -> dict[str, tuple[str, Any]]:
-    """Flag -> (field, value) for ``cls``'s own fields that take one value: a switch and its
-    negation map to True and False, an option to None (its value follows it). Repeatable
-    tuples, sections and subcommands are left out."""
-    flags: dict[str, tuple[str, Any]] = {}
-    if not dataclasses.is_dataclass(cls):
-        return flags
-    hints = typing.get_type_hints(cls, include_extras=True)
-    for field in dataclasses.fields(cls):
-        kind = hints[field.name]
-        while typing.get_origin(kind) is Annotated:
-            kind = typing.get_args(kind)[0]
-        if typing.get_origin(kind) in (tuple, list) or dataclasses.is_dataclass(kind):
+def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str) -> None:
+    """Raise ValueError for a ``--flag`` of ``argv`` that is not one of ``flags`` (the command's,
+    :func:`~simoun_agent.cli.command_flags.command_flags`), naming the flags it most likely
+    meant, found by meaning as well as spelling (``--learning-rate``: ``--agent.lr``;
+    ``--num-episodes``: ``--episodes``). Nothing is checked before a subcommand is named: tyro
+    asks for one."""
+    if not flags:
+        return
+    docs = {flag.key: flag.doc for flag in flags.values()}
+    named = subcommands(command)
+    sub = next((f" {arg}" for arg in argv if arg in named), "")
+    for arg in argv:
+        if arg == "--":
+            break
+        name = arg.partition("=")[0]
+        if not name.startswith("--") or name in flags or name in ("--help", "--version"):
             continue
-        flag = "--" + field.name.replace("_", "-")
-        flags[flag] = (field.name, True if kind is bool else None)
-        if kind is bool:
-            flags[negated(flag)] = (field.name, False)
-    return flags
+        matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
+        hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
+        raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
 
-def refuse_repeated(argv: Sequence[str], cls: type) -> None:
-    """Raise ValueError for an option of ``cls`` given twice with different values
-    (``--episodes 1 --episodes 2``, ``--video --no-video``): tyro would keep the last without a
-    word. Switches come as ``--video`` / ``--no-video`` here (:func:`bool_argv` ran first)."""
-    flags = single_valued_flags(cls)
+def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: bool) -> None:
+    """Raise ValueError for a word after a switch in a command that takes no positional
+    argument (``--progress maybe``): tyro would name only the word, not the switch it was
+    meant for. :func:`bool_argv` already took true/false words."""
+    if positional:
+        return
+    for arg, following in itertools.pairwise(argv):
+        if arg == "--":
+            break
+        flag = flags.get(arg)
+        if flag is not None and flag.switch is not None and not following.startswith("-"):
+            raise ValueError(
+                f"{arg} is a switch: it takes true or false ({arg} true, {arg} false), or give "
+                f"{arg} alone; got {following!r}"
+            )
+
+
+def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
+    """Raise ValueError for an option of ``flags`` given twice with different values
+    (``--episodes 1 --episodes 2``, ``--video --no-video``, a subcommand's ``--study-dir a
+    --study-dir b``): tyro would keep the last without a word. Switches come as ``--video`` /
+    ``--no-video`` here (:func:`bool_argv` ran first); a list's flag is meant to be repeated,
+    and the run config's keys are compared by value where they are read
+    (:func:`simoun_agent.cli.config_flags.check_given_once`)."""
     given: dict[str, dict[str, str]] = {}
     for i, arg in enumerate(argv):
         if arg == "--":
             break
         name, eq, text = arg.partition("=")
-        if name not in flags:
+        flag = flags.get(name)
+        if flag is None or flag.repeatable or flag.config:
             continue
-        field, switch = flags[name]
-        if switch is not None:
-            value, said = str(switch), arg
+        if flag.switch is not None:
+            value, said = str(flag.switch), arg
         elif eq or i + 1 < len(argv):
             value = text if eq else argv[i + 1]
             said = arg if eq else f"{arg} {value}"
         else:
             continue  # tyro says the value is missing
-        given.setdefault(field, {}).setdefault(value, said)
-    for field, values in given.items():
+        given.setdefault(flag.key, {}).setdefault(value, said)
+    for key, values in given.items():
         if len(values) > 1:
             raise ValueError(
-                f"--{field.replace('_', '-')} is given twice with different values "
+                f"--{key.replace('_', '-')} is given twice with different values "
                 f"({' and '.join(values.values())}); give it once"
             )
 
@@ -264,7 +290,7 @@ def installed_version() -> str:
 
 
 def parse(
-    cls: type[T],
+    cls: Any,
     argv: Sequence[str] | None,
     prog: str,
     description: str,
@@ -280,7 +306,10 @@ def parse(
         sys.exit(0)
     try:
         argv = bool_argv(argv, switches)
-        refuse_repeated(argv, cls)
+        flags = command_flags(cls, argv)
+        refuse_unknown(argv, flags, cls, prog)
+        refuse_stray_words(argv, flags, takes_positional(cls, argv))
+        refuse_repeated(argv, flags)
     except ValueError as err:
         fail(prog, err)
     with _help_unwrapped_in_pipes():

@@ -26,7 +26,6 @@ from simoun_agent.cli.config_flags import (
     PRESETS_LIST,
     RECIPES_HELP,
     ConfigFlags,
-    check_flags_known,
     config_default,
     config_switches,
     overrides_from,
@@ -77,19 +76,6 @@ class TrainCommand:
     """the run config"""
 
 
-OWN_FLAGS = (
-    "-h",
-    "--help",
-    "--version",
-    "--resume",
-    "--overwrite",
-    "--no-overwrite",
-    "--preset",
-    "--set",
-)
-"""simoun-train's flags that are not config keys"""
-
-
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""
@@ -129,7 +115,6 @@ def parse_command(argv: Sequence[str]) -> TrainCommand:
     """``argv`` read with tyro over the defaults of the preset it names; bad input exits with
     status 2."""
     try:
-        check_flags_known(argv, OWN_FLAGS)
         default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
     except SetupError as err:
         fail(PROG, err)

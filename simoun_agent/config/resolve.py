@@ -29,6 +29,7 @@ from simoun_agent.config.errors import SetupError
 from simoun_agent.config.keys import check_keys, config_fields, config_sections
 from simoun_agent.config.presets import PRESETS
 from simoun_agent.config.recipes import RECIPES
+from simoun_agent.config.rules import rules_of
 from simoun_agent.config.train import TrainConfig
 
 
@@ -137,19 +138,38 @@ SAVED_BEFORE = {"agent.next_state_encoder": "online"}
 key was added with this value as its default, which the default has since left."""
 
 
-def from_dict(data: dict[str, Any]) -> TrainConfig:
-    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know. A key
-    the config predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did),
-    else this version's default."""
+def from_dict(data: dict[str, Any], where: str = "saved config") -> TrainConfig:
+    """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know, or
+    for ``data`` that is not a dict (a damaged file, named by ``where``). A key the config
+    predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did), else this
+    version's default."""
+    if not isinstance(data, dict):
+        raise SetupError(
+            f"{where} holds {type(data).__name__} where a JSON object of config keys belongs: "
+            "it is damaged; restore it from a copy, or train the run again"
+        )
     flat = {**SAVED_BEFORE, **flatten(data)}
     check_keys(
         flat,
-        "saved config",
+        where,
         "it was written by another version of simoun; use that version, or train it again",
     )
     known = config_fields()
+    sections = config_sections()
     for key, value in flat.items():
-        kind = known[key][0]
+        kind, default, _ = known[key]
         if isinstance(value, list) and (typing.get_origin(kind) or kind) is tuple:
-            flat[key] = tuple(value)
-    return from_flat(flat)
+            flat[key] = value = tuple(value)
+        name = key.rpartition(".")[2]
+        rule = rules_of(sections[key.removesuffix(name)])[name]
+        if not rule.ok(value):
+            raise SetupError(
+                f"{where}: {key} is {json.dumps(value)}, which must be {rule.need}; the file is "
+                f"damaged or was edited: set {key} there to what the run was trained with (the "
+                f"default is {json.dumps(default)}), restore the file from a copy, or train the "
+                "run again"
+            )
+    try:
+        return from_flat(flat)
+    except SetupError as err:  # a cross-field check, spelled as flags: say where it came from
+        raise SetupError(f"{where} does not hold a valid config: {err}") from None

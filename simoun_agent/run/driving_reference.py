@@ -19,8 +19,10 @@ the agent sees it (the frames ``simoun-eval --video`` writes for a learned drive
 
 from __future__ import annotations
 
-import argparse
 import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -28,7 +30,9 @@ import gymnasium as gym
 import numpy as np
 
 from simoun_agent import table
-from simoun_agent.config import TrainConfig, resolve
+from simoun_agent.cli.flags import fail, parse
+from simoun_agent.config import PRESETS, SetupError, TrainConfig, resolve
+from simoun_agent.config.envs import is_highway
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.video import write_video
@@ -177,20 +181,63 @@ def markdown_table(metrics: dict[str, dict]) -> str:
     return table.markdown_table(headers, rows)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description="Reference drivers' metrics on highway-cpu.")
-    parser.add_argument("--episodes", type=int, default=20)
-    parser.add_argument("--seed", type=int, default=1000, help="seed of the first episode")
-    parser.add_argument("--preset", default="highway-cpu")
-    parser.add_argument(
-        "--video", type=Path, help="write the lane-keeping driver's first episode here (.gif/.mp4)"
-    )
-    args = parser.parse_args(argv)
-    if args.video is not None and not args.video.parent.is_dir():
-        parser.error(f"--video {args.video}: the folder {args.video.parent} does not exist")
+@dataclass
+class DrivingReferenceCommand:
+    """What ``python -m simoun_agent.run.driving_reference`` is asked."""
+
+    episodes: int = 20
+    """episodes each driver plays"""
+    seed: int = 1000
+    """seed of the first episode (the others follow it)"""
+    preset: str = "highway-cpu"
+    """a highway-env preset: highway-cpu or highway"""
+    video: Path | None = None
+    """write the lane-keeping driver's first episode here (.gif or .mp4)"""
+
+
+PROG = "python -m simoun_agent.run.driving_reference"
+
+VIDEO_SUFFIXES = (".gif", ".mp4")
+
+
+def check_command(args: DrivingReferenceCommand) -> TrainConfig:
+    """The preset's config, with every value of ``args`` checked before an episode is played;
+    SetupError naming the flag and a value that works."""
+    if args.episodes < 1:
+        raise SetupError(f"--episodes must be 1 or more, got {args.episodes}; e.g. --episodes 20")
+    if args.seed < 0:
+        raise SetupError(f"--seed must be 0 or more, got {args.seed}; e.g. --seed 1000")
     config = resolve(args.preset, {"device": "cpu"})
+    if not is_highway(config.env):
+        highway = [name for name, preset in PRESETS.items() if preset.envs == "highway"]
+        raise SetupError(
+            f"--preset {args.preset} trains on {config.env}, not highway-env: the reference "
+            f"drivers steer a highway-env car; choose one of {', '.join(highway)}"
+        )
+    if args.video is not None:
+        if args.video.suffix not in VIDEO_SUFFIXES:
+            raise SetupError(
+                f"--video {args.video}: a video is written as .gif or .mp4, not "
+                f"{args.video.suffix or 'a name without a suffix'}; e.g. --video lane-keeping.gif"
+            )
+        if not args.video.parent.is_dir():
+            raise SetupError(
+                f"--video {args.video}: the folder {args.video.parent} does not exist; create it "
+                "or pass a path in an existing folder"
+            )
+    return config
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Print the reference drivers' table."""
+    args = parse(DrivingReferenceCommand, argv, PROG, "Reference drivers' metrics on highway-env.")
+    try:
+        config = check_command(args)
+    except SetupError as err:
+        fail(PROG, err)
     print(markdown_table(reference_metrics(config, args.episodes, args.seed, args.video)))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -13,6 +13,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
@@ -30,10 +31,8 @@ class CsvLog:
         self.last_row: dict[str, str] | None = None
         """the last row kept on resume (None for a new log)"""
         if resume_step is not None and path.exists():
-            with path.open(newline="") as f:
-                reader = csv.DictReader(f)
-                self.columns = reader.fieldnames
-                rows = [row for row in reader if int(row["env_step"]) <= resume_step]
+            self.columns, rows = read_log(path)
+            rows = [row for row in rows if int(row["env_step"]) <= resume_step]
             self._rewrite(rows)
             self.last_row = rows[-1] if rows else None
         elif path.exists():
@@ -60,6 +59,41 @@ class CsvLog:
             self._rewrite(rows)
         with self.path.open("a", newline="") as f:
             csv.DictWriter(f, self.columns).writerow(row)
+
+
+def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
+    """The columns and rows of a log written by :class:`CsvLog`, checked before a resumed run
+    rewrites it; SetupError naming the file, the damage and the fix when it is empty, has no
+    ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
+    the user's file stays as it is."""
+    try:
+        with path.open(newline="") as f:
+            lines = list(csv.reader(f))
+    except (UnicodeDecodeError, csv.Error) as err:
+        raise damaged_log(path, f"it is not a CSV file ({err})") from None
+    if not lines or "env_step" not in lines[0]:
+        problem = "it is empty" if not lines else "its first line has no env_step column"
+        raise damaged_log(path, problem)
+    columns, at = lines[0], lines[0].index("env_step")
+    rows = []
+    for number, values in enumerate(lines[1:], start=2):
+        if len(values) != len(columns):
+            fields = f"{len(values)} fields where the header has {len(columns)}"
+            raise damaged_log(path, f"line {number} has {fields}")
+        if not values[at].isdigit():
+            raise damaged_log(path, f"line {number}'s env_step {values[at]!r} is not a step count")
+        rows.append(dict(zip(columns, values, strict=True)))
+    return columns, rows
+
+
+def damaged_log(path: Path, problem: str) -> SetupError:
+    """The error for a damaged log: what is wrong, that nothing was changed, and two fixes that
+    let the run resume (a resumed run without the file starts it again)."""
+    return SetupError(
+        f"{path} is damaged: {problem}. Nothing in the run was changed. Restore the file from a "
+        f"copy, or move it aside (mv {path} {path}.damaged) and resume again: the run goes on "
+        f"from its checkpoint with a new {path.name} from there"
+    )
 
 
 def read_csv(path: Path) -> list[dict[str, float]]:

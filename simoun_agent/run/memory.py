@@ -98,8 +98,20 @@ def update_bytes(config: TrainConfig) -> int:
             frames = torch.zeros(batch, agent_config.num_frames, *shape, dtype=torch.uint8)
             bootstrap = (frames, torch.zeros(batch))
         action, reward = torch.zeros(batch, ACTION_DIM), torch.zeros(batch)
-        agent.update_window(window, action, reward, torch.ones(batch), 1, bootstrap)
+        try:
+            agent.update_window(window, action, reward, torch.ones(batch), 1, bootstrap)
+        except RuntimeError as err:
+            # A tensor of more than 2**63 bytes (frames of 100,000 pixels a side at a batch of
+            # 512): torch cannot even size it on the meta device, and no machine holds it.
+            if "overflow" not in str(err):
+                raise
+            return MORE_THAN_TORCH_COUNTS
     return held + counter.peak
+
+
+MORE_THAN_TORCH_COUNTS = 2**63 - 1
+"""What :func:`update_bytes` returns for an update whose tensors torch cannot size: a lower bound
+of its need, larger than any machine's memory."""
 
 
 def replay_bytes(config: TrainConfig) -> int:

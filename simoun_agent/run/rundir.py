@@ -117,9 +117,9 @@ def require_checkpoint(run_dir: Path) -> None:
     """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint."""
     if (run_dir / TRAINER_FILES[0]).exists() and not (run_dir / CHECKPOINT_NAME).exists():
         raise SetupError(
-            f"{run_dir} has no checkpoint: the run stopped before its first one, so there is "
-            f"nothing to resume. Start it over with its flags plus --run-dir {run_dir} "
-            "--overwrite"
+            f"{run_dir} has no {CHECKPOINT_NAME}: the run stopped before its first checkpoint, "
+            "or the file was moved or deleted, so there is nothing to resume. Restore it from a "
+            f"copy, or start the run over with its flags plus --run-dir {run_dir} --overwrite"
         )
 
 

@@ -35,6 +35,7 @@ import math
 import random
 import signal
 import time
+import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
@@ -68,10 +69,12 @@ from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
     CURVE_PNG,
+    EVAL_CSV,
     SUMMARY_NAME,
+    TRAIN_CSV,
     VIDEO_NAME,
 )
-from simoun_agent.run.logger import RunLogger
+from simoun_agent.run.logger import RunLogger, read_log
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
@@ -200,7 +203,10 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"a resumed run keeps its config; only {', '.join(RESUMABLE_FIELDS)} may change, "
             f"but {', '.join(fixed)} was given. Start a new run to change it."
         )
-    config = from_dict(saved)
+    config = from_dict(saved, str(config_path))
+    for log in (EVAL_CSV, TRAIN_CSV):  # before anything in the run is changed
+        if (run_dir / log).exists():
+            read_log(run_dir / log)
     for key, value in overrides.items():
         setattr(config, key, value)
     config.run_dir = str(run_dir)
@@ -226,11 +232,18 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     env, eval_env, agent, _ = build(config, check)
     try:
         agent.load_state_dict(payload["agent"])
-        replay = FrameReplay.load(payload["replay_path"])
-    except (RuntimeError, KeyError, ValueError, OSError) as err:
+    except (RuntimeError, KeyError, ValueError) as err:
         raise SetupError(
             f"the checkpoint in {run_dir} does not fit this agent ({type(err).__name__}: "
             f"{err}); start a new run"
+        ) from None
+    try:
+        replay = FrameReplay.load(payload["replay_path"])
+    except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise SetupError(
+            f"{payload['replay_path']} (the replay of the checkpoint) is damaged "
+            f"({type(err).__name__}: {err}); the run cannot continue exactly. Restore it from a "
+            "copy, or start a new run"
         ) from None
     restore_rng(payload["rng"])
     rng = np.random.default_rng()

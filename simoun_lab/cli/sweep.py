@@ -153,8 +153,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     # absolute: Tune runs each trial in a working directory of its own
     sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
     try:
-        ray = load_ray()
+        # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        ray = load_ray()
     except SetupError as err:
         fail(PROG, err)
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]

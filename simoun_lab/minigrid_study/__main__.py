@@ -17,7 +17,7 @@ from typing import Annotated, Union
 
 import tyro
 
-from simoun_agent.cli.flags import installed_version, quiet_pipe
+from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec
@@ -98,19 +98,16 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 ]
 
 
+DESCRIPTION = (
+    "SB3 PPO on MiniGrid pixels with no intrinsic reward, consistency curiosity or RND: train the "
+    "runs on Ray Tune (resumable), then report; probe an intrinsic reward's link to novelty "
+    "without PPO."
+)
+
+
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
-    if "--version" in (sys.argv[1:] if argv is None else argv):
-        print(f"{PROG} {installed_version()}")
-        return 0
-    args = tyro.cli(
-        Command,
-        prog=PROG,
-        description="SB3 PPO on MiniGrid pixels with no intrinsic reward, consistency curiosity "
-        "or RND: train the runs on Ray Tune (resumable), then report; probe an intrinsic reward's "
-        "link to novelty without PPO.",
-        args=argv,
-    )
+    args = parse(Command, argv, PROG, DESCRIPTION)
     if isinstance(args, Probe):
         from simoun_lab.minigrid_study.probe import write_probe
 
@@ -122,8 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 )
             print(write_probe(args.settings, args.probes, args.out))
         except ValueError as err:
-            print(f"error: {err}", file=sys.stderr)
-            return 2
+            fail(PROG, err)
         return 0
     try:
         spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
@@ -148,8 +144,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
         print(write_report(spec, args.archive))
     except SetupError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+        fail(PROG, err)
     return 0
 
 

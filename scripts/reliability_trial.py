@@ -1,0 +1,678 @@
+"""A reliability trial: inputs a new user gets wrong, run against the commands, the wrappers'
+Python API and the files users keep, each classified by what the user is told.
+
+    python scripts/reliability_trial.py                 # every case, a table on stdout
+    python scripts/reliability_trial.py --area files    # one area
+    python scripts/reliability_trial.py --area flags --command sweep   # one command's cases
+    python scripts/reliability_trial.py --markdown out.md
+
+Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
+it needs one) and is stopped after 20 s: a case that passes its checks is not left to train.
+A case is
+
+- clear: refused with status 2 (a command) or a ValueError/TypeError-like error (the API), the
+  message naming the argument, flag or file the case is about, no traceback; or, for a case
+  marked ``ok`` (valid input, or a file the command does not need), it went on without error;
+- unclear: refused, but the message does not name what the case is about;
+- wrong: a traceback, an error from inside a library, accepted where it must be refused, or
+  still running where it should have been refused (work started).
+
+The classification is mechanical; docs/reliability.md records how the last trial's cases read to
+a person. Add a case to a list below, never change one: the next trial reruns them all.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import os
+import shutil
+import sys
+import tempfile
+import traceback
+from pathlib import Path
+
+import gymnasium as gym
+import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+from flag_lists import override  # noqa: E402  (the tests' helper, found through ROOT)
+
+TIMEOUT = 20.0
+SPEC = (ROOT / "docs/studies/dmc100k.toml").read_text()
+
+TINY = [
+    "--env", "simoun/PointReach-v0", "--image-size", "32", "--warmup-agent-steps", "10",
+    "--eval-every", "20", "--eval-episodes", "1", "--checkpoint-every", "20", "--device", "cpu",
+    "--torch-threads", "1", "--agent.batch-size", "8", "--agent.num-filters", "4",
+    "--agent.feature-dim", "8", "--agent.hidden-dim", "16", "--agent.aux-hidden-dim", "16",
+    "--no-progress", "--no-video",
+]  # fmt: skip
+
+
+def tiny(*extra: str) -> list[str]:
+    """TINY with ``extra``'s flags in place of TINY's own (a flag given twice is its own case)."""
+    return override(TINY, *extra)
+
+
+def sweep_tiny(*extra: str) -> list[str]:
+    """:func:`tiny` for simoun-sweep, which sets torch_threads itself (--cpus-per-trial)."""
+    flags = tiny(*extra)
+    at = flags.index("--torch-threads")
+    return flags[:at] + flags[at + 2 :]
+
+
+COMMANDS = {
+    "train": "simoun_agent.cli.train",
+    "eval": "simoun_agent.cli.eval",
+    "sweep": "simoun_lab.cli.sweep",
+    "study": "simoun_lab.cli.study",
+    "report": "simoun_lab.cli.report",
+    "analyze": "simoun_lab.cli.analyze",
+    "minigrid": "simoun_lab.minigrid_study.__main__",
+    "driving": "simoun_agent.run.driving_reference",
+}
+
+
+def cli(area: str, command: str, argv: list[str], names: str, ok: bool = False, setup=None):
+    """A command-line case: ``command``'s main on ``argv`` ({run} is a copy of the tiny run)."""
+    return {
+        "area": area,
+        "command": command,
+        "argv": argv,
+        "names": names,
+        "ok": ok,
+        "setup": setup,
+    }
+
+
+def api(code: str, names: str, ok: bool = False):
+    """A Python API case: ``code`` run with gym, np, w (simoun_wrappers) and pickle in scope."""
+    return {"area": "api", "code": code, "names": names, "ok": ok}
+
+
+# command lines: flags, values, combinations
+FLAG_CASES = [
+    cli("flags", "train", tiny("--total-env-step", "5"), "--total-env-steps"),
+    cli("flags", "train", tiny("--batch-size", "8"), "--agent.batch-size"),
+    cli("flags", "train", tiny("--discount", "0.9"), "--agent.discount"),
+    cli("flags", "train", tiny("--envs", "Pendulum-v1"), "--env"),
+    cli("flags", "train", tiny("--run_dir", "x"), "--run-dir"),
+    cli("flags", "train", tiny("--agent.lr", "-1"), "lr"),
+    cli("flags", "train", tiny("--agent.lr", "nan"), "lr"),
+    cli("flags", "train", tiny("--agent.lr", "inf"), "lr"),
+    cli("flags", "train", tiny("--agent.discount", "1.5"), "discount"),
+    cli("flags", "train", tiny("--agent.batch-size", "0"), "batch_size"),
+    cli("flags", "train", tiny("--agent.batch-size", "8.5"), "--agent.batch-size"),
+    cli("flags", "train", tiny("--total-env-steps", "0"), "total_env_steps"),
+    cli("flags", "train", tiny("--total-env-steps", "-5"), "total_env_steps"),
+    cli("flags", "train", tiny("--eval-every", "0"), "eval_every"),
+    cli("flags", "train", tiny("--eval-episodes", "0"), "eval_episodes"),
+    cli("flags", "train", tiny("--checkpoint-every", "-1"), "checkpoint_every"),
+    cli("flags", "train", tiny("--seed", "-1"), "seed"),
+    cli("flags", "train", tiny("--seed", "1e3"), "--seed"),
+    cli("flags", "train", tiny("--action-repeat", "0"), "action_repeat"),
+    cli("flags", "train", tiny("--torch-threads", "0"), "torch_threads"),
+    cli("flags", "train", tiny("--device", "cuda:9"), "device"),
+    cli("flags", "train", tiny("--device", "tpu"), "device"),
+    cli("flags", "train", tiny("--env", "Pendulum-v9"), "Pendulum"),
+    cli("flags", "train", tiny("--env", "CartPole-v1"), "CartPole"),
+    cli("flags", "train", tiny("--env", "nosuchmodule:Foo-v0"), "nosuchmodule"),
+    cli("flags", "train", tiny("--env-kwargs", "[1]"), "--env-kwargs"),
+    cli("flags", "train", tiny("--env-kwargs", '{"nope": 1}'), "nope"),
+    cli("flags", "train", tiny("--agent.recipe", "curll"), "recipe"),
+    cli("flags", "train", tiny("--agent.augmentation", "crop"), "augmentation"),
+    cli("flags", "train", tiny("--agent.n-step", "0"), "n_step"),
+    cli("flags", "train", tiny("--set", "agent.lr"), "--set"),
+    cli("flags", "train", tiny("--set", "=3"), "--set"),
+    cli("flags", "train", tiny("--set", "agent=3"), "agent"),
+    cli("flags", "train", tiny("--set", "agent.nope=3"), "agent.nope"),
+    cli("flags", "train", tiny("--set", "seed=abc"), "seed"),
+    cli("flags", "train", tiny("--eval-distraction", "colour_hard"), "colour_hard"),
+    cli("flags", "train", tiny("--progress", "maybe"), "--progress"),
+    cli("flags", "train", tiny("--image-size", "8"), "image"),
+    cli("flags", "train", tiny("--image-size", "100000"), "image"),
+    cli("flags", "train", tiny("--agent.replay-capacity", "1"), "replay"),
+    cli("flags", "train", tiny("--resume"), "--resume"),
+    cli("flags", "train", ["--resume", "{run}", "--preset", "cpu"], "--preset"),
+    cli("flags", "train", ["--resume", "{run}", "--overwrite"], "--overwrite"),
+    cli("flags", "train", ["--resume", "{run}", "--total-env-steps", "10"], "total"),
+    cli("flags", "train", ["--resume", "{run}", "--agent.lr", "0.1"], "agent.lr"),
+    cli("flags", "train", ["--resume", "{run}", "--seed", "9"], "seed"),
+    cli("flags", "train", tiny("--run-dir", "{run}"), "run"),
+    cli("flags", "train", tiny("--total-env-steps", "100000", "--run-dir", "r"), "", ok=True),
+    cli("flags", "train", ["--preset", "highway", "--env", "Pendulum-v1"], "highway"),
+    cli("flags", "train", tiny("--preset", "cpu", "--preset=cpux"), "--preset"),
+    cli("flags", "train", tiny("--env-module", "nosuchmodule"), "nosuchmodule"),
+    cli("flags", "train", tiny("--", "--seed", "3"), "--"),
+    cli("flags", "eval", ["{run}", "--episodes", "0"], "--episodes"),
+    cli("flags", "eval", ["{run}", "--episodes", "-3"], "--episodes"),
+    cli("flags", "eval", ["{run}", "--episode", "3"], "--episodes"),
+    cli("flags", "eval", ["{run}", "--seed", "-1"], "--seed"),
+    cli("flags", "eval", ["{run}", "--torch-threads", "0"], "--torch-threads"),
+    cli("flags", "eval", ["{run}", "--distraction", "colour_easy"], "colour_easy"),
+    cli("flags", "eval", ["{run}", "--distraction", "color_easy"], "dm_control"),
+    cli("flags", "eval", ["{run}", "--out", "/proc/nope"], "--out"),
+    cli("flags", "eval", ["{run}", "--videos", "nowhere"], "--videos"),
+    cli("flags", "eval", ["{run}", "{run}"], "several"),
+    cli("flags", "eval", [], "run directory"),
+    cli("flags", "eval", ["{run}", "--device", "tpu"], "device"),
+    cli("flags", "eval", ["{run}", "--episodes", "1", "--no-video"], "", ok=True),
+    cli("flags", "eval", ["{run}", "--episodes", "1", "--episodes", "1"], "", ok=True),
+    cli("flags", "report", ["{run}", "--at-step", "0"], "--at-step"),
+    cli("flags", "report", ["{run}", "--at-wall-time", "-1"], "--at-wall-time"),
+    cli("flags", "report", ["{run}", "--at-step", "20", "--at-wall-time", "5"], "--at-"),
+    cli("flags", "report", ["{run}", "--at-steps", "20"], "--at-step"),
+    cli("flags", "report", ["{run}", "--out", "/proc/x"], "--out"),
+    cli("flags", "report", [], "DIR"),
+    cli("flags", "report", ["{run}", "--at-step", "20"], "", ok=True),
+    cli("flags", "report", ["{run}", "--at-step", "7"], "", ok=True),
+    cli("flags", "analyze", ["masks", "{run}", "--steps", "a,b"], "--steps"),
+    cli("flags", "analyze", ["masks", "{run}", "--steps", "-1"], "--steps"),
+    cli("flags", "analyze", ["masks", "{run}", "--query", "1"], "--query"),
+    cli("flags", "analyze", ["masks", "{run}", "--query", "999,999"], "--query"),
+    cli("flags", "analyze", ["masks", "{run}", "--episodes", "0"], "--episodes"),
+    cli("flags", "analyze", ["masks", "{run}", "--video", "avi"], "--video"),
+    cli("flags", "analyze", ["masks", "{run}", "--step", "2"], "--steps"),
+    cli("flags", "analyze", ["masks", "{run}", "--out", "a", "--out", "b"], "--out"),
+    cli("flags", "analyze", ["bias", "{run}", "{run}"], "--out"),
+    cli("flags", "analyze", ["bias", "{run}", "--episodes", "0"], "--episodes"),
+    cli("flags", "analyze", ["mask", "{run}"], "masks"),
+    cli("flags", "analyze", ["masks", "{run}", "--device", "tpu"], "device"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lr"), "--grid"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lrr=1,2"), "agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.lr=1e-3,abc"), "agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--grid", "agent.recipe=simoun,drqq"), "drqq"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "5-2"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "a-b"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", ""), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "1,1"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--envs", "Pendulum-v9"), "Pendulum-v9"),
+    cli("flags", "sweep", sweep_tiny("--envs", ","), "--envs"),
+    cli("flags", "sweep", sweep_tiny("--cpus-per-trial", "0"), "--cpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--gpus-per-trial", "lots"), "--gpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--gpus-per-trial", "-1"), "--gpus-per-trial"),
+    cli("flags", "sweep", sweep_tiny("--num-cpus", "0"), "--num-cpus"),
+    cli("flags", "sweep", sweep_tiny("--verbose", "3"), "--verbose"),
+    cli("flags", "sweep", ["--resume"], "--sweep-dir"),
+    cli("flags", "sweep", ["--resume", "--sweep-dir", "nowhere"], "nowhere"),
+    cli("flags", "sweep", sweep_tiny("--sweep-dir", "{run}"), "sweep-dir"),
+    cli("flags", "sweep", sweep_tiny("--learning-rate", "3"), "--agent.lr"),
+    cli("flags", "sweep", sweep_tiny("--sweep-dir", "a", "--sweep-dir", "b"), "--sweep-dir"),
+    cli("flags", "sweep", sweep_tiny("--seeds", "1", "--seeds", "2"), "--seeds"),
+    cli("flags", "sweep", sweep_tiny("--address", "nohost:1"), "--address"),
+    cli("flags", "study", ["plan"], "SPEC"),
+    cli("flags", "study", ["plann", "spec.toml"], "plan"),
+    cli("flags", "study", ["plan", "spec.toml", "--probe-updates", "-1"], "--probe-updates"),
+    cli("flags", "study", ["plan", "spec.toml", "--probe-update", "1"], "--probe-updates"),
+    cli(
+        "flags",
+        "study",
+        ["plan", "spec.toml", "--probe-updates", "1", "--probe-updates", "2"],
+        "--probe-updates",
+    ),
+    cli("flags", "study", ["run", "spec.toml"], "--study-dir"),
+    cli(
+        "flags",
+        "study",
+        ["run", "spec.toml", "--study-dir", "a", "--study-dir", "b"],
+        "--study-dir",
+    ),
+    cli(
+        "flags", "study", ["run", "spec.toml", "--study-dir", "a", "--num-cpus", "0"], "--num-cpus"
+    ),
+    cli("flags", "study", ["run", "spec.toml", "--studydir", "a"], "--study-dir"),
+    cli("flags", "study", ["report", "spec.toml", "--study-dir", "nowhere"], "nowhere"),
+    cli("flags", "study", ["report", "spec.toml", "--study-dir", "{run}"], "study"),
+    cli("flags", "study", ["plan", "spec.toml", "--resume"], "--resume"),
+    cli("flags", "minigrid", ["run", "--concurrent", "0", "--archive", "."], "--concurrent"),
+    cli("flags", "minigrid", ["run", "--work-dir", "a", "--work-dir", "b"], "--work-dir"),
+    cli("flags", "minigrid", ["report", "--archiv", "x"], "--archive"),
+    cli("flags", "minigrid", ["reprot"], "report"),
+    cli("flags", "minigrid", ["report", "--archive", "nowhere"], "nowhere"),
+    cli("flags", "minigrid", ["report", "--archive", "{run}"], "spec.json"),
+    cli("flags", "minigrid", ["probe", "--probes", "rndd", "--out", "p"], "rndd"),
+    cli("flags", "minigrid", ["probe", "--settings.steps", "0", "--out", "p"], "steps"),
+    cli("flags", "minigrid", ["probe", "--settings.n-envs", "0", "--out", "p"], "n_envs"),
+    cli(
+        "flags",
+        "minigrid",
+        ["probe", "--settings.env-id", "MiniGrid-Nope-v0", "--out", "p"],
+        "MiniGrid-Nope-v0",
+    ),
+    cli("flags", "minigrid", ["select", "--archive", "nowhere"], "nowhere"),
+    cli("flags", "minigrid", ["report", "--spec", "nowhere.json", "--archive", "."], "nowhere"),
+    cli("flags", "driving", ["--episodes", "0"], "--episodes"),
+    cli("flags", "driving", ["--episodes", "-1"], "--episodes"),
+    cli("flags", "driving", ["--seed", "-1"], "--seed"),
+    cli("flags", "driving", ["--preset", "cpux"], "cpux"),
+    cli("flags", "driving", ["--preset", "cpu"], "--preset"),
+    cli("flags", "driving", ["--video", "x.txt"], "--video"),
+    cli("flags", "driving", ["--video", "nowhere/x.gif"], "--video"),
+    cli("flags", "driving", ["--episdoes", "2"], "--episodes"),
+    cli("flags", "driving", ["--episodes", "1", "--episodes", "2"], "--episodes"),
+]
+
+# the files users keep: a tiny run damaged one file at a time
+DAMAGES = {
+    "config.json": {
+        "missing": None,
+        "empty": b"",
+        "truncated": "half",
+        "not JSON": b"{oops",
+        "a list": b"[]",
+        "null": b"null",
+        "unknown key": "config+nope",
+        "wrong type": "config+image_size",
+    },
+    "eval.csv": {
+        "missing": None,
+        "empty": b"",
+        "header only": b"env_step,return_mean\n",
+        "truncated": "half",
+        "text": b"hello\nworld\n",
+        "non-numeric": "eval+abc",
+    },
+    "summary.json": {"missing": None, "empty": b"", "truncated": "half", "a list": b"[]"},
+    "checkpoint.pt": {
+        "missing": None,
+        "empty": b"",
+        "truncated": "half",
+        "garbage": b"\x00garbage" * 50,
+        "text": b"not a checkpoint\n",
+    },
+    "replay": {"missing": None, "truncated": "half"},
+    "train.csv": {"missing": None, "empty": b""},
+}
+
+FILE_COMMANDS = {
+    "eval": ["{run}", "--episodes", "1", "--no-video"],
+    "train": ["--resume", "{run}", "--total-env-steps", "60"],
+    "report": ["{run}"],
+    "analyze": ["masks", "{run}", "--steps", "1"],
+}
+
+
+def damage(run: Path, name: str, how) -> None:
+    """Damage ``run``'s file ``name`` as ``how`` says (None: delete; bytes: write them)."""
+    path = next(run.glob("replay-*.npz")) if name == "replay" else run / name
+    if how is None:
+        path.unlink()
+    elif how == "half":
+        data = path.read_bytes()
+        path.write_bytes(data[: len(data) // 2])
+    elif how == "config+nope":
+        config = json.loads(path.read_text())
+        config["nope"] = 1
+        path.write_text(json.dumps(config))
+    elif how == "config+image_size":
+        config = json.loads(path.read_text())
+        config["image_size"] = "big"
+        path.write_text(json.dumps(config))
+    elif how == "eval+abc":
+        lines = path.read_text().splitlines()
+        path.write_text("\n".join([lines[0], "abc," * (lines[0].count(",")) + "x"]) + "\n")
+    else:
+        path.write_bytes(how)
+
+
+FILE_CASES = [
+    cli(
+        "files", command, argv, "replay" if name == "replay" else name, ok=True,
+        setup=(name, how),
+    )
+    for name, ways in DAMAGES.items()
+    for how in ways.values()
+    for command, argv in FILE_COMMANDS.items()
+]  # fmt: skip
+for case, (name, way) in zip(
+    FILE_CASES,
+    [(n, w) for n, ways in DAMAGES.items() for w in ways for _ in FILE_COMMANDS],
+    strict=True,
+):
+    case["what"] = f"{name} {way}"
+
+
+def spec_case(text: str, names: str, suffix: str = ".toml"):
+    return cli("specs", "study", ["plan", f"spec{suffix}", "--probe-updates", "0"], names,
+               setup=("spec", (suffix, text)))  # fmt: skip
+
+
+SPEC_CASES = [
+    spec_case("", "recipes"),
+    spec_case("recipes = [", "spec"),
+    spec_case(SPEC.replace('recipes = ["simoun"', 'recipes = ["simoun", "simoun"'), "simoun"),
+    spec_case(SPEC.replace('"simoun", "drq"', '"simoun", "drqq"'), "drqq"),
+    spec_case(SPEC.replace('selection = "auc"', 'selection = "best"'), "selection"),
+    spec_case(SPEC.replace("eval_episodes = 10", "eval_episodes = 0"), "eval_episodes"),
+    spec_case(SPEC.replace("eval_episodes = 10", "eval_episode = 10"), "eval_episode"),
+    spec_case(SPEC.replace('seeds = "101-102"', 'seeds = "102-101"'), "seeds"),
+    spec_case(SPEC.replace('seeds = "101-102"', 'seeds = "1-2"'), "seed"),
+    spec_case(SPEC.replace("env_steps = 50_000", "env_steps = 0"), "env_steps"),
+    spec_case(SPEC.replace("env_steps = 50_000", 'env_steps = "50k"'), "env_steps"),
+    spec_case(SPEC.replace("agent.n_step = [1, 3]", "agent.n_step = []"), "n_step"),
+    spec_case(SPEC.replace("agent.n_step = [1, 3]", "agent.n_stp = [1, 3]"), "n_stp"),
+    spec_case(SPEC.replace("agent.n_step = [1, 3]", "agent.n_step = 3"), "n_step"),
+    spec_case(SPEC.replace('grid_overrides = ["agent.n_step"]', ""), "n_step"),
+    spec_case(SPEC.replace('cartpole-swingup-v0"]\nseeds', 'cartpole-swingup-v9"]\nseeds'), "v9"),
+    spec_case(SPEC.replace("cpus_per_trial = 1 ", "cpus_per_trial = 0 "), "cpus_per_trial"),
+    spec_case(
+        SPEC.replace("max_concurrent_trials = 2", "max_concurrent_trials = -1"),
+        "max_concurrent_trials",
+    ),
+    spec_case(SPEC.replace("[resources]", "[resource]"), "resource"),
+    spec_case(SPEC.replace('preset = "cpu"', 'preset = "cpux"'), "cpux"),
+    spec_case(SPEC.replace("action_repeat = 8", "action_repeat = 0"), "action_repeat"),
+    spec_case(SPEC.replace("video = false", 'video = "no"'), "video"),
+    spec_case(SPEC + '\n[diagnostics]\nsimoun = ["simoun_no_nothing"]\n', "simoun_no_nothing"),
+    spec_case(SPEC + '\n[generalization]\nmodes = ["colour_hard"]\n', "colour_hard"),
+    spec_case(json.dumps({"recipes": ["simoun"]}), "TOML", suffix=".json"),
+    spec_case("\x00\x01binary", "spec"),
+    cli("specs", "study", ["plan", "nowhere.toml"], "nowhere.toml"),
+    cli("specs", "study", ["plan", "."], "."),
+    cli(
+        "specs",
+        "minigrid",
+        ["report", "--spec", "spec.json", "--archive", "."],
+        "spec.json",
+        setup=("spec", (".json", "{")),
+    ),
+    cli(
+        "specs",
+        "minigrid",
+        ["report", "--spec", "spec.json", "--archive", "."],
+        "spec.json",
+        setup=("spec", (".json", "[]")),
+    ),
+    cli(
+        "specs",
+        "minigrid",
+        ["report", "--spec", "spec.json", "--archive", "."],
+        "nope",
+        setup=("spec", (".json", '{"nope": 1}')),
+    ),
+    cli(
+        "specs",
+        "minigrid",
+        ["report", "--spec", "spec.json", "--archive", "."],
+        "spec.json",
+        setup=("spec", (".json", "")),
+    ),
+    cli("specs", "sweep", ["--resume", "--sweep-dir", "{run}"], "sweep.json"),
+    cli("specs", "report", ["."], "config.json", setup=("sweep", b"{")),
+    cli("specs", "sweep", ["--resume", "--sweep-dir", "."], "sweep.json", setup=("sweep", b"{")),
+    cli("specs", "sweep", ["--resume", "--sweep-dir", "."], "sweep.json", setup=("sweep", b"")),
+    cli(
+        "specs",
+        "sweep",
+        ["--resume", "--sweep-dir", "."],
+        "sweep.json",
+        setup=("sweep", b'{"grid": 3}'),
+    ),
+]
+
+P = "gym.make('Pendulum-v1', render_mode='rgb_array')"
+M = "gym.make('MiniGrid-Empty-5x5-v0', render_mode='rgb_array')"
+API_CASES = [
+    api(f"w.SimounObservation({P}, size=0)", "size"),
+    api(f"w.SimounObservation({P}, size=-84)", "size"),
+    api(f"w.SimounObservation({P}, size='84')", "size"),
+    api(f"w.SimounObservation({P}, size=84.0)", "size"),
+    api(f"w.SimounObservation({P}, size=(84,))", "size"),
+    api(f"w.SimounObservation({P}, size=(84, 0))", "size"),
+    api(f"w.SimounObservation({P}, size=(84, 84, 3))", "size"),
+    api(f"w.SimounObservation({P}, size=[84, 84]).reset(seed=0)", "", ok=True),
+    api(f"w.SimounObservation({P}, size=np.int64(40)).reset(seed=0)", "", ok=True),
+    api(f"w.SimounObservation({P}, grayscale='yes')", "grayscale"),
+    api(f"w.SimounObservation({P}, grayscale=None)", "grayscale"),
+    api(f"w.SimounObservation({P}, motion='no')", "motion"),
+    api(f"w.SimounObservation({P}, fold_frames=1)", "fold_frames"),
+    api(f"w.SimounObservation({P}, num_frames=0)", "num_frames"),
+    api(f"w.SimounObservation({P}, num_frames=2)", "num_frames"),
+    api(f"w.SimounObservation({P}, num_frames=2.5)", "num_frames"),
+    api(f"w.SimounObservation({P}, source='pixel')", "source"),
+    api(f"w.SimounObservation({P}, source=3)", "source"),
+    api("w.SimounObservation(gym.make('Pendulum-v1'))", "render_mode"),
+    api("w.SimounObservation('Pendulum-v1')", "env"),
+    api("w.SimounObservation(None)", "env"),
+    api("w.SimounObservation(gym.make_vec('Pendulum-v1', 2, render_mode='rgb_array'))", "vector"),
+    api(f"e = w.SimounObservation({P}, size=40); e.step(e.action_space.sample())", "reset"),
+    api(f"e = w.SimounObservation({P}, size=40); e.reset(seed=0); e.step(np.zeros(5))", "action"),
+    api(f"e = w.SimounObservation({P}, size=40); e.reset(seed=-1)", "seed"),
+    api(f"e = w.SimounObservation({P}, size=40); e.reset(seed='a')", "seed"),
+    api(f"e = w.SimounObservation({P}, size=40); e.reset(seed=1.5)", "seed"),
+    api(
+        f"e = w.SimounObservation({P}, size=40); e.reset(seed=0); pickle.loads(pickle.dumps(e))",
+        "",
+        ok=True,
+    ),
+    api(f"e = w.SimounObservation({P}, size=40); e.close(); e.close()", "", ok=True),
+    api(
+        f"e = w.SimounObservation({M}, size=40); e.reset(seed=0); e.step(0); e.step(1)", "", ok=True
+    ),
+    api(f"w.SimounObservation(w.SimounObservation({P}, size=40))", "SimounObservation"),
+    api(f"w.FrameTriplet({P})", "frame"),
+    api(f"w.FrameTriplet(w.SimounObservation({P}, size=40), num_frames=0)", "num_frames"),
+    api(f"w.ResidualMotion({P})", "frame"),
+    api("w.residual_motion(np.zeros((2, 3, 8, 8), np.uint8))", "frames"),
+    api("w.residual_motion(np.zeros((3, 3, 8, 8), np.float32))", "uint8"),
+    api("w.residual_motion([[1, 2]])", "frames"),
+    api("w.residual_motion(np.zeros((3, 8, 8), np.uint8))", "frames"),
+    api(f"w.ActionRepeat({P}, 0)", "repeat"),
+    api(f"w.ActionRepeat({P}, -1)", "repeat"),
+    api(f"w.ActionRepeat({P}, 2.0)", "repeat"),
+    api(f"w.ActionRepeat({P}, '2')", "repeat"),
+    api(f"w.ActionRepeat({P}, True)", "repeat"),
+    api(f"w.ActionRepeat({P}, np.int32(2)).reset(seed=0)", "", ok=True),
+    api(f"w.RandomConvolution({P})", "frame"),
+    api(f"w.RandomConvolution(w.SimounObservation({P}, size=40), kernel_size=0)", "kernel_size"),
+    api(f"w.RandomConvolution(w.SimounObservation({P}, size=40), kernel_size=2)", "kernel_size"),
+    api(f"w.RandomConvolution(w.SimounObservation({P}, size=40), kernel_size=99)", "kernel"),
+    api(f"w.RandomConvolution(w.SimounObservation({P}, size=40), source='x')", "source"),
+    api("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), kernel_size=4)", "kernel_size"),
+    api("import torch; w.random_conv(torch.zeros(3, 8, 8))", "batch"),
+    api("w.random_conv(np.zeros((2, 3, 8, 8), np.float32))", "tensor"),
+    api("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), clamp=(1, 0))", "clamp"),
+    api(f"w.ColorShift({P}, level='extreme')", "level"),
+    api(f"w.ColorShift({P}, level='easy', seed=-1)", "seed"),
+    api(f"w.MovingBackground({P}, level='hardest')", "level"),
+    api(f"w.MovingBackground({P}, videos='nowhere')", "nowhere"),
+    api(f"w.MultiCamera({P}, cameras=[])", "cameras"),
+    api(f"w.MultiCamera({P}, cameras=[1, 2])", "camera"),
+    api(f"w.MultiCamera({P}, cameras=[lambda e: e.render()], size=0)", "size"),
+    api(f"w.MultiCamera({P}, cameras=[lambda e: None], size=40).reset(seed=0)", "camera"),
+    api(
+        f"w.MultiCamera({P}, cameras=[lambda e: np.zeros((4, 4))], size=40).reset(seed=0)", "camera"
+    ),
+    api(f"w.ConstantBonusReward({P}, scale='0.1')", "scale"),
+    api(f"w.ConstantBonusReward({P}, scale=float('nan'))", "scale"),
+    api(f"w.ConstantBonusReward({P}, scale=0.1, decay=-1)", "decay"),
+    api(f"w.ConstantBonusReward({P}, scale=0.1, decay=float('inf'))", "decay"),
+    api(f"w.ConstantBonusReward({P}, scale=0.1).reset(seed=0)", "", ok=True),
+    api(f"pickle.loads(pickle.dumps(w.ConstantBonusReward({P}, scale=0.1)))", "", ok=True),
+    api(f"w.ConsistencyCuriosityReward({P}, features=None)", "features"),
+    api(f"w.ConsistencyCuriosityReward({P}, features=3)", "features"),
+    api(f"w.RNDReward({P}, novelty=None)", "novelty"),
+    api(f"w.check_sb3_policy({P}, 'MlpPolicyy')", "MlpPolicy"),
+    api(f"w.check_sb3_policy({P}, 3)", "policy"),
+    api(f"w.check_sb3_policy(w.SimounObservation({M}, size=40), 'CnnPolicy')", "MultiInput"),
+    api("w.check_sb3_policy(None, 'CnnPolicy')", "env"),
+]
+
+for mode in ("NEXT_STEP", "SAME_STEP"):
+    vec = (
+        f"gym.make_vec('Pendulum-v1', 2, vectorization_mode='sync', render_mode='rgb_array', "
+        f"vector_kwargs={{'autoreset_mode': gym.vector.AutoresetMode.{mode}}}, "
+        "wrappers=[lambda e: w.SimounObservation(e, size=40)])"
+    )
+    API_CASES += [
+        api(
+            f"v = {vec}; v.reset(seed=0); [v.step(v.action_space.sample()) for _ in range(3)]",
+            "",
+            ok=True,
+        ),
+        api(
+            f"v = w.ConstantBonusVectorReward({vec}, scale=0.1); v.reset(seed=0); "
+            "[v.step(v.action_space.sample()) for _ in range(3)]",
+            "",
+            ok=True,
+        ),
+        api(f"w.ConstantBonusReward({vec}, scale=0.1)", "Vector"),
+        api(f"v = {vec}; v.reset(seed=[0])", "seed"),
+        api(f"v = {vec}; v.reset(seed=0); v.step(np.zeros((3, 1), np.float32))", "action"),
+        api(f"w.SimounObservation({vec})", "vector"),
+    ]
+
+CASES = FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES
+
+
+def tiny_run(where: Path) -> Path:
+    """A tiny finished simoun-train run (40 env steps, PointReach 32x32)."""
+    from simoun_agent.cli import train
+
+    run = where / "tiny"
+    status = train.main([*TINY, "--total-env-steps", "40", "--run-dir", str(run)])
+    assert status == 0, status
+    return run
+
+
+def prepare(case: dict, here: Path, run: Path) -> list[str]:
+    """Lay out ``here`` for ``case``; its argv with {run} filled."""
+    shutil.copytree(run, here / "run")
+    (here / "spec.toml").write_text(SPEC)
+    setup = case.get("setup")
+    if setup and setup[0] == "spec":
+        suffix, text = setup[1]
+        (here / f"spec{suffix}").write_text(text)
+    elif setup and setup[0] == "sweep":
+        (here / "sweep.json").write_bytes(setup[1])
+    elif setup:
+        damage(here / "run", *setup)
+    return [arg.replace("{run}", str(here / "run")) for arg in case["argv"]]
+
+
+def child(case: dict, here: Path, run: Path, out: Path) -> None:
+    os.chdir(here)
+    fd = os.open(out, os.O_WRONLY | os.O_CREAT)
+    os.dup2(fd, 1)
+    os.dup2(fd, 2)
+    status: object = 0
+    try:
+        if "code" in case:
+            import pickle
+
+            import simoun_wrappers as w
+
+            exec(case["code"], {"gym": gym, "np": np, "w": w, "pickle": pickle})
+        else:
+            import importlib
+
+            argv = prepare(case, here, run)
+            status = importlib.import_module(COMMANDS[case["command"]]).main(argv)
+    except SystemExit as stop:
+        status = stop.code
+    except Exception as err:  # the API's errors, read below
+        origin = traceback.extract_tb(err.__traceback__)[-1].filename
+        status = f"{type(err).__name__} from {origin}: {err}"
+    sys.stdout.flush()
+    sys.stderr.flush()
+    with open(out, "a") as f:
+        f.write(f"\n@@STATUS {status}\n")
+    os._exit(0)
+
+
+def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
+    """(clear | unclear | wrong, the message's first line)."""
+    status = text.rpartition("@@STATUS ")[2].strip() if "@@STATUS" in text else "?"
+    body = text.rpartition("@@STATUS")[0]
+    lines = [line for line in body.splitlines() if "error" in line.lower() or "Error" in line]
+    message = lines[-1] if lines else status
+    if timed_out:
+        return ("clear" if case["ok"] else "wrong"), "still running after its checks"
+    if "Traceback" in body:
+        return "wrong", message
+    if "code" in case:
+        if status == "0":
+            return ("clear" if case["ok"] else "wrong"), "accepted"
+        kind, _, rest = status.partition(" from ")
+        inside = "/site-packages/" in rest.partition(":")[0]
+        if inside or kind not in {"ValueError", "TypeError", "ResetNeeded", "SetupError",
+                                   "FileNotFoundError", "InvalidAction", "Error"}:  # fmt: skip
+            return "wrong", status
+        return ("clear" if case["names"] in status else "unclear"), status
+    if status in ("0", "None"):
+        return ("clear" if case["ok"] else "wrong"), "accepted"
+    if case["names"] in body:
+        return "clear", message
+    return "unclear", message
+
+
+def run_case(case: dict, work: Path, run: Path, index: int) -> tuple[str, str]:
+    here = work / f"case{index}"
+    here.mkdir()
+    out = here.with_suffix(".out")
+    process = multiprocessing.get_context("fork").Process(target=child, args=(case, here, run, out))
+    process.start()
+    process.join(TIMEOUT)
+    timed_out = process.is_alive()
+    if timed_out:
+        process.kill()
+        process.join()
+    text = out.read_text(errors="replace") if out.exists() else ""
+    shutil.rmtree(here, ignore_errors=True)
+    return classify(case, text, timed_out)
+
+
+def describe(case: dict) -> str:
+    if "code" in case:
+        return case["code"]
+    return f"{case['command']} {' '.join(case['argv'])}" + (
+        f" [{case['what']}]" if "what" in case else ""
+    )
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--area", choices=("flags", "files", "specs", "api"), action="append")
+    parser.add_argument(
+        "--command", choices=(*COMMANDS, "api"), action="append", help="only its cases"
+    )
+    parser.add_argument("--markdown", type=Path, help="also write the table here")
+    args = parser.parse_args()
+    for name in COMMANDS.values():  # imported once, before the children fork
+        __import__(name)
+    cases = [
+        case
+        for case in CASES
+        if (args.area is None or case["area"] in args.area)
+        and (args.command is None or case.get("command", "api") in args.command)
+    ]
+    counts = {"clear": 0, "unclear": 0, "wrong": 0}
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        run = tiny_run(work)
+        for index, case in enumerate(cases):
+            verdict, message = run_case(case, work, run, index)
+            counts[verdict] += 1
+            rows.append((index, case["area"], describe(case), verdict, message))
+            print(f"{index}\t{case['area']}\t{verdict}\t{describe(case)[:110]}\t{message[:200]}",
+                  flush=True)  # fmt: skip
+    print(f"cases {len(cases)}: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if args.markdown:
+        from simoun_agent import table
+
+        args.markdown.write_text(
+            table.markdown_table(
+                ["#", "area", "case", "verdict", "message"],
+                [[str(i), a, f"`{d}`", v, m.replace("|", "/")] for i, a, d, v, m in rows],
+            )
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

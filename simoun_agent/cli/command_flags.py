@@ -1,0 +1,132 @@
+"""The flags a command's dataclass makes on tyro's command line, read from its fields the way
+tyro names them: a field ``sweep_dir`` is ``--sweep-dir``, a section ``agent`` prefixes its
+fields (``--agent.lr``) unless it is named ``""``, a switch also has its negation
+(``--agent.no-curiosity``) and a positional field makes no flag. For a union of subcommands the
+flags are those of the subcommand that the command line names, so a subcommand's options are
+checked as a plain command's are (:func:`simoun_agent.cli.flags.parse` refuses an unknown flag
+with the ones it most likely meant, and an option given twice).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+import tyro
+
+from simoun_agent.config import AgentConfig, TrainConfig
+from simoun_agent.config.keys import field_docs
+
+CONFIG_SECTIONS = (TrainConfig, AgentConfig)
+"""The run config's sections: filled without their checks (those run once, in ``resolve``),
+and their keys given twice compared by value
+(``simoun_agent.cli.config_flags.check_given_once``)."""
+
+ARG = type(tyro.conf.arg())
+SUBCOMMAND = type(tyro.conf.subcommand())
+
+
+@dataclass(frozen=True)
+class Flag:
+    """One flag of a command."""
+
+    key: str
+    """the field it sets, dotted from the command: ``agent.lr``, ``sweep_dir``"""
+    doc: str
+    """the field's docstring (its help)"""
+    switch: bool | None
+    """True for a switch, False for its negation, None for an option that takes a value"""
+    repeatable: bool
+    """a list given by repeating the flag"""
+    config: bool
+    """a key of the run config (compared by value where it is read)"""
+
+
+def unwrap(hint: Any) -> tuple[Any, list[Any]]:
+    """``Annotated[T, m1, m2]`` (nested too) -> ``(T, [m1, m2])``."""
+    markers: list[Any] = []
+    while typing.get_origin(hint) is Annotated:
+        hint, *more = typing.get_args(hint)
+        markers.extend(more)
+    return hint, markers
+
+
+def subcommands(command: Any) -> dict[str, type]:
+    """Subcommand name -> dataclass for a union of ``Annotated[cls, tyro.conf.subcommand(..)]``;
+    empty for a plain dataclass."""
+    if typing.get_origin(command) is not typing.Union:
+        return {}
+    named = {}
+    for option in typing.get_args(command):
+        cls, markers = unwrap(option)
+        for marker in markers:
+            if isinstance(marker, SUBCOMMAND) and marker.name:
+                named[marker.name] = cls
+    return named
+
+
+def chosen(command: Any, argv: Sequence[str]) -> type | None:
+    """The dataclass ``argv`` runs: ``command`` itself, or the subcommand it names first (None
+    when it names none: tyro then asks for one)."""
+    named = subcommands(command)
+    if not named:
+        return command if dataclasses.is_dataclass(command) else None
+    for arg in argv:
+        if arg == "--":
+            break
+        if arg in named:
+            return named[arg]
+    return None
+
+
+def command_flags(command: Any, argv: Sequence[str]) -> dict[str, Flag]:
+    """Every spelling of every flag of the dataclass ``argv`` runs (:func:`chosen`) -> its
+    :class:`Flag`; empty when ``argv`` names no subcommand of a union."""
+    cls = chosen(command, argv)
+    flags: dict[str, Flag] = {}
+    if cls is not None:
+        _add_fields(cls, "", False, flags)
+    return flags
+
+
+def takes_positional(command: Any, argv: Sequence[str]) -> bool:
+    """Whether the dataclass ``argv`` runs has a positional argument (True when it names no
+    subcommand: nothing is known yet)."""
+    cls = chosen(command, argv)
+    if cls is None:
+        return True
+    hints = typing.get_type_hints(cls, include_extras=True)
+    return any(
+        tyro.conf.Positional in unwrap(hints[field.name])[1] for field in dataclasses.fields(cls)
+    )
+
+
+def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) -> None:
+    hints = typing.get_type_hints(cls, include_extras=True)
+    docs = field_docs(cls)
+    config = config or cls in CONFIG_SECTIONS
+    for field in dataclasses.fields(cls):
+        # the config's informational preset key: the commands' own --preset resolves it
+        if not field.init or (cls is TrainConfig and field.name == "preset"):
+            continue
+        kind, markers = unwrap(hints[field.name])
+        if any(marker is tyro.conf.Positional for marker in markers):
+            continue
+        given = [m for m in markers if isinstance(m, ARG)]
+        name = next((m.name for m in given if m.name is not None), field.name)
+        doc = next((m.help for m in given if m.help), docs.get(field.name, ""))
+        if dataclasses.is_dataclass(kind):
+            _add_fields(kind, f"{prefix}{name}." if name else prefix, config, flags)
+            continue
+        key = prefix + name
+        flag = "--" + key.replace("_", "-")
+        repeatable = typing.get_origin(kind) in (tuple, list) or kind in (tuple, list)
+        switch = True if kind is bool else None
+        flags[flag] = Flag(key, doc, switch, repeatable, config)
+        if kind is bool and tyro.conf.FlagCreatePairsOff not in markers:
+            section, dot, last = flag[2:].rpartition(".")
+            negation = Flag(key, doc, False, False, config)
+            flags[f"--{section}{dot}no-{last}"] = flags[f"--no-{flag[2:]}"] = negation

@@ -1,0 +1,111 @@
+"""Every command line, subcommands included, checks its flags the same way before anything
+runs: an unknown flag is named with the flags it most likely meant (by meaning as well as
+spelling), an option given twice with different values is refused, a word after a switch is
+named with the switch; the driving references check every value before an episode."""
+
+import pytest
+
+from simoun_agent.cli import eval as eval_cli
+from simoun_agent.cli import train as train_cli
+from simoun_agent.run import driving_reference
+from simoun_lab.cli import analyze as analyze_cli
+from simoun_lab.cli import report as report_cli
+from simoun_lab.cli import study as study_cli
+from simoun_lab.cli import sweep as sweep_cli
+from simoun_lab.minigrid_study import __main__ as minigrid_cli
+
+MINIGRID = "python -m simoun_lab.minigrid_study"
+DRIVING = "python -m simoun_agent.run.driving_reference"
+
+
+def refused(capsys, main, argv) -> str:
+    """The error ``main`` prints for ``argv``, refused with status 2 and no traceback."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (sweep_cli.main, ["--learning-rate", "3e-4"], "unknown flag --learning-rate (did you "
+         "mean --agent.lr?); `simoun-sweep --help` lists every flag"),
+        (sweep_cli.main, ["--sweepdir", "x"], "(did you mean --sweep-dir?)"),
+        (eval_cli.main, ["RUN", "--num-episodes", "3"], "unknown flag --num-episodes (did you "
+         "mean --episodes?); `simoun-eval --help`"),
+        (report_cli.main, ["DIR", "--at-stpe", "5"], "(did you mean --at-step"),
+        (study_cli.main, ["plan", "spec.toml", "--probe-update", "1"], "unknown flag "
+         "--probe-update (did you mean --probe-updates?); `simoun-study plan --help`"),
+        (analyze_cli.main, ["masks", "RUN", "--step", "2"], "(did you mean --steps?); "
+         "`simoun-analyze masks --help`"),
+        (minigrid_cli.main, ["report", "--archiv", "x"], "unknown flag --archiv (did you mean "
+         f"--archive?); `{MINIGRID} report --help`"),
+        (minigrid_cli.main, ["probe", "--settings.stesp", "3"], "--settings.steps"),
+        (driving_reference.main, ["--episdoes", "2"], "(did you mean --episodes?)"),
+        (train_cli.main, ["--xyzzy"], "unknown flag --xyzzy; `simoun-train --help`"),
+    ],
+)  # fmt: skip
+def test_every_command_names_the_flag_an_unknown_one_meant(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (study_cli.main, ["run", "s.toml", "--study-dir", "a", "--study-dir", "b"],
+         "--study-dir is given twice with different values (--study-dir a and --study-dir b)"),
+        (study_cli.main, ["plan", "s.toml", "--probe-updates=1", "--probe-updates", "2"],
+         "--probe-updates is given twice"),
+        (minigrid_cli.main, ["run", "--work-dir", "a", "--work-dir", "b"],
+         "--work-dir is given twice"),
+        (analyze_cli.main, ["masks", "RUN", "--out", "a", "--out", "b"], "--out is given twice"),
+        (analyze_cli.main, ["bias", "RUN", "--overwrite", "--pairs", "1", "--pairs", "2"],
+         "--pairs is given twice"),
+        (sweep_cli.main, ["--seeds", "1", "--seeds", "2"], "--seeds is given twice"),
+        (driving_reference.main, ["--episodes", "1", "--episodes", "2"],
+         "--episodes is given twice"),
+    ],
+)  # fmt: skip
+def test_a_subcommand_option_given_twice_is_refused(main, argv, said, capsys):
+    err = refused(capsys, main, argv)
+    assert said in err and "give it once" in err
+
+
+def test_the_same_subcommand_option_twice_with_one_value_is_kept(capsys):
+    # refused for the missing spec, not for the option given twice alike
+    err = refused(capsys, study_cli.main, ["plan", "s.toml", "--probe-updates", "1",
+                                           "--probe-updates", "1"])  # fmt: skip
+    assert "cannot read the study spec s.toml" in err
+
+
+def test_a_word_after_a_switch_names_the_switch(capsys):
+    err = refused(capsys, train_cli.main, ["--progress", "maybe"])
+    assert "--progress is a switch: it takes true or false" in err and "'maybe'" in err
+
+
+def test_set_without_a_key_shows_the_form(capsys):
+    err = refused(capsys, train_cli.main, ["--set", "=3"])
+    assert "--set takes KEY=VALUE, got '=3'; e.g. --set agent.lr=3e-4" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--episodes", "0"], "--episodes must be 1 or more, got 0"),
+        (["--seed", "-1"], "--seed must be 0 or more, got -1"),
+        (["--preset", "cpu"], "--preset cpu trains on dm_control/cartpole-swingup-v0, not "
+         "highway-env: the reference drivers steer a highway-env car; choose one of highway, "
+         "highway-cpu"),
+        (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
+        (["--video", "lane.txt"], "--video lane.txt: a video is written as .gif or .mp4"),
+        (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
+    ],
+)  # fmt: skip
+def test_the_driving_references_check_every_value_before_playing(argv, said, capsys, tmp_path,
+                                                                 monkeypatch):  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    assert said in refused(capsys, driving_reference.main, argv)
+    assert list(tmp_path.iterdir()) == []
