@@ -13,7 +13,7 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec, WrapperSpec
 from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_positive_int, is_int
 from simoun_wrappers.frames import FrameTriplet, check_single_env, frame_stack_in
 from simoun_wrappers.motion import ResidualMotion
 
@@ -74,10 +74,7 @@ def check_stack_options(
             raise TypeError(f"{name} must be True or False, got {value!r}.")
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
-    if not is_int(num_frames) or num_frames < 1:
-        raise ValueError(
-            f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
-        )
+    check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")
     if motion and not fold_frames and num_frames < 2:
         raise ValueError(
             f"motion=True needs at least 2 frames to take differences, got "

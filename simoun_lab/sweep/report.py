@@ -717,6 +717,21 @@ def _ci(point: float, low: float, high: float) -> str:
     return f"{point:.3g} [{low:.3g}, {high:.3g}]"
 
 
+def _interval(row: dict, key: str) -> str:
+    """``row[key]`` with its 95 % interval (``key_low``, ``key_high``)."""
+    return _ci(row[key], row[f"{key}_low"], row[f"{key}_high"])
+
+
+def _interval_table(rows: list[dict], columns: list[str], mean: str) -> str:
+    """A table of ``columns`` (row keys, also the headers), then each row's IQM and its ``mean``
+    key with their 95 % intervals."""
+    return table.markdown_table(
+        [*columns, "IQM [95 % CI]", "mean [95 % CI]"],
+        [[*(row[c] for c in columns), _interval(row, "iqm"), _interval(row, mean)] for row in rows],
+        align="llrrr",
+    )
+
+
 def raw_tasks(groups: list[Group]) -> list[str]:
     """The envs whose returns stay raw (no known maximum)."""
     envs = dict.fromkeys((group.env, group.env_id) for group in groups)
@@ -794,20 +809,7 @@ def markdown(
         f"{BOOTSTRAP_REPS} stratified bootstrap resamples of the seeds (seed {BOOTSTRAP_SEED}; "
         "Agarwal et al. 2021). A wide interval says the seeds disagree: more seeds narrow it.",
         "",
-        table.markdown_table(
-            ["variant", "env", "n", "IQM [95 % CI]", "mean [95 % CI]"],
-            [
-                [
-                    row["variant"],
-                    row["env"],
-                    row["n"],
-                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
-                    _ci(row["norm_mean"], row["norm_mean_low"], row["norm_mean_high"]),
-                ]
-                for row in rows
-            ],
-            align="llrrr",
-        ),
+        _interval_table(rows, ["variant", "env", "n"], "norm_mean"),
     ]
     lines += [
         "",
@@ -822,20 +824,7 @@ def markdown(
             else ""
         ),
         "",
-        table.markdown_table(
-            ["variant", "tasks", "runs", "IQM [95 % CI]", "mean [95 % CI]"],
-            [
-                [
-                    row["variant"],
-                    row["tasks"],
-                    row["runs"],
-                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
-                    _ci(row["mean"], row["mean_low"], row["mean_high"]),
-                ]
-                for row in aggregates
-            ],
-            align="llrrr",
-        ),
+        _interval_table(aggregates, ["variant", "tasks", "runs"], "mean"),
     ]
     if improvements:
         lines += _improvement_table(improvements)
