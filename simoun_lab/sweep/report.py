@@ -837,44 +837,37 @@ def markdown(
     ]
     if comparison.unfinished:
         title = "Unfinished runs" if budget is None else "Runs short of the budget"
-        lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in comparison.unfinished]
+        lines += _run_list(f"{title} (not counted)", comparison.unfinished)
     if comparison.nearby:
-        lines += [
-            "",
-            f"## Runs counted at the evaluation nearest to {budget[1]:g} env steps",
-            "",
+        lines += _run_list(
+            f"Runs counted at the evaluation nearest to {budget[1]:g} env steps",
+            comparison.nearby,
             "No evaluation at exactly the budget (a stop mid-episode and a resume move the "
             "later evaluations off the grid by less than an episode); the nearest one within "
             "half its eval_every counts.",
-            "",
-        ] + [f"- {n}" for n in comparison.nearby]
-    if comparison.duplicates:
-        lines += [
-            "",
-            "## Duplicate seeds (dropped)",
-            "",
-            "A seed counts once per row: of two runs with one seed, the one that counts "
-            "(finished, or at the budget) is kept, then one that did not fail, then the most "
-            "recent.",
-            "",
-        ] + [f"- {d}" for d in comparison.duplicates]
-    if comparison.off_grid:
-        lines += [
-            "",
-            "## Runs on another evaluation grid (not counted)",
-            "",
-        ] + [f"- {o}" for o in comparison.off_grid]
-    if comparison.failures:
-        lines += ["", "## Failed runs", ""] + [f"- {f}" for f in comparison.failures]
-    if comparison.damaged:
-        lines += [
-            "",
-            "## Damaged runs (not counted)",
-            "",
-            "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
-            "",
-        ] + [f"- {d}" for d in comparison.damaged]
+        )
+    lines += _run_list(
+        "Duplicate seeds (dropped)",
+        comparison.duplicates,
+        "A seed counts once per row: of two runs with one seed, the one that counts "
+        "(finished, or at the budget) is kept, then one that did not fail, then the most "
+        "recent.",
+    )
+    lines += _run_list("Runs on another evaluation grid (not counted)", comparison.off_grid)
+    lines += _run_list("Failed runs", comparison.failures)
+    lines += _run_list(
+        "Damaged runs (not counted)",
+        comparison.damaged,
+        "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
+    )
     return "\n".join(lines) + "\n"
+
+
+def _run_list(title: str, runs: list[str], note: str = "") -> list[str]:
+    """A report section listing ``runs`` under ``title`` after ``note``; none without runs."""
+    if not runs:
+        return []
+    return ["", f"## {title}", "", *([note, ""] if note else []), *(f"- {run}" for run in runs)]
 
 
 def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
