@@ -181,21 +181,14 @@ class PixelEncoder(nn.Module):
 
 
 class OnePathEncoder(PixelEncoder):
-    """Base of the ablations with one conv path (``convs``, on ``in_channels``): the state is the
-    contrastive features of the whole float stack."""
+    """Base of the ablations with one conv path, ``convs`` (a :func:`conv_trunk`): the state is
+    the contrastive features of the whole float stack."""
 
     key_is_frame = False
 
-    def __init__(
-        self,
-        frame_shape: tuple[int, int, int],
-        in_channels: int,
-        num_filters: int,
-        channels_last: bool,
-    ) -> None:
+    def __init__(self, convs: nn.Sequential, channels_last: bool) -> None:
         super().__init__(channels_last)
-        self.convs = conv_trunk(in_channels, num_filters)
-        self.maps_dim = trunk_dim(frame_shape, num_filters)
+        self.convs = convs
 
     def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         f = self.encode_key(self.to_float(obs))
@@ -216,9 +209,10 @@ class StackedEncoder(OnePathEncoder):
         channels_last: bool = True,
         head: bool = True,
     ) -> None:
-        super().__init__(frame_shape, num_frames * frame_shape[0], num_filters, channels_last)
-        self.head = Head(self.maps_dim, feature_dim) if head else FlatMaps()
-        self.repr_dim = feature_dim if head else self.maps_dim
+        super().__init__(conv_trunk(num_frames * frame_shape[0], num_filters), channels_last)
+        flat = trunk_dim(frame_shape, num_filters)
+        self.head = Head(flat, feature_dim) if head else FlatMaps()
+        self.repr_dim = feature_dim if head else flat
 
     def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         stack = view if view.ndim == 4 else view.flatten(1, 2)
@@ -256,8 +250,9 @@ class FlareEncoder(OnePathEncoder):
         feature_dim: int,
         channels_last: bool = True,
     ) -> None:
-        super().__init__(frame_shape, frame_shape[0], num_filters, channels_last)
-        self.fc = nn.Linear((2 * num_frames - 1) * self.maps_dim, feature_dim)
+        super().__init__(conv_trunk(frame_shape[0], num_filters), channels_last)
+        latent = trunk_dim(frame_shape, num_filters)
+        self.fc = nn.Linear((2 * num_frames - 1) * latent, feature_dim)
         self.norm = nn.LayerNorm(feature_dim)
         self.repr_dim = feature_dim
 
