@@ -25,10 +25,11 @@ pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n
 
 TINY = override(
     tiny_flags(total_env_steps=60),
-    *("--image-size", "24", "--eval-every", "30", "--checkpoint-every", "30"),
+    *("--image-size", "24", "--eval-every", "20", "--checkpoint-every", "20"),
 )
 """The benchmark's tiny PointReach run, shorter (40 updates after 20 random steps) and on smaller
-frames: the sweep's machinery is under test, not learning."""
+frames: the sweep's machinery is under test, not learning. PointReach's episodes last 20 steps,
+and an evaluation waits for an episode's end, so every step count here is a multiple of 20."""
 
 
 def tiny_without(flag: str) -> list[str]:
@@ -106,7 +107,7 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
     for name, rows in reported.items():
         run_dir = sweep_dir / name
         logged = read_csv(run_dir / "eval.csv")
-        assert [row["env_step"] for row in rows] == [0, 30, 60]
+        assert [row["env_step"] for row in rows] == [0, 20, 40, 60]
         assert [row["return_mean"] for row in rows] == [row["return_mean"] for row in logged]
 
 
@@ -136,15 +137,15 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     # once both have and a long one has written a checkpoint, well before it can finish. (Under
     # load the first long trial can checkpoint while the second short one still runs: CI saw it,
     # so the test waits for both conditions; the second long trial starts only after both.)
-    argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=30,150"]
+    argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=40,160"]
     argv += ["--seeds", "0-1", "--sweep-dir"]
     argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
     command = [sys.executable, "-m", "simoun_lab.cli.sweep", *argv]
     log = tmp_path / "sweep.log"  # a file, not a pipe nobody reads until the end
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
-    long_runs = [sweep_dir / f"total_env_steps=150/simoun-PointReach-v0/s{s}" for s in (0, 1)]
-    short_runs = [sweep_dir / f"total_env_steps=30/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    long_runs = [sweep_dir / f"total_env_steps=160/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    short_runs = [sweep_dir / f"total_env_steps=40/simoun-PointReach-v0/s{s}" for s in (0, 1)]
 
     def ready() -> bool:
         shorts_done = all((d / "summary.json").exists() for d in short_runs)
@@ -328,13 +329,14 @@ def test_a_finished_sweep_extended_with_total_env_steps_trains_each_run_on(
     assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 60
     capsys.readouterr()
 
-    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "30"], capsys)
-    assert "--total-env-steps 30 is below the sweep's 60" in err
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "40"], capsys)
+    assert "--total-env-steps 40 is below the sweep's 60" in err
     extend = ["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "120"]
     assert cli.main([*extend, "--address", ray_address, "--verbose", "0"]) == 0
     assert "1 trials to run, 0 already finished" in capsys.readouterr().out
     # went on from the final checkpoint: the evaluations continue the grid, none repeated
-    assert [row["env_step"] for row in read_csv(run_dir / "eval.csv")] == [0, 30, 60, 90, 120]
+    evaluated = [row["env_step"] for row in read_csv(run_dir / "eval.csv")]
+    assert evaluated == [0, 20, 40, 60, 80, 100, 120]
     assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 120
     assert json.loads((sweep_dir / SWEEP_FILE).read_text())["base"]["total_env_steps"] == 120
     assert cli.main(["--resume", "--sweep-dir", str(sweep_dir)]) == 0
