@@ -30,7 +30,8 @@ SEEDS = (0, 1)
 
 
 def tiny_flags(total_env_steps: int) -> list[str]:
-    """The tiny run of tests/test_train_resume.py as config flags."""
+    """The tiny run of tests/test_train_resume.py as config flags (tests/test_sweep.py runs it
+    shorter, on smaller frames)."""
     return [
         "--env", "simoun/PointReach-v0",
         "--image-size", "32",

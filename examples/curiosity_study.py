@@ -19,6 +19,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import torch
+from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import VecEnv
@@ -171,3 +172,20 @@ class EpisodeLog(BaseCallback):
 
         self.path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write(self.path, dump)
+
+
+def learn_and_log(
+    agent: BaseAlgorithm,
+    algo: str,
+    args: argparse.Namespace,
+    curiosity: CuriosityModel | None,
+    **learn_kwargs: Any,
+) -> None:
+    """Train ``agent`` for ``args.steps`` with an :class:`EpisodeLog`, close its envs (which stops
+    the curiosity model's update thread) and say where the CSV went."""
+    log = EpisodeLog(csv_path(args, algo), algo, args, curiosity)
+    agent.learn(total_timesteps=args.steps, callback=log, **learn_kwargs)
+    agent.get_env().close()
+    print(f"{len(log.rows)} episodes -> {log.path}")
+    if curiosity is not None:
+        print(f"curiosity model: {curiosity.updates} updates, last {curiosity.last_metrics}")

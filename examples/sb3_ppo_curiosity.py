@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import argparse
 
-from curiosity_study import EpisodeLog, add_arguments, csv_path, make_envs
+from curiosity_study import add_arguments, learn_and_log, make_envs
 from stable_baselines3 import PPO
 
 
@@ -43,12 +43,7 @@ def main() -> None:
         verbose=1,
         tensorboard_log=args.tensorboard,
     )
-    log = EpisodeLog(csv_path(args, "ppo"), "ppo", args, curiosity)
-    agent.learn(total_timesteps=args.steps, callback=log)
-    envs.close()  # also stops the curiosity model's update thread
-    print(f"{len(log.rows)} episodes -> {log.path}")
-    if curiosity is not None:
-        print(f"curiosity model: {curiosity.updates} updates, last {curiosity.last_metrics}")
+    learn_and_log(agent, "ppo", args, curiosity)
 
 
 if __name__ == "__main__":

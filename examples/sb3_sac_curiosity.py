@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import argparse
 
-from curiosity_study import EpisodeLog, add_arguments, csv_path, make_envs
+from curiosity_study import add_arguments, learn_and_log, make_envs
 from stable_baselines3 import SAC
 
 
@@ -40,12 +40,7 @@ def main() -> None:
         device=args.device,
         verbose=1,
     )
-    log = EpisodeLog(csv_path(args, "sac"), "sac", args, curiosity)
-    agent.learn(total_timesteps=args.steps, callback=log, log_interval=1)
-    envs.close()  # also stops the curiosity model's update thread
-    print(f"{len(log.rows)} episodes -> {log.path}")
-    if curiosity is not None:
-        print(f"curiosity model: {curiosity.updates} updates, last {curiosity.last_metrics}")
+    learn_and_log(agent, "sac", args, curiosity, log_interval=1)
 
 
 if __name__ == "__main__":

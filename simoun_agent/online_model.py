@@ -176,11 +176,11 @@ class OnlineModel(ABC):
         self._init_frames(frame_shape, config.encoder_size)
         smallest, needs, size = self._smallest_frame()
         if min(self.encoded_shape[1:]) < smallest:
+            pooling = f"{self.pool}, {type(config).__name__}.encoder_size={config.encoder_size}"
             raise ValueError(
                 f"frames of {frame_shape} are encoded at {self.encoded_shape} (pooled by "
-                f"{self.pool}, {type(config).__name__}.encoder_size={config.encoder_size}); "
-                f"{needs} need H, W >= {smallest}. Render larger frames (SimounObservation(env, "
-                f"size={size}) or more) or raise encoder_size."
+                f"{pooling}); {needs} need H, W >= {smallest}. Render larger frames "
+                f"(SimounObservation(env, size={size}) or more) or raise encoder_size."
             )
         self.action_space = action_space
         self.device = default_device(device)

@@ -104,11 +104,11 @@ class RNDModel(OnlineModel):
 
     Example:
         >>> import gymnasium as gym
+        >>> from simoun_agent.rnd_model import RNDConfig, RNDModel
         >>> from simoun_wrappers import SimounObservation
         >>> from simoun_wrappers.rnd import RNDReward
-        >>> from simoun_agent.rnd_model import RNDConfig, RNDModel
-        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=36)
         >>> config = RNDConfig(batch_size=8, learning_starts=8, update_every=4, seed=0)
+        >>> env = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=36)
         >>> env = RNDReward(env, RNDModel.for_env(env, config, device="cpu"), warmup=4)
         >>> _ = env.reset(seed=0)
         >>> rewards = [env.step(t % 2)[4]["reward_intrinsic"] for t in range(12)]

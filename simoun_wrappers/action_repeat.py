@@ -8,7 +8,7 @@ from typing import Any, SupportsFloat
 
 import gymnasium as gym
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_positive_int
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 
 
@@ -40,11 +40,12 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
         check_single_env(env, "ActionRepeat")
         gym.utils.RecordConstructorArgs.__init__(self, repeat=repeat)
         gym.Wrapper.__init__(self, env)
-        if not is_int(repeat) or repeat < 1:
-            raise ValueError(
-                f"repeat must be a positive int, got {repeat!r}; e.g. ActionRepeat(env, 8) for "
-                f"cartpole-swingup, or leave the wrapper out for no repeat."
-            )
+        check_positive_int(
+            repeat,
+            "repeat",
+            "e.g. ActionRepeat(env, 8) for cartpole-swingup, or leave the wrapper out for no "
+            "repeat.",
+        )
         refuse_over_frame_stack(
             env,
             "ActionRepeat",

@@ -172,10 +172,9 @@ class ConsistencyCuriosityVectorReward(ConsistencyArguments, IntrinsicVectorRewa
         >>> import numpy as np
         >>> from simoun_wrappers import SimounObservation
         >>> from simoun_wrappers.curiosity_reward import ConsistencyCuriosityVectorReward
-        >>> projection = np.random.default_rng(0).normal(size=(3 * 16 * 16, 8)) / 400
-        >>> def features(triplets):
-        ...     f_a = triplets.reshape(*triplets.shape[:2], -1) @ projection
-        ...     return (f_a[:, 2] - f_a[:, 1]).astype(np.float32), f_a.astype(np.float32)
+        >>> def features(triplets):  # each frame's mean brightness, and its last change
+        ...     f_a = triplets.mean(axis=(2, 3, 4), dtype=np.float32)[..., None]
+        ...     return f_a[:, 2] - f_a[:, 1], f_a
         >>> envs = gym.make_vec("CartPole-v1", num_envs=2, vectorization_mode="sync",
         ...                     render_mode="rgb_array",
         ...                     wrappers=[lambda e: SimounObservation(e, size=16)])

@@ -11,7 +11,7 @@ from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
 from gymnasium.wrappers import FrameStackObservation
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_positive_int
 
 
 class FrameRing:
@@ -76,10 +76,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
         check_single_env(env, "FrameTriplet")
         gym.utils.RecordConstructorArgs.__init__(self, num_frames=num_frames)
         gym.Wrapper.__init__(self, env)
-        if not is_int(num_frames) or num_frames < 1:
-            raise ValueError(
-                f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
-            )
+        check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")
         space = env.observation_space
         if not isinstance(space, spaces.Box):
             raise TypeError(

@@ -6,18 +6,14 @@ import functools
 import operator
 from copy import deepcopy
 
+import cv2
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec, WrapperSpec
-from gymnasium.wrappers import (
-    AddRenderObservation,
-    GrayscaleObservation,
-    ResizeObservation,
-    TransformObservation,
-)
+from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_positive_int, is_int
 from simoun_wrappers.frames import FrameTriplet, check_single_env, frame_stack_in
 from simoun_wrappers.motion import ResidualMotion
 
@@ -78,10 +74,7 @@ def check_stack_options(
             raise TypeError(f"{name} must be True or False, got {value!r}.")
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
-    if not is_int(num_frames) or num_frames < 1:
-        raise ValueError(
-            f"num_frames must be a positive int, got {num_frames!r}; use 3 for a triplet."
-        )
+    check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")
     if motion and not fold_frames and num_frames < 2:
         raise ValueError(
             f"motion=True needs at least 2 frames to take differences, got "
@@ -136,11 +129,35 @@ def layout_hint(space: gym.Space) -> str | None:
     return None
 
 
+LUMA = np.array([0.2125, 0.7154, 0.0721])
+"""RGB weights of one luminance channel: gymnasium's ``GrayscaleObservation``'s, so frames match
+those of its wrappers."""
+
+
+def frame_shape(
+    layout: tuple[int, int, int], size: tuple[int, int] | None, grayscale: bool
+) -> tuple[int, int, int]:
+    """``(C, H, W)`` of the frames :func:`to_frame` makes from ``(H, W, C)`` images."""
+    height, width, channels = layout
+    if size is not None:
+        height, width = size
+    return (1 if grayscale else channels), height, width
+
+
 # The chain's transforms are module-level functions (or partials of them), not lambdas, so a
 # SimounObservation pickles whenever the env it wraps does (vector envs' subprocesses, Ray).
-def _channel_first(obs: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
-    """An ``(H, W[, C])`` image as ``(C, H, W)``."""
-    return obs.reshape(shape).transpose(2, 0, 1)
+def to_frame(image: np.ndarray, size: tuple[int, int] | None, grayscale: bool) -> np.ndarray:
+    """An ``(H, W[, C])`` uint8 image as one channel-first ``(C, H, W)`` frame: resized to
+    ``size`` (OpenCV area interpolation, as gymnasium's ``ResizeObservation``), made one
+    luminance channel when ``grayscale`` and RGB (:data:`LUMA`). The per-frame step of
+    ``SimounObservation`` and ``SimounParallelObservation``."""
+    if size is not None and image.shape[:2] != size:
+        image = cv2.resize(image, size[::-1], interpolation=cv2.INTER_AREA)
+    if image.ndim == 2:
+        image = image[:, :, None]
+    if grayscale and image.shape[2] == 3:
+        image = np.sum(np.multiply(image, LUMA), axis=-1).astype(np.uint8)[:, :, None]
+    return image.transpose(2, 0, 1)
 
 
 def _fold(frames: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
@@ -275,7 +292,7 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
 
     def __reduce__(self) -> tuple:
         """Pickled as its arguments around the pickled source env, since gymnasium's wrappers in
-        the chain (AddRenderObservation, ResizeObservation) hold lambdas: it pickles whenever
+        the chain (AddRenderObservation) hold lambdas: it pickles whenever
         the source env does. The copy is built anew, so it is reset before its first step."""
         return (_rebuilt, (type(self), self._source_env, dict(self._saved_kwargs)))
 
@@ -311,10 +328,10 @@ class SimounObservation(ChainWrapper):
     Observations that hold pixels in another layout are refused with the conversion to make:
     channel-first ``(C, H, W)`` planes (one image or stacked grayscale frames: only you know
     which) and MiniGrid's ``ImgObsWrapper`` object-id grid (put
-    ``RGBImgPartialObsWrapper`` under it). Frames are resized (``ResizeObservation``, OpenCV area
-    interpolation), optionally made grayscale (``GrayscaleObservation``), made channel-first
-    ``(C, H, W)``, stacked by ``FrameTriplet`` with reset padding, and given residual motion
-    channels by ``ResidualMotion``. The observation is
+    ``RGBImgPartialObsWrapper`` under it). Frames are resized (OpenCV area interpolation, as
+    gymnasium's ``ResizeObservation``), optionally made grayscale (``GrayscaleObservation``'s
+    weights), made channel-first ``(C, H, W)`` (:func:`to_frame`), stacked by ``FrameTriplet``
+    with reset padding, and given residual motion channels by ``ResidualMotion``. The observation is
 
     - ``{"frames": (k, C, H, W) uint8, "motion": ((k-1)*C, H, W) int16}`` (default),
     - ``{"frames": (k, C, H, W) uint8}`` with ``motion=False``,
@@ -393,16 +410,10 @@ class SimounObservation(ChainWrapper):
                 f"env (drop FrameStackObservation; set num_frames={num_frames} here instead)."
             )
         chain, from_render = pixel_env(env, source)
-        height, width, channels = image_layout(chain.observation_space)
-        if hw is not None and hw != (height, width):
-            chain = ResizeObservation(chain, hw)
-            height, width = hw
-        if grayscale and channels == 3:
-            chain = GrayscaleObservation(chain, keep_dim=True)
-            channels = 1
+        channels, height, width = frame_shape(image_layout(chain.observation_space), hw, grayscale)
         frame_space = spaces.Box(0, 255, (channels, height, width), dtype=np.uint8)
         chain = TransformObservation(
-            chain, functools.partial(_channel_first, shape=(height, width, channels)), frame_space
+            chain, functools.partial(to_frame, size=hw, grayscale=grayscale), frame_space
         )
         chain = FrameTriplet(chain, num_frames)
         if fold_frames:

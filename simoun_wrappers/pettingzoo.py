@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import cv2
 import numpy as np
 from gymnasium import spaces
 from pettingzoo.utils.env import AECEnv, ParallelEnv
@@ -12,10 +11,13 @@ from pettingzoo.utils.wrappers import BaseParallelWrapper
 
 from simoun_wrappers.frames import FrameRing
 from simoun_wrappers.motion import residual_motion
-from simoun_wrappers.observation import check_stack_options, image_layout, parse_size
-
-# gymnasium.wrappers.GrayscaleObservation's weights, so single- and multi-agent frames agree.
-_LUMA = np.array([0.2125, 0.7154, 0.0721])
+from simoun_wrappers.observation import (
+    check_stack_options,
+    frame_shape,
+    image_layout,
+    parse_size,
+    to_frame,
+)
 
 
 class SimounParallelObservation(BaseParallelWrapper):
@@ -51,16 +53,9 @@ class SimounParallelObservation(BaseParallelWrapper):
         fold_frames: bool = False,
         source: str = "auto",
     ) -> None:
-        """Wrap ``env``; the options mean what they mean for ``SimounObservation``.
-
-        Args:
-            env: a ParallelEnv with image observations per agent, or ``render_mode="rgb_array"``.
-            size: frame size, an int (square) or ``(H, W)``; None keeps the image's size.
-            grayscale: convert RGB frames to one luminance channel.
-            num_frames: frames per stack.
-            motion: add the residual motion channels (needs ``num_frames >= 2``).
-            fold_frames: return ``(num_frames*C, H, W)`` uint8 boxes (no motion key).
-            source: ``"auto"``, ``"observation"`` (each agent's image) or ``"render"``.
+        """Wrap ``env``, a ParallelEnv with image observations per agent or
+        ``render_mode="rgb_array"``. The other arguments are ``SimounObservation``'s, applied to
+        each agent (``source="observation"``: each agent's own image).
         """
         if isinstance(env, AECEnv):
             raise TypeError(
@@ -107,18 +102,13 @@ class SimounParallelObservation(BaseParallelWrapper):
             if self._from_render and self._size is not None:
                 # rgb_array renders are (H, W, 3) and get resized: no render needed, which lets
                 # observation_space() answer before reset() (PettingZoo envs cannot render yet).
-                height, width, channels = (*self._size, 3)
+                layout = (*self._size, 3)
             elif self._from_render:
                 frame = self.env.render() if frame is None else frame
-                height, width = frame.shape[:2]
-                channels = frame.shape[2] if frame.ndim == 3 else 1
+                layout = (*frame.shape[:2], frame.shape[2] if frame.ndim == 3 else 1)
             else:
-                height, width, channels = image_layout(self.env.observation_space(agent))
-                if self._size is not None:
-                    height, width = self._size
-            if self._grayscale:
-                channels = 1
-            self._layouts[agent] = (channels, height, width)
+                layout = image_layout(self.env.observation_space(agent))
+            self._layouts[agent] = frame_shape(layout, self._size, self._grayscale)
         return self._layouts[agent]
 
     def observation_space(self, agent: Any) -> spaces.Space:
@@ -135,16 +125,6 @@ class SimounParallelObservation(BaseParallelWrapper):
                 space = spaces.Dict({"frames": frames})
             self._spaces[agent] = space
         return self._spaces[agent]
-
-    def _frame(self, image: np.ndarray) -> np.ndarray:
-        """One channel-first uint8 frame, transformed as ``SimounObservation`` does."""
-        if self._size is not None and image.shape[:2] != self._size:
-            image = cv2.resize(image, self._size[::-1], interpolation=cv2.INTER_AREA)
-        if image.ndim == 2:
-            image = image[:, :, None]
-        if self._grayscale and image.shape[2] == 3:
-            image = np.sum(np.multiply(image, _LUMA), axis=-1).astype(np.uint8)[:, :, None]
-        return image.transpose(2, 0, 1)
 
     def _output(self, stack: np.ndarray) -> np.ndarray | dict[str, np.ndarray]:
         if self._fold:
@@ -177,7 +157,7 @@ class SimounParallelObservation(BaseParallelWrapper):
     def _stack(self, images: dict[Any, np.ndarray]) -> dict[Any, Any]:
         out = {}
         for agent, image in images.items():
-            frame = self._frame(image)
+            frame = to_frame(image, self._size, self._grayscale)
             ring = self._rings.get(agent)
             if ring is None:
                 c, h, w = self._layout(agent, image)

@@ -7,23 +7,22 @@ import pytest
 
 
 @pytest.fixture
-def small_ppo() -> Callable[[Any], Any]:
+def small_ppo() -> Callable[..., Any]:
     """A factory: a small, seeded Stable-Baselines3 ``CnnPolicy`` PPO on ``env`` (64-step
-    rollouts, one epoch, a 32-unit NatureCNN head, cpu), for short runs through a wrapper.
-    Imports SB3 only when used (it is an optional extra)."""
+    rollouts, one epoch, a 32-unit NatureCNN head, cpu; keyword arguments replace these), for
+    short runs through a wrapper. Imports SB3 only when used (it is an optional extra)."""
 
-    def build(env: Any) -> Any:
+    def build(env: Any, **overrides: Any) -> Any:
         import stable_baselines3 as sb3
 
-        return sb3.PPO(
-            "CnnPolicy",
-            env,
-            n_steps=64,
-            batch_size=32,
-            n_epochs=1,
-            policy_kwargs={"features_extractor_kwargs": {"features_dim": 32}},
-            device="cpu",
-            seed=0,
-        )
+        settings = {
+            "n_steps": 64,
+            "batch_size": 32,
+            "n_epochs": 1,
+            "policy_kwargs": {"features_extractor_kwargs": {"features_dim": 32}},
+            "device": "cpu",
+            "seed": 0,
+        }
+        return sb3.PPO("CnnPolicy", env, **{**settings, **overrides})
 
     return build

@@ -4,6 +4,17 @@ The command lines refuse a flag given twice with different values, so a test tha
 flag of a shared base list replaces it instead of appending a second value.
 """
 
+TINY_AGENT = [
+    "--device", "cpu",
+    "--torch-threads", "1",
+    "--agent.batch-size", "8",
+    "--agent.num-filters", "4",
+    "--agent.feature-dim", "8",
+    "--agent.hidden-dim", "16",
+    "--agent.aux-hidden-dim", "16",
+]  # fmt: skip
+"""A tiny agent on one CPU thread, as simoun-train flags: runs of a few seconds."""
+
 
 def override(base: list[str], *flags: str) -> list[str]:
     """``base`` without the flags (and their values) that ``flags`` gives, then ``flags``.

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 import torch
-from flag_lists import override
+from flag_lists import TINY_AGENT, override
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
@@ -27,13 +27,7 @@ TINY = [
     "--eval-every", "20",
     "--eval-episodes", "1",
     "--checkpoint-every", "20",
-    "--device", "cpu",
-    "--torch-threads", "1",
-    "--agent.batch-size", "8",
-    "--agent.num-filters", "4",
-    "--agent.feature-dim", "8",
-    "--agent.hidden-dim", "16",
-    "--agent.aux-hidden-dim", "16",
+    *TINY_AGENT,
 ]  # fmt: skip
 
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import shimmy
 import torch
+from test_curiosity_model_by_hand import SMALL
 
 from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
 from simoun_wrappers import SimounObservation
@@ -23,16 +24,7 @@ gym.register_envs(shimmy)
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
 SIZE = 32
-TINY = CuriosityConfig(
-    num_filters=8,
-    feature_dim=16,
-    aux_hidden_dim=32,
-    batch_size=8,
-    capacity=64,
-    learning_starts=16,
-    update_every=2,
-    seed=0,
-)
+TINY = CuriosityConfig(**SMALL, batch_size=8, capacity=64, learning_starts=16)
 
 
 def cartpole(size: int = SIZE) -> gym.Env:

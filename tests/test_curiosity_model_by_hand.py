@@ -17,20 +17,21 @@ SHAPE = (3, 24, 24)
 ACTIONS = spaces.Discrete(3)
 
 
+SMALL = {"num_filters": 8, "feature_dim": 16, "aux_hidden_dim": 32, "update_every": 2, "seed": 0}
+"""Small networks and a step every 2nd call: the CuriosityConfig of the model tests."""
+BY_HAND = {
+    "encoder_size": None,
+    "capacity": 8,
+    "batch_size": 2,
+    "learning_starts": 2,
+    "background": False,
+}
+"""No pooling, no thread, a batch of 2 from the 2nd transition: numbers a test can write out."""
+
+
 def model_of(shape=SHAPE, **overrides) -> CuriosityModel:
-    config = dict(
-        num_filters=8,
-        feature_dim=16,
-        aux_hidden_dim=32,
-        encoder_size=None,
-        capacity=8,
-        batch_size=2,
-        learning_starts=2,
-        update_every=2,
-        background=False,
-        seed=0,
-    )
-    return CuriosityModel(shape, ACTIONS, CuriosityConfig(**{**config, **overrides}), "cpu")
+    config = CuriosityConfig(**{**SMALL, **BY_HAND, **overrides})
+    return CuriosityModel(shape, ACTIONS, config, "cpu")
 
 
 def triplets_of(rng: np.random.Generator, n: int, shape=SHAPE) -> np.ndarray:

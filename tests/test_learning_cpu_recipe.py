@@ -54,15 +54,9 @@ def test_cpu_preset_agent_beats_a_random_policy_on_point_reach(tmp_path):
     """800 env steps (100 random, then one update per step) at 24x24, batch 32, seed 0.
 
     Measured (commit 1ef25e7, 2 shared CPU cores, torch 1 thread; 45-120 s a run
-    on the loaded machine, about 25 s of CPU), mean return over the same 20 episodes:
-
-    | seed | trained | random policy |
-    |------|---------|---------------|
-    | 0    | -2.44   | -12.99        |
-    | 1    | -4.20   | -13.82        |
-    | 2    | -2.46   | -13.12        |
-    | 3    | -5.20   | -13.01        |
-    | 4    | -2.15   | -15.26        |
+    on the loaded machine, about 25 s of CPU), mean return over the same 20 episodes, trained /
+    random policy, for seeds 0-4: -2.44 / -12.99, -4.20 / -13.82, -2.46 / -13.12,
+    -5.20 / -13.01, -2.15 / -15.26.
 
     Trained -3.29 +- 1.34, random -13.64 +- 0.96 (600 env steps gave -4.22 +- 1.93, worst
     -7.04: too close to a bar). MARGIN = 5 puts the bar 3.3 above the worst seed's random mean

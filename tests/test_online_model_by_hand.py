@@ -8,29 +8,16 @@ import pickle
 import numpy as np
 import pytest
 import torch
-from gymnasium import spaces
+from test_curiosity_model_by_hand import SHAPE
+from test_curiosity_model_by_hand import model_of as curiosity_model_of
 
 from simoun_agent.curiosity_model import AgentFeatures, CuriosityConfig, CuriosityModel
 from simoun_agent.rnd_model import RNDConfig
 
-SHAPE = (3, 24, 24)
-ACTIONS = spaces.Discrete(3)
-
 
 def model_of(**overrides) -> CuriosityModel:
-    config = dict(
-        num_filters=8,
-        feature_dim=16,
-        aux_hidden_dim=32,
-        encoder_size=None,
-        capacity=4,
-        batch_size=2,
-        learning_starts=2,
-        update_every=2,
-        background=False,
-        seed=0,
-    )
-    return CuriosityModel(SHAPE, ACTIONS, CuriosityConfig(**{**config, **overrides}), "cpu")
+    """test_curiosity_model_by_hand's model with a buffer of 4, which wraps within a test."""
+    return curiosity_model_of(**{"capacity": 4, **overrides})
 
 
 def frames_of(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -46,6 +46,17 @@ def window(batch: int = 6, seed: int = 0) -> tuple[torch.Tensor, ...]:
     )
 
 
+def random_replay() -> FrameReplay:
+    """A replay of one 30-step episode of random frames, actions and rewards (seed 0)."""
+    rng = np.random.default_rng(0)
+    replay = FrameReplay(100, FRAME, 2, seed=0)
+    replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
+    for _ in range(30):
+        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
+        replay.add(rng.uniform(-1, 1, 2), rng.normal(), frame, False, False)
+    return replay
+
+
 def losses_of(agent: SimounAgent) -> set[str]:
     return set(agent.update_window(*window(), step=0)) & AUX_LOSSES
 
@@ -300,12 +311,7 @@ def test_drqv2_steps_critic_actor_and_targets_together_on_3_step_returns_every_2
     agent = recipe_agent("drqv2")
     assert agent.config.n_step == 3 and agent.config.lr == 1e-4
     assert agent.config.update_every_steps == 2
-    rng = np.random.default_rng(0)
-    replay = FrameReplay(100, FRAME, 2, seed=0)
-    replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
-    for _ in range(30):
-        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
-        replay.add(rng.uniform(-1, 1, 2), rng.normal(), frame, False, False)
+    replay = random_replay()
     moved = []
     for step in range(4):
         before = {name: copy.deepcopy(getattr(agent, name)) for name in ("actor", "critic_target")}
@@ -442,12 +448,7 @@ def test_config_sections_are_found_from_the_dataclass_fields():
 def test_state_dict_resumes_drq_and_drqv2_bit_exactly(name):
     """Their extra state: DrQ's target encoder, DrQ-v2's env step (act()'s default schedule
     step) and its lack of a temperature."""
-    rng = np.random.default_rng(0)
-    replay = FrameReplay(100, FRAME, 2, seed=0)
-    replay.start_episode(rng.integers(0, 256, FRAME, dtype=np.uint8))
-    for _ in range(30):
-        frame = rng.integers(0, 256, FRAME, dtype=np.uint8)
-        replay.add(rng.uniform(-1, 1, 2), rng.normal(), frame, False, False)
+    replay = random_replay()
     agent = recipe_agent(name)
     for step in range(2):
         agent.update(replay, 1000 * step)

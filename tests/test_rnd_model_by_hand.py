@@ -5,6 +5,7 @@ it is trained on."""
 import numpy as np
 import pytest
 import torch
+from test_curiosity_model_by_hand import BY_HAND
 from torch import nn
 
 from simoun_agent.rnd_model import RNDConfig, RNDModel, rnd_network
@@ -13,18 +14,10 @@ SHAPE = (3, 36, 36)
 
 
 def model_of(**overrides) -> RNDModel:
-    config = dict(
-        feature_dim=16,
-        encoder_size=None,
-        capacity=8,
-        batch_size=4,
-        learning_starts=4,
-        update_every=10_000,
-        background=False,
-        lr=5e-4,
-        seed=0,
-    )
-    return RNDModel(SHAPE, config=RNDConfig(**{**config, **overrides}), device="cpu")
+    """No pooling, no thread, a batch of 4 from the 4th frame, and steps only when a test asks."""
+    by_hand = {**BY_HAND, "batch_size": 4, "learning_starts": 4, "update_every": 10_000}
+    config = RNDConfig(**{**by_hand, "feature_dim": 16, "lr": 5e-4, "seed": 0, **overrides})
+    return RNDModel(SHAPE, config=config, device="cpu")
 
 
 def triplets_of(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -13,7 +13,9 @@ from pathlib import Path
 
 import pytest
 import ray  # the lab extra, which CI installs: a missing install fails instead of skipping
+from flag_lists import override
 
+from benchmarks.sweep import tiny_flags
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
 from simoun_lab.cli import sweep as cli
@@ -21,24 +23,13 @@ from simoun_lab.sweep.grid import SWEEP_FILE, parse_seeds, split_values
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
 
-TINY = [
-    "--env", "simoun/PointReach-v0",
-    "--image-size", "32",
-    "--total-env-steps", "120",
-    "--warmup-agent-steps", "20",
-    "--replay-capacity", "1000",
-    "--eval-every", "60",
-    "--eval-episodes", "1",
-    "--checkpoint-every", "60",
-    "--video", "false",
-    "--device", "cpu",
-    "--set", "agent.batch_size=8",
-    "--set", "agent.num_filters=8",
-    "--set", "agent.feature_dim=16",
-    "--set", "agent.hidden_dim=32",
-    "--set", "agent.aux_hidden_dim=32",
-]  # fmt: skip
-"""The tiny run of tests/test_train_resume.py as simoun-train flags (a few seconds per run)."""
+TINY = override(
+    tiny_flags(total_env_steps=60),
+    *("--image-size", "24", "--eval-every", "20", "--checkpoint-every", "20"),
+)
+"""The benchmark's tiny PointReach run, shorter (40 updates after 20 random steps) and on smaller
+frames: the sweep's machinery is under test, not learning. PointReach's episodes last 20 steps,
+and an evaluation waits for an episode's end, so every step count here is a multiple of 20."""
 
 
 def tiny_without(flag: str) -> list[str]:
@@ -116,7 +107,7 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
     for name, rows in reported.items():
         run_dir = sweep_dir / name
         logged = read_csv(run_dir / "eval.csv")
-        assert [row["env_step"] for row in rows] == [0, 60, 120]
+        assert [row["env_step"] for row in rows] == [0, 20, 40, 60]
         assert [row["return_mean"] for row in rows] == [row["return_mean"] for row in logged]
 
 
@@ -146,15 +137,15 @@ def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_p
     # once both have and a long one has written a checkpoint, well before it can finish. (Under
     # load the first long trial can checkpoint while the second short one still runs: CI saw it,
     # so the test waits for both conditions; the second long trial starts only after both.)
-    argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=120,360"]
+    argv = [*tiny_without("--total-env-steps"), "--grid", "total_env_steps=40,160"]
     argv += ["--seeds", "0-1", "--sweep-dir"]
     argv += [str(sweep_dir), "--address", ray_address, "--verbose", "0"]
     command = [sys.executable, "-m", "simoun_lab.cli.sweep", *argv]
     log = tmp_path / "sweep.log"  # a file, not a pipe nobody reads until the end
     with log.open("w") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
-    long_runs = [sweep_dir / f"total_env_steps=360/simoun-PointReach-v0/s{s}" for s in (0, 1)]
-    short_runs = [sweep_dir / f"total_env_steps=120/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    long_runs = [sweep_dir / f"total_env_steps=160/simoun-PointReach-v0/s{s}" for s in (0, 1)]
+    short_runs = [sweep_dir / f"total_env_steps=40/simoun-PointReach-v0/s{s}" for s in (0, 1)]
 
     def ready() -> bool:
         shorts_done = all((d / "summary.json").exists() for d in short_runs)
@@ -297,8 +288,9 @@ def test_a_replay_or_a_batch_the_run_cannot_hold_is_refused_before_ray_starts(tm
     assert "fewer than a batch of 50 (--agent.batch-size 50)" in err
     assert "Set --replay-capacity 54 or more" in err
     # 512x512 frames at a batch of 512: hundreds of GB for one update
-    bigger = {"32": "512", "agent.batch_size=8": "agent.batch_size=512"}  # --image-size 32
-    err = error_of([*(bigger.get(a, a) for a in TINY), "--sweep-dir", str(tmp_path / "r")], capsys)
+    bigger = override(TINY, "--image-size", "512")
+    bigger = ["agent.batch_size=512" if a == "agent.batch_size=8" else a for a in bigger]
+    err = error_of([*bigger, "--sweep-dir", str(tmp_path / "r")], capsys)
     assert re.search(
         r"trial base/simoun-PointReach-v0/s\d: --image-size 512 with --agent.batch-size 512", err
     )
@@ -334,18 +326,19 @@ def test_a_finished_sweep_extended_with_total_env_steps_trains_each_run_on(
     argv = [*TINY, "--seeds", "0", "--sweep-dir", str(sweep_dir), "--address", ray_address]
     assert cli.main([*argv, "--verbose", "0"]) == 0
     run_dir = sweep_dir / "base/simoun-PointReach-v0/s0"
-    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 120
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 60
     capsys.readouterr()
 
-    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "60"], capsys)
-    assert "--total-env-steps 60 is below the sweep's 120" in err
-    extend = ["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "240"]
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "40"], capsys)
+    assert "--total-env-steps 40 is below the sweep's 60" in err
+    extend = ["--resume", "--sweep-dir", str(sweep_dir), "--total-env-steps", "120"]
     assert cli.main([*extend, "--address", ray_address, "--verbose", "0"]) == 0
     assert "1 trials to run, 0 already finished" in capsys.readouterr().out
     # went on from the final checkpoint: the evaluations continue the grid, none repeated
-    assert [row["env_step"] for row in read_csv(run_dir / "eval.csv")] == [0, 60, 120, 180, 240]
-    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 240
-    assert json.loads((sweep_dir / SWEEP_FILE).read_text())["base"]["total_env_steps"] == 240
+    evaluated = [row["env_step"] for row in read_csv(run_dir / "eval.csv")]
+    assert evaluated == [0, 20, 40, 60, 80, 100, 120]
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 120
+    assert json.loads((sweep_dir / SWEEP_FILE).read_text())["base"]["total_env_steps"] == 120
     assert cli.main(["--resume", "--sweep-dir", str(sweep_dir)]) == 0
     assert "0 trials to run, 1 already finished" in capsys.readouterr().out
 

@@ -17,6 +17,7 @@ import time
 import numpy as np
 import pytest
 import torch
+from flag_lists import TINY_AGENT
 
 from simoun_agent.cli import train as train_cli
 from simoun_agent.config import resolve
@@ -31,13 +32,7 @@ TINY = [
     "--checkpoint-every", "1000000",
     "--progress", "false",
     "--video", "false",
-    "--device", "cpu",
-    "--torch-threads", "1",
-    "--agent.batch-size", "8",
-    "--agent.num-filters", "4",
-    "--agent.feature-dim", "8",
-    "--agent.hidden-dim", "16",
-    "--agent.aux-hidden-dim", "16",
+    *TINY_AGENT,
 ]  # fmt: skip
 
 HIGHWAY_KWARGS = {

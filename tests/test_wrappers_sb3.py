@@ -17,19 +17,10 @@ def point_reach(**options) -> gym.Env:
     return SimounObservation(gym.make("simoun/PointReach-v0"), size=36, **options)
 
 
-def test_folded_triplet_with_cnn_policy_convolves_all_frames_and_learns():
+def test_folded_triplet_with_cnn_policy_convolves_all_frames_and_learns(small_ppo):
     env = point_reach(fold_frames=True)
     assert check_sb3_policy(env, "CnnPolicy") == "CnnPolicy"
-    ppo = sb3.PPO(
-        "CnnPolicy",
-        env,
-        n_steps=32,
-        batch_size=16,
-        n_epochs=1,
-        policy_kwargs={"features_extractor_kwargs": {"features_dim": 16}},
-        device="cpu",
-        seed=0,
-    )
+    ppo = small_ppo(env, n_steps=32, batch_size=16)
     extractor = ppo.policy.features_extractor
     assert type(extractor).__name__ == "NatureCNN"
     assert extractor.cnn[0].in_channels == 9  # the three RGB frames of the triplet

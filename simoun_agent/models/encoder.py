@@ -63,6 +63,12 @@ def conv_trunk(in_channels: int, num_filters: int) -> nn.Sequential:
     return nn.Sequential(*layers)
 
 
+def trunk_dim(frame_shape: tuple[int, int, int], num_filters: int) -> int:
+    """Length of the flattened last maps of :func:`conv_trunk` on frames of ``(C, H, W)``."""
+    _, height, width = frame_shape
+    return num_filters * conv_output_size(height) * conv_output_size(width)
+
+
 def flatten_maps(maps: torch.Tensor) -> torch.Tensor:
     """Feature maps ``(N, c, h, w)`` -> ``(N, h * w * c)``, in (h, w, c) order: a free view of a
     channels-last map."""
@@ -174,12 +180,25 @@ class PixelEncoder(nn.Module):
         return current, following
 
 
-class StackedEncoder(PixelEncoder):
+class OnePathEncoder(PixelEncoder):
+    """Base of the ablations with one conv path, ``convs`` (a :func:`conv_trunk`): the state is
+    the contrastive features of the whole float stack."""
+
+    key_is_frame = False
+
+    def __init__(self, convs: nn.Sequential, channels_last: bool) -> None:
+        super().__init__(channels_last)
+        self.convs = convs
+
+    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
+        f = self.encode_key(self.to_float(obs))
+        return Encoding(state=f, anchor=f)
+
+
+class StackedEncoder(OnePathEncoder):
     """Ablations "stacked" / "stacked_wide": one conv path on the k frames folded into kC
     channels (CURL / DrQ's encoder). With ``head=False`` the state is the flattened conv maps
     (DrQ-v2's Encoder), on which the actor and the critic put their own trunks."""
-
-    key_is_frame = False
 
     def __init__(
         self,
@@ -190,20 +209,14 @@ class StackedEncoder(PixelEncoder):
         channels_last: bool = True,
         head: bool = True,
     ) -> None:
-        super().__init__(channels_last)
-        c, h, w = frame_shape
-        self.convs = conv_trunk(num_frames * c, num_filters)
-        flat = num_filters * conv_output_size(h) * conv_output_size(w)
+        super().__init__(conv_trunk(num_frames * frame_shape[0], num_filters), channels_last)
+        flat = trunk_dim(frame_shape, num_filters)
         self.head = Head(flat, feature_dim) if head else FlatMaps()
         self.repr_dim = feature_dim if head else flat
 
     def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         stack = view if view.ndim == 4 else view.flatten(1, 2)
         return self.head(self.convs(self.trunk_input(stack)))
-
-    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
-        f = self.encode_key(self.to_float(obs))
-        return Encoding(state=f, anchor=f)
 
 
 class SingleFrameEncoder(StackedEncoder):
@@ -225,11 +238,9 @@ class SingleFrameEncoder(StackedEncoder):
         return super().forward(obs[:, -1:], frame_features)
 
 
-class FlareEncoder(PixelEncoder):
+class FlareEncoder(OnePathEncoder):
     """Ablation "flare" (latent flow, Shang et al. 2021): each frame through one conv path, then
     the flattened latents and their differences with the earlier frame detached, FC + LayerNorm."""
-
-    key_is_frame = False
 
     def __init__(
         self,
@@ -239,10 +250,8 @@ class FlareEncoder(PixelEncoder):
         feature_dim: int,
         channels_last: bool = True,
     ) -> None:
-        super().__init__(channels_last)
-        c, h, w = frame_shape
-        self.convs = conv_trunk(c, num_filters)
-        latent = num_filters * conv_output_size(h) * conv_output_size(w)
+        super().__init__(conv_trunk(frame_shape[0], num_filters), channels_last)
+        latent = trunk_dim(frame_shape, num_filters)
         self.fc = nn.Linear((2 * num_frames - 1) * latent, feature_dim)
         self.norm = nn.LayerNorm(feature_dim)
         self.repr_dim = feature_dim
@@ -253,10 +262,6 @@ class FlareEncoder(PixelEncoder):
         z = maps.permute(0, 2, 3, 1).reshape(n, k, -1)
         flow = z[:, 1:] - z[:, :-1].detach()
         return self.norm(self.fc(torch.cat([z.flatten(1), flow.flatten(1)], dim=1)))
-
-    def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
-        f = self.encode_key(self.to_float(obs))
-        return Encoding(state=f, anchor=f)
 
 
 class DualPathEncoder(PixelEncoder):
@@ -289,8 +294,8 @@ class DualPathEncoder(PixelEncoder):
         channels_last: bool = True,
     ) -> None:
         super().__init__(channels_last)
-        c, h, w = frame_shape
-        flat = num_filters * conv_output_size(h) * conv_output_size(w)
+        c = frame_shape[0]
+        flat = trunk_dim(frame_shape, num_filters)
         self.appearance = conv_trunk(c, num_filters)
         self.motion = conv_trunk(2 * c, num_filters)
         self.head_appearance = Head(flat, feature_dim)
@@ -436,6 +441,22 @@ def _dual(name: str) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncod
     return build
 
 
+def _stacked(filters_per_path: int) -> Callable[[AgentConfig, tuple[int, int, int]], PixelEncoder]:
+    """A builder of the stacked encoder with ``filters_per_path`` times ``num_filters`` filters."""
+
+    def build(c: AgentConfig, shape: tuple[int, int, int]) -> PixelEncoder:
+        return StackedEncoder(
+            shape,
+            c.num_frames,
+            filters_per_path * c.num_filters,
+            c.feature_dim,
+            c.channels_last,
+            not c.separate_trunks,
+        )
+
+    return build
+
+
 ENCODERS: dict[str, EncoderEntry] = {
     "single": EncoderEntry(
         lambda c, shape: SingleFrameEncoder(
@@ -445,26 +466,12 @@ ENCODERS: dict[str, EncoderEntry] = {
         description="one conv path on frame t only",
     ),
     "stacked": EncoderEntry(
-        lambda c, shape: StackedEncoder(
-            shape,
-            c.num_frames,
-            c.num_filters,
-            c.feature_dim,
-            c.channels_last,
-            not c.separate_trunks,
-        ),
+        _stacked(filters_per_path=1),
         shape=ENCODER_SHAPES["stacked"],
         description="one conv path on the frames folded into channels (CURL, DrQ)",
     ),
     "stacked_wide": EncoderEntry(
-        lambda c, shape: StackedEncoder(
-            shape,
-            c.num_frames,
-            2 * c.num_filters,
-            c.feature_dim,
-            c.channels_last,
-            not c.separate_trunks,
-        ),
+        _stacked(filters_per_path=2),
         shape=ENCODER_SHAPES["stacked_wide"],
         description="stacked with twice the filters (about the dual path's parameter count)",
     ),

@@ -717,6 +717,21 @@ def _ci(point: float, low: float, high: float) -> str:
     return f"{point:.3g} [{low:.3g}, {high:.3g}]"
 
 
+def _interval(row: dict, key: str) -> str:
+    """``row[key]`` with its 95 % interval (``key_low``, ``key_high``)."""
+    return _ci(row[key], row[f"{key}_low"], row[f"{key}_high"])
+
+
+def _interval_table(rows: list[dict], columns: list[str], mean: str) -> str:
+    """A table of ``columns`` (row keys, also the headers), then each row's IQM and its ``mean``
+    key with their 95 % intervals."""
+    return table.markdown_table(
+        [*columns, "IQM [95 % CI]", "mean [95 % CI]"],
+        [[*(row[c] for c in columns), _interval(row, "iqm"), _interval(row, mean)] for row in rows],
+        align="llrrr",
+    )
+
+
 def raw_tasks(groups: list[Group]) -> list[str]:
     """The envs whose returns stay raw (no known maximum)."""
     envs = dict.fromkeys((group.env, group.env_id) for group in groups)
@@ -794,20 +809,7 @@ def markdown(
         f"{BOOTSTRAP_REPS} stratified bootstrap resamples of the seeds (seed {BOOTSTRAP_SEED}; "
         "Agarwal et al. 2021). A wide interval says the seeds disagree: more seeds narrow it.",
         "",
-        table.markdown_table(
-            ["variant", "env", "n", "IQM [95 % CI]", "mean [95 % CI]"],
-            [
-                [
-                    row["variant"],
-                    row["env"],
-                    row["n"],
-                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
-                    _ci(row["norm_mean"], row["norm_mean_low"], row["norm_mean_high"]),
-                ]
-                for row in rows
-            ],
-            align="llrrr",
-        ),
+        _interval_table(rows, ["variant", "env", "n"], "norm_mean"),
     ]
     lines += [
         "",
@@ -822,20 +824,7 @@ def markdown(
             else ""
         ),
         "",
-        table.markdown_table(
-            ["variant", "tasks", "runs", "IQM [95 % CI]", "mean [95 % CI]"],
-            [
-                [
-                    row["variant"],
-                    row["tasks"],
-                    row["runs"],
-                    _ci(row["iqm"], row["iqm_low"], row["iqm_high"]),
-                    _ci(row["mean"], row["mean_low"], row["mean_high"]),
-                ]
-                for row in aggregates
-            ],
-            align="llrrr",
-        ),
+        _interval_table(aggregates, ["variant", "tasks", "runs"], "mean"),
     ]
     if improvements:
         lines += _improvement_table(improvements)
@@ -848,44 +837,37 @@ def markdown(
     ]
     if comparison.unfinished:
         title = "Unfinished runs" if budget is None else "Runs short of the budget"
-        lines += ["", f"## {title} (not counted)", ""] + [f"- {u}" for u in comparison.unfinished]
+        lines += _run_list(f"{title} (not counted)", comparison.unfinished)
     if comparison.nearby:
-        lines += [
-            "",
-            f"## Runs counted at the evaluation nearest to {budget[1]:g} env steps",
-            "",
+        lines += _run_list(
+            f"Runs counted at the evaluation nearest to {budget[1]:g} env steps",
+            comparison.nearby,
             "No evaluation at exactly the budget (a stop mid-episode and a resume move the "
             "later evaluations off the grid by less than an episode); the nearest one within "
             "half its eval_every counts.",
-            "",
-        ] + [f"- {n}" for n in comparison.nearby]
-    if comparison.duplicates:
-        lines += [
-            "",
-            "## Duplicate seeds (dropped)",
-            "",
-            "A seed counts once per row: of two runs with one seed, the one that counts "
-            "(finished, or at the budget) is kept, then one that did not fail, then the most "
-            "recent.",
-            "",
-        ] + [f"- {d}" for d in comparison.duplicates]
-    if comparison.off_grid:
-        lines += [
-            "",
-            "## Runs on another evaluation grid (not counted)",
-            "",
-        ] + [f"- {o}" for o in comparison.off_grid]
-    if comparison.failures:
-        lines += ["", "## Failed runs", ""] + [f"- {f}" for f in comparison.failures]
-    if comparison.damaged:
-        lines += [
-            "",
-            "## Damaged runs (not counted)",
-            "",
-            "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
-            "",
-        ] + [f"- {d}" for d in comparison.damaged]
+        )
+    lines += _run_list(
+        "Duplicate seeds (dropped)",
+        comparison.duplicates,
+        "A seed counts once per row: of two runs with one seed, the one that counts "
+        "(finished, or at the budget) is kept, then one that did not fail, then the most "
+        "recent.",
+    )
+    lines += _run_list("Runs on another evaluation grid (not counted)", comparison.off_grid)
+    lines += _run_list("Failed runs", comparison.failures)
+    lines += _run_list(
+        "Damaged runs (not counted)",
+        comparison.damaged,
+        "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
+    )
     return "\n".join(lines) + "\n"
+
+
+def _run_list(title: str, runs: list[str], note: str = "") -> list[str]:
+    """A report section listing ``runs`` under ``title`` after ``note``; none without runs."""
+    if not runs:
+        return []
+    return ["", f"## {title}", "", *([note, ""] if note else []), *(f"- {run}" for run in runs)]
 
 
 def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:

@@ -39,8 +39,8 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
     Example:
         >>> import gymnasium as gym
         >>> import shimmy
+        >>> gym.register_envs(shimmy)  # the dm_control/... ids
         >>> from simoun_wrappers import MovingBackground
-        >>> gym.register_envs(shimmy)
         >>> env = gym.make(
         ...     "dm_control/cartpole-swingup-v0",
         ...     render_mode="rgb_array",
