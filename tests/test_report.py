@@ -399,3 +399,19 @@ def test_a_read_only_directory_is_refused_naming_it_and_the_out_flag(runs_dir, t
     assert "pass a writable --out" in result.stderr
     assert "Traceback" not in result.stderr
     assert not (root / report.REPORT_MD).exists()
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["{not json", "[]", '{"preset": null, "base": {}, "grid": [], "seeds": [0], "envs": ["a"]}'],
+)
+def test_a_damaged_sweep_json_is_named_with_its_fix(runs_dir, text, tmp_path, capsys):
+    root = copy_runs(runs_dir, ["a-s0", "b-s0"], tmp_path / "sweep")
+    (root / "sweep.json").write_text(text)
+    with pytest.raises(SystemExit) as exit_info:
+        report_cli.main([str(root)])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{root / 'sweep.json'} is damaged" in err
+    assert "restore it from a copy" in err
+    assert "Traceback" not in err

@@ -296,9 +296,17 @@ class SweepSpec:
                 "a sweep that simoun-sweep started, or drop --resume to start one"
             )
         try:
-            return cls(**json.loads(path.read_text()))
-        except (json.JSONDecodeError, TypeError) as err:
-            raise SetupError(f"{path} is corrupt ({err}); start a new sweep") from None
+            spec = cls(**json.loads(path.read_text()))
+        except (json.JSONDecodeError, UnicodeDecodeError, TypeError) as err:
+            spec, problem = None, str(err)
+        else:
+            problem = "its grid is not a JSON object" if not isinstance(spec.grid, dict) else ""
+        if spec is None or problem:
+            raise SetupError(
+                f"{path} is damaged ({problem}); restore it from a copy (it records the sweep's "
+                "base, grid, seeds and envs), or start a new sweep in a new --sweep-dir"
+            )
+        return spec
 
 
 def check_runnable(trials: list[Trial], envs_flag: str) -> None:

@@ -55,7 +55,7 @@ from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
 from simoun_lab import stats
-from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE
+from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE, SweepSpec
 from simoun_lab.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
@@ -237,15 +237,20 @@ TASK_KEYS = {"env", "env_kwargs", "action_repeat"}
 they still tell variants apart."""
 
 
+def sweep_grid(root: Path) -> dict[str, list[Any]] | None:
+    """The grid of the sweep in ``root`` (its ``sweep.json``), None for runs of no sweep;
+    SetupError naming the file when it is damaged."""
+    return SweepSpec.load(root).grid if (root / SWEEP_FILE).is_file() else None
+
+
 def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
     """The keys that name a variant: a sweep's grid keys; else the keys that differ between
     runs (within an env, or across envs for any key but :data:`TASK_KEYS`: runs configured
     differently on two tasks are two variants, never pooled as one across tasks), recipe and
     preset first, each kept only if it tells apart runs the kept ones do not
     (``agent.recipe`` differing implies its encoder, losses... which then add nothing)."""
-    sweep_file = root / SWEEP_FILE
-    if sweep_file.is_file():
-        return list(json.loads(sweep_file.read_text())["grid"])
+    if (grid := sweep_grid(root)) is not None:
+        return list(grid)
     candidates = list(dict.fromkeys(key for record in records for key in record.config))
     candidates.sort(key=lambda key: not key.endswith(("recipe", "preset")))
     keys: list[str] = []
@@ -369,8 +374,7 @@ def group_runs(records: list[RunRecord], keys: list[str], root: Path) -> list[Gr
         label = env_label(record.env)
         groups.setdefault((variant, label), Group(variant, label, [])).runs.append(record)
     order = list(dict.fromkeys(group.variant for group in groups.values()))
-    if (root / SWEEP_FILE).is_file():
-        grid = json.loads((root / SWEEP_FILE).read_text())["grid"]
+    if (grid := sweep_grid(root)) is not None:
         combos = itertools.product(*grid.values())
         order = [variant_name(dict(zip(grid, c, strict=True)), list(grid)) for c in combos]
     return sorted(groups.values(), key=lambda group: order.index(group.variant))
