@@ -49,10 +49,13 @@ def rows(path: Path) -> list[dict[str, str]]:
 
 def study(*args: str) -> tuple[int, str]:
     """``python -m simoun_lab.minigrid_study ARGS`` in this process (on the module's Ray
-    instance): its exit status and what it printed."""
+    instance): its exit status (returned, or exited with) and what it printed."""
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
-        status = main(list(args))
+        try:
+            status = main(list(args))
+        except SystemExit as exit_info:
+            status = exit_info.code
     return status, out.getvalue()
 
 
