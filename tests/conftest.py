@@ -1,6 +1,6 @@
 """Fixtures shared by several test modules."""
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
@@ -26,3 +26,14 @@ def small_ppo() -> Callable[..., Any]:
         return sb3.PPO("CnnPolicy", env, **{**settings, **overrides})
 
     return build
+
+
+@pytest.fixture(scope="module")
+def ray_address() -> Iterator[str]:
+    """One local Ray instance for the module (each study or sweep would otherwise start its
+    own); its address. Imports Ray only when used (the lab extra)."""
+    import ray
+
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield ray.get_runtime_context().gcs_address
+    ray.shutdown()

@@ -1,7 +1,10 @@
 """The MiniGrid PPO study at a tiny budget: every arm trained on Ray Tune through the command
-line, archived, skipped on a rerun, reported; and the SB3 adapter over a Gymnasium vector env."""
+line, killed mid-way and resumed from the archive, skipped on a rerun, reported; a run resumed
+from its own checkpoint; and the SB3 adapter over a Gymnasium vector env."""
 
+import contextlib
 import csv
+import io
 import json
 import os
 import shutil
@@ -14,26 +17,29 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
+import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 import torch
 from gymnasium.vector import AutoresetMode
 
+from simoun_lab.minigrid_study.__main__ import main
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, restore
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
 from simoun_lab.minigrid_study.run import train_run
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
 from simoun_lab.minigrid_study.training import set_up
 
+pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
+
 TINY = {
     "tasks": [{"env_id": "MiniGrid-DoorKey-5x5-v0", "steps": 2048, "seeds": [0]}],
     "ppo": {"n_epochs": 1},
-    "evaluations": 1,
+    "evaluations": 2,
     "eval_episodes": 2,
 }
+"""two PPO rollouts of 1024 env steps per run, an evaluation after each: a checkpoint between"""
 
-
-def study(*args: str) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "simoun_lab.minigrid_study", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=600)
+RUN = "MiniGrid-DoorKey-5x5-v0/ppo/s0"
+"""the run whose archived checkpoint the study is killed at"""
 
 
 def rows(path: Path) -> list[dict[str, str]]:
@@ -41,22 +47,60 @@ def rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(file))
 
 
-def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
-    spec_file = tmp_path / "spec.json"
+def study(*args: str) -> tuple[int, str]:
+    """``python -m simoun_lab.minigrid_study ARGS`` in this process (on the module's Ray
+    instance): its exit status (returned, or exited with) and what it printed."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+        try:
+            status = main(list(args))
+        except SystemExit as exit_info:
+            status = exit_info.code
+    return status, out.getvalue()
+
+
+@pytest.fixture(scope="module")
+def tiny_study(ray_address, tmp_path_factory):
+    """The tiny study started on the command line and killed (driver, Ray and trials) once the
+    archive holds a checkpoint of ``RUN``; then, its work directory deleted (a fresh machine),
+    run to its end: (paths, what the killed study printed, what the resumed one printed, the
+    env step of the archived checkpoint)."""
+    root = tmp_path_factory.mktemp("minigrid_study")
+    spec_file = root / "spec.json"
     spec_file.write_text(json.dumps(TINY))
-    archive, work = tmp_path / "archive", tmp_path / "work"
+    archive, work = root / "archive", root / "work"
     archive.mkdir()  # a study's archive is never created by default
-    paths = ["--archive", str(archive), "--spec", str(spec_file)]
-    done = study("run", *paths, "--work-dir", str(work))
-    assert done.returncode == 0, done.stderr[-4000:]
-    assert "0 of 3 runs finished" in done.stdout
+    paths = ["--archive", str(archive), "--spec", str(spec_file), "--work-dir", str(work)]
+    archived = archive / RUN / CHECKPOINT
+    command = [sys.executable, "-m", "simoun_lab.minigrid_study", "run", *paths]
+    with (root / "killed.txt").open("w") as printed:
+        process = subprocess.Popen(command, start_new_session=True, stdout=printed)
+        deadline = time.monotonic() + 600  # generous: the suite may share a loaded machine
+        while not archived.is_file():
+            assert process.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    assert not archived.with_name("summary.json").exists()
+    saved_step = torch.load(archived, weights_only=False)["env_step"]
+    shutil.rmtree(work)
+    status, resumed = study("run", *paths)
+    assert status == 0, resumed[-4000:]
+    return paths, (root / "killed.txt").read_text(), resumed, saved_step
+
+
+def test_a_tiny_study_runs_every_arm_resumes_and_reports(tiny_study):
+    paths, killed, _, _ = tiny_study
+    archive, spec_file = Path(paths[1]), Path(paths[3])
+    assert "0 of 3 runs finished" in killed
     for arm in ("ppo", "consistency", "rnd"):
         run_dir = archive / "MiniGrid-DoorKey-5x5-v0" / arm / "s0"
         summary = json.loads((run_dir / "summary.json").read_text())
         assert summary["env_steps"] == 2048 and summary["steps_per_s"] > 0
         assert json.loads((run_dir / "config.json").read_text())["run"].endswith(f"{arm}/s0")
+        assert not (run_dir / CHECKPOINT).exists()  # removed once the run finished
         evals = rows(run_dir / "eval.csv")
-        assert [int(r["env_step"]) for r in evals] == [0, 2048]
+        assert [int(r["env_step"]) for r in evals] == [0, 1024, 2048]
         assert all(0 <= float(r["success_rate"]) <= 1 for r in evals)
         train = rows(run_dir / "train.csv")
         assert [int(float(r["env_step"])) for r in train] == [1024, 2048]
@@ -70,23 +114,37 @@ def test_a_tiny_study_runs_every_arm_resumes_and_reports(tmp_path):
             assert intrinsic[0] == 0.0 and intrinsic[1] > 0
     assert load_spec(archive / "spec.json") == load_spec(spec_file)
 
-    again = study("run", *paths, "--work-dir", str(work))
-    assert again.returncode == 0 and "3 of 3 runs finished" in again.stdout
+    again, printed = study("run", *paths)
+    assert again == 0 and "3 of 3 runs finished" in printed
 
-    other = tmp_path / "other.json"
+    other = spec_file.with_name("other.json")
     other.write_text(json.dumps({**TINY, "eval_episodes": 3}))
-    refused = study("run", "--archive", str(archive), "--spec", str(other))
-    assert refused.returncode == 2 and "another spec" in refused.stderr
-    assert "Traceback" not in refused.stderr
+    refused, printed = study("run", "--archive", str(archive), "--spec", str(other))
+    assert refused == 2 and "another spec" in printed and "Traceback" not in printed
 
-    report = study("report", "--archive", str(archive))
-    assert report.returncode == 0, report.stderr[-4000:]
+    status, printed = study("report", "--archive", str(archive))
+    assert status == 0, printed[-4000:]
     text = (archive / "report" / "report.md").read_text()
     assert "3 of 3 runs finished" in text and "| consistency |" in text and "P(rnd > ppo)" in text
     assert "## Is it a survival bonus?" in text
     assert "| MiniGrid-DoorKey-5x5-v0 | consistency | 10-30 % | " in text
     assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_success.png").is_file()
     assert (archive / "report" / "MiniGrid-DoorKey-5x5-v0_intrinsic.png").is_file()
+
+
+def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_gone(tiny_study):
+    """The study was killed once the archive held a run's checkpoint; with the work directory
+    deleted, the rerun went on from the archived checkpoint and, finished, removed it."""
+    paths, _, resumed, saved_step = tiny_study
+    assert saved_step == 1024  # the first rollout after the evaluation at 1024
+    line = next(x for x in resumed.splitlines() if x.startswith("from the archive's checkpoints"))
+    assert RUN in line.split(": ")[1].split(", ")
+    run_dir = Path(paths[1]) / RUN
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["env_steps"] == 2048
+    assert [p["env_step_start"] for p in summary["parts"]] == [0, saved_step]
+    walls = [float(r["wall_s"]) for r in rows(run_dir / "eval.csv")]
+    assert walls == sorted(walls)  # training time counts on from the saved seconds
 
 
 def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_pooled_score(tmp_path):
@@ -162,7 +220,7 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     """A run killed after its first checkpoint is resumed from it: the learner, the RNGs and the
     intrinsic model come back as saved, and the records go on without a gap or a repeat."""
     spec = spec_from_dict(
-        {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 4096}], "evaluations": 4}, "test"
+        {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 3072}], "evaluations": 3}, "test"
     )
     (run,) = [r for r in spec.runs() if r.arm == "consistency"]
     run_dir = tmp_path / "run"
@@ -201,50 +259,15 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     training.close()
 
     summary = train_run(spec, run, run_dir)
-    assert summary["env_steps"] == 4096
+    assert summary["env_steps"] == 3072
     assert [p["env_step_start"] for p in summary["parts"]] == [0, 1024]
     evals = rows(run_dir / "eval.csv")
-    assert [int(r["env_step"]) for r in evals] == [0, 1024, 2048, 3072, 4096]
+    assert [int(r["env_step"]) for r in evals] == [0, 1024, 2048, 3072]
     walls = [float(r["wall_s"]) for r in evals]
     assert walls == sorted(walls)  # training time counts on from the saved seconds
     train = rows(run_dir / "train.csv")
-    assert [int(float(r["env_step"])) for r in train] == [1024, 2048, 3072, 4096]
+    assert [int(float(r["env_step"])) for r in train] == [1024, 2048, 3072]
     assert not (run_dir / CHECKPOINT).exists()
-
-
-def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_gone(tmp_path):
-    """The study is killed (driver, Ray and the trial) once the archive holds a run's
-    checkpoint; with the work directory deleted (a fresh machine), a rerun goes on from the
-    archived checkpoint and, finished, removes it from the archive."""
-    spec_file = tmp_path / "spec.json"
-    tiny = {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 8192}], "arms": ["ppo"]}
-    spec_file.write_text(json.dumps({**tiny, "evaluations": 8}))
-    archive, work = tmp_path / "archive", tmp_path / "work"
-    archive.mkdir()  # a study's archive is never created by default
-    paths = ["--archive", str(archive), "--spec", str(spec_file), "--work-dir", str(work)]
-    archived = archive / "MiniGrid-DoorKey-5x5-v0" / "ppo" / "s0" / CHECKPOINT
-    command = [sys.executable, "-m", "simoun_lab.minigrid_study", "run", *paths]
-    process = subprocess.Popen(command, start_new_session=True, stdout=subprocess.DEVNULL)
-    deadline = time.monotonic() + 600  # generous: the suite may share a loaded machine
-    while not archived.is_file():
-        assert process.poll() is None and time.monotonic() < deadline
-        time.sleep(0.05)
-    os.killpg(process.pid, signal.SIGKILL)
-    process.wait()
-    assert not archived.with_name("summary.json").exists()
-    saved_step = torch.load(archived, weights_only=False)["env_step"]
-    assert saved_step >= 1024
-    shutil.rmtree(work)
-
-    again = study("run", *paths)
-    assert again.returncode == 0, again.stderr[-4000:]
-    assert "from the archive's checkpoints: MiniGrid-DoorKey-5x5-v0/ppo/s0" in again.stdout
-    summary = json.loads(archived.with_name("summary.json").read_text())
-    assert summary["env_steps"] == 8192
-    assert [p["env_step_start"] for p in summary["parts"]] == [0, saved_step]
-    evals = rows(archived.with_name("eval.csv"))
-    assert [int(r["env_step"]) for r in evals] == list(range(0, 8193, 1024))
-    assert not archived.exists()
 
 
 def test_survival_row_by_hand():

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import ray  # the lab extra, which CI installs: a missing install fails instead of skipping
+import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 
 from simoun_agent.config import RECIPES, SetupError
 from simoun_lab.cli import study as cli
@@ -26,7 +26,19 @@ from simoun_lab.study.toml_lines import key_line
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
 
-SPEC = """\
+SMALL_AGENT = """\
+video = false
+device = "cpu"
+agent.batch_size = 8
+agent.num_filters = 8
+agent.feature_dim = 16
+agent.hidden_dim = 32
+agent.aux_hidden_dim = 32
+"""
+"""the [base] keys of every tiny study here: a small agent on the CPU, no video"""
+
+SPEC = (
+    """\
 description = "a tiny study for tests"
 recipes = ["simoun", "sac"]
 
@@ -37,14 +49,9 @@ replay_capacity = 1000
 eval_every = 40
 eval_episodes = 1
 checkpoint_every = 40
-video = false
-device = "cpu"
-agent.batch_size = 8
-agent.num_filters = 8
-agent.feature_dim = 16
-agent.hidden_dim = 32
-agent.aux_hidden_dim = 32
-
+"""
+    + SMALL_AGENT
+    + """
 [grid]
 agent.n_step = [1, 3]
 
@@ -61,20 +68,13 @@ env_steps = 80
 [resources]
 max_concurrent_trials = 2
 """
+)
 """tests/test_sweep.py's tiny run, shortened to 80 env steps, as a study (a few seconds per run)."""
 
 
 def write_spec(path: Path, text: str = SPEC) -> Path:
     path.write_text(text)
     return path
-
-
-@pytest.fixture(scope="module")
-def ray_address():
-    """One local Ray instance for the module (each study would otherwise start its own)."""
-    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
-    yield ray.get_runtime_context().gcs_address
-    ray.shutdown()
 
 
 @pytest.fixture(scope="module")
@@ -500,7 +500,8 @@ def test_without_ray_a_study_plans_and_says_how_to_install_ray_to_run(
     assert not (tmp_path / "s").exists()
 
 
-DMC_SPEC = """\
+DMC_SPEC = (
+    """\
 description = "a tiny study with diagnostics and generalization"
 recipes = ["simoun", "sac"]
 
@@ -512,14 +513,9 @@ replay_capacity = 1000
 eval_every = 1000
 eval_episodes = 1
 checkpoint_every = 1000
-video = false
-device = "cpu"
-agent.batch_size = 8
-agent.num_filters = 8
-agent.feature_dim = 16
-agent.hidden_dim = 32
-agent.aux_hidden_dim = 32
-
+"""
+    + SMALL_AGENT
+    + """
 [grid]
 agent.n_step = [1]
 
@@ -543,6 +539,7 @@ episodes = 1
 [resources]
 max_concurrent_trials = 2
 """
+)
 """A 1 s cartpole-swingup episode (13 decisions at its action repeat of 8, a reward above 0 at
 every step): one tuning and one evaluation seed, simoun's aux-loss ablation as a diagnostic and
 two distraction modes."""

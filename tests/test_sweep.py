@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 import pytest
-import ray  # the lab extra, which CI installs: a missing install fails instead of skipping
+import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 from flag_lists import override
 
 from benchmarks.sweep import tiny_flags
@@ -36,14 +36,6 @@ def tiny_without(flag: str) -> list[str]:
     """TINY less one flag and its value (for a key the grid gives instead)."""
     at = TINY.index(flag)
     return TINY[:at] + TINY[at + 2 :]
-
-
-@pytest.fixture(scope="module")
-def ray_address():
-    """One local Ray instance for the module (each sweep would otherwise start its own)."""
-    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
-    yield ray.get_runtime_context().gcs_address
-    ray.shutdown()
 
 
 def run_dirs(sweep_dir: Path) -> list[Path]:

@@ -11,8 +11,9 @@
 evaluates the selected settings on the held-out seeds and writes the report
 (:mod:`simoun_lab.study.report`); ``report`` writes it again from the finished runs of a study
 directory or its archive (``simoun-study report SPEC --study-dir docs/studies/NAME``). The
-study is run by :mod:`simoun_lab.study.runner`; the runs go through ``simoun-sweep``'s code:
-the same trial directories, Tune experiments, STOP file on SIGTERM and failure handling.
+study is run by :mod:`simoun_lab.study.runner`; the runs go through the engine
+(:mod:`simoun_lab.engine.launcher`) as ``simoun-sweep``'s do: the same trial directories, Tune
+experiments, STOP file on SIGTERM and failure handling.
 """
 
 from __future__ import annotations
@@ -28,10 +29,10 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.study.checks import check_study
 from simoun_lab.study.plan import describe
 from simoun_lab.study.runner import StudyOptions, report_study, run_study, spec_from
-from simoun_lab.sweep.launch import load_ray
 
 PROG = "simoun-study"
 

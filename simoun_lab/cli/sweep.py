@@ -30,19 +30,17 @@ from simoun_agent.cli.config_flags import (
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
 from simoun_lab.sweep.launch import (
     check_fits,
-    connect,
-    finished,
     gpus_per_trial,
-    load_ray,
     run_sweep,
     stop_trials_on_sigterm,
     summarize,
 )
-from simoun_lab.sweep.trainable import STOP_FILE
+from simoun_lab.sweep.trainable import STOP_FILE, finished
 
 PROG = "simoun-sweep"
 

@@ -32,7 +32,7 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     archive that holds them (``archive`` is ARCHIVE, or ``new``: a ``run`` may start a study in
     an empty directory). An archive that is not there is refused rather than made up: a
     mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
-    from simoun_lab.minigrid_study.tune import SPEC_FILE
+    from simoun_lab.minigrid_study.runner import SPEC_FILE
 
     if not archive.is_dir():
         where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
@@ -124,7 +124,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
         if isinstance(args, Run):
-            from simoun_lab.minigrid_study.tune import run_study
+            from simoun_lab.minigrid_study.runner import run_study
 
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
             print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
@@ -135,7 +135,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(write_selection(spec, args.archive))
             return 0
         from simoun_lab.minigrid_study.report import write_report
-        from simoun_lab.minigrid_study.tune import finished_runs
+        from simoun_lab.minigrid_study.runner import finished_runs
 
         if not finished_runs(spec, args.archive):
             raise SetupError(

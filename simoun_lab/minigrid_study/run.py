@@ -18,13 +18,14 @@ from typing import Any
 from stable_baselines3.common.callbacks import CallbackList
 
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.engine.trial import SUMMARY
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, RunCheckpoint, restore
 from simoun_lab.minigrid_study.spec import Run, StudySpec
 from simoun_lab.minigrid_study.training import CONFIG, set_up, write_json
 
 __all__ = ["EVAL_CSV", "RUN_FILES", "SUMMARY", "TRAIN_CSV", "train_run"]
 
-EVAL_CSV, TRAIN_CSV, SUMMARY = "eval.csv", "train.csv", "summary.json"
+EVAL_CSV, TRAIN_CSV = "eval.csv", "train.csv"
 RUN_FILES = (CONFIG, EVAL_CSV, TRAIN_CSV, SUMMARY)
 """a run's files, ``summary.json`` last: its presence marks a finished run"""
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME, TRAIN_CSV
+from simoun_lab.engine.launcher import archive_files, read_run_files
 from simoun_lab.sweep.trainable import TRIAL_FILE
 
 GENERALIZATION_CSV = "generalization.csv"
@@ -36,9 +37,7 @@ def archive_run(study_dir: Path, archive: Path, name: str) -> bool:
     run_dir, kept = study_dir / name, archive / name
     if not (run_dir / SUMMARY_NAME).is_file() or (kept / SUMMARY_NAME).is_file():
         return False
-    for file in RUN_FILES:
-        if (run_dir / file).is_file():
-            copy_file(run_dir / file, kept / file)
+    archive_files(archive, name, read_run_files(run_dir, RUN_FILES))
     return True
 
 

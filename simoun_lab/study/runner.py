@@ -1,6 +1,7 @@
 """Running a study from its spec (the library under ``simoun-study``,
-:mod:`simoun_lab.cli.study`): the study record, both phases on Ray Tune through
-:mod:`simoun_lab.sweep.launch`, the selection between them and the report at the end.
+:mod:`simoun_lab.cli.study`): the study record, both phases on Ray Tune through the engine
+(:mod:`simoun_lab.engine.launcher`, which archives each run as it finishes), the selection
+between them and the report at the end.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from typing import Any, Literal
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CHECKPOINT_NAME
+from simoun_lab.engine.launcher import changed_keys, run_trials
+from simoun_lab.engine.ray_start import connect
 from simoun_lab.study import archive as archiving
 from simoun_lab.study.archive import GENERALIZATION_CSV
 from simoun_lab.study.checks import check_fixed_spec, check_study
@@ -33,6 +36,7 @@ from simoun_lab.study.provenance import code_version, same_code
 from simoun_lab.study.report import REPORT_DIR, REPORT_MD, write_study_report
 from simoun_lab.study.spec import StudySpec, load_spec
 from simoun_lab.sweep import launch
+from simoun_lab.sweep.trainable import STOP_FILE, SacTrial
 
 STUDY_FILE = "study.json"
 """The study record, in the study directory and the archive: the spec (its file, text and
@@ -94,7 +98,7 @@ def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: 
     says ``problem``, the keys that differ and ``fix``. A record saved before a spec key
     existed has that key's default (read through :meth:`StudySpec.from_json`)."""
     saved, wanted = StudySpec.from_json(record["spec"]).to_json(), spec.to_json()
-    changed = [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
+    changed = changed_keys(saved, wanted)
     if changed:
         raise SetupError(
             f"{problem} ({', '.join(changed)} differ from the saved {STUDY_FILE}); {fix}"
@@ -145,7 +149,7 @@ def save_record(record: dict[str, Any], places: list[Path]) -> None:
 
 
 class Phases:
-    """Runs the study's phases on Ray Tune through simoun-sweep's trial code."""
+    """Runs the study's phases on Ray Tune through the engine, each run a SAC trial."""
 
     def __init__(
         self, spec: StudySpec, spec_path: str, options: StudyOptions, ray: ModuleType
@@ -165,7 +169,7 @@ class Phases:
         """Start (or join) Ray, once: only when there is something to run."""
         if self.gpus is not None:
             return
-        self.started = launch.connect(self.ray, self.options.address, self.options.num_cpus)
+        self.started = connect(self.ray, self.options.address, self.options.num_cpus)
         device = self.spec.base.get("device", resolve(self.spec.preset, {}).device)
         wanted = str(self.spec.gpus_per_trial)
         self.gpus = launch.gpus_per_trial(self.ray, wanted, device)
@@ -222,7 +226,11 @@ class Phases:
         """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
         restored = self.restore(runs)
         todo = [run for run in runs if not run.finished(self.study_dir)]
-        self.todo = [run.trial(self.spec, self.study_dir) for run in todo]
+        stop_file = str(self.study_dir / STOP_FILE)
+        self.todo = [
+            SacTrial(run.trial(self.spec, self.study_dir), run.name, stop_file, archiving.RUN_FILES)
+            for run in todo
+        ]
         print(
             f"{phase}: {len(todo)} runs to run, {len(runs) - len(todo)} already finished"
             + (f" ({restored} restored from {self.archive})" if restored else ""),
@@ -232,19 +240,12 @@ class Phases:
             self.sync(runs)
             return {}
         self.connect()
-        callbacks = []
-        if self.archive is not None:
-            from simoun_lab.study.tune_callback import ArchiveOnComplete
-
-            names = {run.trial(self.spec, self.study_dir).name: run.name for run in todo}
-            callbacks.append(ArchiveOnComplete(self.study_dir, self.archive, names))
-        outcome = launch.run_trials(
+        outcome = run_trials(
             self.todo,
-            self.study_dir,
-            self.spec.cpus_per_trial,
-            self.gpus,
+            self.study_dir / "tune",
+            {"cpu": self.spec.cpus_per_trial, "gpu": self.gpus},
             self.options.verbose,
-            callbacks,
+            self.archive,
             self.spec.max_concurrent_trials,
             name=f"{phase}-",
         )

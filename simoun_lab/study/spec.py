@@ -366,19 +366,23 @@ class _Reader:
             raise self.fail(where, f"give a table ([{'.'.join(where)}]), not {value!r}")
         return dict(value)
 
+    def known_recipe(self, recipe: Any, where: tuple[str, ...]) -> None:
+        """Refuse a name that is no recipe, suggesting the closest one."""
+        if recipe not in RECIPES:
+            hint = difflib.get_close_matches(str(recipe), RECIPES, n=1)
+            raise self.fail(
+                where,
+                f"unknown recipe {recipe!r}"
+                + (f" (did you mean {hint[0]!r}?)" if hint else "")
+                + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
+            )
+
     def recipes(self, value: Any) -> list[str]:
         where = ("recipes",)
         if not isinstance(value, list) or not value:
             raise self.fail(where, 'give a non-empty list, e.g. recipes = ["simoun", "drq"]')
         for recipe in value:
-            if recipe not in RECIPES:
-                hint = difflib.get_close_matches(str(recipe), RECIPES, n=1)
-                raise self.fail(
-                    where,
-                    f"unknown recipe {recipe!r}"
-                    + (f" (did you mean {hint[0]!r}?)" if hint else "")
-                    + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
-                )
+            self.known_recipe(recipe, where)
         repeated = sorted({r for r in value if value.count(r) > 1})
         if repeated:
             raise self.fail(where, f"{repeated[0]!r} is listed twice; list each recipe once")
@@ -664,14 +668,7 @@ class _Reader:
                     where, f'give a non-empty list of recipes, e.g. {method} = ["{method}_no_aux"]'
                 )
             for ablation in ablations:
-                if ablation not in RECIPES:
-                    hint = difflib.get_close_matches(str(ablation), RECIPES, n=1)
-                    raise self.fail(
-                        where,
-                        f"unknown recipe {ablation!r}"
-                        + (f" (did you mean {hint[0]!r}?)" if hint else "")
-                        + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
-                    )
+                self.known_recipe(ablation, where)
                 if ablation in recipes:
                     raise self.fail(
                         where,

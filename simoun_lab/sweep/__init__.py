@@ -1,8 +1,9 @@
 """Sweeps: a grid of ordinary training runs on Ray Tune (``simoun-sweep``), and their report
 (``simoun-report``).
 
-Ray is an optional extra (``pip install 'simoun[lab]'``) imported only by
-:mod:`simoun_lab.sweep.trainable` and :mod:`simoun_lab.sweep.launch`; the grid
+Ray is an optional extra (``pip install 'simoun[lab]'``) imported only by the study engine
+(:mod:`simoun_lab.engine`), :mod:`simoun_lab.sweep.trainable` (the SAC trial) and
+:mod:`simoun_lab.sweep.launch`; the grid
 (:mod:`simoun_lab.sweep.grid`) and the report (:mod:`simoun_lab.sweep.report`) work without
 it, and ``simoun_agent`` never imports this package.
 

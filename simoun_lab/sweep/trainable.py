@@ -1,5 +1,6 @@
-"""Ray Tune's trainable: each trial is one ordinary ``simoun-train`` run in its own run directory,
-reporting every evaluation to Tune through a :class:`~simoun_agent.run.callback.TrainCallback`.
+"""The SAC trainer behind the engine's trial interface: each trial is one ordinary ``simoun-train``
+run in its own run directory, reporting every evaluation to Tune through a
+:class:`~simoun_agent.run.callback.TrainCallback`.
 
 A trial continues from its run directory's checkpoint when there is one (a resumed sweep), and
 writes ``error.txt`` (the traceback) into its run directory when it fails, so the failure stays
@@ -17,7 +18,8 @@ import signal
 import socket
 import time
 import traceback
-from dataclasses import asdict
+from collections.abc import Callable
+from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -26,7 +28,7 @@ from simoun_agent.config import resolve
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
 from simoun_agent.run import train
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
+from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.signals import Stopped
 from simoun_lab.sweep.grid import Trial
 from simoun_lab.sweep.report import ERROR_FILE
@@ -84,33 +86,66 @@ def open_run(trial: Trial) -> train.Run:
     return train.create_run(config, check=check_eval_distractions)
 
 
-def run_trial(
-    config: dict[str, Any], trials: dict[str, dict[str, Any]], stop_file: str | None = None
-) -> None:
-    """Tune's function trainable: train the trial named ``config["trial"]`` to the end, or until
-    ``stop_file`` appears (then it ends unfinished, with a checkpoint to resume from)."""
-    trial = Trial(**trials[config["trial"]])
-    run_dir = Path(trial.run_dir)
-    callbacks: list[train.TrainCallback] = [TuneReporter()]
-    if stop_file is not None:
-        callbacks.append(StopFile(Path(stop_file)))
+def finished(trial: Trial) -> bool:
+    """True once the trial's run has ended at the sweep's budget (a sweep extended with a larger
+    ``--total-env-steps`` makes its finished runs unfinished again)."""
+    path = Path(trial.run_dir) / SUMMARY_NAME
+    if not path.is_file():
+        return False
     try:
-        run = open_run(trial)
-        part = start_part(run)
+        done = json.loads(path.read_text())["env_step"]
+    except (json.JSONDecodeError, KeyError, TypeError, UnicodeDecodeError):
+        return True  # damaged: the report names it; training cannot tell how far the run got
+    return done >= trial_budget(trial)
+
+
+@dataclass(frozen=True)
+class SacTrial:
+    """A sweep trial (one ``simoun-train`` run) as the engine's
+    :class:`~simoun_lab.engine.trial.Trial`: trained to the end, or until ``stop_file`` appears
+    (then it ends unfinished, with a checkpoint to resume from). Its checkpoint holds the replay
+    buffer, too large to carry into an archive."""
+
+    run: Trial
+    """the sweep's trial"""
+    name: str
+    """the run's name in the Tune experiment and its path under the archive"""
+    stop_file: str | None = None
+    run_files: tuple[str, ...] = ()
+    """the files an archive keeps of the finished run"""
+    checkpoint: str | None = None
+
+    @property
+    def run_dir(self) -> str:
+        return self.run.run_dir
+
+    def finished(self) -> bool:
+        return finished(self.run)
+
+    def train(self, on_checkpoint: Callable[[Path], None] | None = None) -> None:
+        """Train the run, writing ``error.txt`` (the traceback) into its run directory when it
+        fails (``on_checkpoint`` is not called: the checkpoint is not carried)."""
+        run_dir = Path(self.run_dir)
+        callbacks: list[train.TrainCallback] = [TuneReporter()]
+        if self.stop_file is not None:
+            callbacks.append(StopFile(Path(self.stop_file)))
         try:
-            train.train(run, callbacks=[*distraction_callbacks(run.config), *callbacks])
-        except Stopped:
-            return
-        finally:
-            run.env.close()
-            run.eval_env.close()
-            end_part(run, part)
-    except Exception:
-        text = traceback.format_exc()
-        run_dir.mkdir(parents=True, exist_ok=True)
-        atomic_write(run_dir / ERROR_FILE, lambda tmp: tmp.write_text(text))
-        raise
-    (run_dir / ERROR_FILE).unlink(missing_ok=True)
+            run = open_run(self.run)
+            part = start_part(run)
+            try:
+                train.train(run, callbacks=[*distraction_callbacks(run.config), *callbacks])
+            except Stopped:
+                return
+            finally:
+                run.env.close()
+                run.eval_env.close()
+                end_part(run, part)
+        except Exception:
+            text = traceback.format_exc()
+            run_dir.mkdir(parents=True, exist_ok=True)
+            atomic_write(run_dir / ERROR_FILE, lambda tmp: tmp.write_text(text))
+            raise
+        (run_dir / ERROR_FILE).unlink(missing_ok=True)
 
 
 def cpu_seconds() -> float:
@@ -159,9 +194,3 @@ def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
     """The parts recorded in a run directory's ``trial.json`` (none without one)."""
     path = Path(run_dir) / TRIAL_FILE
     return json.loads(path.read_text())["parts"] if path.is_file() else []
-
-
-def trial_table(trials: list[Trial]) -> dict[str, dict[str, Any]]:
-    """``{trial name: its fields}``, the lookup :func:`run_trial` is given (Tune's config then
-    holds only the short name, which its progress table shows)."""
-    return {trial.name: asdict(trial) for trial in trials}

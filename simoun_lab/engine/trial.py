@@ -1,0 +1,63 @@
+"""What one run must offer the study engine (:mod:`simoun_lab.engine.launcher`).
+
+A run lives in its run directory and is finished once its ``summary.json`` exists: the run
+writes it last, so its presence marks a whole run. The engine trains each unfinished trial on
+Ray Tune, hands each checkpoint the trial writes to Tune (then to the archive), and copies the
+trial's ``run_files`` into the archive once it has finished.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from simoun_agent.run.layout import SUMMARY_NAME
+
+__all__ = ["SUMMARY", "Trial", "summary_written"]
+
+SUMMARY = SUMMARY_NAME
+"""a finished run's summary, written last: its presence marks a finished run"""
+
+
+def summary_written(run_dir: Path | str) -> bool:
+    """Whether the run directory ``run_dir`` holds a finished run."""
+    return (Path(run_dir) / SUMMARY).is_file()
+
+
+@runtime_checkable
+class Trial(Protocol):
+    """One run of a study or sweep, as the engine runs it (pickled to Ray's workers)."""
+
+    @property
+    def name(self) -> str:
+        """unique among the trials launched together; the run's path under the archive"""
+        ...
+
+    @property
+    def run_dir(self) -> str:
+        """where the run writes its files (absolute: Tune runs each trial in a folder of its
+        own)"""
+        ...
+
+    @property
+    def run_files(self) -> tuple[str, ...]:
+        """the files of a finished run that the archive keeps, ``summary.json`` last"""
+        ...
+
+    @property
+    def checkpoint(self) -> str | None:
+        """the file name of the run's checkpoint, carried into the archive while the run is in
+        progress and resumed from there when the run directory is gone (None: not carried,
+        e.g. one holding a replay buffer)"""
+        ...
+
+    def finished(self) -> bool:
+        """Whether the run in ``run_dir`` has finished."""
+        ...
+
+    def train(self, on_checkpoint: Callable[[Path], None] | None) -> None:
+        """Train the run in ``run_dir`` to its end (going on from a checkpoint there), calling
+        ``on_checkpoint`` with each checkpoint it writes; a run asked to stop may return
+        unfinished."""
+        ...

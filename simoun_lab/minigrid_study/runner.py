@@ -1,0 +1,84 @@
+"""The MiniGrid study on the engine (:mod:`simoun_lab.engine.launcher`): every unfinished run
+as a :class:`~simoun_lab.minigrid_study.trial.MiniGridTrial`, two at a time, one torch thread
+each, each finished run's files and each in-progress checkpoint copied into the archive.
+
+Resuming: a run whose ``summary.json`` is in the archive is finished and skipped. A run ended
+mid-way goes on from the checkpoint in its run directory, ``<work_dir>/runs/<task>/<arm>/s<seed>``,
+when that is still there, else from the archive's ``<run>/checkpoint.pt``, else from scratch.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from simoun_agent.config import SetupError
+from simoun_lab.engine.launcher import changed_keys, run_trials
+from simoun_lab.engine.ray_start import connect, load_ray
+from simoun_lab.engine.trial import summary_written
+from simoun_lab.minigrid_study.spec import StudySpec
+from simoun_lab.minigrid_study.training import write_json
+from simoun_lab.minigrid_study.trial import MiniGridTrial
+from simoun_lab.study.provenance import code_version
+
+__all__ = ["SPEC_FILE", "finished_runs", "run_study"]
+
+SPEC_FILE = "spec.json"
+"""the spec the archive's runs were trained with"""
+
+
+def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
+    """The names of the spec's runs whose summary is in the archive."""
+    return [run.name for run in spec.runs() if summary_written(archive / run.name)]
+
+
+def record_spec(spec: StudySpec, archive: Path) -> None:
+    """Write the spec into the archive, or refuse a spec that differs from the one there (the
+    finished runs would be compared with runs of another design)."""
+    path = archive / SPEC_FILE
+    wanted = spec.to_json()
+    if path.is_file():
+        changed = sorted(changed_keys(json.loads(path.read_text()), wanted))
+        if changed:
+            raise SetupError(
+                f"--archive {archive} holds runs of another spec (keys {changed} differ from "
+                f"{path}); pass the spec it was run with, or a new --archive"
+            )
+        return
+    archive.mkdir(parents=True, exist_ok=True)
+    write_json(path, wanted)
+
+
+def run_study(
+    spec: StudySpec,
+    archive: Path,
+    work_dir: Path,
+    address: str | None = None,
+    concurrent: int = 2,
+    verbose: int = 1,
+) -> dict[str, list[str]]:
+    """Run every unfinished run of ``spec`` (Ray Tune's records and the run directories under
+    ``work_dir``), archiving each as it finishes; returns the run names grouped as skipped
+    (finished before), finished and failed."""
+    if concurrent < 1:
+        raise SetupError(f"--concurrent must be >= 1, got {concurrent}")
+    record_spec(spec, archive)
+    done = set(finished_runs(spec, archive))
+    commit, work = code_version()["commit"], str(work_dir.resolve())
+    todo = [MiniGridTrial(spec, run, work, commit) for run in spec.runs() if run.name not in done]
+    print(f"{len(done)} of {len(spec.runs())} runs finished in {archive}; {len(todo)} to run")
+    outcome = {"skipped": sorted(done), "finished": [], "failed": []}
+    if not todo:
+        return outcome
+    ray = load_ray()
+    started = connect(ray, address, None)
+    try:
+        ran = run_trials(
+            todo, work_dir, {"cpu": 1}, verbose, archive, concurrent, name="minigrid_study-"
+        )
+    finally:
+        if started:
+            ray.shutdown()
+    outcome["finished"] = [trial.name for trial in ran["finished"]]
+    outcome["failed"] = [trial.name for trial in ran["failed"] + ran["stopped"]]
+    return outcome

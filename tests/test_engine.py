@@ -1,0 +1,46 @@
+"""The study engine without Ray: both trainers offer its trial interface, and the archive's
+writer copies a finished run's files and drops its carried checkpoint. The engine on Ray
+Tune is exercised by tests/test_study.py, tests/test_sweep.py and tests/test_minigrid_study.py."""
+
+from pathlib import Path
+
+from simoun_lab.engine.launcher import archive_files, changed_keys, read_run_files
+from simoun_lab.engine.trial import Trial
+from simoun_lab.minigrid_study.spec import StudySpec
+from simoun_lab.minigrid_study.trial import MiniGridTrial
+from simoun_lab.sweep.grid import SweepSpec
+from simoun_lab.sweep.trainable import SacTrial
+
+
+def test_both_trainers_are_engine_trials(tmp_path):
+    spec = StudySpec()
+    minigrid = MiniGridTrial(spec, spec.runs()[0], str(tmp_path))
+    assert isinstance(minigrid, Trial)
+    assert minigrid.run_dir == str(tmp_path / "runs" / "MiniGrid-DoorKey-6x6-v0/ppo/s0")
+    assert minigrid.checkpoint == "checkpoint.pt" and minigrid.run_files[-1] == "summary.json"
+    assert not minigrid.finished()
+    (sweep_trial,) = SweepSpec.create(None, {}, [], "0", None).trials(str(tmp_path))
+    sac = SacTrial(sweep_trial, "tuning/a/s0")
+    assert isinstance(sac, Trial) and sac.checkpoint is None  # its replay stays out of archives
+    assert sac.run_dir == sweep_trial.run_dir and not sac.finished()
+
+
+def test_the_archive_gets_the_run_files_and_loses_the_carried_checkpoint(tmp_path):
+    run_dir, archive = tmp_path / "run", tmp_path / "archive"
+    run_dir.mkdir()
+    for name in ("summary.json", "eval.csv", "config.json"):
+        (run_dir / name).write_text(name)
+    files = read_run_files(run_dir, ("config.json", "summary.json", "eval.csv", "absent.csv"))
+    assert list(files) == ["config.json", "summary.json", "eval.csv"]  # the absent one skipped
+    (archive / "a/s0").mkdir(parents=True)
+    (archive / "a/s0/checkpoint.pt").write_bytes(b"saved")
+    archive_files(archive, "a/s0", files, "checkpoint.pt")
+    written = {p.name for p in archive.joinpath("a/s0").iterdir()}
+    assert written == {"config.json", "eval.csv", "summary.json"}
+    assert Path(archive, "a/s0/eval.csv").read_text() == "eval.csv"
+
+
+def test_changed_keys_names_each_key_whose_value_differs_or_is_missing():
+    saved, wanted = {"a": 1, "b": [2], "c": 3}, {"a": 1, "b": [3], "d": 4}
+    assert changed_keys(saved, wanted) == ["b", "c", "d"]
+    assert changed_keys(saved, dict(saved)) == []
