@@ -1,10 +1,13 @@
-"""The study engine without Ray: both trainers offer its trial interface, and the archive's
-writer copies a finished run's files and drops its carried checkpoint. The engine on Ray
-Tune is exercised by tests/test_study.py, tests/test_sweep.py and tests/test_minigrid_study.py."""
+"""The study engine: both trainers offer its trial interface, the archive's writer copies a
+finished run's files and drops its carried checkpoint, and a local Ray instance runs trials at
+the driver's priority. The engine on Ray Tune is exercised by tests/test_study.py,
+tests/test_sweep.py and tests/test_minigrid_study.py."""
 
+import os
 from pathlib import Path
 
 from simoun_lab.engine.launcher import archive_files, changed_keys, read_run_files
+from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.engine.trial import Trial
 from simoun_lab.minigrid_study.spec import StudySpec
 from simoun_lab.minigrid_study.trial import MiniGridTrial
@@ -44,3 +47,13 @@ def test_changed_keys_names_each_key_whose_value_differs_or_is_missing():
     saved, wanted = {"a": 1, "b": [2], "c": 3}, {"a": 1, "b": [3], "d": 4}
     assert changed_keys(saved, wanted) == ["b", "c", "d"]
     assert changed_keys(saved, dict(saved)) == []
+
+
+def test_a_local_ray_instance_runs_trials_at_the_drivers_priority():
+    ray = load_ray()
+    assert connect(ray, None, 1)
+    try:
+        worker_niceness = ray.get(ray.remote(lambda: os.nice(0)).remote())
+    finally:
+        ray.shutdown()
+    assert worker_niceness == os.nice(0)  # Ray's own default puts its workers 15 lower
