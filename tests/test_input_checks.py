@@ -71,6 +71,17 @@ def test_the_minigrid_report_outside_the_clone_writes_nothing(tmp_path, capsys, 
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize(
+    ("text", "kind"), [("[]", "an array"), ("null", "null"), ("3", "a number")]
+)
+def test_a_minigrid_spec_that_is_not_an_object_is_named(text, kind, tmp_path, capsys):
+    spec = tmp_path / "spec.json"
+    spec.write_text(text)
+    argv = ["report", "--spec", str(spec), "--archive", str(tmp_path)]
+    err = refused(capsys, minigrid_cli.main, argv)
+    assert f"--spec {spec} holds {kind}, not the object of a study spec" in err
+
+
 def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys):
     err = refused(capsys, report_cli.main, [str(tmp_path / "nope")])
     assert f"{tmp_path / 'nope'} does not exist; pass a sweep directory" in err

@@ -164,6 +164,12 @@ def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
     return build(StudySpec, values, where)
 
 
+def json_kind(value: Any) -> str:
+    """What JSON calls ``value``'s kind (an array, null, a number...), for messages."""
+    kinds = {list: "an array", type(None): "null", bool: "true/false", str: "a string"}
+    return kinds.get(type(value), "a number")
+
+
 def load_spec(path: Path) -> StudySpec:
     """The spec in the JSON file ``path``."""
     try:
@@ -172,4 +178,10 @@ def load_spec(path: Path) -> StudySpec:
         raise SetupError(f"--spec {path}: no such file") from None
     except json.JSONDecodeError as err:
         raise SetupError(f"--spec {path}: not valid JSON ({err})") from None
+    if not isinstance(values, dict):
+        raise SetupError(
+            f"--spec {path} holds {json_kind(values)}, not the object of a study spec "
+            '({"tasks": [...], "arms": [...], ...}); write one as docs/studies/minigrid-v2/'
+            "tuning/spec.json does, or leave --spec out to use the archive's"
+        )
     return spec_from_dict(values, str(path))
