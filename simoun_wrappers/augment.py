@@ -11,6 +11,7 @@ padding, as in netrand), so the image keeps its size.
 
 from __future__ import annotations
 
+import numbers
 from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
@@ -23,6 +24,15 @@ from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
 if TYPE_CHECKING:
     import torch
+
+
+def _ordered_bounds(clamp: object) -> bool:
+    """Whether ``clamp`` is a pair of real numbers ``(low, high)`` with ``low <= high``."""
+    if not isinstance(clamp, (tuple, list)) or len(clamp) != 2:
+        return False
+    low, high = clamp
+    real = all(isinstance(b, numbers.Real) and not isinstance(b, bool) for b in clamp)
+    return real and low <= high
 
 
 def random_conv(
@@ -73,6 +83,11 @@ def random_conv(
             f"{kernel_size!r}; use 3 (Lee et al. 2020) or another odd value."
         )
     check_kernel_fits(kernel_size, batch.shape[-2], batch.shape[-1])
+    if clamp is not None and not _ordered_bounds(clamp):
+        raise ValueError(
+            f"clamp must be (low, high) with low <= high, got {clamp!r}; e.g. clamp=(0.0, 1.0) "
+            "for images in [0, 1], or None for the raw output."
+        )
     shape = batch.shape
     frames = batch if batch.ndim == 5 else batch.unsqueeze(1)
     b, t, c, h, w = frames.shape

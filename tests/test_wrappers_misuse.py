@@ -206,6 +206,14 @@ def test_random_conv_names_a_numpy_array_as_such():
         random_conv(np.zeros((1, 3, 8, 8), np.float32))
 
 
+@pytest.mark.parametrize("clamp", [(1.0, 0.0), (0.0,), "01", (0.0, "high")])
+def test_random_conv_refuses_clamp_bounds_that_are_not_low_then_high(clamp):
+    with pytest.raises(ValueError, match=r"clamp must be \(low, high\) with low <= high"):
+        random_conv(torch.rand(1, 3, 8, 8), clamp=clamp)
+    out = random_conv(torch.rand(1, 3, 8, 8), clamp=(0.0, 0.5))
+    assert 0.0 <= out.min() and out.max() <= 0.5
+
+
 def triplets(**options) -> gym.Env:
     return SimounObservation(minigrid_pixels(), size=16, **options)
 
