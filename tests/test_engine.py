@@ -6,6 +6,9 @@ tests/test_sweep.py and tests/test_minigrid_study.py."""
 import os
 from pathlib import Path
 
+import pytest
+
+from simoun_agent.config import SetupError
 from simoun_lab.engine.launcher import archive_files, changed_keys, read_run_files
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.engine.trial import Trial
@@ -57,3 +60,12 @@ def test_a_local_ray_instance_runs_trials_at_the_drivers_priority():
     finally:
         ray.shutdown()
     assert worker_niceness == os.nice(0)  # Ray's own default puts its workers 15 lower
+
+
+def test_a_local_ray_instance_of_no_cpu_is_refused_before_ray_starts():
+    ray = load_ray()
+    with pytest.raises(
+        SetupError, match=r"--num-cpus 0: a local Ray instance needs at least 1 CPU"
+    ):
+        connect(ray, None, 0)
+    assert not ray.is_initialized()

@@ -34,6 +34,11 @@ def connect(ray: ModuleType, address: str | None, num_cpus: int | None) -> bool:
     Returns whether Ray was started here (False when this process had already initialized it,
     e.g. a notebook that called ``ray.init`` itself): only then does the sweep shut it down.
     """
+    if num_cpus is not None and num_cpus < 1:
+        raise SetupError(
+            f"--num-cpus {num_cpus}: a local Ray instance needs at least 1 CPU to run a trial; "
+            "drop --num-cpus to give it this machine's, or pass 1 or more"
+        )
     if ray.is_initialized():
         return False
     if address is None:

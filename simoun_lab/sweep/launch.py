@@ -46,8 +46,8 @@ def check_fits(ray: ModuleType, cpus: int, gpus: float) -> None:
     for name, need, flag in (("CPU", cpus, "--cpus-per-trial"), ("GPU", gpus, "--gpus-per-trial")):
         if need > have.get(name, 0):
             raise SetupError(
-                f"each trial asks for {need:g} {name}s ({flag}) but the Ray cluster has "
-                f"{have.get(name, 0):g}; lower {flag} or add machines"
+                f"each trial asks for {need:g} {name}{'s' * (need != 1)} ({flag}) but the Ray "
+                f"cluster has {have.get(name, 0):g}; lower {flag} or add machines"
             )
 
 
