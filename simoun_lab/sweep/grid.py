@@ -298,10 +298,10 @@ class SweepSpec:
         try:
             spec = cls(**json.loads(path.read_text()))
         except (json.JSONDecodeError, UnicodeDecodeError, TypeError) as err:
-            spec, problem = None, str(err)
+            problem = str(err)
         else:
-            problem = "its grid is not a JSON object" if not isinstance(spec.grid, dict) else ""
-        if spec is None or problem:
+            problem = "" if isinstance(spec.grid, dict) else "its grid is not a JSON object"
+        if problem:
             raise SetupError(
                 f"{path} is damaged ({problem}); restore it from a copy (it records the sweep's "
                 "base, grid, seeds and envs), or start a new sweep in a new --sweep-dir"
