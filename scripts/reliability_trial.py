@@ -510,7 +510,13 @@ for mode in ("NEXT_STEP", "SAME_STEP"):
         api(f"w.SimounObservation({vec})", "vector"),
     ]
 
-CASES = FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES
+# the second trial's cases, new inputs of every area, run alone with --set second
+SECOND_COMMAND_CASES: list[dict] = []
+SECOND_API_CASES: list[dict] = []
+for _case in SECOND_COMMAND_CASES + SECOND_API_CASES:
+    _case["set"] = "second"
+
+CASES = FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES + SECOND_COMMAND_CASES + SECOND_API_CASES
 
 
 def tiny_run(where: Path) -> Path:
@@ -624,6 +630,9 @@ def main() -> int:
     parser.add_argument(
         "--command", choices=(*COMMANDS, "api"), action="append", help="only its cases"
     )
+    parser.add_argument(
+        "--set", choices=("first", "second"), help="only that trial's cases (default: all)"
+    )
     parser.add_argument("--markdown", type=Path, help="also write the table here")
     args = parser.parse_args()
     for name in COMMANDS.values():  # imported once, before the children fork
@@ -633,6 +642,7 @@ def main() -> int:
         for case in CASES
         if (args.area is None or case["area"] in args.area)
         and (args.command is None or case.get("command", "api") in args.command)
+        and (args.set is None or case.get("set", "first") == args.set)
     ]
     counts = {"clear": 0, "unclear": 0, "wrong": 0}
     rows = []
