@@ -34,7 +34,7 @@ from torch import nn
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.losses import deterministic_actor_loss, deterministic_value
-from simoun_agent.models.networks import mlp, state_trunk
+from simoun_agent.models.networks import ActorNet
 from simoun_agent.models.sac import Actor, Critic
 
 
@@ -45,7 +45,7 @@ def exploration_std(step: int, start: float, end: float, duration: int) -> float
     return (1.0 - progress) * start + progress * end
 
 
-class DeterministicActor(nn.Module):
+class DeterministicActor(ActorNet):
     """DrQ-v2's policy (Yarats et al. 2022): a = tanh(mu(f_t)), no entropy and no temperature.
 
     It explores with Gaussian noise whose std follows :func:`exploration_std` of the global env
@@ -66,15 +66,13 @@ class DeterministicActor(nn.Module):
         noise_clip: float,
         trunk_dim: int | None = None,
     ) -> None:
-        super().__init__()
-        self.state_trunk, in_dim = state_trunk(repr_dim, trunk_dim)
-        self.trunk = mlp(in_dim, hidden_dim, action_dim)
+        super().__init__(repr_dim, hidden_dim, action_dim, trunk_dim)
         self.schedule = (std_start, std_end, std_steps)
         self.noise_clip = noise_clip
 
     def forward(self, state: torch.Tensor) -> torch.Tensor:
         """The deterministic action mu(f_t) in [-1, 1]."""
-        return torch.tanh(self.trunk(self.state_trunk(state)))
+        return torch.tanh(self.outputs(state))
 
     def std(self, step: int) -> float:
         """The exploration noise std at global env step ``step``."""

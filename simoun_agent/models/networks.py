@@ -25,6 +25,20 @@ def state_trunk(repr_dim: int, trunk_dim: int | None) -> tuple[nn.Module, int]:
     return layers, trunk_dim
 
 
+class ActorNet(nn.Module):
+    """Base of the actors: the actor's own :func:`state_trunk` on the encoder's state, then an
+    :func:`mlp` of two hidden layers to ``out_dim`` raw outputs (:meth:`outputs`)."""
+
+    def __init__(self, repr_dim: int, hidden_dim: int, out_dim: int, trunk_dim: int | None) -> None:
+        super().__init__()
+        self.state_trunk, in_dim = state_trunk(repr_dim, trunk_dim)
+        self.trunk = mlp(in_dim, hidden_dim, out_dim)
+
+    def outputs(self, state: torch.Tensor) -> torch.Tensor:
+        """The network's raw outputs on ``state`` ``(B, repr_dim)``."""
+        return self.trunk(self.state_trunk(state))
+
+
 class TransitionModel(nn.Module):
     """G(f^m_t, a_t): two FC layers predicting the next motion feature f^m_{t+1} (Eq. 2)."""
 

@@ -8,10 +8,10 @@ import torch
 from torch import nn
 
 from simoun_agent.losses import actor_loss, soft_value
-from simoun_agent.models.networks import mlp, state_trunk
+from simoun_agent.models.networks import ActorNet, mlp, state_trunk
 
 
-class Actor(nn.Module):
+class Actor(ActorNet):
     """Tanh-squashed Gaussian policy pi(a | f_t) with log-std bounded by a tanh rescale (SAC-AE).
 
     The ``"gaussian"`` entry of :data:`simoun_agent.models.actors.ACTORS`: it explores by
@@ -29,9 +29,7 @@ class Actor(nn.Module):
         log_std_max: float,
         trunk_dim: int | None = None,
     ) -> None:
-        super().__init__()
-        self.state_trunk, in_dim = state_trunk(repr_dim, trunk_dim)
-        self.trunk = mlp(in_dim, hidden_dim, 2 * action_dim)
+        super().__init__(repr_dim, hidden_dim, 2 * action_dim, trunk_dim)
         self.log_std_min = log_std_min
         self.log_std_max = log_std_max
 
@@ -39,7 +37,7 @@ class Actor(nn.Module):
         self, state: torch.Tensor, deterministic: bool = False
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """Return a squashed action and its log-probability ``(B, 1)`` (of the sampled action)."""
-        mu, log_std = self.trunk(self.state_trunk(state)).chunk(2, dim=-1)
+        mu, log_std = self.outputs(state).chunk(2, dim=-1)
         log_std = torch.tanh(log_std)
         log_std = self.log_std_min + 0.5 * (self.log_std_max - self.log_std_min) * (log_std + 1)
         noise = torch.zeros_like(mu) if deterministic else torch.randn_like(mu)
