@@ -52,6 +52,7 @@ from __future__ import annotations
 import difflib
 import itertools
 import json
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -366,6 +367,17 @@ class _Reader:
             raise self.fail(where, f"give a table ([{'.'.join(where)}]), not {value!r}")
         return dict(value)
 
+    def entries(
+        self, value: Any, section: str, names: list[str], what: str, fix: str
+    ) -> Iterator[tuple[str, Any, tuple[str, ...]]]:
+        """``(key, entry, where)`` for each entry of the table ``[section]``; a key that is not
+        one of ``names`` is refused as not ``what``, with ``fix``."""
+        for key, entry in self.table(value, (section,)).items():
+            where = (section, key)
+            if key not in names:
+                raise self.fail(where, f"{key!r} is {what} ({', '.join(names)}); {fix}")
+            yield key, entry, where
+
     def known_recipe(self, recipe: Any, where: tuple[str, ...]) -> None:
         """Refuse a name that is no recipe, suggesting the closest one."""
         if recipe not in RECIPES:
@@ -606,17 +618,15 @@ class _Reader:
         preset: str | None,
         base: dict[str, Any],
     ) -> dict[str, dict]:
-        table = self.table(value, ("tasks",))
         used = list(dict.fromkeys(tuning.tasks + evaluation.tasks))
         config = {}
-        for task, extras in table.items():
-            where = ("tasks", task)
-            if task not in used:
-                raise self.fail(
-                    where,
-                    f"{task!r} is no task of [tuning] or [evaluation] ({', '.join(used)}); add "
-                    "it to a phase's tasks or remove this table",
-                )
+        for task, extras, where in self.entries(
+            value,
+            "tasks",
+            used,
+            "no task of [tuning] or [evaluation]",
+            "add it to a phase's tasks or remove this table",
+        ):
             extras = self.config_table(self.table(extras, where), where, recipes)
             for key in extras:
                 if key in base:
@@ -652,17 +662,15 @@ class _Reader:
     def diagnostics(self, value: Any, recipes: list[str]) -> dict[str, list[str]]:
         """Method -> its ablation recipes: the method is one of the study's recipes; each
         ablation is a known recipe, not compared in the study itself, listed once."""
-        table = self.table(value, ("diagnostics",))
         seen: set[str] = set()
         out = {}
-        for method, ablations in table.items():
-            where = ("diagnostics", method)
-            if method not in recipes:
-                raise self.fail(
-                    where,
-                    f"{method!r} is not one of the study's recipes ({', '.join(recipes)}); "
-                    "diagnostics run at a compared recipe's selected setting",
-                )
+        for method, ablations, where in self.entries(
+            value,
+            "diagnostics",
+            recipes,
+            "not one of the study's recipes",
+            "diagnostics run at a compared recipe's selected setting",
+        ):
             if not isinstance(ablations, list) or not ablations:
                 raise self.fail(
                     where, f'give a non-empty list of recipes, e.g. {method} = ["{method}_no_aux"]'
