@@ -73,21 +73,38 @@ def _dmc_preset(task: str) -> Preset:
     )
 
 
+def _highway_preset(
+    description: str, env: str, config: dict, cameras: int, overrides: dict
+) -> Preset:
+    """A preset for the highway-env ``env`` with its ``config``, ``cameras`` views and the other
+    ``overrides``; action repeat 1, as highway-env's own ``policy_frequency`` sets how often the
+    agent decides."""
+    return Preset(
+        description=description,
+        overrides={
+            "env": env,
+            "env_kwargs": {"config": config},
+            "action_repeat": 1,
+            "cameras": cameras,
+            **overrides,
+        },
+        envs="highway",
+    )
+
+
 PRESETS: dict[str, Preset] = {task: _dmc_preset(task) for task in PAPER_ACTION_REPEAT}
-PRESETS["highway"] = Preset(
-    description="highway-env driving: 3 viewports around the ego vehicle -> 84x252, continuous "
+PRESETS["highway"] = _highway_preset(
+    "highway-env driving: 3 viewports around the ego vehicle -> 84x252, continuous "
     "[acceleration, steering], 40 s episodes, 20 vehicles at density 1",
+    "highway-v0",
+    HIGHWAY_CONFIG,
+    cameras=3,
     overrides={
-        "env": "highway-v0",
-        "env_kwargs": {"config": HIGHWAY_CONFIG},
-        "action_repeat": 1,
-        "cameras": 3,
         "total_env_steps": 100_000,
         "eval_every": 5_000,
         "eval_episodes": 5,
         "agent": {"batch_size": 128},
     },
-    envs="highway",
 )
 CPU_PRESET_TIME = "52-81 min wall beside a second run on 2 loaded cores (measured: dmc100k v1)"
 """Time of one cpu-preset run: the dmc100k study's 5 evaluation seeds on cartpole-swingup
@@ -121,16 +138,15 @@ PRESETS["cpu"] = Preset(
     },
 )
 
-PRESETS["highway-cpu"] = Preset(
-    description="highway-env driving sized for 2 CPU cores: highway-fast-v0, one 64x64 grayscale "
+PRESETS["highway-cpu"] = _highway_preset(
+    "highway-env driving sized for 2 CPU cores: highway-fast-v0, one 64x64 grayscale "
     "view ahead of the ego vehicle (--cameras 3: the paper's three views, 64x192), continuous "
     "[acceleration, steering] at 5 decisions/s, 150-decision episodes ending off-road, batch 32, "
     "8 filters, hidden 256, random shift, 3-step returns, one torch thread",
+    "highway-fast-v0",
+    HIGHWAY_FAST_CONFIG,
+    cameras=1,
     overrides={
-        "env": "highway-fast-v0",
-        "env_kwargs": {"config": HIGHWAY_FAST_CONFIG},
-        "action_repeat": 1,
-        "cameras": 1,
         "image_size": 64,
         "grayscale": True,
         "total_env_steps": 50_000,
@@ -148,7 +164,6 @@ PRESETS["highway-cpu"] = Preset(
             "n_step": 3,
         },
     },
-    envs="highway",
 )
 """Why these sizes. Measured on the project's 2-core machine while it was loaded by other work
 (load average 4-15): timings in process CPU seconds, one torch thread, each comparison within one
