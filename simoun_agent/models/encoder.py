@@ -181,14 +181,22 @@ class PixelEncoder(nn.Module):
 
 
 class OnePathEncoder(PixelEncoder):
-    """Base of the ablations with one conv path, ``convs`` (a :func:`conv_trunk`): the state is
-    the contrastive features of the whole float stack."""
+    """Base of the ablations with one conv path, ``convs`` (a :func:`conv_trunk` on
+    ``in_channels``), whose flattened last maps on frames of ``frame_shape`` are ``latent_dim``
+    long: the state is the contrastive features of the whole float stack."""
 
     key_is_frame = False
 
-    def __init__(self, convs: nn.Sequential, channels_last: bool) -> None:
+    def __init__(
+        self,
+        in_channels: int,
+        frame_shape: tuple[int, int, int],
+        num_filters: int,
+        channels_last: bool,
+    ) -> None:
         super().__init__(channels_last)
-        self.convs = convs
+        self.convs = conv_trunk(in_channels, num_filters)
+        self.latent_dim = trunk_dim(frame_shape, num_filters)
 
     def forward(self, obs: torch.Tensor, frame_features: bool = False) -> Encoding:
         f = self.encode_key(self.to_float(obs))
@@ -209,10 +217,9 @@ class StackedEncoder(OnePathEncoder):
         channels_last: bool = True,
         head: bool = True,
     ) -> None:
-        super().__init__(conv_trunk(num_frames * frame_shape[0], num_filters), channels_last)
-        flat = trunk_dim(frame_shape, num_filters)
-        self.head = Head(flat, feature_dim) if head else FlatMaps()
-        self.repr_dim = feature_dim if head else flat
+        super().__init__(num_frames * frame_shape[0], frame_shape, num_filters, channels_last)
+        self.head = Head(self.latent_dim, feature_dim) if head else FlatMaps()
+        self.repr_dim = feature_dim if head else self.latent_dim
 
     def encode_key(self, view: torch.Tensor) -> torch.Tensor:
         stack = view if view.ndim == 4 else view.flatten(1, 2)
@@ -250,9 +257,8 @@ class FlareEncoder(OnePathEncoder):
         feature_dim: int,
         channels_last: bool = True,
     ) -> None:
-        super().__init__(conv_trunk(frame_shape[0], num_filters), channels_last)
-        latent = trunk_dim(frame_shape, num_filters)
-        self.fc = nn.Linear((2 * num_frames - 1) * latent, feature_dim)
+        super().__init__(frame_shape[0], frame_shape, num_filters, channels_last)
+        self.fc = nn.Linear((2 * num_frames - 1) * self.latent_dim, feature_dim)
         self.norm = nn.LayerNorm(feature_dim)
         self.repr_dim = feature_dim
 
