@@ -20,6 +20,7 @@ from simoun_wrappers.intrinsic_reward import (
     IntrinsicSignal,
     IntrinsicVectorReward,
     SharedSource,
+    SourceProtocol,
 )
 
 __all__ = ["ConsistencyCuriosityReward", "ConsistencyCuriosityVectorReward", "ConsistencySignal"]
@@ -34,14 +35,15 @@ class ConsistencySignal(IntrinsicSignal):
     features' frame-to-frame changes (:func:`~simoun_wrappers.curiosity.consistency_distance`),
     from a :class:`~simoun_wrappers.curiosity.FeatureSource`."""
 
+    source_protocol = SourceProtocol(
+        "features",
+        FeatureSource,
+        "callable: uint8 (B, 3, C, H, W) -> f_m (B, D), f_a (B, 3, D)",
+        "simoun_agent.curiosity_model.CuriosityModel",
+    )
+
     def __init__(self, features: FeatureSource | SharedSource) -> None:
         super().__init__(features)
-        if not isinstance(self.source, FeatureSource):
-            raise TypeError(
-                f"features must be a FeatureSource (callable: uint8 (B, 3, C, H, W) -> f_m (B, D), "
-                f"f_a (B, 3, D)), got {type(self.source).__name__}. Use e.g. "
-                "simoun_agent.curiosity_model.CuriosityModel."
-            )
 
     @property
     def features(self) -> FeatureSource:

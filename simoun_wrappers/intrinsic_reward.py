@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from typing import Any, ClassVar, SupportsFloat
+from typing import Any, ClassVar, NamedTuple, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
@@ -122,6 +122,19 @@ class SharedSource:
         return source.source if isinstance(source, SharedSource) else source
 
 
+class SourceProtocol(NamedTuple):
+    """The protocol a signal's source must follow, and how a refusal explains it."""
+
+    argument: str
+    """the wrappers' argument that takes the source"""
+    protocol: type
+    """a ``runtime_checkable`` Protocol"""
+    expects: str
+    """what the protocol's call takes and returns"""
+    example: str
+    """a source that follows it"""
+
+
 class IntrinsicSignal(ABC):
     """A raw intrinsic value for each frame triplet reached: novelty, disagreement, a bonus.
 
@@ -130,11 +143,21 @@ class IntrinsicSignal(ABC):
     it. ``source`` is the model behind the signal (None for a signal that needs none); when it
     has ``watch(triplets, actions, next_triplets, terminated, truncated)`` it is handed every
     scored transition (to learn online), and its ``close()`` is called by the wrappers'
-    ``close()``. A new signal is one subclass implementing :meth:`raw`.
+    ``close()``. A new signal is one subclass implementing :meth:`raw`; one that needs a source
+    names the protocol the source must follow in :attr:`source_protocol`.
     """
+
+    source_protocol: ClassVar[SourceProtocol | None] = None
+    """what the source must be, checked when the signal is built; None: anything"""
 
     def __init__(self, source: Any = None) -> None:
         self.source = SharedSource.unwrap(source)
+        wanted = self.source_protocol
+        if wanted is not None and not isinstance(self.source, wanted.protocol):
+            raise TypeError(
+                f"{wanted.argument} must be a {wanted.protocol.__name__} ({wanted.expects}), got "
+                f"{type(self.source).__name__}. Use e.g. {wanted.example}."
+            )
 
     @abstractmethod
     def raw(self, triplets: np.ndarray) -> np.ndarray:

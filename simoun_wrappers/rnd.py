@@ -22,6 +22,7 @@ from simoun_wrappers.intrinsic_reward import (
     IntrinsicSignal,
     IntrinsicVectorReward,
     SharedSource,
+    SourceProtocol,
 )
 
 __all__ = ["NoveltySource", "RNDReward", "RNDSignal", "RNDVectorReward"]
@@ -44,14 +45,15 @@ class NoveltySource(Protocol):
 class RNDSignal(IntrinsicSignal):
     """The novelty source's error on the newest frame of each triplet."""
 
+    source_protocol = SourceProtocol(
+        "novelty",
+        NoveltySource,
+        "callable: uint8 (B, 3, C, H, W) -> (B,) errors",
+        "simoun_agent.rnd_model.RNDModel.for_env(env)",
+    )
+
     def __init__(self, novelty: NoveltySource | SharedSource) -> None:
         super().__init__(novelty)
-        if not isinstance(self.source, NoveltySource):
-            raise TypeError(
-                f"novelty must be a NoveltySource (callable: uint8 (B, 3, C, H, W) -> (B,) "
-                f"errors), got {type(self.source).__name__}. Use e.g. "
-                "simoun_agent.rnd_model.RNDModel.for_env(env)."
-            )
 
     def raw(self, triplets: np.ndarray) -> np.ndarray:
         errors = self.source(triplets)
