@@ -26,6 +26,7 @@ from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, restore
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
 from simoun_lab.minigrid_study.run import train_run
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
+from simoun_lab.minigrid_study.study_command import is_ppo_spec, load_ppo_spec
 from simoun_lab.minigrid_study.training import set_up
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
@@ -145,6 +146,94 @@ def test_a_run_goes_on_from_its_archived_checkpoint_when_its_run_directory_is_go
     assert [p["env_step_start"] for p in summary["parts"]] == [0, saved_step]
     walls = [float(r["wall_s"]) for r in rows(run_dir / "eval.csv")]
     assert walls == sorted(walls)  # training time counts on from the saved seconds
+
+
+def simoun_study(*args: str) -> tuple[int, str]:
+    """``simoun-study ARGS`` in this process: its exit status and what it printed."""
+    from simoun_lab.cli import study as study_cli
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+        try:
+            status = study_cli.main(list(args))
+        except SystemExit as exit_info:
+            status = exit_info.code
+    return status, out.getvalue()
+
+
+TINY_TOML = """\
+arms = ["ppo", "consistency", "rnd"]
+evaluations = 2
+eval_episodes = 2
+
+[[tasks]]
+env_id = "MiniGrid-DoorKey-5x5-v0"
+steps = 2048
+seeds = [0]
+
+[ppo]
+n_epochs = 1
+"""
+"""TINY in TOML, as simoun-study reads a MiniGrid spec beside the SAC ones"""
+
+
+def test_simoun_study_plans_resumes_and_reports_a_minigrid_spec(tiny_study, tmp_path):
+    paths, _, _, _ = tiny_study
+    archive, spec_file, work = Path(paths[1]), Path(paths[3]), Path(paths[5])
+    toml_spec = tmp_path / "tiny.toml"
+    toml_spec.write_text(TINY_TOML)
+    assert load_ppo_spec(str(toml_spec)) == load_spec(spec_file)
+
+    status, printed = simoun_study("plan", str(toml_spec))
+    assert status == 0 and "a MiniGrid PPO study, 3 runs" in printed
+    assert "MiniGrid-DoorKey-5x5-v0/rnd/s0  2,048" in printed
+
+    where = ["--study-dir", str(work), "--archive", str(archive)]
+    status, printed = simoun_study("run", str(spec_file), *where)
+    assert status == 2 and "already holds a MiniGrid study" in printed and "--resume" in printed
+    status, printed = simoun_study(
+        "run", str(toml_spec), *where, "--resume", "--allow-other-commit"
+    )
+    assert status == 2 and "drop the flag" in printed
+    status, printed = simoun_study("run", str(toml_spec), *where, "--resume")
+    assert status == 0 and "3 of 3 runs finished" in printed and "0 to run" in printed
+    status, printed = simoun_study(
+        "run", str(toml_spec), "--study-dir", str(tmp_path / "new"), "--resume"
+    )
+    assert status == 2 and "no study to resume" in printed
+
+    assert study("report", "--archive", str(archive))[0] == 0
+    report = archive / "report" / "report.md"
+    before = report.read_bytes()
+    report.unlink()
+    status, printed = simoun_study("report", str(toml_spec), "--study-dir", str(archive))
+    assert status == 0, printed[-4000:]
+    assert report.read_bytes() == before  # the engine's command writes the same report
+    other = tmp_path / "other.toml"
+    other.write_text(TINY_TOML.replace("eval_episodes = 2", "eval_episodes = 3"))
+    status, printed = simoun_study("report", str(other), "--study-dir", str(archive))
+    assert status == 2 and "another spec" in printed
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        (TINY_TOML.replace("evaluations", "evaluation"), "unknown key(s) ['evaluation']"),
+        (TINY_TOML.replace("n_epochs", "epochs"), "ppo: unknown key(s) ['epochs']"),
+        (TINY_TOML.replace('"rnd"', '"rdn"'), "rdn"),
+    ],
+)
+def test_simoun_study_refuses_a_bad_minigrid_toml_spec_naming_the_key(text, said, tmp_path):
+    spec = tmp_path / "bad.toml"
+    spec.write_text(text)
+    status, printed = simoun_study("plan", str(spec))
+    assert status == 2 and said in printed and "Traceback" not in printed
+
+
+def test_a_sac_spec_is_not_read_as_a_minigrid_one():
+    assert is_ppo_spec("docs/studies/minigrid-v2/tuning/spec.json")
+    assert not is_ppo_spec("docs/studies/dmc100k.toml")
+    assert not is_ppo_spec("no/such/spec.toml")  # the SAC reader names the missing file
 
 
 def test_a_task_with_fewer_than_three_seeds_gets_no_interval_and_enters_no_pooled_score(tmp_path):

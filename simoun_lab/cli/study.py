@@ -14,6 +14,9 @@ directory or its archive (``simoun-study report SPEC --study-dir docs/studies/NA
 study is run by :mod:`simoun_lab.study.runner`; the runs go through the engine
 (:mod:`simoun_lab.engine.launcher`) as ``simoun-sweep``'s do: the same trial directories, Tune
 experiments, STOP file on SIGTERM and failure handling.
+
+A MiniGrid PPO spec (a JSON file, or TOML with ``arms``) is planned, run and reported on the same
+engine by :mod:`simoun_lab.minigrid_study.study_command`.
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ import tyro
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_lab.engine.ray_start import load_ray
+from simoun_lab.minigrid_study import study_command
+from simoun_lab.minigrid_study.study_command import is_ppo_spec
 from simoun_lab.study.checks import check_study
 from simoun_lab.study.plan import describe
 from simoun_lab.study.runner import StudyOptions, report_study, run_study, spec_from
@@ -49,7 +54,10 @@ examples:
   simoun-study report docs/studies/dmc100k.toml --study-dir docs/studies/dmc100k
 
 The spec's layout is documented in simoun_lab/study/spec.py; docs/studies/dmc100k.toml is a
-full example."""
+full example. A MiniGrid PPO spec (SB3 PPO with or without an intrinsic reward, e.g.
+docs/studies/minigrid-v2/tuning/spec.json) runs the same way:
+  simoun-study run docs/studies/minigrid-v2/tuning/spec.json --study-dir runs/minigrid-v2 \\
+      --archive docs/studies/minigrid-v2/tuning --resume"""
 
 
 @dataclass
@@ -103,6 +111,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""
     args = parse(Command, argv, PROG, DESCRIPTION)
     try:
+        if is_ppo_spec(args.spec):
+            return ppo_study(args)
         spec = spec_from(args.spec)
         if isinstance(args, Plan):
             if args.probe_updates < 0:
@@ -123,6 +133,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run_study(spec, args.spec, options, ray)
     except SetupError as err:
         fail(PROG, err)
+
+
+def ppo_study(args: Plan | Run | Report) -> int:
+    """The command on a MiniGrid PPO spec."""
+    spec = study_command.load_ppo_spec(args.spec)
+    if isinstance(args, Plan):
+        print(study_command.plan(spec, args.spec))
+        return 0
+    if isinstance(args, Report):
+        print(f"report: {study_command.report(spec, args.study_dir)}")
+        return 0
+    options = dataclasses.replace(
+        args,
+        study_dir=args.study_dir.absolute(),
+        archive=args.archive.absolute() if args.archive else None,
+    )
+    return study_command.run(spec, options)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,120 @@
+"""``simoun-study`` on a MiniGrid PPO spec: plan, run and report it with the command that runs
+the SAC studies, on the same engine.
+
+A spec is a MiniGrid PPO study's when it is a JSON file (``docs/studies/minigrid-v2/tuning/
+spec.json``) or a TOML file with a top-level ``arms`` key holding the same keys; a SAC study's
+spec has ``recipes`` instead. The options keep their meaning: ``--study-dir`` holds Ray Tune's
+records and the runs in progress (each with its checkpoint), ``--archive`` the finished runs,
+the spec and each in-progress checkpoint (``--study-dir`` itself when left out), ``--resume``
+goes on with the runs an archive holds.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import tomllib
+
+from simoun_agent.config import SetupError
+from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
+from simoun_lab.study.runner import StudyOptions
+
+__all__ = ["is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
+
+
+def _toml(path: Path) -> dict | None:
+    """The TOML file's tables, or None when it cannot be read or parsed (the SAC reader then
+    names the problem)."""
+    try:
+        return tomllib.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+
+
+def is_ppo_spec(path: str) -> bool:
+    """Whether the spec at ``path`` is a MiniGrid PPO study's (see the module's docstring)."""
+    if Path(path).suffix.lower() == ".json":
+        return True
+    data = _toml(Path(path))
+    return data is not None and "arms" in data and "recipes" not in data
+
+
+def load_ppo_spec(path: str) -> StudySpec:
+    """The MiniGrid PPO spec at ``path``, JSON or TOML; SetupError naming the file and key."""
+    if Path(path).suffix.lower() == ".json":
+        return load_spec(Path(path))
+    return spec_from_dict(_toml(Path(path)) or {}, path)
+
+
+def plan(spec: StudySpec, path: str) -> str:
+    """Every run of the spec, in the order they run, with its budget."""
+    runs = spec.runs()
+    lines = [f"{path}: a MiniGrid PPO study, {len(runs)} runs (task / arm / seed, env steps)"]
+    lines += [f"  {run.name}  {run.task.steps:,}" for run in runs]
+    total = sum(run.task.steps for run in runs)
+    lines.append(f"{total:,} env steps in all; two runs at a time, one torch thread each")
+    return "\n".join(lines)
+
+
+def _runner():
+    """The runner, imported when a study runs or is reported: it imports SB3 and MiniGrid, which
+    a SAC study's command does not need."""
+    from simoun_lab.minigrid_study import runner
+
+    return runner
+
+
+def archive_of(options: StudyOptions) -> Path:
+    return options.archive if options.archive is not None else options.study_dir
+
+
+def run(spec: StudySpec, options: StudyOptions) -> int:
+    """Train every unfinished run of ``spec`` (:func:`~simoun_lab.minigrid_study.runner.
+    run_study`); 1 when a run failed."""
+    if options.allow_other_commit:
+        raise SetupError(
+            "--allow-other-commit is for SAC study specs; a MiniGrid PPO study goes on at any "
+            "commit (each run records its own): drop the flag"
+        )
+    runner = _runner()
+    archive = archive_of(options)
+    started = (archive / runner.SPEC_FILE).is_file()
+    if started and not options.resume:
+        raise SetupError(
+            f"{archive} already holds a MiniGrid study ({runner.SPEC_FILE}); pass --resume to "
+            "go on with its runs, or a new --archive (or --study-dir) to start another"
+        )
+    if options.resume and not started:
+        raise SetupError(
+            f"no study to resume: {archive} holds no {runner.SPEC_FILE}; drop --resume to start "
+            "the study, or pass the --archive of the study to continue"
+        )
+    archive.mkdir(parents=True, exist_ok=True)
+    outcome = runner.run_study(
+        spec,
+        archive,
+        options.study_dir,
+        options.address,
+        options.num_cpus or 2,
+        options.verbose,
+    )
+    print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
+    return 1 if outcome["failed"] else 0
+
+
+def report(spec: StudySpec, study_dir: Path) -> Path:
+    """The MiniGrid report of the archive ``study_dir``, written into it."""
+    from simoun_lab.minigrid_study.report import write_report
+
+    runner = _runner()
+    saved = study_dir / runner.SPEC_FILE
+    if saved.is_file() and load_spec(saved) != spec:
+        raise SetupError(
+            f"--study-dir {study_dir} holds runs of another spec ({saved}); pass the spec it "
+            "was run with"
+        )
+    if not runner.finished_runs(spec, study_dir):
+        raise SetupError(
+            f"--study-dir {study_dir} holds no finished run of this spec: nothing to report yet"
+        )
+    return write_report(spec, study_dir)
