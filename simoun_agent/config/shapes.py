@@ -115,7 +115,9 @@ def frame_fits(agent: EncoderSettings, height: int, width: int) -> bool:
 def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: EncoderSettings) -> None:
     """What ``SimounAgent`` is built for: channel-first frames its encoder accepts, and at least
     one action dimension. Raises ValueError naming the argument and the fix."""
-    shape = tuple(frame_shape)
+    shape = tuple(frame_shape) if isinstance(frame_shape, Sequence) else (frame_shape,)
+    if hasattr(frame_shape, "tolist"):  # a numpy array of the three sizes
+        shape = tuple(frame_shape.tolist())
     if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
         raise ValueError(
             f"frame_shape must be (C, H, W) positive ints, got {shape!r}; pass "
