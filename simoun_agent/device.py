@@ -19,7 +19,8 @@ def default_device(device: str | torch.device | None = None) -> torch.device:
             f"device must be a str or torch.device, got {type(device).__name__} {device!r}; "
             "e.g. device='cpu' or 'cuda:0', or None for cuda when there is one"
         )
-    problem = device_problem(str(device))
+    # "meta" is torch's shape-only device, on which the memory estimate builds the agent
+    problem = None if str(device) == "meta" else device_problem(str(device))
     if problem is not None:
         raise ValueError(f"device {str(device)!r}: {problem}")
     return torch.device(device)
