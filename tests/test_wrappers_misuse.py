@@ -25,6 +25,7 @@ from simoun_wrappers import (
     ConstantBonusReward,
     ConstantBonusVectorReward,
     FrameTriplet,
+    MovingBackground,
     RandomConvolution,
     RNDReward,
     SimounObservation,
@@ -289,6 +290,12 @@ def test_a_bad_reset_seed_is_refused_before_a_wrapper_seeds_its_own_rng(seed):
     colors = ColorShift(gym.make("dm_control/cartpole-swingup-v0"))
     with pytest.raises(ValueError, match=r"ColorShift.reset\(seed=...\)"):
         colors.reset(seed=seed)
+
+
+def test_moving_background_names_videos_that_are_no_path():
+    cartpole = gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array")
+    with pytest.raises(TypeError, match="videos must be a folder path"):
+        MovingBackground(cartpole, videos=3)
 
 
 def test_color_shift_pickles_and_deep_copies():
