@@ -510,9 +510,346 @@ for mode in ("NEXT_STEP", "SAME_STEP"):
         api(f"w.SimounObservation({vec})", "vector"),
     ]
 
+# the second trial's API cases: every public wrapper, the PettingZoo wrapper and the agent's API
+S = f"w.SimounObservation({P}, size=16)"
+C = "gym.make('CartPole-v1', render_mode='rgb_array')"
+NOV = "import functools; nov = functools.partial(np.mean, axis=(1, 2, 3, 4)); "
+FEAT = (
+    "def feat(t):\n"
+    "    f = t.reshape(*t.shape[:2], -1)[..., :4].astype(np.float32)\n"
+    "    return f[:, 2] - f[:, 1], f\n"
+)
+DMC = (
+    "import shimmy; gym.register_envs(shimmy); "
+    "d = gym.make('dm_control/cartpole-swingup-v0', render_mode='rgb_array'); "
+)
+PZ = (
+    "import pettingzoo; from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; "
+    "pz = pettingzoo.make('parallel', 'butterfly/pistonball-v6', n_pistons=3, "
+    "render_mode='rgb_array'); "
+)
+AEC = "import pettingzoo; aec = pettingzoo.make('aec', 'butterfly/pistonball-v6', n_pistons=3); "
+AGENT = (
+    "from simoun_agent import AgentConfig, FrameReplay, SimounAgent; cfg = AgentConfig("
+    "batch_size=8, num_filters=4, feature_dim=8, hidden_dim=16, aux_hidden_dim=16); "
+)
+A = "SimounAgent((3, 32, 32), 1, cfg, device='cpu')"
+REWARD = f"gym.wrappers.TransformReward({P}, lambda r: {{}})"
+NAN, INF = REWARD.format("float('nan')"), REWARD.format("float('inf')")
+STEP = "e.reset(seed=0); e.step(e.action_space.sample())"
+
+
+def vec(mode: str, env: str = "Pendulum-v1", wrap: str = "w.SimounObservation(e, size=16)") -> str:
+    """A 2-env sync vector env of ``env`` in autoreset ``mode``, each sub-env wrapped by
+    ``wrap``."""
+    return (
+        f"gym.make_vec('{env}', 2, vectorization_mode='sync', render_mode='rgb_array', "
+        f"vector_kwargs={{'autoreset_mode': gym.vector.AutoresetMode.{mode}}}, "
+        f"wrappers=[lambda e: {wrap}])"
+    )
+
+
+# (code with one {} for the value, the name the refusal must give, the values)
+SECOND_REFUSED = [
+    (f"w.SimounObservation({P}, size={{}})", "size",
+     "True", "float('nan')", "10**6", "(16, '16')", "(16, None)"),
+    (f"w.SimounObservation({P}, num_frames={{}})", "num_frames",
+     "True", "3.0", "'3'", "None", "-1", "10**9"),
+    (f"w.SimounObservation({P}, {{}})", "grayscale", "grayscale=1"),
+    (f"w.SimounObservation({P}, {{}})", "motion", "motion=None"),
+    (f"w.SimounObservation({P}, {{}})", "fold_frames", "fold_frames='True'"),
+    (f"w.SimounObservation({P}, source={{}})", "source", "None", "'RENDER'"),
+    (f"w.ActionRepeat({P}, {{}})", "repeat", "None", "1.5", "np.float64(2)", "[2]", "'two'"),
+    (f"w.FrameTriplet({P}, num_frames={{}})", "num_frames",
+     "True", "'3'", "3.0", "None", "-2", "10**9"),
+    (f"w.RandomConvolution({P}, kernel_size={{}})", "kernel_size",
+     "True", "3.0", "'3'", "None", "-3"),
+    (f"w.RandomConvolution({P}, source={{}})", "source", "'pixels'"),
+    (f"w.MultiCamera({P}, cameras=[lambda e: e.render()], size={{}})", "size", "True", "-1"),
+    (f"w.MultiCamera({P}, cameras={{}})", "cameras", "'side'", "None"),
+    (f"w.MultiCamera({P}, cameras=[{{}}])", "dm_control", "0", "'side'"),
+    (f"w.MultiCamera({P}, cameras=[{{}}])", "highway", "{'scaling': 2.0}"),
+    (f"w.ConstantBonusReward({S}, scale={{}})", "scale",
+     "True", "-0.1", "None", "float('inf')", "np.float32('nan')"),
+    (f"w.ConstantBonusReward({S}, scale=0.1, decay={{}})", "decay",
+     "None", "'0'", "True", "-1e-3"),
+    (NOV + f"w.RNDReward({S}, nov, warmup={{}})", "warmup", "-1", "1.5", "True", "None"),
+    (NOV + f"w.RNDReward({S}, nov, progress={{}})", "progress", "0", "2", "True", "'0.5'"),
+    (NOV + f"w.RNDReward({S}, nov, normalization={{}})", "normalization",
+     "'nope'", "None", "3"),
+    (NOV + f"w.RNDReward({S}, nov, scale={{}})", "scale", "-1", "'big'"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, r_e_max_init={{}})", "r_e_max_init",
+     "0", "-1", "float('nan')", "'1'"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, r_i_max_init={{}})", "r_i_max_init",
+     "0", "True"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, {{}})", "decay", "decay=-1"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, {{}})", "normalization",
+     "normalization='paperr'"),
+    (f"w.ConsistencyCuriosityReward({S}, features={{}})", "features", "np.zeros(3)", "'model'"),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), kernel_size={})", "kernel_size",
+     "True", "3.0"),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), clamp={})", "clamp",
+     "(0, float('nan'))", "(0, 1, 2)", "'01'"),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), generator={})", "generator", "3"),
+    ("import torch; w.random_conv({})", "float",
+     "torch.zeros(2, 3, 8, 8, dtype=torch.uint8)"),
+    ("import torch; w.random_conv({})", "kernel_size", "torch.zeros(2, 3, 2, 2)"),
+    ("w.residual_motion({})", "uint8",
+     "np.zeros((3, 1, 4, 4), np.int16)", "None", "np.zeros((3, 1, 4, 4), bool)"),
+    (f"w.check_sb3_policy(w.SimounObservation({P}, size=40, fold_frames=True), {{}})", "policy",
+     "None", "'cnnpolicy'"),
+    (f"w.check_sb3_policy(w.SimounObservation({P}, size=40, fold_frames=True), {{}})",
+     "CnnPolicy", "'MlpPolicy'"),
+    (f"w.check_sb3_policy(w.SimounObservation({P}, size=16, fold_frames=True), {{}})", "36",
+     "'CnnPolicy'"),
+    (DMC + "w.ColorShift(d, level={})", "level", "None", "'EASY'"),
+    (DMC + "w.ColorShift(d, seed={})", "seed", "1.5", "'0'", "True"),
+    (DMC + "w.MovingBackground(d, {})", "videos", "videos=3"),
+    (DMC + "w.MovingBackground(d, {})", "seed", "seed=-5"),
+    (PZ + "SPO(pz, {})", "size", "size=True"),
+    (PZ + "SPO(pz, {})", "num_frames", "num_frames=0", "num_frames=1.5"),
+    (PZ + "SPO(pz, {})", "grayscale", "grayscale='no'"),
+    (PZ + "SPO(pz, {})", "source", "source='x'"),
+    (AGENT + "SimounAgent({}, 1, cfg, device='cpu')", "frame_shape",
+     "(3, 32.0, 32)", "'3,32,32'", "None", "(0, 32, 32)", "(3, 32)"),
+    (AGENT + "SimounAgent({}, 1, cfg, device='cpu')", "(3, 32, 32)", "(32, 32, 3)"),
+    (AGENT + "SimounAgent({}, 1, cfg, device='cpu')", "too small", "(3, 4, 4)"),
+    (AGENT + "SimounAgent((3, 32, 32), {}, cfg, device='cpu')", "action_dim",
+     "1.0", "'1'", "True", "0", "None"),
+    (AGENT + "SimounAgent((3, 32, 32), {}, cfg, device='cpu')", "continuous",
+     "gym.spaces.Discrete(2)"),
+    (AGENT + "SimounAgent((3, 32, 32), 1, {}, device='cpu')", "config",
+     "{'lr': 1e-3}", "'cpu'", "AgentConfig"),
+    (AGENT + "SimounAgent((3, 32, 32), 1, cfg, device={})", "device", "'tpu'", "'cuda:7'", "3"),
+    (AGENT + f"{A}.act({{}})", "frames",
+     "np.zeros((3, 3, 16, 16), np.uint8)", "np.zeros((3, 32, 32), np.uint8)",
+     "{'frames': np.zeros((3, 3, 32, 32), np.uint8)}"),
+    (AGENT + f"{A}.act({{}})", "uint8", "np.zeros((3, 3, 32, 32), np.float32)"),
+    (AGENT + "FrameReplay({}, (3, 32, 32), 1)", "capacity", "0", "10.5", "'100'", "None"),
+    (AGENT + "FrameReplay(100, (3, 32, 32), 1, {})", "num_frames", "num_frames=0"),
+    (AGENT + "FrameReplay(100, (3, 32, 32), 1, {})", "seed", "seed=-1"),
+    (AGENT + "FrameReplay(100, (3, 32, 32), {})", "action_dim", "0", "1.5"),
+    (AGENT + "AgentConfig({})", "lr", "lr='0.001'", "lr=0"),
+    (AGENT + "AgentConfig({})", "batch_size", "batch_size=8.0", "batch_size=True"),
+    (AGENT + "AgentConfig({})", "discount", "discount=float('nan')"),
+    (AGENT + "AgentConfig({})", "encoder", "encoder='dual-path'"),
+    (AGENT + "AgentConfig({})", "nope", "nope=1"),
+    (AGENT + "AgentConfig({})", "n_step", "n_step=0"),
+    (AGENT + "AgentConfig({})", "feature_dim", "feature_dim=-8"),
+    (AGENT + "AgentConfig({})", "augmentation", "augmentation=None"),
+    (AGENT + "AgentConfig({})", "curiosity", "curiosity='yes'"),
+    ("from simoun_agent.config import resolve; resolve({})", "cpux", "'cpux', {}"),
+    ("from simoun_agent.config import resolve; resolve({})", "agent.lr",
+     "'cpu', {'agent.lrr': 1e-3}", "'cpu', {'agent.lr': 'abc'}"),
+    ("from simoun_agent.config import resolve; resolve({})", "overrides",
+     "'cpu', [('agent.lr', 1e-3)]"),
+    ("from simoun_agent.config import resolve; resolve({})", "drqq",
+     "None, {'agent.recipe': 'drqq'}"),
+    ("from simoun_agent.config import resolve; resolve({})", "seed", "'cpu', {'seed': -1}"),
+]  # fmt: skip
+
+# (code, the name the refusal must give, or "" for a valid input that must go on)
+SECOND_CODES = [
+    # envs of every observation kind
+    ("w.SimounObservation(gym.make('MiniGrid-Empty-5x5-v0'))", "render_mode"),
+    ("w.SimounObservation(gym.make('FrozenLake-v1'))", "render_mode"),
+    ("w.SimounObservation(gym.make('CartPole-v1'))", "render_mode"),
+    ("e = w.SimounObservation(gym.make('FrozenLake-v1', render_mode='rgb_array'), size=16); "
+     + STEP, ""),
+    ("import minigrid.wrappers as mw; "
+     "w.SimounObservation(mw.RGBImgObsWrapper(gym.make('MiniGrid-Empty-5x5-v0')))", "image"),
+    ("e = w.SimounObservation(gym.wrappers.GrayscaleObservation(gym.wrappers.AddRenderObservation("
+     f"{C})), size=16); " + STEP, ""),
+    ("w.SimounObservation(gym.wrappers.TransformObservation(gym.wrappers.AddRenderObservation("
+     f"{C}), lambda o: o / 255.0, gym.spaces.Box(0, 1, (400, 600, 3))), source='observation')",
+     "uint8"),
+    ("e = w.SimounObservation(gym.wrappers.ResizeObservation(gym.wrappers.AddRenderObservation("
+     f"{C}), (4, 4)), size=None); " + STEP, ""),
+    ("w.RandomConvolution(gym.wrappers.ResizeObservation(gym.wrappers.AddRenderObservation("
+     f"{C}), (4, 4)), kernel_size=5)", "kernel_size"),
+    ("w.SimounObservation(gym.make('Pendulum-v1', render_mode='human'))", "render_mode"),
+    ("w.SimounObservation(gym.make('Pendulum-v1', render_mode='rgb_array_list'))", "render_mode"),
+    ("w.RandomConvolution(gym.make('Pendulum-v1'))", "render_mode"),
+    (DMC.replace(", render_mode='rgb_array'", "") + "w.MovingBackground(d)", "render_mode"),
+    (f"w.ResidualMotion(w.FrameTriplet({P}))", "uint8"),
+    (f"w.ResidualMotion(w.SimounObservation({P}, size=16, motion=False))", "(k, C, H, W)"),
+    (f"w.ResidualMotion(w.SimounObservation({P}, size=16, fold_frames=True))", "(k, C, H, W)"),
+    (f"w.FrameTriplet({S})", "Box"),
+    ("w.FrameTriplet(gym.make('FrozenLake-v1'))", "Box"),
+    (f"w.ConstantBonusReward({P}, scale=0.1)", "SimounObservation"),
+    (f"w.ConstantBonusReward(w.SimounObservation({P}, size=16, num_frames=4), scale=0.1)",
+     "num_frames"),
+    (f"e = w.ConstantBonusReward(w.SimounObservation({P}, size=16, fold_frames=True), 0.1); "
+     + STEP, ""),
+    ("w.residual_motion(np.zeros((1, 3, 1, 4, 4), np.uint8))", ""),
+    ("import torch; w.random_conv(torch.zeros(0, 3, 8, 8))", ""),
+    ("w.check_sb3_policy(gym.spaces.Discrete(3), 'MlpPolicy')", ""),
+    (f"w.check_sb3_policy({vec('NEXT_STEP', wrap=f'{S[:-1]}, fold_frames=True)')}, 'CnnPolicy')",
+     "36"),
+    (f"w.check_sb3_policy({vec('SAME_STEP')}, 'MultiInputPolicy')", "fold_frames"),
+    # wrappers in the wrong order or twice
+    (f"w.ActionRepeat({S}, 2)", "under"),
+    (f"e = w.ActionRepeat(w.ActionRepeat({P}, 2), 2); " + STEP, ""),
+    (f"w.RandomConvolution({S})", "under"),
+    (f"w.MultiCamera({S}, cameras=[lambda e: e.render()])", "under"),
+    ("w.SimounObservation(gym.wrappers.FrameStackObservation(gym.wrappers.AddRenderObservation("
+     f"{C}), 3))", "FrameStackObservation"),
+    (f"w.SimounObservation(w.ConstantBonusReward({S}, scale=0.1))", "already"),
+    (f"e = w.ConstantBonusReward(w.ConstantBonusReward({S}, 0.1), 0.1); " + STEP, ""),
+    (DMC + "w.MovingBackground(w.SimounObservation(d, size=16))", "under"),
+    (PZ + "SPO(SPO(pz, size=16))", "SimounParallelObservation"),
+    # single envs and vector envs swapped
+    (f"w.ConstantBonusVectorReward({S}, scale=0.1)", "ConstantBonusReward("),
+    (NOV + f"w.RNDVectorReward({S}, nov)", "RNDReward("),
+    (FEAT + f"w.ConsistencyCuriosityVectorReward({S}, feat)", "ConsistencyCuriosityReward("),
+    ("w.ConstantBonusVectorReward(gym.make_vec('Pendulum-v1', 2), scale=0.1)",
+     "SimounObservation"),
+    # PettingZoo envs, parallel and AEC
+    (PZ + "e = SPO(pz, size=16); e.reset(seed=0); "
+     "e.step({a: e.action_space(a).sample() for a in e.agents})", ""),
+    (AEC + "from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; SPO(aec)",
+     "parallel"),
+    (f"from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; SPO({P})",
+     "ParallelEnv"),
+    ("from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; "
+     f"SPO({vec('NEXT_STEP')})", "ParallelEnv"),
+    ("from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; SPO(None)",
+     "ParallelEnv"),
+    ("import pettingzoo; from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO;"
+     " SPO(pettingzoo.make('parallel', 'classic/rps-v2'))", "render_mode"),
+    (PZ.replace(", render_mode='rgb_array'", "") + "SPO(pz, source='render')", "render_mode"),
+    (PZ + "e = SPO(pz, size=16); e.step({a: e.action_space(a).sample() for a in e.agents})",
+     "reset"),
+    (PZ + "SPO(pz, size=16).reset(seed='a')", "seed"),
+    (PZ + "w.SimounObservation(pz)", "gymnasium.Env"),
+    (AEC + "w.ActionRepeat(aec, 2)", "gymnasium.Env"),
+    (AEC + "w.FrameTriplet(aec)", "gymnasium.Env"),
+    (PZ + "w.ConstantBonusReward(pz, scale=0.1)", "gymnasium.Env"),
+    (PZ + NOV + "w.RNDReward(pz, nov)", "gymnasium.Env"),
+    # step before reset, after the episode ended, actions and seeds
+    (f"w.FrameTriplet({P}).step(np.zeros(1, np.float32))", "reset"),
+    (f"w.ActionRepeat({P}, 2).step(np.zeros(1, np.float32))", "reset"),
+    (f"w.RandomConvolution({P}).step(np.zeros(1, np.float32))", "reset"),
+    (f"w.ConstantBonusReward({S}, 0.1).step(np.zeros(1, np.float32))", "reset"),
+    (NOV + f"w.RNDReward({S}, nov).step(np.zeros(1, np.float32))", "reset"),
+    (f"e = w.SimounObservation({C}, size=16); e.reset(seed=0); e.step(2)", "action"),
+    (f"e = w.ActionRepeat({C}, 2); e.reset(seed=0); e.step(np.array([0.5]))", "action"),
+    (f"e = w.ConstantBonusReward({S}, 0.1); e.reset(seed=0); e.step(np.array([100.0]))", ""),
+    (f"e = w.SimounObservation({P}, size=16); e.reset(seed=0); e.step('a')", "action"),
+    (f"w.FrameTriplet({P}).reset(seed='0')", "seed"),
+    (f"w.ActionRepeat({P}, 2).reset(seed=1.5)", "seed"),
+    (f"w.RandomConvolution({P}).reset(seed=-1)", "seed"),
+    (f"w.RandomConvolution({P}).reset(seed='a')", "seed"),
+    (f"w.RandomConvolution({P}).reset(seed=np.int64(3))", ""),
+    (DMC + "w.ColorShift(d).reset(seed=-1)", "seed"),
+    (DMC + "w.MovingBackground(d).reset(seed=1.5)", "seed"),
+    (f"w.ConstantBonusReward({S}, 0.1).reset(seed=[0])", "seed"),
+    # rewards that are NaN or inf
+    (f"e = w.ConstantBonusReward(w.SimounObservation({NAN}, size=16)"
+     ", 0.1); " + STEP, "NaN"),
+    (NOV + f"e = w.RNDReward(w.SimounObservation({NAN}, size=16), nov,"
+     " warmup=0); " + STEP, "NaN"),
+    (FEAT + "e = w.ConsistencyCuriosityReward(w.SimounObservation("
+     f"{INF}, size=16), feat); " + STEP, "inf"),
+    (f"e = w.ActionRepeat({NAN}, 2); " + STEP, ""),
+    (f"e = w.ConstantBonusReward({S}, scale=1e308); e.reset(seed=0); "
+     "[e.step(e.action_space.sample()) for _ in range(3)]", ""),
+    (AGENT + "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), "
+     "np.uint8)); r.add(np.zeros(1), float('nan'), np.zeros((3, 32, 32), np.uint8), False, "
+     "False)", "reward"),
+    # the agent's API
+    (AGENT + f"{A}.act(np.zeros((3, 3, 32, 32), np.uint8))", ""),
+    (AGENT + "SimounAgent([3, 32, 32], np.int64(2), cfg, device='cpu')", ""),
+    (AGENT + "SimounAgent(np.array([3, 32, 32]), 1, cfg, device='cpu')", ""),
+    (AGENT + f"{A}.update(FrameReplay(100, (3, 32, 32), 1), 0)", "batch_size"),
+    (AGENT + "r = FrameReplay(100, (3, 16, 16), 1); r.start_episode(np.zeros((3, 16, 16), "
+     "np.uint8)); [r.add(np.zeros(1), 0.0, np.zeros((3, 16, 16), np.uint8), False, False) for _ "
+     f"in range(9)]; {A}.update(r, 9)", "frame_shape"),
+    (AGENT + "FrameReplay(100, (3, 32, 32), 1).add(np.zeros(1), 0.0, np.zeros((3, 32, 32), "
+     "np.uint8), False, False)", "start_episode"),
+    (AGENT + "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), "
+     "np.uint8)); r.add(np.zeros(1), 'a', np.zeros((3, 32, 32), np.uint8), False, False)",
+     "reward"),
+    (AGENT + "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), "
+     "np.float32))", "uint8"),
+    (AGENT + "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), "
+     "np.uint8)); r.add(np.zeros(3), 0.0, np.zeros((3, 32, 32), np.uint8), False, False)",
+     "action"),
+    ("from simoun_agent.config import resolve; resolve('cpu', {'agent.recipe': 'drq'})", ""),
+    ("from simoun_agent.config import TrainConfig; TrainConfig(total_env_steps=0)",
+     "total_env_steps"),
+    ("from simoun_agent.config import from_dict; from_dict([])", "object"),
+    (f"from simoun_agent.rnd_model import RNDModel; RNDModel.for_env({P})", "SimounObservation"),
+    (f"from simoun_agent.rnd_model import RNDModel; m = RNDModel.for_env({S}); m.close()", ""),
+    ("from simoun_agent.curiosity_model import CuriosityModel; CuriosityModel((32, 32, 3))",
+     "frame_shape"),
+    ("from simoun_agent.curiosity_model import AgentFeatures; AgentFeatures(3)",
+     "encoder_features"),
+]  # fmt: skip
+
+# every wrapper pickled and deep-copied after a step, and stepped again
+COPIED = [
+    f"w.FrameTriplet({P})",
+    f"w.ActionRepeat({P}, 2)",
+    f"w.RandomConvolution({P})",
+    f"import operator; w.MultiCamera({P}, cameras=[operator.methodcaller('render')], size=16)",
+    f"w.ConstantBonusReward({S}, 0.1)",
+    NOV + f"w.RNDReward({S}, nov, warmup=0)",
+    DMC + "w.ColorShift(d, seed=0)",
+    DMC + "w.MovingBackground(d, seed=0)",
+]
+
+
+def copy_case(how: str, wrapper: str) -> dict:
+    """``wrapper`` pickled or deep-copied as made (a rendering env such as Pendulum holds pygame
+    surfaces after its first render, which do not pickle), the copy then reset and stepped."""
+    setup, _, made = wrapper.rpartition("; ")
+    prefix = f"{setup}; " if setup else ""
+    return api(f"import copy; {prefix}e = {made}; c = {how}; c.reset(seed=1); "
+               "c.step(c.action_space.sample())", "", ok=True)  # fmt: skip
+
+
+SECOND_API_CASES = [
+    *(case for code, names, *values in SECOND_REFUSED for case in refused(code, names, *values)),
+    *(api(code, names, ok=not names) for code, names in SECOND_CODES),
+    *(copy_case(how, wrapper) for how in ("pickle.loads(pickle.dumps(e))", "copy.deepcopy(e)")
+      for wrapper in COPIED),
+    api(FEAT + f"import copy; e = w.ConsistencyCuriosityReward({S}, feat); "
+        "c = copy.deepcopy(e); c.reset(seed=0); c.step(c.action_space.sample())", "", ok=True),
+    api(PZ + "import copy; e = SPO(pz, size=16); e.reset(seed=0); c = copy.deepcopy(e); "
+        "c.step({a: c.action_space(a).sample() for a in c.agents})", "", ok=True),
+]  # fmt: skip
+for mode in ("NEXT_STEP", "SAME_STEP"):
+    SECOND_API_CASES += [
+        api(f"w.{wrapper}({vec(mode)}{args})", "make_vec")
+        for wrapper, args in (
+            [("FrameTriplet", ""), ("ActionRepeat", ", 2"), ("RandomConvolution", "")]
+            if mode == "NEXT_STEP"
+            else [("ResidualMotion", ""), ("MultiCamera", ", [0]"), ("ColorShift", "")]
+        )
+    ]
+    cartpole = vec(mode, "CartPole-v1")
+    SECOND_API_CASES += [
+        api(NOV + f"v = w.RNDVectorReward({cartpole}, nov, warmup=0); v.reset(seed=0); "
+            "[v.step(v.action_space.sample()) for _ in range(30)]", "", ok=True),
+        api(FEAT + f"v = w.ConsistencyCuriosityVectorReward({cartpole}, feat); v.reset(seed=0); "
+            "[v.step(v.action_space.sample()) for _ in range(30)]", "", ok=True),
+        api(NOV + f"w.RNDReward({cartpole}, nov)", "RNDVectorReward"),
+        api(FEAT + f"w.ConsistencyCuriosityReward({cartpole}, feat)",
+            "ConsistencyCuriosityVectorReward"),
+        api(f"w.ConstantBonusVectorReward({cartpole}, 0.1).step(np.zeros(2, np.int64))", "reset"),
+        api(f"v = w.ConstantBonusVectorReward({cartpole}, 0.1); v.reset(seed='a')", "seed"),
+        api("v = w.ConstantBonusVectorReward(" + vec(mode, wrap="w.SimounObservation("
+            "gym.wrappers.TransformReward(e, lambda r: float('nan')), size=16)") + ", 0.1); "
+            "v.reset(seed=0); v.step(v.action_space.sample())", "NaN"),
+        api(f"e = w.SimounObservation({C}, size=16); e.reset(seed=0); "
+            "[e.step(1) for _ in range(40)]" if mode == "NEXT_STEP" else
+            f"e = w.ConstantBonusReward(w.SimounObservation(w.ActionRepeat({C}, 2), size=16), "
+            "0.1); e.reset(seed=0); [e.step(1) for _ in range(40)]", "", ok=True),
+    ]  # fmt: skip
+
 # the second trial's cases, new inputs of every area, run alone with --set second
 SECOND_COMMAND_CASES: list[dict] = []
-SECOND_API_CASES: list[dict] = []
 for _case in SECOND_COMMAND_CASES + SECOND_API_CASES:
     _case["set"] = "second"
 
@@ -587,6 +924,8 @@ def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
     if "code" in case:
         if status == "0":
             return ("clear" if case["ok"] else "wrong"), "accepted"
+        if case["ok"]:
+            return "wrong", status
         kind, _, rest = status.partition(" from ")
         inside = "/site-packages/" in rest.partition(":")[0]
         if inside or kind not in {"ValueError", "TypeError", "ResetNeeded", "SetupError",

@@ -79,6 +79,12 @@ class SimounAgent:
         config: AgentConfig | None = None,
         device: str | torch.device | None = None,
     ) -> None:
+        if config is not None and not isinstance(config, AgentConfig):
+            raise TypeError(
+                f"config must be an AgentConfig, got {type(config).__name__} ({config!r:.60}); "
+                "e.g. AgentConfig(batch_size=128), AgentConfig(**values) for a dict, or "
+                "simoun_agent.config.resolve(preset, overrides).agent for a preset"
+            )
         self.config = config = config or AgentConfig()
         check_agent_inputs(frame_shape, action_dim, config)
         self.frame_shape = tuple(int(s) for s in frame_shape)
@@ -247,6 +253,14 @@ class SimounAgent:
         detached 0-d tensors (no host sync here); call ``float()`` on the ones you log.
         """
         cfg = self.config
+        stored = (getattr(replay, "frame_shape", None), getattr(replay, "action_dim", None))
+        if stored != (self.frame_shape, self.action_dim):
+            raise ValueError(
+                f"replay holds frames {stored[0]} and actions of {stored[1]}, but this agent "
+                f"was built for frames {self.frame_shape} and actions of {self.action_dim}; "
+                f"create the replay with FrameReplay(capacity, {self.frame_shape}, "
+                f"{self.action_dim})"
+            )
         batch = replay.sample(cfg.batch_size, cfg.n_step, cfg.discount)
 
         def put(name: str) -> torch.Tensor:

@@ -25,6 +25,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
+from simoun_agent.config.shapes import check_channel_first
 from simoun_agent.device import default_device
 from simoun_wrappers.intrinsic_reward import triplet_shape
 
@@ -305,6 +306,7 @@ class OnlineModel(ABC):
         self.frame_shape = tuple(int(v) for v in frame_shape)
         if len(self.frame_shape) != 3:
             raise ValueError(f"frame_shape must be one frame's (C, H, W), got {frame_shape}.")
+        check_channel_first(self.frame_shape)
         c, h, w = self.frame_shape
         self.pool = max(1, min(h, w) // encoder_size) if encoder_size else 1
         self.encoded_shape = (c, h // self.pool, w // self.pool)

@@ -11,6 +11,8 @@ from typing import IO
 
 import numpy as np
 
+from simoun_wrappers._checks import is_int
+
 _MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
 
 
@@ -66,8 +68,22 @@ class FrameReplay:
         num_frames: int = 3,
         seed: int | None = None,
     ) -> None:
-        if capacity < 1 or num_frames < 1:
-            raise ValueError(f"capacity and num_frames must be >= 1, got {capacity}, {num_frames}")
+        for name, value in (("capacity", capacity), ("action_dim", action_dim)):
+            if not is_int(value) or value < 1:
+                raise ValueError(
+                    f"{name} must be an int >= 1, got {value!r}; e.g. FrameReplay(100_000, "
+                    "frame_shape, env.action_space.shape[0])"
+                )
+        if not is_int(num_frames) or num_frames < 1:
+            raise ValueError(f"num_frames must be an int >= 1, got {num_frames!r}; use 3")
+        shape = tuple(frame_shape) if isinstance(frame_shape, (tuple, list)) else ()
+        if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
+            raise ValueError(
+                f"frame_shape must be (C, H, W) positive ints, got {frame_shape!r}; pass "
+                "env.observation_space['frames'].shape[1:] of a SimounObservation env"
+            )
+        if seed is not None and not (is_int(seed) and seed >= 0):
+            raise ValueError(f"seed must be None or an int >= 0, got {seed!r}; e.g. seed=0")
         self.capacity = int(capacity)
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
@@ -140,7 +156,13 @@ class FrameReplay:
                 "FrameReplay.add() called with no open episode; call start_episode(first_frame) "
                 "after each env.reset() (and after an episode terminated or was truncated)"
             )
-        reward = float(reward)
+        try:
+            reward = float(reward)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"reward must be a number, got {type(reward).__name__} {reward!r}; pass the "
+                "reward env.step returned"
+            ) from None
         if not np.isfinite(reward):
             raise ValueError(
                 f"reward {reward} is not finite; the replay only stores finite rewards - check "

@@ -11,6 +11,24 @@ def is_int(value: Any) -> bool:
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
+def is_real(value: Any) -> bool:
+    """Whether ``value`` is a real number: a Python or numpy int or float, not a bool
+    (``scale=True`` is a mistake, not 1) and not a string (``scale="0.1"`` is not converted)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+
+
+def check_reset_seed(seed: Any, owner: str) -> None:
+    """A clear error for a ``reset(seed=...)`` that is neither None nor an int >= 0, raised before
+    ``owner`` seeds its own random generator with it (numpy's error names no argument)."""
+    if seed is not None and not (is_int(seed) and seed >= 0):
+        raise ValueError(
+            f"{owner}.reset(seed=...) takes None or an int >= 0, got {seed!r}; e.g. "
+            f"env.reset(seed=0), or env.reset() to continue the random stream."
+        )
+
+
 def check_positive_int(value: Any, name: str, fix: str) -> None:
     """A clear error for a ``value`` of the argument ``name`` that is not a positive int;
     ``fix`` says what to pass instead."""

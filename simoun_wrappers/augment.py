@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_reset_seed, is_int
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
@@ -83,12 +83,19 @@ def random_conv(
             f"{kernel_size!r}; use 3 (Lee et al. 2020) or another odd value."
         )
     check_kernel_fits(kernel_size, batch.shape[-2], batch.shape[-1])
+    if generator is not None and not isinstance(generator, torch.Generator):
+        raise TypeError(
+            f"generator must be a torch.Generator or None, got {described(generator)}; e.g. "
+            "generator=torch.Generator().manual_seed(0), or None for torch's global RNG."
+        )
     if clamp is not None and not _ordered_bounds(clamp):
         raise ValueError(
             f"clamp must be (low, high) with low <= high, got {clamp!r}; e.g. clamp=(0.0, 1.0) "
             "for images in [0, 1], or None for the raw output."
         )
     shape = batch.shape
+    if shape[0] == 0:
+        return batch.clone()  # an empty batch: a grouped convolution needs at least one group
     frames = batch if batch.ndim == 5 else batch.unsqueeze(1)
     b, t, c, h, w = frames.shape
 
@@ -253,6 +260,7 @@ class RandomConvolution(ChainWrapper):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        check_reset_seed(seed, "RandomConvolution")
         if seed is not None:
             self._rng = np.random.default_rng(seed)
         self._kernel_seed = int(self._rng.integers(2**62))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any, SupportsFloat
 
 import gymnasium as gym
@@ -12,6 +13,9 @@ from gymnasium.vector.utils import batch_space
 from gymnasium.wrappers import FrameStackObservation
 
 from simoun_wrappers._checks import check_positive_int
+
+MAX_STACK_BYTES = 2**30
+"""The largest stack ``FrameTriplet`` builds (1 GiB: over 12,000 RGB frames of 84 x 84)."""
 
 
 class FrameRing:
@@ -82,6 +86,14 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
             raise TypeError(
                 f"FrameTriplet stacks Box observations, got {space}; select or build an image "
                 f"first, e.g. SimounObservation(env) or gymnasium.wrappers.AddRenderObservation."
+            )
+        stack_bytes = num_frames * math.prod(space.shape) * space.dtype.itemsize
+        if stack_bytes > MAX_STACK_BYTES:
+            # refused here: batch_space and the ring would otherwise try to allocate it all
+            raise ValueError(
+                f"num_frames={num_frames} makes stacks of {stack_bytes / 2**30:.1f} GiB per "
+                f"observation of shape {space.shape} (at most {MAX_STACK_BYTES // 2**30} GiB); "
+                f"use num_frames=3 for a triplet."
             )
         self.num_frames = int(num_frames)
         self.observation_space = batch_space(space, n=self.num_frames)

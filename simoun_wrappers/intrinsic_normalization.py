@@ -32,6 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 from gymnasium.wrappers.utils import RunningMeanStd
 
+from simoun_wrappers._checks import is_real
 from simoun_wrappers.curiosity import RunningMax
 
 __all__ = [
@@ -122,6 +123,12 @@ class PaperMaxima(Normalization):
     name = "paper"
 
     def __init__(self, r_e_max_init: float = 1.0, r_i_max_init: float = 1.0) -> None:
+        for name, value in (("r_e_max_init", r_e_max_init), ("r_i_max_init", r_i_max_init)):
+            if not (is_real(value) and math.isfinite(value) and value > 0):
+                raise ValueError(
+                    f"{name} must be a finite number > 0 (the initial running maximum that "
+                    f"scales the intrinsic reward), got {value!r}; e.g. {name}=1.0 (the default)."
+                )
         self.maxima = RunningMax(r_e_max=r_e_max_init, r_i_max=r_i_max_init)
 
     def __call__(

@@ -22,7 +22,8 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import is_int, is_real
+from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import Normalization, make_normalization
 
 __all__ = [
@@ -187,7 +188,7 @@ class ConstantSignal(IntrinsicSignal):
 
 def check_scale(scale: float) -> float:
     """``scale`` as a float, or a clear error when it is negative, NaN or infinite."""
-    if not (isinstance(scale, (int, float, np.number)) and math.isfinite(scale) and scale >= 0):
+    if not (is_real(scale) and math.isfinite(scale) and scale >= 0):
         raise ValueError(
             f"scale must be a finite number >= 0 (the weight of the intrinsic reward), got "
             f"{scale!r}; use e.g. scale=0.01, or scale=0 to log the intrinsic reward without "
@@ -198,7 +199,7 @@ def check_scale(scale: float) -> float:
 
 def check_weighting(decay: float, warmup: int, progress: float | None) -> None:
     """A clear error for a ``decay``, ``warmup`` or ``progress`` out of range."""
-    if not (isinstance(decay, (int, float, np.number)) and decay >= 0 and math.isfinite(decay)):
+    if not (is_real(decay) and decay >= 0 and math.isfinite(decay)):
         raise ValueError(
             f"decay must be a finite number >= 0 (lambda of exp(-lambda * t), per env step), got "
             f"{decay!r}; use the paper's decay=2e-5, or decay=0 for a weight that never fades."
@@ -208,7 +209,7 @@ def check_weighting(decay: float, warmup: int, progress: float | None) -> None:
             f"warmup must be an int >= 0 (transitions that get no reward while the statistics "
             f"settle), got {warmup!r}; e.g. warmup=1024."
         )
-    if progress is not None and not (isinstance(progress, (int, float)) and 0 < progress <= 1):
+    if progress is not None and not (is_real(progress) and 0 < progress <= 1):
         raise ValueError(
             f"progress must be None or a number in (0, 1] (NovelD's alpha), got {progress!r}; "
             "NovelD uses progress=0.5."
@@ -259,6 +260,8 @@ class IntrinsicMechanism(ABC):
         normalization, and records every constructor argument for ``env.spec`` (the source held
         by reference: see :class:`SharedSource`)."""
         name = type(self).__name__
+        if not self.vector and not isinstance(env, VectorEnv):
+            check_single_env(env, name)
         if isinstance(env, VectorEnv) != self.vector:
             if self.vector:
                 raise TypeError(

@@ -64,6 +64,22 @@ class SimounParallelObservation(BaseParallelWrapper):
                 f"pettingzoo.make('parallel', ...)), or convert it with "
                 f"pettingzoo.utils.conversions.aec_to_parallel(env)."
             )
+        if not isinstance(env, ParallelEnv):
+            raise TypeError(
+                f"SimounParallelObservation wraps a PettingZoo ParallelEnv, got "
+                f"{type(env).__name__} ({env!r:.60}); for one Gymnasium env use "
+                f"SimounObservation(env, ...), for a vector env gym.make_vec(env_id, num_envs, "
+                f"wrappers=[lambda e: SimounObservation(e, ...)])."
+            )
+        inner = env
+        while isinstance(inner, BaseParallelWrapper):
+            if isinstance(inner, SimounParallelObservation):
+                raise TypeError(
+                    f"SimounParallelObservation stacks frames itself, but {env} already holds "
+                    f"one: over it, each agent's triplet would be replaced by render() frames. "
+                    f"Apply SimounParallelObservation once, to the PettingZoo env."
+                )
+            inner = inner.env
         super().__init__(env)
         check_stack_options(num_frames, motion, fold_frames, source, grayscale)
         self._size = parse_size(size)

@@ -71,6 +71,8 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
         raise TypeError(f"policy must be a policy name (str) or class, got {type(policy).__name__}")
     if isinstance(env, spaces.Space):
         space = env
+    elif isinstance(getattr(env, "single_observation_space", None), spaces.Space):
+        space = env.single_observation_space  # a vector env: SB3 reads one sub-env's space
     elif isinstance(getattr(env, "observation_space", None), spaces.Space):
         space = env.observation_space
     else:

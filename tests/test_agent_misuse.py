@@ -85,3 +85,38 @@ def test_discrete_action_space_is_refused_with_what_to_do(make):
     with pytest.raises(ValueError, match=r"continuous actions \(a 1-D Box\).*ContinuousAction.*"
                        r"fold_frames=True"):  # fmt: skip
         SimounAgent((3, 48, 48), action_dim=space)
+
+
+SMALL = AgentConfig(batch_size=8, num_filters=4, feature_dim=8, hidden_dim=16, aux_hidden_dim=16)
+
+
+@pytest.mark.parametrize(
+    ("build", "error", "said"),
+    [
+        (lambda: SimounAgent((3, SIZE, SIZE), 1, {"lr": 1e-3}), TypeError, "config must be an"),
+        (lambda: SimounAgent((3, SIZE, SIZE), 1, AgentConfig), TypeError, "config must be an"),
+        (lambda: SimounAgent(None, 1, SMALL), ValueError, "frame_shape must be (C, H, W)"),
+        (lambda: SimounAgent((3, SIZE, SIZE), 1, SMALL, "tpu"), ValueError, "device 'tpu': "),
+        (lambda: SimounAgent((3, SIZE, SIZE), 1, SMALL, 3), TypeError, "device must be a str"),
+        (lambda: FrameReplay(10.5, (3, SIZE, SIZE), 1), ValueError, "capacity must be an int"),
+        (lambda: FrameReplay("100", (3, SIZE, SIZE), 1), ValueError, "capacity must be an int"),
+        (lambda: FrameReplay(100, (3, SIZE, SIZE), 0), ValueError, "action_dim must be an int"),
+        (lambda: FrameReplay(100, None, 1), ValueError, "frame_shape must be (C, H, W)"),
+        (lambda: FrameReplay(100, (3, SIZE, SIZE), 1, seed=-1), ValueError, "seed must be None"),
+    ],
+)
+def test_agent_and_replay_arguments_are_named(build, error, said):
+    with pytest.raises(error) as raised:
+        build()
+    assert said in str(raised.value)
+
+
+def test_a_replay_of_other_frames_or_a_word_for_a_reward_is_named():
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    other = FrameReplay(capacity=50, frame_shape=(3, 16, 16), action_dim=2)
+    with pytest.raises(ValueError, match=r"replay holds frames \(3, 16, 16\).*FrameReplay\("):
+        agent.update(other, 0)
+    replay = point_reach_replay(steps=10)
+    assert set(agent.update(replay, 10)) >= {"critic_loss"}
+    with pytest.raises(ValueError, match="reward must be a number, got str 'a'"):
+        replay.add(np.zeros(2), "a", np.zeros((3, SIZE, SIZE), np.uint8), False, False)

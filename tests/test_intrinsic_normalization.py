@@ -103,7 +103,7 @@ def test_bad_names_and_values_are_refused_with_the_fix():
         make_normalization("standardise")
     with pytest.raises(ValueError, match=r"gamma must be a number in \[0, 1\)"):
         ReturnStd(gamma=1.0)
-    with pytest.raises(ValueError, match="r_i_max must be a finite number > 0"):
+    with pytest.raises(ValueError, match="r_i_max_init must be a finite number > 0"):
         PaperMaxima(r_i_max_init=0.0)
     assert isinstance(make_normalization(Raw()), Raw)
 

@@ -225,8 +225,8 @@ def test_load_shows_the_signature_users_call():
 
 
 def test_misuse_is_refused_naming_the_call_and_the_smallest_sizes_work():
-    for capacity, num_frames in ((0, 3), (5, 0)):
-        with pytest.raises(ValueError, match="capacity and num_frames must be >= 1"):
+    for capacity, num_frames, named in ((0, 3, "capacity"), (5, 0, "num_frames")):
+        with pytest.raises(ValueError, match=f"{named} must be an int >= 1, got 0"):
             FrameReplay(capacity, FRAME, 2, num_frames=num_frames)
     replay = FrameReplay(capacity=5, frame_shape=FRAME, action_dim=2, seed=0)
     with pytest.raises(ValueError, match=r"start_episode\(frame\) must be a uint8 array"):

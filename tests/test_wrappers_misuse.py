@@ -1,6 +1,7 @@
 """Wrapper misuse a new user runs into: each case is a clear error, never a
 silently wrong observation. Headless import order and SDL's signal handlers."""
 
+import copy
 import os
 import pickle
 import signal
@@ -19,11 +20,16 @@ from gymnasium.wrappers import TransformReward
 
 from simoun_wrappers import (
     ActionRepeat,
+    ColorShift,
+    ConsistencyCuriosityReward,
     ConstantBonusReward,
     ConstantBonusVectorReward,
     FrameTriplet,
+    MovingBackground,
     RandomConvolution,
+    RNDReward,
     SimounObservation,
+    check_sb3_policy,
     random_conv,
 )
 
@@ -242,3 +248,84 @@ def test_intrinsic_reward_wrappers_pickle_when_the_env_does(fold_frames):
     copy = pickle.loads(pickle.dumps(env))
     copy.reset(seed=1)
     assert copy.step(0)[4]["reward_intrinsic"] == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize(
+    ("build", "said"),
+    [
+        (lambda: ConstantBonusReward(triplets(), scale=True), "scale must be a finite number"),
+        (lambda: ConstantBonusReward(triplets(), 0.1, decay=True), "decay must be a finite"),
+        (lambda: RNDReward(triplets(), np.mean, progress=True), "progress must be None or"),
+        (lambda: ConsistencyCuriosityReward(triplets(), motion_of, r_e_max_init="1"), "r_e_max_"),
+        (
+            lambda: ConsistencyCuriosityReward(triplets(), motion_of, r_i_max_init=0),
+            "r_i_max_init=",
+        ),
+    ],
+)
+def test_reward_wrapper_numbers_refuse_bools_and_strings_naming_the_argument(build, said):
+    with pytest.raises(ValueError) as error:
+        build()
+    assert said in str(error.value)
+
+
+def motion_of(triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A feature source: each frame's first four pixels, and their last change."""
+    f_a = triplets.reshape(*triplets.shape[:2], -1)[..., :4].astype(np.float32)
+    return f_a[:, 2] - f_a[:, 1], f_a
+
+
+def test_a_stack_no_memory_holds_is_refused_naming_num_frames():
+    with pytest.raises(ValueError, match=r"num_frames=1000000000 makes stacks of .* GiB"):
+        FrameTriplet(gym.make("Pendulum-v1"), num_frames=10**9)
+    with pytest.raises(ValueError, match="use num_frames=3"):
+        SimounObservation(minigrid_pixels(), size=16, num_frames=10**9)
+
+
+@pytest.mark.parametrize("seed", [-1, "a", 1.5])
+def test_a_bad_reset_seed_is_refused_before_a_wrapper_seeds_its_own_rng(seed):
+    env = RandomConvolution(minigrid_pixels())
+    with pytest.raises(ValueError, match=r"RandomConvolution.reset\(seed=...\) takes None or an"):
+        env.reset(seed=seed)
+    colors = ColorShift(gym.make("dm_control/cartpole-swingup-v0"))
+    with pytest.raises(ValueError, match=r"ColorShift.reset\(seed=...\)"):
+        colors.reset(seed=seed)
+
+
+def test_moving_background_names_videos_that_are_no_path():
+    cartpole = gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array")
+    with pytest.raises(TypeError, match="videos must be a folder path"):
+        MovingBackground(cartpole, videos=3)
+
+
+def test_color_shift_pickles_and_deep_copies():
+    env = ColorShift(gym.make("dm_control/cartpole-swingup-v0"), seed=0)
+    for copied in (pickle.loads(pickle.dumps(env)), copy.deepcopy(env)):
+        copied.reset(seed=1)
+        assert copied.colors.keys() == env.colors.keys()
+        copied.step(copied.action_space.sample())
+
+
+def test_reward_wrappers_name_a_pettingzoo_env_as_no_gymnasium_env():
+    from pettingzoo.butterfly import pistonball_v6
+
+    with pytest.raises(TypeError, match=r"ConstantBonusReward's env must be a gymnasium\.Env"):
+        ConstantBonusReward(pistonball_v6.parallel_env(n_pistons=3), scale=0.1)
+
+
+def test_random_conv_names_a_generator_of_the_wrong_type_and_keeps_an_empty_batch():
+    with pytest.raises(TypeError, match=r"generator must be a torch\.Generator or None, got int"):
+        random_conv(torch.rand(1, 3, 8, 8), generator=3)
+    assert random_conv(torch.zeros(0, 3, 8, 8)).shape == (0, 3, 8, 8)
+
+
+def test_check_sb3_policy_reads_a_vector_envs_single_observation_space():
+    envs = gym.make_vec(
+        "MiniGrid-Empty-5x5-v0",
+        2,
+        vectorization_mode="sync",
+        render_mode="rgb_array",
+        wrappers=[lambda e: SimounObservation(e, size=16, fold_frames=True)],
+    )
+    with pytest.raises(ValueError, match="NatureCNN needs frames of at least 36x36, got 16x16"):
+        check_sb3_policy(envs, "CnnPolicy")

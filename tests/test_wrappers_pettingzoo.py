@@ -164,3 +164,24 @@ def test_per_agent_frames_equal_simoun_observation(options):
             np.testing.assert_array_equal(
                 got if key is None else got[key], want if key is None else want[key]
             )
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: gym.make("CartPole-v1", render_mode="rgb_array"),
+        lambda: gym.make_vec("CartPole-v1", 2, vectorization_mode="sync"),
+        lambda: None,
+    ],
+)
+def test_anything_but_a_parallel_env_is_refused_naming_what_to_use(make):
+    with pytest.raises(TypeError, match=r"wraps a PettingZoo ParallelEnv, got .*SimounObservation"):
+        SimounParallelObservation(make())
+
+
+def test_wrapping_twice_is_refused():
+    pistons = pettingzoo.make("parallel", "butterfly/pistonball-v6", n_pistons=3)
+    with pytest.raises(
+        TypeError, match=r"stacks frames itself.*Apply SimounParallelObservation once"
+    ):
+        SimounParallelObservation(SimounParallelObservation(pistons, size=16))

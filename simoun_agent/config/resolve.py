@@ -40,6 +40,11 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
     way. Raises SetupError for an unknown preset or key, or a preset meant for another
     environment.
     """
+    if not isinstance(overrides, dict):
+        raise SetupError(
+            f"overrides must be a dict of config keys, got {type(overrides).__name__} "
+            f"{overrides!r:.60}; e.g. resolve('cpu', {{'agent.lr': 3e-4, 'seed': 1}})"
+        )
     check_keys(overrides)
     values: dict[str, Any] = {}
     if preset is not None:

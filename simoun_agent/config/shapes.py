@@ -112,21 +112,29 @@ def frame_fits(agent: EncoderSettings, height: int, width: int) -> bool:
     return min(height, width) >= min_image_size(agent)
 
 
-def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: EncoderSettings) -> None:
-    """What ``SimounAgent`` is built for: channel-first frames its encoder accepts, and at least
-    one action dimension. Raises ValueError naming the argument and the fix."""
-    shape = tuple(frame_shape)
-    if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
-        raise ValueError(
-            f"frame_shape must be (C, H, W) positive ints, got {shape!r}; pass "
-            "env.observation_space['frames'].shape[1:] of a SimounObservation env"
-        )
+def check_channel_first(shape: tuple[int, int, int]) -> None:
+    """Refuse a frame shape that looks channel-last (H, W, C), with the channel-first one."""
     channels, height, width = shape
     if channels not in (1, 3) and width in (1, 3):
         raise ValueError(
             f"frame_shape {shape} looks channel-last (H, W, C); pass it channel-first, "
             f"({width}, {channels}, {height}), as SimounObservation's frames are"
         )
+
+
+def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: EncoderSettings) -> None:
+    """What ``SimounAgent`` is built for: channel-first frames its encoder accepts, and at least
+    one action dimension. Raises ValueError naming the argument and the fix."""
+    shape = tuple(frame_shape) if isinstance(frame_shape, Sequence) else (frame_shape,)
+    if hasattr(frame_shape, "tolist"):  # a numpy array of the three sizes
+        shape = tuple(frame_shape.tolist())
+    if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
+        raise ValueError(
+            f"frame_shape must be (C, H, W) positive ints, got {shape!r}; pass "
+            "env.observation_space['frames'].shape[1:] of a SimounObservation env"
+        )
+    check_channel_first(shape)
+    height, width = shape[1:]
     if isinstance(action_dim, spaces.Space) and not isinstance(action_dim, spaces.Box):
         raise ValueError(
             f"SimounAgent is a SAC agent for continuous actions (a 1-D Box), got the action space "

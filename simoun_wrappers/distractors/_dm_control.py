@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_reset_seed, is_int
 
 LEVELS = ("easy", "hard")
 
@@ -39,7 +39,7 @@ def check_seed(seed: int | None, owner: str) -> None:
 
 
 def episode_rng(
-    seed: int | None, reset_seed: int | None, current: np.random.Generator
+    seed: int | None, reset_seed: int | None, current: np.random.Generator, owner: str
 ) -> np.random.Generator:
     """The generator of an episode's distraction.
 
@@ -48,6 +48,7 @@ def episode_rng(
     wrapper's own stream (seeded by ``seed`` at construction). The env's RNG is never used, so
     the dynamics cannot change.
     """
+    check_reset_seed(reset_seed, owner)
     if reset_seed is None:
         return current
     return np.random.default_rng([reset_seed] if seed is None else [reset_seed, seed])

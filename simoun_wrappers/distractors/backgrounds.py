@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -80,6 +81,12 @@ class VideoBackground:
     """
 
     def __init__(self, folder: str | Path) -> None:
+        if not isinstance(folder, (str, os.PathLike)):
+            raise TypeError(
+                f"videos must be a folder path (str or Path) or None, got "
+                f"{type(folder).__name__} {folder!r}; e.g. videos='davis/JPEGImages/480p', or "
+                f"videos=None for the procedural background."
+            )
         self.folder = Path(folder)
         if not self.folder.is_dir():
             raise ValueError(

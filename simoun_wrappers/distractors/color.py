@@ -123,6 +123,15 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.colors = {key: value.copy() for key, value in self.defaults.items()}
         self._rng = np.random.default_rng(seed)
 
+    def __getstate__(self) -> dict[str, Any]:
+        # MuJoCo's MjSpec does not pickle; it holds only dm_control's common assets, and
+        # _apply sets every colour it compiles, so a copy builds its own
+        return {key: value for key, value in self.__dict__.items() if key != "_spec"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._spec = common_assets_spec()
+
     def _matching_textures(self, model: Any) -> list[str]:
         """The common textures this model has, checked to be the common assets' sizes."""
         import mujoco
@@ -149,7 +158,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
-        self._rng = episode_rng(self.seed, seed, self._rng)
+        self._rng = episode_rng(self.seed, seed, self._rng, "ColorShift")
         distance = SHIFT_RANGES[self.level]
         self.colors = {
             key: shift_color(default, self._rng, distance) for key, default in self.defaults.items()

@@ -100,7 +100,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
-        self._rng = episode_rng(self.seed, seed, self._rng)
+        self._rng = episode_rng(self.seed, seed, self._rng, "MovingBackground")
         self._source.start(self._rng)
         self._t = 0
         return self.env.reset(seed=seed, options=options)
