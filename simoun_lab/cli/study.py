@@ -123,14 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if isinstance(args, Report):
             print(f"report: {report_study(spec, args.study_dir)}")
             return 0
-        # absolute: Tune runs each trial in a working directory of its own
-        options = dataclasses.replace(
-            args,
-            study_dir=args.study_dir.absolute(),
-            archive=args.archive.absolute() if args.archive else None,
-        )
-        ray = load_ray()
-        return run_study(spec, args.spec, options, ray)
+        return run_study(spec, args.spec, absolute(args), load_ray())
     except SetupError as err:
         fail(PROG, err)
 
@@ -144,12 +137,17 @@ def ppo_study(args: Plan | Run | Report) -> int:
     if isinstance(args, Report):
         print(f"report: {study_command.report(spec, args.study_dir)}")
         return 0
-    options = dataclasses.replace(
+    return study_command.run(spec, absolute(args))
+
+
+def absolute(args: Run) -> Run:
+    """``args`` with absolute directories: Tune runs each trial in a working directory of its
+    own."""
+    return dataclasses.replace(
         args,
         study_dir=args.study_dir.absolute(),
         archive=args.archive.absolute() if args.archive else None,
     )
-    return study_command.run(spec, options)
 
 
 if __name__ == "__main__":
