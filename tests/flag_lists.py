@@ -1,4 +1,5 @@
-"""Building command lines in tests: a base list of flags with some of them given new values.
+"""Building command lines in tests: a base list of flags with some of them given new values;
+and a small agent's keys for the study specs of tests.
 
 The command lines refuse a flag given twice with different values, so a test that changes a
 flag of a shared base list replaces it instead of appending a second value.
@@ -14,6 +15,18 @@ TINY_AGENT = [
     "--agent.aux-hidden-dim", "16",
 ]  # fmt: skip
 """A tiny agent on one CPU thread, as simoun-train flags: runs of a few seconds."""
+
+SMALL_AGENT = """\
+video = false
+device = "cpu"
+agent.batch_size = 8
+agent.num_filters = 8
+agent.feature_dim = 16
+agent.hidden_dim = 32
+agent.aux_hidden_dim = 32
+"""
+"""A small agent on the CPU, no video, as the [base] keys of a study spec's TOML: runs of a few
+seconds."""
 
 
 def override(base: list[str], *flags: str) -> list[str]:

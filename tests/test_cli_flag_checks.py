@@ -102,6 +102,8 @@ def test_set_without_a_key_shows_the_form(capsys):
         (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
         (["--video", "lane.txt"], "--video lane.txt: a video is written as .gif or .mp4"),
         (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
+        (["--json", "refs.csv"], "--json refs.csv: the metrics file is written as .json"),
+        (["--json", "nowhere/references.json"], "the folder nowhere does not exist"),
     ],
 )  # fmt: skip
 def test_the_driving_references_check_every_value_before_playing(argv, said, capsys, tmp_path,

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
+from flag_lists import SMALL_AGENT
 
 from simoun_agent.config import RECIPES, SetupError
 from simoun_lab.cli import study as cli
@@ -25,17 +26,6 @@ from simoun_lab.study.spec import load_spec
 from simoun_lab.study.toml_lines import key_line
 
 pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
-
-SMALL_AGENT = """\
-video = false
-device = "cpu"
-agent.batch_size = 8
-agent.num_filters = 8
-agent.feature_dim = 16
-agent.hidden_dim = 32
-agent.aux_hidden_dim = 32
-"""
-"""the [base] keys of every tiny study here: a small agent on the CPU, no video"""
 
 SPEC = (
     """\

@@ -14,12 +14,15 @@ environment stack, with the same metric code (:mod:`simoun_agent.run.driving_met
 
 prints their table on the ``highway-cpu`` preset, one episode per seed from ``--seed`` on;
 ``--video docs/driving/lane-keeping.gif`` also writes the lane-keeping driver's first episode as
-the agent sees it (the frames ``simoun-eval --video`` writes for a learned driver).
+the agent sees it (the frames ``simoun-eval --video`` writes for a learned driver);
+``--json DIR/references.json`` also writes every driver's metrics with the command that measured
+them, which a driving study's report (DIR: its study directory) shows beside the learned drivers.
 """
 
 from __future__ import annotations
 
 import math
+import shlex
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -33,7 +36,8 @@ from simoun_agent import table
 from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import PRESETS, SetupError, TrainConfig, resolve
 from simoun_agent.config.envs import is_highway
-from simoun_agent.run.evaluate import RandomPolicy, evaluate
+from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.video import write_video
 
@@ -193,11 +197,29 @@ class DrivingReferenceCommand:
     """a highway-env preset: highway-cpu or highway"""
     video: Path | None = None
     """write the lane-keeping driver's first episode here (.gif or .mp4)"""
+    json: Path | None = None
+    """also write every driver's metrics here (.json), with this command, for a study's report
+    (its study directory's references.json)"""
 
 
 PROG = "python -m simoun_agent.run.driving_reference"
 
 VIDEO_SUFFIXES = (".gif", ".mp4")
+
+
+def check_output(flag: str, path: Path, what: str, suffixes: tuple[str, ...], example: str) -> None:
+    """SetupError when ``path``, the value of ``flag``, has none of ``suffixes`` or its folder
+    does not exist."""
+    if path.suffix not in suffixes:
+        raise SetupError(
+            f"{flag} {path}: {what} is written as {' or '.join(suffixes)}, not "
+            f"{path.suffix or 'a name without a suffix'}; e.g. {flag} {example}"
+        )
+    if not path.parent.is_dir():
+        raise SetupError(
+            f"{flag} {path}: the folder {path.parent} does not exist; create it or pass a path "
+            "in an existing folder"
+        )
 
 
 def check_command(args: DrivingReferenceCommand) -> TrainConfig:
@@ -215,17 +237,23 @@ def check_command(args: DrivingReferenceCommand) -> TrainConfig:
             f"drivers steer a highway-env car; choose one of {', '.join(highway)}"
         )
     if args.video is not None:
-        if args.video.suffix not in VIDEO_SUFFIXES:
-            raise SetupError(
-                f"--video {args.video}: a video is written as .gif or .mp4, not "
-                f"{args.video.suffix or 'a name without a suffix'}; e.g. --video lane-keeping.gif"
-            )
-        if not args.video.parent.is_dir():
-            raise SetupError(
-                f"--video {args.video}: the folder {args.video.parent} does not exist; create it "
-                "or pass a path in an existing folder"
-            )
+        check_output("--video", args.video, "a video", VIDEO_SUFFIXES, "lane-keeping.gif")
+    if args.json is not None:
+        check_output("--json", args.json, "the metrics file", (".json",), "references.json")
     return config
+
+
+def references_json(args: DrivingReferenceCommand, command: str, metrics: dict) -> str:
+    """The ``--json`` file's text: ``command``, the preset, episodes and first seed, and
+    ``drivers`` (driver -> its metrics; a crash speed without crashes is null)."""
+    record = {
+        "command": command,
+        "preset": args.preset,
+        "episodes": args.episodes,
+        "seed": args.seed,
+        "drivers": metrics,
+    }
+    return metrics_json(record)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -235,7 +263,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         config = check_command(args)
     except SetupError as err:
         fail(PROG, err)
-    print(markdown_table(reference_metrics(config, args.episodes, args.seed, args.video)))
+    metrics = reference_metrics(config, args.episodes, args.seed, args.video)
+    print(markdown_table(metrics))
+    if args.json is not None:
+        words = sys.argv[1:] if argv is None else list(argv)
+        text = references_json(args, shlex.join([*PROG.split(), *words]), metrics)
+        atomic_write(args.json, lambda tmp: tmp.write_text(text))
     return 0
 
 

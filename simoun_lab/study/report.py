@@ -17,6 +17,10 @@ Written into ``<study>/report/`` (and the archive's ``report/``):
   P(method > ablation), with CIs (the ablations stay out of the compared recipes' tables);
 - with ``[generalization]``: per recipe, the return under each distraction mode over the train
   mode's return, IQM over runs with CIs, and P(first recipe > Y) of that ratio;
+- with the driving measures in the evaluation runs' ``eval.csv`` (highway-env): the paper's
+  Table 2, per recipe the IQM over runs of each final measure with CIs beside the reference
+  drivers of the study directory's ``references.json``, and P(first recipe > Y) on return and
+  on crash rate (:mod:`simoun_lab.study.driving`);
 - with ``update_cost.json`` in the study directory (``benchmarks/recipe_update.py --json``, each
   recipe's update time over the baseline's, measured side by side): the IQM curves against wall
   time on the baseline's clock stretched by each recipe's ratio (``iqm_wall_time_update_cost.png``).
@@ -31,6 +35,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -47,6 +52,13 @@ from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_lab import stats
 from simoun_lab.study.choice import SELECTION_FILE, Choice
+from simoun_lab.study.driving import (
+    MEASURES,
+    REFERENCE_COMMAND,
+    REFERENCES_JSON,
+    final_measures,
+    read_references,
+)
 from simoun_lab.study.generalization import read_modes
 from simoun_lab.study.plan import (
     EVALUATION,
@@ -97,6 +109,9 @@ class RunResult:
     modes: dict | None = None
     """mode -> mean return of the final agent (``generalization.csv``, ``train`` included);
     None when it was not played"""
+    driving: dict | None = None
+    """the final evaluation's driving measures (eval.csv's last row, raw return included:
+    :data:`~simoun_lab.study.driving.MEASURES`); None when eval.csv has no driving columns"""
 
 
 def read_result(study_dir: Path, run: StudyRun) -> RunResult | None:
@@ -117,11 +132,12 @@ def read_result(study_dir: Path, run: StudyRun) -> RunResult | None:
     load = parts[0]["loadavg"][0] / parts[0]["cpu_count"] if parts else math.nan
     score = float(stats.normalize(run.task, [final])[0])
     modes = read_modes(run_dir, int(summary["env_step"]))
-    return RunResult(run, final, score, curve, float(summary["wall_time_s"]), cpu, load, modes)
+    wall = float(summary["wall_time_s"])
+    return RunResult(run, final, score, curve, wall, cpu, load, modes, final_measures(rows))
 
 
-def _interval(point: float, low: float, high: float) -> str:
-    return f"{point:.3f} [{low:.3f}, {high:.3f}]"
+def _interval(point: float, low: float, high: float, digits: str = ".3f") -> str:
+    return f"{point:{digits}} [{low:{digits}}, {high:{digits}}]"
 
 
 def _seeds(seeds: list[int]) -> str:
@@ -415,12 +431,16 @@ def results_section(spec: StudySpec, phase_report: Path, recipes: dict[str, str]
     return lines
 
 
-def scores_by_task(results: list[RunResult], recipe: str) -> dict[str, np.ndarray]:
-    """Task -> the normalized final scores of ``recipe``'s runs among ``results``."""
+def scores_by_task(
+    results: list[RunResult], recipe: str, value: Callable[[RunResult], float] | None = None
+) -> dict[str, np.ndarray]:
+    """Task -> ``value`` (default: the normalized final score) of each of ``recipe``'s runs
+    among ``results``."""
     scores: dict[str, list[float]] = {}
     for result in results:
         if result.run.recipe == recipe:
-            scores.setdefault(result.run.task, []).append(result.score)
+            score = result.score if value is None else value(result)
+            scores.setdefault(result.run.task, []).append(score)
     return {task: np.array(values) for task, values in scores.items()}
 
 
@@ -438,6 +458,111 @@ def _pair(method: stats.Scores, other: stats.Scores) -> tuple[dict, dict]:
     """Both score sets on the tasks both have runs of."""
     tasks = [task for task in method if task in other]
     return {t: method[t] for t in tasks}, {t: other[t] for t in tasks}
+
+
+def measure_scores(driven: list[RunResult], recipe: str, key: str) -> dict[str, np.ndarray]:
+    """Task -> the final driving measure ``key`` of each of ``recipe``'s runs among ``driven``
+    (runs with driving measures)."""
+    return scores_by_task(driven, recipe, lambda result: result.driving[key])
+
+
+def reference_lines(spec: StudySpec, references: dict[str, Any] | None) -> list[str]:
+    """Where the reference drivers' rows came from, or how to add them."""
+    if references is None:
+        return [
+            f"No `{REFERENCES_JSON}` in the study directory, so no reference drivers' rows "
+            '(docs/driving.md, "Reference drivers", has their committed numbers). To add them '
+            f"at the study's preset: `{REFERENCE_COMMAND}` (DIR: this study's directory), then "
+            "write the report again (`simoun-study report`)."
+        ]
+    lines = [
+        'The rows marked (reference): the reference drivers of docs/driving.md ("Reference '
+        'drivers"), played through the same environment stack, evaluation and metric code as '
+        f"the learned ones, read from `{REFERENCES_JSON}` in the study directory, written by "
+        f"`{references['command']}`: preset `{references['preset']}`, "
+        f"{references['episodes']} episode(s) from seed {references['seed']}. Each cell is "
+        "the mean over those episodes (no interval)."
+    ]
+    if references["preset"] != spec.preset:
+        lines[0] += (
+            f" They were played on preset `{references['preset']}`, not the study's "
+            f"`{spec.preset}`: their numbers do not compare with the recipes'."
+        )
+    return lines
+
+
+def driving_section(spec: StudySpec, results: list[RunResult], study_dir: Path) -> list[str]:
+    """The paper's Table 2 from the evaluation runs whose eval.csv has the driving measures:
+    per recipe the IQM over runs of each final measure with its interval, the reference
+    drivers' rows, and P(first recipe > Y) on return and on crash rate (fewer crashes). Empty
+    when no run has the measures."""
+    driven = [r for r in results if r.driving is not None and r.run.recipe in spec.recipes]
+    if not driven:
+        return []
+    recipes = [recipe for recipe in spec.recipes if any(r.run.recipe == recipe for r in driven)]
+    rows = []
+    for recipe in recipes:
+        cells = [
+            _interval(*_bootstrap(measure_scores(driven, recipe, key)), digits)
+            for key, _, digits in MEASURES
+        ]
+        rows.append([recipe, sum(r.run.recipe == recipe for r in driven), *cells])
+    references = read_references(study_dir)
+    for driver, metrics in (references or {}).get("drivers", {}).items():
+        cells = [format(metrics[key], digits) for key, _, digits in MEASURES]
+        rows.append([f"{driver} (reference)", "–", *cells])
+    headers = ["recipe or driver", "runs", *(header for _, header, _ in MEASURES)]
+    lines = [
+        "",
+        "## Driving measures (the paper's Table 2)",
+        "",
+        "Each evaluation run's final evaluation (the last row of its `eval.csv`, means over its "
+        "episodes), as `simoun_agent/run/driving_metrics.py` measures them: the return "
+        "(highway-env's reward summed over an episode, not normalized), the crash rate (the "
+        "share of episodes that crashed), the distance travelled, the mean speed, the mean "
+        "abs(steering) over full lock and the brake fraction (the mean braking over full "
+        "braking). A recipe's cell: the IQM over its runs (tasks pooled) with its 95 % "
+        "stratified bootstrap interval.",
+        "",
+        *reference_lines(spec, references),
+        "",
+        table.markdown_table(headers, rows, align="lr" + "r" * len(MEASURES)),
+    ]
+    first = spec.recipes[0]
+    args = (sweep_report.BOOTSTRAP_REPS, sweep_report.CONFIDENCE, sweep_report.BOOTSTRAP_SEED)
+    mine = {key: measure_scores(driven, first, key) for key in ("return_mean", "crash_rate")}
+    pairs = []
+    for other in recipes[1:] if first in recipes else []:
+        x, y = _pair(mine["return_mean"], measure_scores(driven, other, "return_mean"))
+        crash_x, crash_y = _pair(mine["crash_rate"], measure_scores(driven, other, "crash_rate"))
+        if not x:
+            pairs.append([other, "–", "–"])
+            continue
+        # fewer crashes is better: P(-crash rate of X > -crash rate of Y)
+        fewer = stats.probability_of_improvement_ci(
+            {t: -v for t, v in crash_x.items()}, {t: -v for t, v in crash_y.items()}, *args
+        )
+        improvement = stats.probability_of_improvement_ci(x, y, *args)
+        pairs.append([other, _interval(*improvement), _interval(*fewer)])
+    if pairs:
+        lines += [
+            "",
+            f"P({first} > Y): the chance that a run of {first} does better than a run of Y on "
+            "the same task (ties count one half), averaged over the tasks both ran, with its "
+            "95 % stratified bootstrap interval; 0.5 is no difference. On return higher is "
+            "better; on crash rate lower is better, so that column is P(fewer crashes).",
+            "",
+            table.markdown_table(
+                [
+                    "Y",
+                    f"P({first} > Y) on return [95 % CI]",
+                    f"P({first} > Y) on crash rate, lower is better: P(fewer crashes) [95 % CI]",
+                ],
+                pairs,
+                align="lrr",
+            ),
+        ]
+    return lines
 
 
 def diagnostics_section(spec: StudySpec, results: list[RunResult]) -> list[str]:
@@ -846,6 +971,7 @@ def write_study_report(
         recipes = recipe_variants(study_dir / EVALUATION)
         lines += results_section(spec, out / EVALUATION, recipes)
         plot_curves(spec.recipes, results, out / CURVES_PNG)
+        lines += driving_section(spec, results, study_dir)
         if spec.diagnostics:
             lines += diagnostics_section(spec, results)
         if spec.generalization:

@@ -1,0 +1,52 @@
+"""The paper's Table 2 measures of a driving study, as its report reads them.
+
+Each evaluation row of a highway-env run's ``eval.csv`` holds the driving measures of
+:mod:`simoun_agent.run.driving_metrics` beside the return; a run's last row gives its final
+measures. A study tells a driving study by these columns, whatever its env ids. The reference
+drivers (:mod:`simoun_agent.run.driving_reference`) are read from the study directory's
+``references.json``, which that module's ``--json`` writes: played at report time they would
+cost minutes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+MEASURES = (
+    ("return_mean", "return", ".1f"),
+    ("crash_rate", "crash rate", ".2f"),
+    ("distance_m", "distance (m)", ".0f"),
+    ("mean_speed", "mean speed (m/s)", ".1f"),
+    ("mean_abs_steer", "mean abs(steer)", ".3f"),
+    ("brake_fraction", "brake fraction", ".3f"),
+)
+"""The table's measures: eval.csv column (a key of the reference drivers' metrics too), header,
+format."""
+
+REFERENCES_JSON = "references.json"
+"""The reference drivers' metrics in the study directory, written by ``python -m
+simoun_agent.run.driving_reference --json``: ``command``, ``preset``, ``episodes``, ``seed`` (of
+the first episode) and ``drivers`` (driver -> its metrics)."""
+
+REFERENCE_COMMAND = (
+    "python -m simoun_agent.run.driving_reference --episodes 20 --seed 1000 "
+    f"--json DIR/{REFERENCES_JSON}"
+)
+"""The command that writes :data:`REFERENCES_JSON` (DIR: the study directory); its seeds are
+those of docs/driving.md's committed table."""
+
+
+def final_measures(rows: list[dict[str, float]]) -> dict[str, float] | None:
+    """The last evaluation row's :data:`MEASURES`; None when the rows lack any of their columns
+    (a run on an env without an ego vehicle) or there are no rows."""
+    if not rows or any(key not in rows[-1] for key, _, _ in MEASURES):
+        return None
+    return {key: rows[-1][key] for key, _, _ in MEASURES}
+
+
+def read_references(study_dir: Path) -> dict[str, Any] | None:
+    """The study directory's :data:`REFERENCES_JSON`, None when there is none."""
+    path = study_dir / REFERENCES_JSON
+    return json.loads(path.read_text()) if path.is_file() else None
