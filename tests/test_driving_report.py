@@ -1,6 +1,7 @@
 """The study report's driving section (the paper's Table 2) on real tiny highway-fast-v0 runs: its
 cells against values computed by hand from the runs' eval.csv, the reference drivers' rows from
-the file the reference command writes, and no section for runs without the driving columns."""
+the file the reference command writes (a file it did not write is refused naming the command),
+and no section for runs without the driving columns."""
 
 from __future__ import annotations
 
@@ -12,8 +13,9 @@ import numpy as np
 import pytest
 from flag_lists import SMALL_AGENT
 
+from simoun_agent.config import SetupError
 from simoun_agent.run import driving_reference, train
-from simoun_lab.study.driving import MEASURES, REFERENCES_JSON
+from simoun_lab.study.driving import MEASURES, REFERENCES_JSON, read_references
 from simoun_lab.study.plan import evaluation_runs
 from simoun_lab.study.report import driving_section, read_result
 from simoun_lab.study.spec import load_spec
@@ -136,3 +138,27 @@ def test_runs_without_the_driving_columns_get_no_driving_section(tmp_path):
         and result.final_return == final_row(tmp_path / runs[0].name)["return_mean"]
     )
     assert driving_section(spec, [result], tmp_path) == []
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("{not json", "is not JSON"),
+        ("[1, 2]", "holds a JSON list, not an object"),
+        ('{"command": "c", "preset": "highway-cpu"}', "lacks episodes, seed, drivers"),
+        (
+            '{"command": "c", "preset": "p", "episodes": 1, "seed": 0, '
+            '"drivers": {"zero": {"return_mean": 1.0}}}',
+            "driver 'zero' lacks crash_rate, distance_m",
+        ),
+    ],
+)
+def test_a_references_file_the_command_did_not_write_is_named_with_the_command(
+    text, said, tmp_path
+):
+    (tmp_path / REFERENCES_JSON).write_text(text)
+    with pytest.raises(SetupError) as refused:
+        read_references(tmp_path)
+    assert said in str(refused.value)
+    assert "write it again with `python -m simoun_agent.run.driving_reference" in str(refused.value)
+    assert f"--json {tmp_path}/{REFERENCES_JSON}`" in str(refused.value)

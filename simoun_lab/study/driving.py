@@ -14,6 +14,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError
+
 MEASURES = (
     ("return_mean", "return", ".1f"),
     ("crash_rate", "crash rate", ".2f"),
@@ -46,7 +48,25 @@ def final_measures(rows: list[dict[str, float]]) -> dict[str, float] | None:
     return {key: rows[-1][key] for key, _, _ in MEASURES}
 
 
+REFERENCE_KEYS = ("command", "preset", "episodes", "seed", "drivers")
+
+
 def read_references(study_dir: Path) -> dict[str, Any] | None:
-    """The study directory's :data:`REFERENCES_JSON`, None when there is none."""
+    """The study directory's :data:`REFERENCES_JSON`, None when there is none; SetupError when
+    it is not one that the reference command wrote (not JSON, a key or a measure missing)."""
     path = study_dir / REFERENCES_JSON
-    return json.loads(path.read_text()) if path.is_file() else None
+    if not path.is_file():
+        return None
+    fix = f"write it again with `{REFERENCE_COMMAND.replace('DIR', str(study_dir))}`"
+    try:
+        references = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise SetupError(f"{path} is not JSON ({err}); {fix}") from None
+    if not isinstance(references, dict):
+        raise SetupError(f"{path} holds a JSON {type(references).__name__}, not an object; {fix}")
+    if missing := [key for key in REFERENCE_KEYS if key not in references]:
+        raise SetupError(f"{path} lacks {', '.join(missing)}; {fix}")
+    for driver, metrics in references["drivers"].items():
+        if lacking := [key for key, _, _ in MEASURES if key not in metrics]:
+            raise SetupError(f"{path}: driver {driver!r} lacks {', '.join(lacking)}; {fix}")
+    return references
