@@ -76,3 +76,22 @@ def summarize(episodes: list[DrivingEpisode]) -> dict[str, float]:
         "mean_speed": float(np.mean([np.mean(e.speed) if e.speed else math.nan for e in episodes])),
         "brake_fraction": float(np.mean([np.mean(e.brake) for e in episodes])),
     }
+
+
+MEASURES = (
+    ("return_mean", "return", ".1f"),
+    ("return_std", "± std", ".1f"),
+    ("crash_rate", "crash rate", ".2f"),
+    ("distance_m", "distance (m)", ".0f"),
+    ("mean_speed", "mean speed (m/s)", ".1f"),
+    ("mean_abs_steer", "mean abs(steer)", ".3f"),
+    ("brake_fraction", "brake fraction", ".3f"),
+    ("length_mean", "length", ".0f"),
+)
+"""Each driving measure's key, table header and format, for every table that shows one."""
+
+
+def columns(*keys: str) -> tuple[tuple[str, str, str], ...]:
+    """(key, header, format) of each of ``keys``, in that order."""
+    known = {measure[0]: measure for measure in MEASURES}
+    return tuple(known[key] for key in keys)

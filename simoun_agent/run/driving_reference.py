@@ -37,6 +37,7 @@ from simoun_agent.cli.flags import fail, parse
 from simoun_agent.config import PRESETS, SetupError, TrainConfig, resolve
 from simoun_agent.config.envs import is_highway
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.driving_metrics import columns
 from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.video import write_video
@@ -164,23 +165,24 @@ def reference_metrics(
         env.close()
 
 
-COLUMNS = (
-    ("return", "return_mean", "{:.1f}"),
-    ("± std", "return_std", "{:.1f}"),
-    ("crash rate", "crash_rate", "{:.2f}"),
-    ("distance (m)", "distance_m", "{:.0f}"),
-    ("mean speed (m/s)", "mean_speed", "{:.1f}"),
-    ("mean abs(steer)", "mean_abs_steer", "{:.3f}"),
-    ("length", "length_mean", "{:.0f}"),
+COLUMNS = columns(
+    "return_mean",
+    "return_std",
+    "crash_rate",
+    "distance_m",
+    "mean_speed",
+    "mean_abs_steer",
+    "length_mean",
 )
-"""The table's columns: header, metric key, format."""
+"""The table's columns: metric key, header, format."""
 
 
 def markdown_table(metrics: dict[str, dict]) -> str:
     """One row per driver, the columns of :data:`COLUMNS`."""
-    headers = ["driver"] + [header for header, _, _ in COLUMNS]
+    headers = ["driver"] + [header for _, header, _ in COLUMNS]
     rows = [
-        [name] + [fmt.format(row[key]) for _, key, fmt in COLUMNS] for name, row in metrics.items()
+        [name] + [format(row[key], spec) for key, _, spec in COLUMNS]
+        for name, row in metrics.items()
     ]
     return table.markdown_table(headers, rows)
 

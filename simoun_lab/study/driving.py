@@ -15,14 +15,10 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.driving_metrics import columns
 
-MEASURES = (
-    ("return_mean", "return", ".1f"),
-    ("crash_rate", "crash rate", ".2f"),
-    ("distance_m", "distance (m)", ".0f"),
-    ("mean_speed", "mean speed (m/s)", ".1f"),
-    ("mean_abs_steer", "mean abs(steer)", ".3f"),
-    ("brake_fraction", "brake fraction", ".3f"),
+MEASURES = columns(
+    "return_mean", "crash_rate", "distance_m", "mean_speed", "mean_abs_steer", "brake_fraction"
 )
 """The table's measures: eval.csv column (a key of the reference drivers' metrics too), header,
 format."""
