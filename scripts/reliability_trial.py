@@ -689,53 +689,89 @@ SECOND_FILE_CASES = [
     for command, argv in FILE_COMMANDS.items()
 ]
 
-SPEC_EDITS = [  # (text replaced, by, what the refusal names)
-    ('selection = "auc"', 'selection = "auc"\nnope = 1', "nope"),
-    ("env_steps = 50_000", "env_steps = 50_000\nnope = 1", "nope"),
-    ("env_steps = 100_000", "env_steps = 100_000\nnope = 1", "nope"),
-    ("max_concurrent_trials = 2", "max_concurrent_trials = 2\nnope = 1", "nope"),
-    ("video = false", "video = false\nagent.nope = 1", "agent.nope"),
-    ("action_repeat = 4", "action_repeat = 4\nnope = 1", "nope"),
-    ("[tasks.\"dm_control/cheetah-run-v0\"]", "[tasks.\"dm_control/cheetah-run-v9\"]", "v9"),
-    ('recipes = ["simoun", "drq", "drqv2", "rad", "curl"]', 'recipes = "simoun"', "recipes"),
-    ('recipes = ["simoun", "drq", "drqv2", "rad", "curl"]', "recipes = []", "recipes"),
-    ('recipes = ["simoun", "drq", "drqv2", "rad", "curl"]', 'recipes = ["SIMOUN"]', "SIMOUN"),
-    ('selection = "auc"', "selection = 3", "selection"),
-    ('selection = "auc"', 'selection = "AUC"', "selection"),
-    ('grid_overrides = ["agent.n_step"]', 'grid_overrides = "agent.n_step"', "grid_overrides"),
-    ('grid_overrides = ["agent.n_step"]', 'grid_overrides = ["agent.n_stp"]', "agent.n_stp"),
-    ('description = """', 'description = 3\nd = """', "description"),
-    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = "dm_control/cartpole-swingup-v0"',
-     "tasks"),
-    ('tasks = ["dm_control/cartpole-swingup-v0"]', "tasks = []", "tasks"),
-    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["Pendulum-v1"]', "Pendulum-v1"),
-    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["MiniGrid-Empty-5x5-v0"]',
-     "MiniGrid"),
-    ('seeds = "101-102"', "seeds = 101", "seeds"),
-    ('seeds = "101-102"', 'seeds = "101-1e3"', "seeds"),
-    ('seeds = "101-102"', 'seeds = "101,101"', "seeds"),
-    ('seeds = "101-102"', 'seeds = "-1-2"', "seeds"),
-    ("env_steps = 50_000", "env_steps = 5e4", "env_steps"),
-    ("env_steps = 50_000", "env_steps = true", "env_steps"),
-    ("env_steps = 50_000", "env_steps = 1e400", "env_steps"),
-    ("env_steps = 100_000", "env_steps = nan", "env_steps"),
-    ('seeds = { "dm_control/cartpole-swingup-v0" = "1-5", "dm_control/cheetah-run-v0" = "1-3" }',
-     'seeds = "100-104"', "seed"),
-    ('"dm_control/cheetah-run-v0" = "1-3" }', '"dm_control/cheetah-run-v0" = "102-104" }', "",
-     True),
-    ('"dm_control/cheetah-run-v0" = "1-3" }', "}", "cheetah"),
-    ("cpus_per_trial = 1 ", "cpus_per_trial = 1.5 ", "cpus_per_trial"),
-    ("cpus_per_trial = 1 ", 'cpus_per_trial = "1" ', "cpus_per_trial"),
-    ("max_concurrent_trials = 2", "max_concurrent_trials = 2\ngpus_per_trial = -1", "gpus"),
-    ("eval_every = 10_000", "eval_every = 1.5", "eval_every"),
-    ("eval_every = 10_000", 'eval_every = "often"', "eval_every"),
-    ("agent.n_step = [1, 3]", 'agent.n_step = [1, "three"]', "n_step"),
-    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3, 3]", "n_step"),
-    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.lr = [1e400]", "lr"),
-    ("action_repeat = 8", "action_repeat = 2.5", "action_repeat"),
-    ("[resources]", "[[resources]]", "resources"),
-    ("[grid]", "grid = 3\n[grid2]", "grid"),
-]  # fmt: skip
+SPEC_EDITS = {  # text replaced: (by, what the refusal names[, valid])
+    'selection = "auc"': [
+        ('selection = "auc"\nnope = 1', 'nope'),
+        ('selection = 3', 'selection'),
+        ('selection = "AUC"', 'selection'),
+    ],
+    'env_steps = 50_000': [
+        ('env_steps = 50_000\nnope = 1', 'nope'),
+        ('env_steps = 5e4', 'env_steps'),
+        ('env_steps = true', 'env_steps'),
+        ('env_steps = 1e400', 'env_steps'),
+    ],
+    'env_steps = 100_000': [
+        ('env_steps = 100_000\nnope = 1', 'nope'),
+        ('env_steps = nan', 'env_steps'),
+    ],
+    'max_concurrent_trials = 2': [
+        ('max_concurrent_trials = 2\nnope = 1', 'nope'),
+        ('max_concurrent_trials = 2\ngpus_per_trial = -1', 'gpus'),
+    ],
+    'video = false': [
+        ('video = false\nagent.nope = 1', 'agent.nope'),
+    ],
+    'action_repeat = 4': [
+        ('action_repeat = 4\nnope = 1', 'nope'),
+    ],
+    '[tasks."dm_control/cheetah-run-v0"]': [
+        ('[tasks."dm_control/cheetah-run-v9"]', 'v9'),
+    ],
+    'recipes = ["simoun", "drq", "drqv2", "rad", "curl"]': [
+        ('recipes = "simoun"', 'recipes'),
+        ('recipes = []', 'recipes'),
+        ('recipes = ["SIMOUN"]', 'SIMOUN'),
+    ],
+    'grid_overrides = ["agent.n_step"]': [
+        ('grid_overrides = "agent.n_step"', 'grid_overrides'),
+        ('grid_overrides = ["agent.n_stp"]', 'agent.n_stp'),
+    ],
+    'description = """': [
+        ('description = 3\nd = """', 'description'),
+    ],
+    'tasks = ["dm_control/cartpole-swingup-v0"]': [
+        ('tasks = "dm_control/cartpole-swingup-v0"', 'tasks'),
+        ('tasks = []', 'tasks'),
+        ('tasks = ["Pendulum-v1"]', 'Pendulum-v1'),
+        ('tasks = ["MiniGrid-Empty-5x5-v0"]', 'MiniGrid'),
+    ],
+    'seeds = "101-102"': [
+        ('seeds = 101', 'seeds'),
+        ('seeds = "101-1e3"', 'seeds'),
+        ('seeds = "101,101"', 'seeds'),
+        ('seeds = "-1-2"', 'seeds'),
+    ],
+    'seeds = { "dm_control/cartpole-swingup-v0" = "1-5", "dm_control/cheetah-run-v0" = "1-3" }': [
+        ('seeds = "100-104"', 'seed'),
+    ],
+    '"dm_control/cheetah-run-v0" = "1-3" }': [
+        ('"dm_control/cheetah-run-v0" = "102-104" }', '', True),
+        ('}', 'cheetah'),
+    ],
+    'cpus_per_trial = 1 ': [
+        ('cpus_per_trial = 1.5 ', 'cpus_per_trial'),
+        ('cpus_per_trial = "1" ', 'cpus_per_trial'),
+    ],
+    'eval_every = 10_000': [
+        ('eval_every = 1.5', 'eval_every'),
+        ('eval_every = "often"', 'eval_every'),
+    ],
+    'agent.n_step = [1, 3]': [
+        ('agent.n_step = [1, "three"]', 'n_step'),
+        ('agent.n_step = [1, 3, 3]', 'n_step'),
+        ('agent.n_step = [1, 3]\nagent.lr = [1e400]', 'lr'),
+    ],
+    'action_repeat = 8': [
+        ('action_repeat = 2.5', 'action_repeat'),
+    ],
+    '[resources]': [
+        ('[[resources]]', 'resources'),
+    ],
+    '[grid]': [
+        ('grid = 3\n[grid2]', 'grid'),
+    ],
+}  # fmt: skip
 MINIGRID_SPEC = (ROOT / "docs/studies/minigrid/spec.json").read_text()
 MINIGRID_EDITS = [  # (a change to the spec's JSON value, what the refusal names)
     (lambda s: s["tasks"][0].update(nope=1), "nope"),
@@ -771,7 +807,7 @@ def minigrid_spec(change) -> str:
 
 SECOND_SPEC_CASES = [
     *(spec_case(SPEC.replace(old, new, 1), names, ok=bool(ok))
-      for old, new, names, *ok in SPEC_EDITS),
+      for old, edits in SPEC_EDITS.items() for new, names, *ok in edits),
     spec_case(SPEC.replace("\n", "\r\n"), "", ok=True),
     spec_case("\ufeff" + SPEC, "spec.toml"),
     *(
