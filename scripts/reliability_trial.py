@@ -880,6 +880,12 @@ def child(case: dict, here: Path, run: Path, out: Path) -> None:
     os._exit(0)
 
 
+def named(case: dict, text: str) -> bool:
+    """Whether ``text`` names what ``case`` is about (one of its names, where it has several)."""
+    names = case["names"]
+    return any(name in text for name in ((names,) if isinstance(names, str) else names))
+
+
 def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
     """(clear | unclear | wrong, the message's first line)."""
     status = text.rpartition("@@STATUS ")[2].strip() if "@@STATUS" in text else "?"
@@ -898,10 +904,10 @@ def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
         if inside or kind not in {"ValueError", "TypeError", "ResetNeeded", "SetupError",
                                    "FileNotFoundError", "InvalidAction", "Error"}:  # fmt: skip
             return "wrong", status
-        return ("clear" if case["names"] in status else "unclear"), status
+        return ("clear" if named(case, status) else "unclear"), status
     if status in ("0", "None"):
         return ("clear" if case["ok"] else "wrong"), "accepted"
-    if case["names"] in body:
+    if named(case, body):
         return "clear", message
     return "unclear", message
 
