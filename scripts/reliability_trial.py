@@ -733,7 +733,7 @@ SPEC_EDITS = {  # text replaced: (by, what the refusal names[, valid])
     'tasks = ["dm_control/cartpole-swingup-v0"]': [
         ('tasks = "dm_control/cartpole-swingup-v0"', 'tasks'),
         ('tasks = []', 'tasks'),
-        ('tasks = ["Pendulum-v1"]', 'Pendulum-v1'),
+        ('tasks = ["Pendulum-v1"]', '', True),
         ('tasks = ["MiniGrid-Empty-5x5-v0"]', 'MiniGrid'),
     ],
     'seeds = "101-102"': [
