@@ -52,11 +52,16 @@ def is_real(value: Any) -> bool:
 
 
 def integer(low: int, optional: bool = False, fix: str = "", odd: bool = False) -> Rule:
-    """An int ``>= low`` (odd when ``odd``), or None when ``optional``."""
-    need = f"an {'odd ' if odd else ''}int >= {low}" + (" or none" if optional else "")
+    """An int ``>= low`` (odd when ``odd``) that int64 holds, or None when ``optional``: the
+    counters are numpy and torch int64s, so a larger one would wrap around."""
+    need = f"an {'odd ' if odd else ''}int >= {low} (below 2**63)" + (
+        " or none" if optional else ""
+    )
     return Rule(
         need,
-        lambda v: (optional and v is None) or (is_int(v) and v >= low and (not odd or v % 2)),
+        lambda v: (
+            (optional and v is None) or (is_int(v) and low <= v < 2**63 and (not odd or v % 2))
+        ),
         fix,
     )
 
