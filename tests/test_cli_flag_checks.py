@@ -109,3 +109,21 @@ def test_the_driving_references_check_every_value_before_playing(argv, said, cap
     monkeypatch.chdir(tmp_path)
     assert said in refused(capsys, driving_reference.main, argv)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "flag"),
+    [
+        (eval_cli.main, ["RUN", "--episodes", "9" * 30], "--episodes"),
+        (eval_cli.main, ["RUN", "--torch-threads=" + "9" * 30], "--torch-threads"),
+        (report_cli.main, ["DIR", "--at-step", str(2**63)], "--at-step"),
+        (analyze_cli.main, ["masks", "RUN", "--episodes", "-" + "9" * 30], "--episodes"),
+        (study_cli.main, ["run", "s.toml", "--study-dir", "s", "--num-cpus", "9" * 30],
+         "--num-cpus"),
+        (minigrid_cli.main, ["run", "--concurrent", "9" * 30], "--concurrent"),
+        (driving_reference.main, ["--seed", "9" * 30], "--seed"),
+    ],
+)  # fmt: skip
+def test_a_number_past_int64_is_refused_naming_its_flag(main, argv, flag, capsys):
+    err = refused(capsys, main, argv)
+    assert f"{flag} " in err and "below 2**63); give a smaller number" in err, err
