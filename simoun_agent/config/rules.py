@@ -123,7 +123,7 @@ def setting(default: Any, rule: Rule) -> Any:
         ... class Example:
         ...     size: int = setting(8, integer(1))
         >>> rules_of(Example)["size"].need
-        'an int >= 1'
+        'an int >= 1 (below 2**63)'
     """
     return dataclasses.field(default=default, metadata=with_rule(rule))
 
