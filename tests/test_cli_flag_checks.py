@@ -3,6 +3,8 @@ runs: an unknown flag is named with the flags it most likely meant (by meaning a
 spelling), an option given twice with different values is refused, a word after a switch is
 named with the switch; the driving references check every value before an episode."""
 
+from pathlib import Path
+
 import pytest
 
 from simoun_agent.cli import eval as eval_cli
@@ -102,6 +104,7 @@ def test_set_without_a_key_shows_the_form(capsys):
         (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
         (["--video", "lane.txt"], "--video lane.txt: a video is written as .gif or .mp4"),
         (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
+        (["--video", "/proc/lane.gif"], "cannot write to the output directory /proc"),
     ],
 )  # fmt: skip
 def test_the_driving_references_check_every_value_before_playing(argv, said, capsys, tmp_path,
@@ -127,3 +130,19 @@ def test_the_driving_references_check_every_value_before_playing(argv, said, cap
 def test_a_number_past_int64_is_refused_naming_its_flag(main, argv, flag, capsys):
     err = refused(capsys, main, argv)
     assert f"{flag} " in err and "below 2**63); give a smaller number" in err, err
+
+
+def test_an_output_directory_flag_given_a_file_is_refused_before_work(tmp_path, capsys):
+    spec, taken = tmp_path / "spec.toml", tmp_path / "taken"
+    spec.write_text(Path("docs/studies/dmc100k.toml").read_text())
+    taken.write_text("")
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", str(taken)])
+    assert f"the output directory {taken} is a file" in err and "--study-dir" in err
+    err = refused(capsys, sweep_cli.main, ["--preset", "cpu", "--sweep-dir", str(taken)])
+    assert f"--sweep-dir {taken} is a file, not a directory" in err
+
+
+def test_the_probe_takes_only_a_minigrid_task(tmp_path, capsys):
+    argv = ["probe", "--settings.env-id", "Pendulum-v1", "--out", str(tmp_path / "p")]
+    err = refused(capsys, minigrid_cli.main, argv)
+    assert "--settings.env-id Pendulum-v1: must be a registered MiniGrid id" in err

@@ -35,6 +35,7 @@ from simoun_agent.config import PRESETS, SetupError, TrainConfig, resolve
 from simoun_agent.config.envs import is_highway
 from simoun_agent.run.evaluate import RandomPolicy, evaluate
 from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.video import write_video
 
 
@@ -225,6 +226,7 @@ def check_command(args: DrivingReferenceCommand) -> TrainConfig:
                 f"--video {args.video}: the folder {args.video.parent} does not exist; create it "
                 "or pass a path in an existing folder"
             )
+        make_output_dir(args.video.parent, "--video")
     return config
 
 

@@ -101,6 +101,11 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
     """The sweep to run: from the flags (``base``: the config overrides they give), or the saved
     one on ``--resume`` (which the flags, when given, must match; ``--total-env-steps`` alone may
     differ, and extends every trial to the new budget)."""
+    if sweep_dir.exists() and not sweep_dir.is_dir():
+        raise SetupError(
+            f"--sweep-dir {sweep_dir} is a file, not a directory; pass a new directory, or with "
+            "--resume the directory of the sweep"
+        )
     preset = args.flags.preset
     if not args.resume:
         if (sweep_dir / SWEEP_FILE).exists():
