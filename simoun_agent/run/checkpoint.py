@@ -232,11 +232,18 @@ def check_seed_scheme(payload: dict, path: Path) -> None:
         )
 
 
-def check_config(payload: dict, current: dict, path: Path) -> None:
-    """Refuse a checkpoint written under another config (resumable fields may differ)."""
+def check_config(payload: dict, current: dict, path: Path, saved: Path | None = None) -> None:
+    """Refuse a checkpoint written under another config (resumable fields may differ);
+    ``saved``: ``current`` is that file's config, before any override, so the file is named."""
     differences = config_differences(payload["config"], current)
     if differences:
         listed = "; ".join(differences)
+        if saved is not None:
+            raise SetupError(
+                f"{saved} does not hold the config of the checkpoint in {path} ({listed}): the "
+                "file was edited or damaged. Restore it from a copy, or start a new run in "
+                "another directory."
+            )
         raise SetupError(
             f"checkpoint {path} comes from another config ({listed}). Resume without those "
             "overrides, or start a new run in another directory."

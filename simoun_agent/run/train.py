@@ -204,7 +204,14 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"but {', '.join(fixed)} was given. Start a new run to change it."
         )
     config = from_dict(saved, str(config_path))
-    for log in (EVAL_CSV, TRAIN_CSV):  # before anything in the run is changed
+    as_saved = to_dict(config)
+    for name in (EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything in the run is changed
+        if (run_dir / name).exists() and not (run_dir / name).is_file():
+            raise SetupError(
+                f"{run_dir / name} is not a file; move it aside (mv {run_dir / name} "
+                f"{run_dir / name}.damaged) and resume again"
+            )
+    for log in (EVAL_CSV, TRAIN_CSV):
         if (run_dir / log).exists():
             read_log(run_dir / log)
     for key, value in overrides.items():
@@ -213,6 +220,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
     check_seed_scheme(payload, run_dir)
+    check_config(payload, as_saved, run_dir, saved=config_path)
     check_config(payload, to_dict(config), run_dir)
     done = payload["state"]["env_step"]
     finished = (run_dir / SUMMARY_NAME).exists()
