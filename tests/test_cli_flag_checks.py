@@ -146,3 +146,12 @@ def test_the_probe_takes_only_a_minigrid_task(tmp_path, capsys):
     argv = ["probe", "--settings.env-id", "Pendulum-v1", "--out", str(tmp_path / "p")]
     err = refused(capsys, minigrid_cli.main, argv)
     assert "--settings.env-id Pendulum-v1: must be a registered MiniGrid id" in err
+
+
+@pytest.mark.parametrize(("value", "said"), [("", "takes a number or auto, got ''"),
+                                             ("nan", "must be a finite number"),
+                                             ("inf", "must be a finite number")])  # fmt: skip
+def test_gpus_per_trial_is_read_before_ray_starts(value, said, tmp_path, capsys):
+    argv = ["--preset", "cpu", "--sweep-dir", str(tmp_path / "s"), "--gpus-per-trial", value]
+    assert said in refused(capsys, sweep_cli.main, argv)
+    assert not (tmp_path / "s").exists()

@@ -36,6 +36,7 @@ from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
 from simoun_lab.sweep.launch import (
     check_fits,
     gpus_per_trial,
+    gpus_wanted,
     run_sweep,
     stop_trials_on_sigterm,
     summarize,
@@ -158,6 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        gpus_wanted(args.gpus_per_trial)
         ray = load_ray()
     except SetupError as err:
         fail(PROG, err)
