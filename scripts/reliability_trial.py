@@ -584,7 +584,7 @@ SECOND_FLAG_CASES = [
     ),
     *(cli("flags", command, argv, names) for command, argv, names in CASE_CHOICES),
     *(cli("flags", "train", tiny("--env", env), names) for env, names in WRONG_ENVS),
-    cli("flags", "sweep", sweep_tiny("--envs", "MiniGrid-Empty-5x5-v0"), "MiniGrid"),
+    cli("flags", "sweep", [*sweep_tiny()[2:], "--envs", "MiniGrid-Empty-5x5-v0"], "MiniGrid"),
     cli(
         "flags", "minigrid", ["probe", "--settings.env-id", "Pendulum-v1", "--out", "p"], "Pendulum"
     ),
@@ -746,7 +746,7 @@ SPEC_EDITS = {  # text replaced: (by, what the refusal names[, valid])
         ('seeds = "100-104"', 'seed'),
     ],
     '"dm_control/cheetah-run-v0" = "1-3" }': [
-        ('"dm_control/cheetah-run-v0" = "102-104" }', '', True),
+        ('"dm_control/cheetah-run-v0" = "102-104" }', "102"),
         ('}', 'cheetah'),
     ],
     'cpus_per_trial = 1 ': [
@@ -792,7 +792,7 @@ MINIGRID_EDITS = [  # (a change to the spec's JSON value, what the refusal names
     (lambda s: s["ppo"].update(n_envs=0), "n_envs"),
     (lambda s: s["ppo"].update(gamma=1.5), "gamma"),
     (lambda s: s.update(evaluations=0.5), "evaluations"),
-    (lambda s: s.update(eval_seed=2), "eval_seed"),
+    (lambda s: s.update(eval_seed=2), ""),
     (lambda s: s.update(eval_seed="1e6"), "eval_seed"),
     (lambda s: s.update(device="tpu"), "device"),
     (lambda s: s.update(ppo=[]), "ppo"),
