@@ -170,6 +170,11 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
             f"{path} is a file that is not a checkpoint (.pt); pass a run directory that "
             f"simoun-train created, or its {CHECKPOINT_NAME}"
         )
+    if path.exists() and not path.is_file():
+        raise SetupError(
+            f"{path} is not a file, so it holds no checkpoint; move it aside (mv {path} "
+            f"{path}.damaged) and restore {CHECKPOINT_NAME} from a copy, or start a new run"
+        )
     if not path.is_file():
         raise SetupError(
             f"no checkpoint at {path}: the run stopped before its first checkpoint, or the path "
