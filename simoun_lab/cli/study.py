@@ -29,7 +29,7 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.rundir import make_output_dir, refuse_a_file
 from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.study.checks import check_study
 from simoun_lab.study.plan import describe
@@ -120,10 +120,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             study_dir=args.study_dir.absolute(),
             archive=args.archive.absolute() if args.archive else None,
         )
-        make_output_dir(options.study_dir, "--study-dir")
-        if options.archive is not None:
-            make_output_dir(options.archive, "--archive")
+        outputs = {"--study-dir": options.study_dir, "--archive": options.archive}
+        for flag, path in outputs.items():  # before Ray, which takes seconds to import
+            if path is not None:
+                refuse_a_file(path, flag)
         ray = load_ray()
+        for flag, path in outputs.items():
+            if path is not None:
+                make_output_dir(path, flag)
         return run_study(spec, args.spec, options, ray)
     except SetupError as err:
         fail(PROG, err)
