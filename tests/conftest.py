@@ -34,6 +34,14 @@ def ray_address() -> Iterator[str]:
     own); its address. Imports Ray only when used (the lab extra)."""
     import ray
 
-    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False)
+    # at pytest's own priority: Ray's default (nice 15 above it) starves the trials whenever
+    # anything else runs, and a suite under load then waits on them for tens of minutes
+    ray.init(
+        address="local",
+        num_cpus=2,
+        include_dashboard=False,
+        log_to_driver=False,
+        _system_config={"worker_niceness": 0},
+    )
     yield ray.get_runtime_context().gcs_address
     ray.shutdown()
