@@ -103,9 +103,9 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
         check_stack_bytes(num_frames, space.shape, space.dtype)  # before batch_space allocates
         self.num_frames = int(num_frames)
         self.observation_space = batch_space(space, n=self.num_frames)
-        # What reset() and step() hand each observation to: a FrameRing here, a FrameStack in
-        # SimounObservation's chain (simoun_wrappers.stack.StreamTriplet).
-        self._stack = FrameRing(self.num_frames, space.shape, space.dtype)
+        # What reset() and step() hand each observation to: a FrameRing here, a FrameStack (same
+        # reset and push) in SimounObservation's chain (simoun_wrappers.stack.StreamTriplet).
+        self._ring = FrameRing(self.num_frames, space.shape, space.dtype)
         self._has_reset = False
 
     def reset(
@@ -113,7 +113,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         obs, info = self.env.reset(seed=seed, options=options)
         self._has_reset = True
-        return self._stack.reset(obs), info
+        return self._ring.reset(obs), info
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
         if not self._has_reset:
@@ -123,7 +123,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 "frame stack in reset(); call env.reset(seed=...) first."
             )
         obs, reward, terminated, truncated, info = self.env.step(action)
-        return self._stack.push(obs), reward, terminated, truncated, info
+        return self._ring.push(obs), reward, terminated, truncated, info
 
 
 def frame_stack_in(env: gym.Env) -> gym.Wrapper | None:

@@ -131,5 +131,5 @@ class StreamTriplet(FrameTriplet):
         # stack holds its own for the frames made from them.
         self.num_frames = stack.num_frames
         self.observation_space = stack.observation_space
-        self._stack = stack
+        self._ring = stack
         self._has_reset = False
