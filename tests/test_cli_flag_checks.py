@@ -3,6 +3,8 @@ runs: an unknown flag is named with the flags it most likely meant (by meaning a
 spelling), an option given twice with different values is refused, a word after a switch is
 named with the switch; the driving references check every value before an episode."""
 
+from pathlib import Path
+
 import pytest
 
 from simoun_agent.cli import eval as eval_cli
@@ -104,6 +106,7 @@ def test_set_without_a_key_shows_the_form(capsys):
         (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
         (["--json", "refs.csv"], "--json refs.csv: the metrics file is written as .json"),
         (["--json", "nowhere/references.json"], "the folder nowhere does not exist"),
+        (["--video", "/proc/lane.gif"], "cannot write to the output directory /proc"),
     ],
 )  # fmt: skip
 def test_the_driving_references_check_every_value_before_playing(argv, said, capsys, tmp_path,
@@ -111,3 +114,46 @@ def test_the_driving_references_check_every_value_before_playing(argv, said, cap
     monkeypatch.chdir(tmp_path)
     assert said in refused(capsys, driving_reference.main, argv)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "flag"),
+    [
+        (eval_cli.main, ["RUN", "--episodes", "9" * 30], "--episodes"),
+        (eval_cli.main, ["RUN", "--torch-threads=" + "9" * 30], "--torch-threads"),
+        (report_cli.main, ["DIR", "--at-step", str(2**63)], "--at-step"),
+        (analyze_cli.main, ["masks", "RUN", "--episodes", "-" + "9" * 30], "--episodes"),
+        (study_cli.main, ["run", "s.toml", "--study-dir", "s", "--num-cpus", "9" * 30],
+         "--num-cpus"),
+        (minigrid_cli.main, ["run", "--concurrent", "9" * 30], "--concurrent"),
+        (driving_reference.main, ["--seed", "9" * 30], "--seed"),
+    ],
+)  # fmt: skip
+def test_a_number_past_int64_is_refused_naming_its_flag(main, argv, flag, capsys):
+    err = refused(capsys, main, argv)
+    assert f"{flag} " in err and "below 2**63); give a smaller number" in err, err
+
+
+def test_an_output_directory_flag_given_a_file_is_refused_before_work(tmp_path, capsys):
+    spec, taken = tmp_path / "spec.toml", tmp_path / "taken"
+    spec.write_text(Path("docs/studies/dmc100k.toml").read_text())
+    taken.write_text("")
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", str(taken)])
+    assert f"the output directory {taken} is a file" in err and "--study-dir" in err
+    err = refused(capsys, sweep_cli.main, ["--preset", "cpu", "--sweep-dir", str(taken)])
+    assert f"--sweep-dir {taken} is a file, not a directory" in err
+
+
+def test_the_probe_takes_only_a_minigrid_task(tmp_path, capsys):
+    argv = ["probe", "--settings.env-id", "Pendulum-v1", "--out", str(tmp_path / "p")]
+    err = refused(capsys, minigrid_cli.main, argv)
+    assert "--settings.env-id Pendulum-v1: must be a registered MiniGrid id" in err
+
+
+@pytest.mark.parametrize(("value", "said"), [("", "takes a number or auto, got ''"),
+                                             ("nan", "must be a finite number"),
+                                             ("inf", "must be a finite number")])  # fmt: skip
+def test_gpus_per_trial_is_read_before_ray_starts(value, said, tmp_path, capsys):
+    argv = ["--preset", "cpu", "--sweep-dir", str(tmp_path / "s"), "--gpus-per-trial", value]
+    assert said in refused(capsys, sweep_cli.main, argv)
+    assert not (tmp_path / "s").exists()

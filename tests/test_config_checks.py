@@ -108,6 +108,8 @@ def test_bad_value_names_the_flag(key):
         ({"eval_every": 0}, ["--eval-every 0", "int >= 1"]),
         ({"checkpoint_every": 0}, ["--checkpoint-every 0", "int >= 1"]),
         ({"action_repeat": 0}, ["--action-repeat 0", "int >= 1"]),
+        ({"total_env_steps": 10**30}, ["--total-env-steps 1" + "0" * 30, "below 2**63"]),
+        ({"eval_every": 2**63}, [f"--eval-every {2**63}", "below 2**63"]),
         ({"image_size": 7}, ["--image-size 7", "too small", "--image-size 19 or more"]),
         ({"replay_capacity": 100, "agent.batch_size": 512}, ["--replay-capacity 100", "512"]),
         ({"agent.log_std_min": 3.0}, ["--agent.log-std-min 3", "--agent.log-std-max 2"]),

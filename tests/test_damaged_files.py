@@ -8,7 +8,7 @@ import pytest
 
 from simoun_agent.cli import train as train_cli
 from simoun_agent.config import resolve, to_dict
-from simoun_agent.run.logger import CsvLog, read_log
+from simoun_agent.run.logger import CsvLog, read_csv, read_log
 
 
 @pytest.mark.parametrize("text", ["[]", "null", "3", '"config"'])
@@ -52,8 +52,11 @@ def test_a_wrong_type_in_config_json_is_named_as_the_files_key(tmp_path, capsys)
         ("eval.csv", b"env_step,return_mean\n20,1.5\n4", "line 3 has 1 fields"),
         ("eval.csv", b"env_step,return_mean\nabc,x\n", "line 2's env_step 'abc'"),
         ("train.csv", b"env_step,return\n\xff\xfe\n", "it is not a CSV file"),
+        ("eval.csv", b"env_step,return_mean\n40,1\n20,2\n", "line 3's env_step 20 does not "
+         "come after line 2's 40 (rows out of order or repeated)"),
+        ("train.csv", b"env_step,return\n20,1\n20,1\n", "line 3's env_step 20 does not come"),
     ],
-)
+)  # fmt: skip
 def test_a_damaged_log_is_named_and_kept_on_resume(log, text, problem, tmp_path, capsys):
     run_dir = saved_run(tmp_path)
     (run_dir / log).write_bytes(text)
@@ -79,3 +82,13 @@ def test_a_resumed_log_keeps_its_rows_up_to_the_checkpoint(tmp_path):
         ["env_step", "return_mean"],
         [{"env_step": "20", "return_mean": "2.0"}, resumed.last_row],
     )
+
+
+def test_a_log_saved_with_a_byte_order_mark_reads_as_written(tmp_path):
+    path = tmp_path / "eval.csv"
+    path.write_text("\ufeffenv_step,return_mean\r\n20,2.0\r\n", newline="")
+    assert read_log(path) == (
+        ["env_step", "return_mean"],
+        [{"env_step": "20", "return_mean": "2.0"}],
+    )
+    assert read_csv(path) == [{"env_step": 20.0, "return_mean": 2.0}]

@@ -82,6 +82,35 @@ def test_a_minigrid_spec_that_is_not_an_object_is_named(text, kind, tmp_path, ca
     assert f"--spec {spec} holds {kind}, not the object of a study spec" in err
 
 
+MINIGRID_SPEC = json.loads(Path("docs/studies/minigrid/spec.json").read_text())
+
+
+@pytest.mark.parametrize(
+    ("change", "said"),
+    [
+        ({"tasks": {}}, "tasks is {}, which must be a non-empty array of task objects"),
+        ({"tasks": [{"steps": 5000, "seeds": [0]}]},
+         "tasks[0]: no 'env_id'; give it: a registered MiniGrid id"),
+        ({"tasks": [{**MINIGRID_SPEC["tasks"][0], "steps": "400k"}]},
+         'tasks[0]: steps is "400k", which must be an int >= 1'),
+        ({"tasks": [{**MINIGRID_SPEC["tasks"][0], "seeds": 3}]}, "tasks[0]: seeds is 3"),
+        ({"tasks": [{**MINIGRID_SPEC["tasks"][0], "env_id": "Pendulum-v1"}]},
+         'tasks[0]: env_id is "Pendulum-v1", which must be a registered MiniGrid id'),
+        ({"ppo": []}, "ppo is [], which must be an object of PPO settings"),
+        ({"ppo": {"learning_rate": "fast"}}, 'ppo: learning_rate is "fast", which must be a'),
+        ({"arms": "ppo"}, 'arms is "ppo", which must be a non-empty array of arm names'),
+        ({"evaluations": 0.5}, "evaluations is 0.5, which must be an int >= 1"),
+        ({"device": "tpu"}, 'device is "tpu", which must be a torch device name'),
+    ],
+)  # fmt: skip
+def test_a_minigrid_spec_value_of_the_wrong_kind_is_named(change, said, tmp_path, capsys):
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps({**MINIGRID_SPEC, **change}))
+    for command in ("report", "select"):
+        err = refused(capsys, minigrid_cli.main, [command, "--spec", str(spec), "--archive", "."])
+        assert f"{spec}: {said}" in err, err
+
+
 def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys):
     err = refused(capsys, report_cli.main, [str(tmp_path / "nope")])
     assert f"{tmp_path / 'nope'} does not exist; pass a sweep directory" in err

@@ -415,3 +415,35 @@ def test_a_damaged_sweep_json_is_named_with_its_fix(runs_dir, text, tmp_path, ca
     assert f"{root / 'sweep.json'} is damaged" in err
     assert "restore it from a copy" in err
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("name", "change", "said"),
+    [
+        ("eval.csv", lambda rows: [rows[0], *reversed(rows[1:])], "eval.csv line 3: env_step"),
+        ("eval.csv", lambda rows: [*rows, rows[-1]], "does not come after the line before"),
+        ("eval.csv", lambda rows: [rows[0], ["-20", *rows[1][1:]], *rows[2:]], "is negative"),
+        ("summary.json", {"env_step": "forty"}, "summary.json: env_step is 'forty', not a number"),
+    ],
+)
+def test_a_run_with_steps_out_of_order_or_a_summary_of_the_wrong_type_is_named(
+    runs_dir, name, change, said, tmp_path, capsys
+):
+    run = tmp_path / "a-s0"
+    shutil.copytree(runs_dir / "a-s0", run)
+    path = run / name
+    if name == "summary.json":
+        path.write_text(json.dumps({**json.loads(path.read_text()), **change}))
+    else:
+        rows = [line.split(",") for line in path.read_text().splitlines()]
+        path.write_text("\n".join(",".join(row) for row in change(rows)) + "\n")
+    with pytest.raises(SystemExit):
+        report_cli.main([str(tmp_path)])
+    err = capsys.readouterr().err
+    assert "every run is damaged" in err and said in err, err
+
+
+def test_an_equal_wall_time_budget_must_be_finite(runs_dir, capsys):
+    with pytest.raises(SystemExit):
+        report_cli.main([str(runs_dir), "--at-wall-time", "inf"])
+    assert "--at-wall-time inf: give a positive finite number" in capsys.readouterr().err

@@ -100,7 +100,11 @@ def test_checkpoint_from_another_config_is_refused(finished_run, tmp_path):
     other.mkdir()
     (other / "config.json").write_text(json.dumps(config))
     (other / "checkpoint.pt").write_bytes((finished_run / "checkpoint.pt").read_bytes())
-    with pytest.raises(SetupError, match=r"another config \(agent\.lr: 0\.001 in the checkpoint"):
+    with pytest.raises(
+        SetupError,
+        match=r"config\.json does not hold the config of the checkpoint in .* \(agent\.lr: 0\.001 "
+        r"in the checkpoint, 0\.0005 now\): the file was edited or damaged",
+    ):
         train.resume_run(other, {})
 
 
@@ -159,3 +163,27 @@ def test_a_missing_checkpoint_is_named_with_both_fixes(finished_run, tmp_path):
     with pytest.raises(SetupError, match=r"has no checkpoint\.pt: .* moved or deleted") as refusal:
         train.resume_run(run_dir, {"total_env_steps": 60})
     assert "Restore it from a copy" in str(refusal.value)
+
+
+def test_a_config_json_that_lost_a_section_is_named_not_blamed_on_overrides(finished_run, tmp_path):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    config = json.loads((run_dir / "config.json").read_text())
+    del config["agent"]
+    (run_dir / "config.json").write_text(json.dumps(config))
+    with pytest.raises(
+        SetupError, match=r"config\.json does not hold the config of the checkpoint"
+    ):
+        train.resume_run(run_dir, {"total_env_steps": 60})
+
+
+@pytest.mark.parametrize("name", ["summary.json", "eval.csv", "config.json", "checkpoint.pt"])
+def test_a_kept_file_that_is_a_directory_is_named_and_nothing_changes(finished_run, tmp_path, name):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    (run_dir / name).unlink()
+    (run_dir / name).mkdir()
+    before = {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()}
+    with pytest.raises(SetupError, match=rf"{name} is not a file.*; move it aside"):
+        train.resume_run(run_dir, {"total_env_steps": 60})
+    assert {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()} == before

@@ -28,6 +28,7 @@ import functools
 import itertools
 import json
 import os
+import re
 import sys
 import typing
 from collections.abc import Callable, Iterable, Iterator, Sequence
@@ -274,6 +275,29 @@ def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
             )
 
 
+INT64_END = 2**63
+"""Where int64 ends: a count, seed or step at or past it wraps around in numpy and torch."""
+
+
+def refuse_huge_numbers(argv: Sequence[str], flags: dict[str, Flag], prog: str) -> None:
+    """Raise ValueError for an option of ``flags`` given a whole number that int64 does not
+    hold (``--episodes 99999999999999999999``): every count, seed and step becomes a numpy or
+    torch int64, where it would wrap around or fail from inside the library."""
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        name, eq, text = arg.partition("=")
+        flag = flags.get(name)
+        if flag is None or flag.switch is not None or not (eq or i + 1 < len(argv)):
+            continue
+        value = text if eq else argv[i + 1]
+        if re.fullmatch(r"[+-]?[0-9_]+", value.strip()) and abs(int(value)) >= INT64_END:
+            raise ValueError(
+                f"{name} {value}: larger than any count, seed or step can be (they are int64s, "
+                f"below 2**63); give a smaller number (`{prog} --help` shows each default)"
+            )
+
+
 def negated(flag: str) -> str:
     """tyro's negation of a switch: ``--video`` -> ``--no-video``, ``--agent.curiosity`` ->
     ``--agent.no-curiosity``."""
@@ -310,6 +334,7 @@ def parse(
         refuse_unknown(argv, flags, cls, prog)
         refuse_stray_words(argv, flags, takes_positional(cls, argv))
         refuse_repeated(argv, flags)
+        refuse_huge_numbers(argv, flags, prog)
     except ValueError as err:
         fail(prog, err)
     with _help_unwrapped_in_pipes():

@@ -12,7 +12,7 @@ Example:
     >>> AgentConfig(batch_size=0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: --agent.batch-size 0 (AgentConfig.batch_size) must be an int >= 1; e.g. ...
+    ValueError: --agent.batch-size 0 (AgentConfig.batch_size) must be an int >= 1 (below 2**63)...
 """
 
 from __future__ import annotations
@@ -52,11 +52,16 @@ def is_real(value: Any) -> bool:
 
 
 def integer(low: int, optional: bool = False, fix: str = "", odd: bool = False) -> Rule:
-    """An int ``>= low`` (odd when ``odd``), or None when ``optional``."""
-    need = f"an {'odd ' if odd else ''}int >= {low}" + (" or none" if optional else "")
+    """An int ``>= low`` (odd when ``odd``) that int64 holds, or None when ``optional``: the
+    counters are numpy and torch int64s, so a larger one would wrap around."""
+    need = f"an {'odd ' if odd else ''}int >= {low} (below 2**63)" + (
+        " or none" if optional else ""
+    )
     return Rule(
         need,
-        lambda v: (optional and v is None) or (is_int(v) and v >= low and (not odd or v % 2)),
+        lambda v: (
+            (optional and v is None) or (is_int(v) and low <= v < 2**63 and (not odd or v % 2))
+        ),
         fix,
     )
 
@@ -118,7 +123,7 @@ def setting(default: Any, rule: Rule) -> Any:
         ... class Example:
         ...     size: int = setting(8, integer(1))
         >>> rules_of(Example)["size"].need
-        'an int >= 1'
+        'an int >= 1 (below 2**63)'
     """
     return dataclasses.field(default=default, metadata=with_rule(rule))
 

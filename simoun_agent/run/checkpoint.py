@@ -170,6 +170,11 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
             f"{path} is a file that is not a checkpoint (.pt); pass a run directory that "
             f"simoun-train created, or its {CHECKPOINT_NAME}"
         )
+    if path.exists() and not path.is_file():
+        raise SetupError(
+            f"{path} is not a file, so it holds no checkpoint; move it aside (mv {path} "
+            f"{path}.damaged) and restore {CHECKPOINT_NAME} from a copy, or start a new run"
+        )
     if not path.is_file():
         raise SetupError(
             f"no checkpoint at {path}: the run stopped before its first checkpoint, or the path "
@@ -232,11 +237,18 @@ def check_seed_scheme(payload: dict, path: Path) -> None:
         )
 
 
-def check_config(payload: dict, current: dict, path: Path) -> None:
-    """Refuse a checkpoint written under another config (resumable fields may differ)."""
+def check_config(payload: dict, current: dict, path: Path, saved: Path | None = None) -> None:
+    """Refuse a checkpoint written under another config (resumable fields may differ);
+    ``saved``: ``current`` is that file's config, before any override, so the file is named."""
     differences = config_differences(payload["config"], current)
     if differences:
         listed = "; ".join(differences)
+        if saved is not None:
+            raise SetupError(
+                f"{saved} does not hold the config of the checkpoint in {path} ({listed}): the "
+                "file was edited or damaged. Restore it from a copy, or start a new run in "
+                "another directory."
+            )
         raise SetupError(
             f"checkpoint {path} comes from another config ({listed}). Resume without those "
             "overrides, or start a new run in another directory."

@@ -40,6 +40,7 @@ from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.driving_metrics import columns
 from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
 from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.video import write_video
 
 
@@ -211,7 +212,7 @@ VIDEO_SUFFIXES = (".gif", ".mp4")
 
 def check_output(flag: str, path: Path, what: str, suffixes: tuple[str, ...], example: str) -> None:
     """SetupError when ``path``, the value of ``flag``, has none of ``suffixes`` or its folder
-    does not exist."""
+    does not exist or cannot be written."""
     if path.suffix not in suffixes:
         raise SetupError(
             f"{flag} {path}: {what} is written as {' or '.join(suffixes)}, not "
@@ -222,6 +223,7 @@ def check_output(flag: str, path: Path, what: str, suffixes: tuple[str, ...], ex
             f"{flag} {path}: the folder {path.parent} does not exist; create it or pass a path "
             "in an existing folder"
         )
+    make_output_dir(path.parent, flag)
 
 
 def check_command(args: DrivingReferenceCommand) -> TrainConfig:

@@ -53,7 +53,7 @@ class CsvLog:
             self.columns = list(row)
             self._rewrite([])
         elif any(key not in self.columns for key in row):
-            with self.path.open(newline="") as f:
+            with self.path.open(newline="", encoding="utf-8-sig") as f:
                 rows = list(csv.DictReader(f))
             self.columns += [key for key in row if key not in self.columns]
             self._rewrite(rows)
@@ -67,7 +67,7 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
     the user's file stays as it is."""
     try:
-        with path.open(newline="") as f:
+        with path.open(newline="", encoding="utf-8-sig") as f:  # a spreadsheet's BOM too
             lines = list(csv.reader(f))
     except (UnicodeDecodeError, csv.Error) as err:
         raise damaged_log(path, f"it is not a CSV file ({err})") from None
@@ -82,6 +82,10 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
             raise damaged_log(path, f"line {number} has {fields}")
         if not values[at].isdigit():
             raise damaged_log(path, f"line {number}'s env_step {values[at]!r} is not a step count")
+        if rows and int(values[at]) <= int(rows[-1]["env_step"]):
+            raise damaged_log(path, f"line {number}'s env_step {values[at]} does not come after "
+                              f"line {number - 1}'s {rows[-1]['env_step']} (rows out of order or "
+                              "repeated)")  # fmt: skip
         rows.append(dict(zip(columns, values, strict=True)))
     return columns, rows
 
@@ -98,7 +102,7 @@ def damaged_log(path: Path, problem: str) -> SetupError:
 
 def read_csv(path: Path) -> list[dict[str, float]]:
     """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty)."""
-    with path.open(newline="") as f:
+    with path.open(newline="", encoding="utf-8-sig") as f:
         return [{k: float(v or "nan") for k, v in row.items()} for row in csv.DictReader(f)]
 
 

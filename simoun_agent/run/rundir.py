@@ -25,16 +25,22 @@ _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""
 
 
-def make_output_dir(path: Path, flag: str = "--out") -> bool:
-    """Create ``path`` (with its parents) and check that it can be written. Returns True when
-    it did not exist before, so a caller that stops later can remove what it made; raises
-    SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
-    created = not path.exists()
+def refuse_a_file(path: Path, flag: str) -> None:
+    """Raise SetupError naming ``flag`` when the output directory ``path`` is a file; creates
+    nothing, so a command can check before work whose failure must leave nothing behind."""
     if path.exists() and not path.is_dir():
         raise SetupError(
             f"the output directory {path} is a file, not a directory; pass a new or existing "
             f"directory to {flag}"
         )
+
+
+def make_output_dir(path: Path, flag: str = "--out") -> bool:
+    """Create ``path`` (with its parents) and check that it can be written. Returns True when
+    it did not exist before, so a caller that stops later can remove what it made; raises
+    SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
+    created = not path.exists()
+    refuse_a_file(path, flag)
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / ".write-test"

@@ -178,6 +178,14 @@ def write_config(run_dir: Path, config: TrainConfig) -> None:
     atomic_write(run_dir / CONFIG_NAME, lambda tmp: tmp.write_text(text))
 
 
+def not_a_file(path: Path) -> SetupError:
+    """The error for a kept file of a run that is a directory (or another thing, not a file)."""
+    return SetupError(
+        f"{path} is not a file; move it aside (mv {path} {path}.damaged), restore the file "
+        "from a copy, and resume again"
+    )
+
+
 def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
@@ -188,6 +196,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"--resume {run_dir} {why}; pass the directory that simoun-train created (its "
             "path is printed as 'run directory: ...' when a run starts)"
         )
+    if config_path.exists() and not config_path.is_file():
+        raise not_a_file(config_path)
     if not config_path.is_file():
         raise SetupError(
             f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "
@@ -204,7 +214,11 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"but {', '.join(fixed)} was given. Start a new run to change it."
         )
     config = from_dict(saved, str(config_path))
-    for log in (EVAL_CSV, TRAIN_CSV):  # before anything in the run is changed
+    as_saved = to_dict(config)
+    for name in (EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything in the run is changed
+        if (run_dir / name).exists() and not (run_dir / name).is_file():
+            raise not_a_file(run_dir / name)
+    for log in (EVAL_CSV, TRAIN_CSV):
         if (run_dir / log).exists():
             read_log(run_dir / log)
     for key, value in overrides.items():
@@ -213,6 +227,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
     check_seed_scheme(payload, run_dir)
+    check_config(payload, as_saved, run_dir, saved=config_path)
     check_config(payload, to_dict(config), run_dir)
     done = payload["state"]["env_step"]
     finished = (run_dir / SUMMARY_NAME).exists()

@@ -7,6 +7,7 @@ runs, per variant and env, over seeds (:mod:`simoun_lab.sweep.report` describes 
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -63,8 +64,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         budget = ("env_step", args.at_step)
     elif args.at_wall_time is not None:
         budget = ("wall_time_s", args.at_wall_time)
-    if budget is not None and budget[1] <= 0:
-        fail(PROG, "--at-step / --at-wall-time must be positive")
+    if budget is not None and not (math.isfinite(budget[1]) and budget[1] > 0):
+        flag = "--at-step" if budget[0] == "env_step" else "--at-wall-time"
+        fail(PROG, f"{flag} {budget[1]:g}: give a positive finite number, e.g. {flag} 100000")
     try:
         written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
     except SetupError as err:

@@ -32,6 +32,7 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.run.rundir import make_output_dir, refuse_a_file
 from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.minigrid_study import study_command
 from simoun_lab.minigrid_study.study_command import is_ppo_spec
@@ -123,7 +124,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         if isinstance(args, Report):
             print(f"report: {report_study(spec, args.study_dir)}")
             return 0
-        return run_study(spec, args.spec, absolute(args), load_ray())
+        options = absolute(args)
+        check_outputs(options)  # before Ray, which takes seconds to import
+        ray = load_ray()
+        for flag, path in outputs(options).items():
+            make_output_dir(path, flag)
+        return run_study(spec, args.spec, options, ray)
     except SetupError as err:
         fail(PROG, err)
 
@@ -137,7 +143,21 @@ def ppo_study(args: Plan | Run | Report) -> int:
     if isinstance(args, Report):
         print(f"report: {study_command.report(spec, args.study_dir)}")
         return 0
-    return study_command.run(spec, absolute(args))
+    options = absolute(args)
+    check_outputs(options)
+    return study_command.run(spec, options)
+
+
+def outputs(options: Run) -> dict[str, Path]:
+    """The output directories the run was given, by flag."""
+    given = {"--study-dir": options.study_dir, "--archive": options.archive}
+    return {flag: path for flag, path in given.items() if path is not None}
+
+
+def check_outputs(options: Run) -> None:
+    """Refuse an output directory that is a file, creating nothing."""
+    for flag, path in outputs(options).items():
+        refuse_a_file(path, flag)
 
 
 def absolute(args: Run) -> Run:

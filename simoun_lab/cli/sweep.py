@@ -36,6 +36,7 @@ from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
 from simoun_lab.sweep.launch import (
     check_fits,
     gpus_per_trial,
+    gpus_wanted,
     run_sweep,
     stop_trials_on_sigterm,
     summarize,
@@ -101,6 +102,11 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
     """The sweep to run: from the flags (``base``: the config overrides they give), or the saved
     one on ``--resume`` (which the flags, when given, must match; ``--total-env-steps`` alone may
     differ, and extends every trial to the new budget)."""
+    if sweep_dir.exists() and not sweep_dir.is_dir():
+        raise SetupError(
+            f"--sweep-dir {sweep_dir} is a file, not a directory; pass a new directory, or with "
+            "--resume the directory of the sweep"
+        )
     preset = args.flags.preset
     if not args.resume:
         if (sweep_dir / SWEEP_FILE).exists():
@@ -153,6 +159,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        gpus_wanted(args.gpus_per_trial)
         ray = load_ray()
     except SetupError as err:
         fail(PROG, err)

@@ -20,7 +20,7 @@ import tyro
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings
-from simoun_lab.minigrid_study.spec import StudySpec, load_spec
+from simoun_lab.minigrid_study.spec import MINIGRID_ID, StudySpec, load_spec
 
 ARCHIVE = Path("docs/studies/minigrid")
 
@@ -116,6 +116,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 raise SetupError(
                     f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "
                     "run from the root of a clone of simoun, or pass an --out whose folder exists"
+                )
+            if not MINIGRID_ID.ok(args.settings.env_id):
+                raise SetupError(
+                    f"--settings.env-id {args.settings.env_id}: must be {MINIGRID_ID.need}"
                 )
             print(write_probe(args.settings, args.probes, args.out))
         except ValueError as err:

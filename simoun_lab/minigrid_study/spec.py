@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
+
 from simoun_agent.config import SetupError
+from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
 from simoun_lab.minigrid_study.arms import ARMS, parse_arm
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
@@ -28,23 +32,23 @@ class PPOSettings:
     SB3 scales images by 1/255 itself, and normalizing the reward would rescale each arm's
     intrinsic reward by a different running statistic."""
 
-    n_envs: int = 8
+    n_envs: int = setting(8, integer(1))
     """sub-envs stepped together (zoo: 8)"""
-    n_steps: int = 128
+    n_steps: int = setting(128, integer(1))
     """steps per sub-env per rollout (zoo: 128), so 1024 transitions per update"""
-    batch_size: int = 64
+    batch_size: int = setting(64, integer(1))
     """minibatch size (zoo: 64)"""
-    n_epochs: int = 10
+    n_epochs: int = setting(10, integer(1))
     """passes over each rollout (zoo: 10)"""
-    learning_rate: float = 2.5e-4
+    learning_rate: float = setting(2.5e-4, real(0, open_low=True))
     """Adam learning rate (zoo: 2.5e-4)"""
-    gamma: float = 0.99
+    gamma: float = setting(0.99, real(0, 1))
     """discount (zoo: 0.99)"""
-    gae_lambda: float = 0.95
+    gae_lambda: float = setting(0.95, real(0, 1))
     """GAE lambda (zoo: 0.95)"""
-    ent_coef: float = 0.0
+    ent_coef: float = setting(0.0, real(0))
     """entropy bonus weight (zoo: 0.0)"""
-    clip_range: float = 0.2
+    clip_range: float = setting(0.2, real(0, open_low=True))
     """PPO's ratio clip (zoo: 0.2)"""
 
     def kwargs(self) -> dict[str, Any]:
@@ -52,15 +56,53 @@ class PPOSettings:
         return {k: v for k, v in dataclasses.asdict(self).items() if k != "n_envs"}
 
 
+def is_minigrid_id(value: Any) -> bool:
+    """A registered MiniGrid or BabyAI task id."""
+    import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
+
+    return (
+        isinstance(value, str)
+        and value.startswith(("MiniGrid-", "BabyAI-"))
+        and (value in gym.registry)
+    )
+
+
+def items(value: Any, ok) -> bool:
+    """A non-empty array (a tuple once read) whose every item is ``ok``."""
+    return isinstance(value, list | tuple) and len(value) > 0 and all(ok(item) for item in value)
+
+
+MINIGRID_ID = Rule("a registered MiniGrid id, e.g. MiniGrid-DoorKey-6x6-v0", is_minigrid_id)
+SEEDS = Rule(
+    "a non-empty array of whole numbers >= 0, e.g. [0, 1, 2]",
+    lambda v: items(v, lambda s: is_int(s) and 0 <= s < 2**63),
+)
+TASKS = Rule(
+    'a non-empty array of task objects, e.g. [{"env_id": "MiniGrid-DoorKey-6x6-v0", '
+    '"steps": 400000, "seeds": [0, 1, 2]}]',
+    lambda v: items(v, lambda task: isinstance(task, dict | Task)),
+)
+ARM_NAMES = Rule(
+    'a non-empty array of arm names, e.g. ["ppo", "rnd"]', lambda v: items(v, str.__instancecheck__)
+)
+PPO = Rule(
+    'an object of PPO settings, e.g. {"n_envs": 8}', lambda v: isinstance(v, dict | PPOSettings)
+)
+DEVICE = Rule(
+    "a torch device name: cpu, cuda, cuda:N or mps",
+    lambda v: isinstance(v, str) and re.fullmatch(r"cpu|mps|cuda(:[0-9]+)?", v) is not None,
+)
+
+
 @dataclass(frozen=True)
 class Task:
     """A MiniGrid task, its budget and its training seeds."""
 
-    env_id: str
+    env_id: str = field(metadata=with_rule(MINIGRID_ID))
     """a registered MiniGrid id, e.g. MiniGrid-DoorKey-6x6-v0"""
-    steps: int
+    steps: int = field(metadata=with_rule(integer(1)))
     """env steps per run (all sub-envs together)"""
-    seeds: tuple[int, ...]
+    seeds: tuple[int, ...] = field(metadata=with_rule(SEEDS))
     """training seeds: one run per arm and seed"""
 
 
@@ -75,21 +117,21 @@ def default_tasks() -> tuple[Task, ...]:
 class StudySpec:
     """Tasks x arms x seeds, each run trained and evaluated the same way."""
 
-    tasks: tuple[Task, ...] = field(default_factory=default_tasks)
+    tasks: tuple[Task, ...] = field(default_factory=default_tasks, metadata=with_rule(TASKS))
     """the tasks with their budgets and seeds"""
-    arms: tuple[str, ...] = ("ppo", "consistency", "rnd")
+    arms: tuple[str, ...] = setting(("ppo", "consistency", "rnd"), ARM_NAMES)
     """arms: entries of ``simoun_lab.minigrid_study.arms.ARMS``, each optionally with settings
     (``"rnd,normalization=return_std,scale=0.01"``)"""
-    ppo: PPOSettings = field(default_factory=PPOSettings)
+    ppo: PPOSettings = field(default_factory=PPOSettings, metadata=with_rule(PPO))
     """PPO's settings, shared by every arm"""
-    evaluations: int = 20
+    evaluations: int = setting(20, integer(1))
     """evaluations per run, evenly spaced over its budget (and one before training)"""
-    eval_episodes: int = 32
+    eval_episodes: int = setting(32, integer(1))
     """episodes per evaluation, on the env seeds ``eval_seed``, ``eval_seed + 1``, ...: fixed,
     the same for every run, and never used to seed training"""
-    eval_seed: int = 1_000_000
+    eval_seed: int = setting(1_000_000, integer(0))
     """first held-out env seed of the evaluation episodes"""
-    device: str = "cpu"
+    device: str = setting("cpu", DEVICE)
     """torch device of PPO and of the intrinsic-reward models"""
 
     def __post_init__(self) -> None:
@@ -140,27 +182,40 @@ class Run:
 
 
 def build(cls: type, values: dict[str, Any], where: str) -> Any:
-    """``cls(**values)``, or a SetupError naming the unknown key and the known ones."""
-    known = {f.name for f in dataclasses.fields(cls)}
-    unknown = sorted(set(values) - known)
+    """``cls`` from the JSON object ``values`` (arrays as tuples), or a SetupError naming an
+    unknown or missing key, or a value its field's rule refuses, with the fix."""
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(values) - set(fields))
     if unknown:
-        raise SetupError(f"{where}: unknown key(s) {unknown}; known keys: {sorted(known)}")
-    return cls(**values)
+        raise SetupError(f"{where}: unknown key(s) {unknown}; known keys: {sorted(fields)}")
+    rules = rules_of(cls)
+    for name, f in fields.items():
+        if name not in values:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise SetupError(f"{where}: no {name!r}; give it: {rules[name].need}")
+        elif not rules[name].ok(values[name]):
+            raise SetupError(
+                f"{where}: {name} is {json.dumps(values[name])}, which must be {rules[name].need}"
+            )
+    return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
 
 
 def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
     """The spec ``values`` describe (as :meth:`StudySpec.to_json` writes it; missing keys take
     their defaults); ``where`` names the source in errors."""
     values = dict(values)
+    for name in ("tasks", "ppo"):  # checked as JSON before they are read into dataclasses
+        rule = rules_of(StudySpec)[name]
+        if name in values and not rule.ok(values[name]):
+            raise SetupError(
+                f"{where}: {name} is {json.dumps(values[name])}, which must be {rule.need}"
+            )
     if "tasks" in values:
         values["tasks"] = tuple(
-            build(Task, {**t, "seeds": tuple(t.get("seeds", ()))}, f"{where}: tasks[{i}]")
-            for i, t in enumerate(values["tasks"])
+            build(Task, t, f"{where}: tasks[{i}]") for i, t in enumerate(values["tasks"])
         )
     if "ppo" in values:
         values["ppo"] = build(PPOSettings, values["ppo"], f"{where}: ppo")
-    if "arms" in values:
-        values["arms"] = tuple(values["arms"])
     return build(StudySpec, values, where)
 
 

@@ -322,6 +322,11 @@ class _Reader:
         overrides = data.get("grid_overrides", [])
         if not isinstance(overrides, list) or not all(isinstance(k, str) for k in overrides):
             raise self.fail(("grid_overrides",), 'give a list of grid keys, e.g. ["agent.n_step"]')
+        for key in overrides:
+            if key not in self.fields:
+                raise self.fail(
+                    ("grid_overrides",), f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}"
+                )
         grid = self.grid(data["grid"], every, preset, base, overrides)
         tuning = self.phase(data["tuning"], "tuning")
         evaluation = self.phase(data["evaluation"], "evaluation")

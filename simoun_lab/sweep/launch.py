@@ -9,6 +9,7 @@ Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``; t
 
 from __future__ import annotations
 
+import math
 import signal
 import sys
 from collections.abc import Iterator, Sequence
@@ -25,18 +26,29 @@ from simoun_lab.sweep.grid import SweepSpec, Trial
 from simoun_lab.sweep.trainable import ERROR_FILE, STOP_FILE, SacTrial, finished
 
 
-def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
-    """``auto``: one GPU per trial when the cluster has GPUs and the config's ``device`` is not
-    ``cpu``, else none; or the number given."""
+def gpus_wanted(wanted: str) -> float | None:
+    """``--gpus-per-trial``'s value as a number, None for ``auto``; read before Ray starts, so
+    a bad value is answered at once."""
     if wanted == "auto":
-        has_gpus = ray.cluster_resources().get("GPU", 0) > 0
-        return 1.0 if has_gpus and device != "cpu" else 0.0
+        return None
     try:
         gpus = float(wanted)
     except ValueError:
-        raise SetupError(f"--gpus-per-trial takes a number or auto, got {wanted!r}") from None
-    if gpus < 0:
-        raise SetupError(f"--gpus-per-trial must be 0 or more, got {wanted}")
+        raise SetupError(
+            f"--gpus-per-trial takes a number or auto, got {wanted!r}; e.g. --gpus-per-trial 1"
+        ) from None
+    if not (math.isfinite(gpus) and gpus >= 0):
+        raise SetupError(f"--gpus-per-trial must be a finite number, 0 or more, got {wanted}")
+    return gpus
+
+
+def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
+    """``auto``: one GPU per trial when the cluster has GPUs and the config's ``device`` is not
+    ``cpu``, else none; or the number given."""
+    gpus = gpus_wanted(wanted)
+    if gpus is None:
+        has_gpus = ray.cluster_resources().get("GPU", 0) > 0
+        return 1.0 if has_gpus and device != "cpu" else 0.0
     return gpus
 
 

@@ -49,7 +49,7 @@ from simoun_agent import table
 from simoun_agent.config import SetupError, from_dict, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
-from simoun_agent.config.rules import show
+from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
@@ -203,6 +203,13 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     if np.any(bad):
         line = int(np.argmax(bad)) + 2  # 1-based, after the header
         raise DamagedRun(f"{path.name} line {line} has an empty, NaN or infinite value")
+    steps = curve["env_step"]
+    if len(steps) and (steps[0] < 0 or np.any(np.diff(steps) <= 0)):
+        line = 2 if steps[0] < 0 else int(np.argmax(np.diff(steps) <= 0)) + 3
+        raise DamagedRun(
+            f"{path.name} line {line}: env_step {steps[line - 2]:g} is negative or does not come "
+            "after the line before (rows out of order or repeated)"
+        )
     return curve
 
 
@@ -221,6 +228,11 @@ def read_run(config_path: Path) -> RunRecord:
         value = final.get("return_mean") if isinstance(final, dict) else None
         if not (isinstance(value, (int, float)) and math.isfinite(value)):
             raise DamagedRun(f"{SUMMARY_NAME} has no finite final_eval.return_mean ({value})")
+        for key in ("env_step", "wall_time_s"):
+            if not (is_real(summary.get(key)) and summary[key] >= 0):
+                raise DamagedRun(
+                    f"{SUMMARY_NAME}: {key} is {summary.get(key)!r}, not a number >= 0"
+                )
         if not len(curve["env_step"]):
             raise DamagedRun(f"{EVAL_CSV} holds no evaluation, but the run finished")
     error_path = run_dir / ERROR_FILE
