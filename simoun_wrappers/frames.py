@@ -15,7 +15,20 @@ from gymnasium.wrappers import FrameStackObservation
 from simoun_wrappers._checks import check_positive_int
 
 MAX_STACK_BYTES = 2**30
-"""The largest stack ``FrameTriplet`` builds (1 GiB: over 12,000 RGB frames of 84 x 84)."""
+"""The largest stack ``FrameTriplet`` or ``FrameStack`` builds (1 GiB: over 12,000 RGB frames of
+84 x 84)."""
+
+
+def check_stack_bytes(num_frames: int, shape: tuple[int, ...], dtype: np.dtype) -> None:
+    """Raise ValueError when ``num_frames`` frames of ``shape`` and ``dtype`` take more than
+    :data:`MAX_STACK_BYTES`: refused before anything tries to allocate them all."""
+    stack_bytes = num_frames * math.prod(shape) * np.dtype(dtype).itemsize
+    if stack_bytes > MAX_STACK_BYTES:
+        raise ValueError(
+            f"num_frames={num_frames} makes stacks of {stack_bytes / 2**30:.1f} GiB per "
+            f"observation of shape {shape} (at most {MAX_STACK_BYTES // 2**30} GiB); "
+            f"use num_frames=3 for a triplet."
+        )
 
 
 class FrameRing:
@@ -87,16 +100,11 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 f"FrameTriplet stacks Box observations, got {space}; select or build an image "
                 f"first, e.g. SimounObservation(env) or gymnasium.wrappers.AddRenderObservation."
             )
-        stack_bytes = num_frames * math.prod(space.shape) * space.dtype.itemsize
-        if stack_bytes > MAX_STACK_BYTES:
-            # refused here: batch_space and the ring would otherwise try to allocate it all
-            raise ValueError(
-                f"num_frames={num_frames} makes stacks of {stack_bytes / 2**30:.1f} GiB per "
-                f"observation of shape {space.shape} (at most {MAX_STACK_BYTES // 2**30} GiB); "
-                f"use num_frames=3 for a triplet."
-            )
+        check_stack_bytes(num_frames, space.shape, space.dtype)  # before batch_space allocates
         self.num_frames = int(num_frames)
         self.observation_space = batch_space(space, n=self.num_frames)
+        # What reset() and step() hand each observation to: a FrameRing here, a FrameStack (same
+        # reset and push) in SimounObservation's chain (simoun_wrappers.stack.StreamTriplet).
         self._ring = FrameRing(self.num_frames, space.shape, space.dtype)
         self._has_reset = False
 

@@ -43,6 +43,13 @@ def residual_motion(frames: np.ndarray) -> np.ndarray:
     return diff.reshape(*lead, k1 * c, h, w)
 
 
+def motion_space(frames: spaces.Box) -> spaces.Box:
+    """The space of :func:`residual_motion`'s channels for stacks in ``frames``, a ``(k, C, H, W)``
+    Box: int16 ``((k-1)*C, H, W)`` in [-255, 255]."""
+    k, c, h, w = frames.shape
+    return spaces.Box(-255, 255, ((k - 1) * c, h, w), dtype=np.int16)
+
+
 class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     """Add residual motion channels to a stacked ``(k, C, H, W)`` uint8 observation.
 
@@ -80,18 +87,13 @@ class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                 f"ResidualMotion expects a uint8 Box of shape (k, C, H, W), got {space}; "
                 f"stack channel-first uint8 frames first, e.g. SimounObservation(env) does it all."
             )
-        k, c, h, w = space.shape
+        k = space.shape[0]
         if k < 2:
             raise ValueError(
                 f"ResidualMotion needs at least 2 stacked frames to take differences, got k={k}; "
                 f"stack more frames (FrameTriplet(env, num_frames=3)) or drop the motion channels."
             )
-        self.observation_space = spaces.Dict(
-            {
-                "frames": space,
-                "motion": spaces.Box(-255, 255, ((k - 1) * c, h, w), dtype=np.int16),
-            }
-        )
+        self.observation_space = spaces.Dict({"frames": space, "motion": motion_space(space)})
 
     def observation(self, observation: np.ndarray) -> dict[str, Any]:
         return {"frames": observation, "motion": residual_motion(observation)}

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import functools
 import operator
 from copy import deepcopy
 
-import cv2
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
@@ -14,8 +12,13 @@ from gymnasium.envs.registration import EnvSpec, WrapperSpec
 from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
 from simoun_wrappers._checks import check_positive_int, is_int
-from simoun_wrappers.frames import FrameTriplet, check_single_env, frame_stack_in
-from simoun_wrappers.motion import ResidualMotion
+from simoun_wrappers.frames import check_single_env, frame_stack_in
+
+# LUMA, frame_shape and to_frame (the per-frame step) are importable from this module too.
+from simoun_wrappers.stack import LUMA as LUMA
+from simoun_wrappers.stack import FrameStack, StreamTriplet
+from simoun_wrappers.stack import frame_shape as frame_shape
+from simoun_wrappers.stack import to_frame as to_frame
 
 _SOURCES = ("auto", "observation", "render")
 
@@ -127,47 +130,6 @@ def layout_hint(space: gym.Space) -> str | None:
             f"o.transpose(1, 2, 0), Box(0, 255, ({h}, {w}, {c}), np.uint8)); {stack}"
         )
     return None
-
-
-LUMA = np.array([0.2125, 0.7154, 0.0721])
-"""RGB weights of one luminance channel: gymnasium's ``GrayscaleObservation``'s, so frames match
-those of its wrappers."""
-
-
-def frame_shape(
-    layout: tuple[int, int, int], size: tuple[int, int] | None, grayscale: bool
-) -> tuple[int, int, int]:
-    """``(C, H, W)`` of the frames :func:`to_frame` makes from ``(H, W, C)`` images."""
-    height, width, channels = layout
-    if size is not None:
-        height, width = size
-    return (1 if grayscale else channels), height, width
-
-
-# The chain's transforms are module-level functions (or partials of them), not lambdas, so a
-# SimounObservation pickles whenever the env it wraps does (vector envs' subprocesses, Ray).
-def to_frame(image: np.ndarray, size: tuple[int, int] | None, grayscale: bool) -> np.ndarray:
-    """An ``(H, W[, C])`` uint8 image as one channel-first ``(C, H, W)`` frame: resized to
-    ``size`` (OpenCV area interpolation, as gymnasium's ``ResizeObservation``), made one
-    luminance channel when ``grayscale`` and RGB (:data:`LUMA`). The per-frame step of
-    ``SimounObservation`` and ``SimounParallelObservation``."""
-    if size is not None and image.shape[:2] != size:
-        image = cv2.resize(image, size[::-1], interpolation=cv2.INTER_AREA)
-    if image.ndim == 2:
-        image = image[:, :, None]
-    if grayscale and image.shape[2] == 3:
-        image = np.sum(np.multiply(image, LUMA), axis=-1).astype(np.uint8)[:, :, None]
-    return image.transpose(2, 0, 1)
-
-
-def _fold(frames: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
-    """``(K, C, H, W)`` frames as one ``(K*C, H, W)`` stack (``np.reshape``'s ``shape`` keyword
-    needs numpy 2.1; the floor is 2.0)."""
-    return frames.reshape(shape)
-
-
-def _frames_dict(frames: np.ndarray) -> dict[str, np.ndarray]:
-    return {"frames": frames}
 
 
 def _rgba(space: gym.Space) -> bool:
@@ -330,8 +292,9 @@ class SimounObservation(ChainWrapper):
     which) and MiniGrid's ``ImgObsWrapper`` object-id grid (put
     ``RGBImgPartialObsWrapper`` under it). Frames are resized (OpenCV area interpolation, as
     gymnasium's ``ResizeObservation``), optionally made grayscale (``GrayscaleObservation``'s
-    weights), made channel-first ``(C, H, W)`` (:func:`to_frame`), stacked by ``FrameTriplet``
-    with reset padding, and given residual motion channels by ``ResidualMotion``. The observation is
+    weights), made channel-first ``(C, H, W)`` (:func:`to_frame`), stacked with reset padding and
+    given residual motion channels (:func:`residual_motion`) by a ``FrameStack``, the pipeline that
+    ``SimounParallelObservation`` runs per agent. The observation is
 
     - ``{"frames": (k, C, H, W) uint8, "motion": ((k-1)*C, H, W) int16}`` (default),
     - ``{"frames": (k, C, H, W) uint8}`` with ``motion=False``,
@@ -410,23 +373,9 @@ class SimounObservation(ChainWrapper):
                 f"env (drop FrameStackObservation; set num_frames={num_frames} here instead)."
             )
         chain, from_render = pixel_env(env, source)
-        channels, height, width = frame_shape(image_layout(chain.observation_space), hw, grayscale)
-        frame_space = spaces.Box(0, 255, (channels, height, width), dtype=np.uint8)
-        chain = TransformObservation(
-            chain, functools.partial(to_frame, size=hw, grayscale=grayscale), frame_space
+        stack = FrameStack(
+            image_layout(chain.observation_space), hw, grayscale, num_frames, motion, fold_frames
         )
-        chain = FrameTriplet(chain, num_frames)
-        if fold_frames:
-            folded = spaces.Box(0, 255, (num_frames * channels, height, width), dtype=np.uint8)
-            chain = TransformObservation(
-                chain, functools.partial(_fold, shape=folded.shape), folded
-            )
-        elif motion:
-            chain = ResidualMotion(chain)
-        else:
-            chain = TransformObservation(
-                chain, _frames_dict, spaces.Dict({"frames": chain.observation_space})
-            )
-        ChainWrapper.__init__(self, chain, env)
+        ChainWrapper.__init__(self, StreamTriplet(chain, stack), env)
         if from_render:
             self.metadata = {**env.metadata, "render_modes": ["rgb_array"]}

@@ -9,25 +9,19 @@ from gymnasium import spaces
 from pettingzoo.utils.env import AECEnv, ParallelEnv
 from pettingzoo.utils.wrappers import BaseParallelWrapper
 
-from simoun_wrappers.frames import FrameRing
-from simoun_wrappers.motion import residual_motion
-from simoun_wrappers.observation import (
-    check_stack_options,
-    frame_shape,
-    image_layout,
-    parse_size,
-    to_frame,
-)
+from simoun_wrappers.observation import check_stack_options, image_layout, parse_size
+from simoun_wrappers.stack import FrameStack
 
 
 class SimounParallelObservation(BaseParallelWrapper):
     """Give every agent of a PettingZoo ParallelEnv Simoun's frame triplet and motion channels.
 
-    The per-agent transformation is ``SimounObservation``'s: each agent's image is resized
-    (OpenCV area interpolation), optionally made grayscale (gymnasium's weights), made
-    channel-first, and stacked in the agent's own ring with reset padding; then motion is
-    added or the stack is folded. Agents that appear mid-episode start with their own
-    reset-padded stack, and an agent's stack is dropped when it terminates or truncates.
+    The per-agent transformation is ``SimounObservation``'s: each agent has its own
+    ``FrameStack`` (``simoun_wrappers.stack``), which resizes the agent's image (OpenCV area
+    interpolation), optionally makes it grayscale (gymnasium's weights), makes it channel-first,
+    stacks it with reset padding, then adds motion or folds the stack. Agents that appear
+    mid-episode start with a reset-padded stack, and an agent's stack starts anew after it
+    terminates or truncates.
     With ``source="render"`` (or ``"auto"`` when observations are not images) every agent
     sees the env's global ``render()`` frame (then, with ``size=None``, ``observation_space``
     needs a render, so call ``reset()`` first). ``observation_space(agent)`` returns the same
@@ -83,14 +77,17 @@ class SimounParallelObservation(BaseParallelWrapper):
         super().__init__(env)
         check_stack_options(num_frames, motion, fold_frames, source, grayscale)
         self._size = parse_size(size)
-        self._grayscale = grayscale
-        self._num_frames = int(num_frames)
-        self._motion = motion and not fold_frames
-        self._fold = fold_frames
+        self._options = {
+            "grayscale": grayscale,
+            "num_frames": num_frames,
+            "motion": motion,
+            "fold_frames": fold_frames,
+        }
         self._from_render = self._pick_source(source)
-        self._spaces: dict[Any, spaces.Space] = {}
-        self._layouts: dict[Any, tuple[int, int, int]] = {}
-        self._rings: dict[Any, FrameRing] = {}
+        # One stack per agent, kept across episodes so that observation_space(agent) returns the
+        # same object; _live names the agents whose stack holds frames of this episode.
+        self._stacks: dict[Any, FrameStack] = {}
+        self._live: set[Any] = set()
 
     def _pick_source(self, source: str) -> bool:
         agent = self.env.possible_agents[0]
@@ -113,41 +110,22 @@ class SimounParallelObservation(BaseParallelWrapper):
             )
         return True
 
-    def _layout(self, agent: Any, frame: np.ndarray | None = None) -> tuple[int, int, int]:
-        if agent not in self._layouts:
+    def _stack_of(self, agent: Any, image: np.ndarray | None = None) -> FrameStack:
+        if agent not in self._stacks:
             if self._from_render and self._size is not None:
                 # rgb_array renders are (H, W, 3) and get resized: no render needed, which lets
                 # observation_space() answer before reset() (PettingZoo envs cannot render yet).
                 layout = (*self._size, 3)
             elif self._from_render:
-                frame = self.env.render() if frame is None else frame
-                layout = (*frame.shape[:2], frame.shape[2] if frame.ndim == 3 else 1)
+                image = self.env.render() if image is None else image
+                layout = (*image.shape[:2], image.shape[2] if image.ndim == 3 else 1)
             else:
                 layout = image_layout(self.env.observation_space(agent))
-            self._layouts[agent] = frame_shape(layout, self._size, self._grayscale)
-        return self._layouts[agent]
+            self._stacks[agent] = FrameStack(layout, self._size, **self._options)
+        return self._stacks[agent]
 
     def observation_space(self, agent: Any) -> spaces.Space:
-        if agent not in self._spaces:
-            c, h, w = self._layout(agent)
-            k = self._num_frames
-            frames = spaces.Box(0, 255, (k, c, h, w), dtype=np.uint8)
-            if self._fold:
-                space = spaces.Box(0, 255, (k * c, h, w), dtype=np.uint8)
-            elif self._motion:
-                motion = spaces.Box(-255, 255, ((k - 1) * c, h, w), dtype=np.int16)
-                space = spaces.Dict({"frames": frames, "motion": motion})
-            else:
-                space = spaces.Dict({"frames": frames})
-            self._spaces[agent] = space
-        return self._spaces[agent]
-
-    def _output(self, stack: np.ndarray) -> np.ndarray | dict[str, np.ndarray]:
-        if self._fold:
-            return stack.reshape(-1, *stack.shape[2:])
-        if self._motion:
-            return {"frames": stack, "motion": residual_motion(stack)}
-        return {"frames": stack}
+        return self._stack_of(agent).observation_space
 
     def _images(self, obs: dict[Any, Any]) -> dict[Any, np.ndarray]:
         if not self._from_render:
@@ -159,7 +137,7 @@ class SimounParallelObservation(BaseParallelWrapper):
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[Any, Any], dict[Any, dict[str, Any]]]:
         obs, infos = self.env.reset(seed=seed, options=options)
-        self._rings = {}
+        self._live = set()
         return self._stack(self._images(obs)), infos
 
     def step(self, actions: dict[Any, Any]) -> tuple[dict[Any, Any], ...]:
@@ -167,18 +145,16 @@ class SimounParallelObservation(BaseParallelWrapper):
         stacked = self._stack(self._images(obs))
         for agent in set(terminations) | set(truncations):
             if terminations.get(agent, False) or truncations.get(agent, False):
-                self._rings.pop(agent, None)
+                self._live.discard(agent)
         return stacked, rewards, terminations, truncations, infos
 
     def _stack(self, images: dict[Any, np.ndarray]) -> dict[Any, Any]:
         out = {}
         for agent, image in images.items():
-            frame = to_frame(image, self._size, self._grayscale)
-            ring = self._rings.get(agent)
-            if ring is None:
-                c, h, w = self._layout(agent, image)
-                ring = self._rings[agent] = FrameRing(self._num_frames, (c, h, w), np.uint8)
-                out[agent] = self._output(ring.reset(frame))
+            stack = self._stack_of(agent, image)
+            if agent in self._live:
+                out[agent] = stack.push(image)
             else:
-                out[agent] = self._output(ring.push(frame))
+                self._live.add(agent)
+                out[agent] = stack.reset(image)
         return out

@@ -124,6 +124,9 @@ def test_errors_name_the_fix():
         SimounParallelObservation(JoiningAgents(), source="camera")
     with pytest.raises(ValueError, match=r"neither image observations.*render_mode='rgb_array'"):
         SimounParallelObservation(JoiningAgents(gym.spaces.Box(-1.0, 1.0, (4,), np.float32)))
+    huge = SimounParallelObservation(JoiningAgents(), size=None, num_frames=10**9)
+    with pytest.raises(ValueError, match=r"num_frames=1000000000 makes stacks of .* GiB"):
+        huge.reset()
 
 
 class Replay(gym.Env):
