@@ -64,10 +64,6 @@ def _runner():
     return runner
 
 
-def archive_of(options: StudyOptions) -> Path:
-    return options.archive if options.archive is not None else options.study_dir
-
-
 def run(spec: StudySpec, options: StudyOptions) -> int:
     """Train every unfinished run of ``spec`` (:func:`~simoun_lab.minigrid_study.runner.
     run_study`); 1 when a run failed."""
@@ -77,7 +73,7 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
             "commit (each run records its own): drop the flag"
         )
     runner = _runner()
-    archive = archive_of(options)
+    archive = options.archive if options.archive is not None else options.study_dir
     started = (archive / runner.SPEC_FILE).is_file()
     if started and not options.resume:
         raise SetupError(
