@@ -29,8 +29,6 @@ from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
 from simoun_lab.minigrid_study.study_command import is_ppo_spec, load_ppo_spec
 from simoun_lab.minigrid_study.training import set_up
 
-pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
-
 TINY = {
     "tasks": [{"env_id": "MiniGrid-DoorKey-5x5-v0", "steps": 2048, "seeds": [0]}],
     "ppo": {"n_epochs": 1},

@@ -25,8 +25,6 @@ from simoun_lab.study.runner import StudyOptions, check_same_spec, open_study
 from simoun_lab.study.spec import load_spec
 from simoun_lab.study.toml_lines import key_line
 
-pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
-
 SPEC = (
     """\
 description = "a tiny study for tests"

@@ -21,8 +21,6 @@ from simoun_agent.run.logger import read_csv
 from simoun_lab.cli import sweep as cli
 from simoun_lab.sweep.grid import SWEEP_FILE, parse_seeds, split_values
 
-pytestmark = pytest.mark.xdist_group("ray")  # one Ray instance under `pytest -n 2 --dist loadgroup`
-
 TINY = override(
     tiny_flags(total_env_steps=60),
     *("--image-size", "24", "--eval-every", "20", "--checkpoint-every", "20"),
