@@ -12,6 +12,7 @@ from gymnasium.vector import VectorWrapper
 
 from simoun_lab.minigrid_study.envs import STATE_KEY
 from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings, pearson, probe, write_probe
+from simoun_lab.minigrid_study.probe_settings import PROBE_NAMES
 
 
 def test_pearson_by_hand():
@@ -58,6 +59,11 @@ def test_a_reward_that_is_the_novelty_correlates_one(monkeypatch, sign):
     assert [r["novelty_corr_moving"] for r in rows] == pytest.approx([sign] * 4)
     visited = [r["states_visited"] for r in rows]
     assert visited == sorted(visited) and visited[0] > 1
+
+
+def test_the_command_lines_default_probes_are_every_probe():
+    # the command line reads the names without torch; the probes themselves need it
+    assert tuple(PROBED) == PROBE_NAMES
 
 
 def test_an_unknown_probe_is_refused_with_the_choices(tmp_path):

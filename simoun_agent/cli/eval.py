@@ -24,17 +24,9 @@ from tqdm import tqdm
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.generalization.evaluation import evaluate_runs
-from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
-from simoun_agent.generalization.suite import parse_distractions
-from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
-from simoun_agent.run.load import load_run
-from simoun_agent.run.make_env import video_fps
 from simoun_agent.run.rundir import make_output_dir
-from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.signals import Stopped, stop_at_once
-from simoun_agent.run.video import write_video
 
 
 class EpisodeProgress:
@@ -133,6 +125,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             "several runs and --videos go with --distraction (e.g. --distraction "
             "train,video_hard); otherwise evaluate one run at a time",
         )
+    # torch, the agent and the env are imported once the flags are checked: --help, --version
+    # and a bad flag are answered in about a second
+    from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
+    from simoun_agent.run.load import load_run
+    from simoun_agent.run.make_env import video_fps
+    from simoun_agent.run.seeds import first_eval_seed
+    from simoun_agent.run.video import write_video
+
     try:
         # The machine may differ from the training one: --device applies before the checks.
         run = load_run(Path(args.checkpoint[0]), args.device, args.torch_threads)
@@ -180,6 +180,10 @@ def evaluate_distractions(args: EvalCommand) -> int:
     write the table, CSV and bar chart; bad input exits with status 2, without traceback."""
     if args.random_policy:
         fail(PROG, "--random-policy does not combine with --distraction")
+    from simoun_agent.generalization.evaluation import evaluate_runs
+    from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
+    from simoun_agent.generalization.suite import parse_distractions
+
     run_dirs = [Path(path) for path in args.checkpoint]
     created, out = False, None
     try:

@@ -17,10 +17,9 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import tyro
-from tqdm import tqdm
 
 from simoun_agent.cli.config_flags import (
     PRESETS_LIST,
@@ -33,10 +32,9 @@ from simoun_agent.cli.config_flags import (
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
-from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
-from simoun_agent.run import train as loop  # called through the module: tests wrap loop.train
-from simoun_agent.run.memory import check_memory
-from simoun_agent.run.signals import Stopped, stop_at_once
+
+if TYPE_CHECKING:
+    from simoun_agent.run.train import Run
 
 PROG = "simoun-train"
 
@@ -81,6 +79,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""
     argv = list(sys.argv[1:] if argv is None else argv)
     command = parse_command(argv)
+    # torch and the trainer are imported once the flags are read: --help, --version and a bad
+    # flag are answered in about a second
+    from tqdm import tqdm
+
+    from simoun_agent.generalization import distraction_callbacks
+    from simoun_agent.run import train as loop  # called through the module: tests wrap loop.train
+    from simoun_agent.run.signals import Stopped, stop_at_once
+
     try:
         with stop_at_once():  # nothing to save during set-up
             run = setup(command, argv)
@@ -121,9 +127,13 @@ def parse_command(argv: Sequence[str]) -> TrainCommand:
     return parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
 
 
-def setup(command: TrainCommand, argv: Sequence[str]) -> loop.Run:
+def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
     """The run that ``command`` (parsed from ``argv``) asks for, new or resumed; bad input
     exits with status 2."""
+    from simoun_agent.generalization import check_eval_distractions
+    from simoun_agent.run import train as loop
+    from simoun_agent.run.memory import check_memory
+
     try:
         overrides = overrides_from(command.flags, argv)
         if command.resume:

@@ -14,26 +14,20 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Literal, Union
 
 import numpy as np
-import torch
 import tyro
 from tyro.constructors import PrimitiveConstructorSpec
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.load import LoadedRun, load_run
-from simoun_agent.run.make_env import video_fps
-from simoun_agent.run.video import write_video
-from simoun_lab.analysis import masks as mask_pictures
-from simoun_lab.analysis.bias import information_bias
-from simoun_lab.analysis.layers import layer_activations
-from simoun_lab.analysis.pairs import make_pairs, sample_rows, usable_steps
-from simoun_lab.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
-from simoun_lab.analysis.report import RunBias, write_report
-from simoun_lab.analysis.runs import play_episode, prepare_output
+
+# The analyses' modules (torch, the agent, the envs) are imported by the functions that run
+# them, once the flags are read: --help, --version and a bad flag are answered in about a second.
+if TYPE_CHECKING:
+    from simoun_agent.run.load import LoadedRun
+    from simoun_lab.analysis.report import RunBias
 
 MAX_BIAS_EPISODES = 200
 """Episodes the bias analysis plays at most to gather its observations."""
@@ -142,6 +136,13 @@ Command = Union[  # noqa: UP007
 
 def masks_command(args: Masks) -> list[Path]:
     """Play the episodes, then write one PNG (+ its heat maps as .npz) per chosen step."""
+    from simoun_agent.run.atomic import atomic_write
+    from simoun_agent.run.load import load_run
+    from simoun_agent.run.make_env import video_fps
+    from simoun_agent.run.video import write_video
+    from simoun_lab.analysis import masks as mask_pictures
+    from simoun_lab.analysis.runs import play_episode, prepare_output
+
     chosen = parse_steps(args.steps) if args.steps is not None else None
     query = parse_pair(args.query) if args.query is not None else None
     run = load_run(Path(args.run), args.device)
@@ -200,6 +201,15 @@ def masks_command(args: Masks) -> list[Path]:
 def bias_of_run(run: LoadedRun, count: int, seed: int, recolour: str = "conv") -> RunBias:
     """Play evaluation episodes until ``count`` usable observations, make the pairs (dynamic
     ones by ``recolour``: ``"conv"`` or ``"model"``), and estimate each layer."""
+    import torch
+
+    from simoun_lab.analysis.bias import information_bias
+    from simoun_lab.analysis.layers import layer_activations
+    from simoun_lab.analysis.pairs import make_pairs, sample_rows, usable_steps
+    from simoun_lab.analysis.recolour import BLOCK, dm_control_physics, replay_recoloured
+    from simoun_lab.analysis.report import RunBias
+    from simoun_lab.analysis.runs import play_episode
+
     block = None
     if recolour == "model":
         dm_control_physics(run.env, run.config.env)
@@ -248,6 +258,11 @@ def bias_of_run(run: LoadedRun, count: int, seed: int, recolour: str = "conv") -
 
 def bias_command(args: Bias) -> list[Path]:
     """The estimates of every run, then one chart, JSON and Markdown for all of them."""
+    from simoun_agent.run.load import load_run
+    from simoun_lab.analysis.recolour import dm_control_physics
+    from simoun_lab.analysis.report import write_report
+    from simoun_lab.analysis.runs import prepare_output
+
     if not args.runs:  # tyro accepts no value for a variable number of them
         raise SetupError("give the runs to compare: run directories (or checkpoint.pt files)")
     if args.out is None and len(args.runs) > 1:

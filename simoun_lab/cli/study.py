@@ -26,7 +26,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Union
+from typing import Annotated, Any, Union
 
 import tyro
 
@@ -34,11 +34,7 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import make_output_dir, refuse_a_file
 from simoun_lab.engine.ray_start import load_ray
-from simoun_lab.minigrid_study import study_command
-from simoun_lab.minigrid_study.study_command import is_ppo_spec
-from simoun_lab.study.checks import check_study
-from simoun_lab.study.plan import describe
-from simoun_lab.study.runner import StudyOptions, report_study, run_study, spec_from
+from simoun_lab.study.options import StudyOptions
 
 PROG = "simoun-study"
 
@@ -111,6 +107,13 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""
     args = parse(Command, argv, PROG, DESCRIPTION)
+    # torch comes with the spec readers, imported once the flags are read: --help, --version and
+    # a bad flag are answered in about a second
+    from simoun_lab.minigrid_study.study_command import is_ppo_spec
+    from simoun_lab.study.checks import check_study
+    from simoun_lab.study.plan import describe
+    from simoun_lab.study.runner import report_study, run_study, spec_from
+
     try:
         if is_ppo_spec(args.spec):
             return ppo_study(args)
@@ -136,6 +139,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def ppo_study(args: Plan | Run | Report) -> int:
     """The command on a MiniGrid PPO spec."""
+    from simoun_lab.minigrid_study import study_command
+
     spec = study_command.load_ppo_spec(args.spec)
     if isinstance(args, Plan):
         print(study_command.plan(spec, args.spec))
@@ -158,6 +163,16 @@ def check_outputs(options: Run) -> None:
     """Refuse an output directory that is a file, creating nothing."""
     for flag, path in outputs(options).items():
         refuse_a_file(path, flag)
+
+
+def __getattr__(name: str) -> Any:
+    """:func:`~simoun_lab.study.runner.spec_from`, readable from here too, imported on first use:
+    at the top it would bring torch into ``--help``."""
+    if name == "spec_from":
+        from simoun_lab.study.runner import spec_from
+
+        return spec_from
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def absolute(args: Run) -> Run:

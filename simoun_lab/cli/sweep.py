@@ -32,16 +32,7 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
-from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
-from simoun_lab.sweep.launch import (
-    check_fits,
-    gpus_per_trial,
-    gpus_wanted,
-    run_sweep,
-    stop_trials_on_sigterm,
-    summarize,
-)
-from simoun_lab.sweep.trainable import STOP_FILE, finished
+from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable, gpus_wanted
 
 PROG = "simoun-sweep"
 
@@ -163,6 +154,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         ray = load_ray()
     except SetupError as err:
         fail(PROG, err)
+    # the trainer (torch) once the flags are read: --help and a bad flag take about a second
+    from simoun_lab.sweep.launch import (
+        check_fits,
+        gpus_per_trial,
+        run_sweep,
+        stop_trials_on_sigterm,
+        summarize,
+    )
+    from simoun_lab.sweep.trainable import STOP_FILE, finished
+
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
     try:

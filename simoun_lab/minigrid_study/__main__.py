@@ -13,14 +13,18 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Union
+from typing import TYPE_CHECKING, Annotated, Union
 
 import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_lab.minigrid_study.probe import PROBED, ProbeSettings
-from simoun_lab.minigrid_study.spec import MINIGRID_ID, StudySpec, load_spec
+from simoun_lab.minigrid_study.probe_settings import PROBE_NAMES, ProbeSettings
+
+# The study's modules (torch, SB3, MiniGrid) are imported once the flags are read: --help,
+# --version and a bad flag are answered in about a second.
+if TYPE_CHECKING:
+    from simoun_lab.minigrid_study.spec import StudySpec
 
 ARCHIVE = Path("docs/studies/minigrid")
 
@@ -33,6 +37,7 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     an empty directory). An archive that is not there is refused rather than made up: a
     mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
     from simoun_lab.minigrid_study.runner import SPEC_FILE
+    from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 
     if not archive.is_dir():
         where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
@@ -79,7 +84,7 @@ class Probe:
     """Correlate each probed intrinsic reward with novelty under a random policy (no PPO)."""
 
     settings: ProbeSettings = field(default_factory=ProbeSettings)
-    probes: list[str] = field(default_factory=lambda: list(PROBED))
+    probes: list[str] = field(default_factory=lambda: list(PROBE_NAMES))
     """probes of ``simoun_lab.minigrid_study.probe.PROBED``"""
     out: Path = ARCHIVE / "probe"
     """where probe.csv and probe.md go"""
@@ -110,6 +115,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse(Command, argv, PROG, DESCRIPTION)
     if isinstance(args, Probe):
         from simoun_lab.minigrid_study.probe import write_probe
+        from simoun_lab.minigrid_study.spec import MINIGRID_ID
 
         try:
             if not args.out.parent.is_dir():

@@ -21,7 +21,6 @@ import functools
 import warnings
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +31,7 @@ from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import ARMS, consistency
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
+from simoun_lab.minigrid_study.probe_settings import ProbeSettings
 
 __all__ = ["PROBED", "ProbeSettings", "probe", "write_probe"]
 
@@ -45,7 +45,8 @@ PROBED: dict[str, Callable[[VectorEnv, int, torch.device], VectorEnv]] = {
 """probe name -> the wrapped vector env: the study's two intrinsic arms, and the consistency
 model with one default changed each: RND's learning rate (1e-4 against 1e-3: features that move
 slower than the policy's visits), a buffer of 10k transitions (10 rollouts of memory against
-one), no structural interactive module (Eq. 4-6)"""
+one), no structural interactive module (Eq. 4-6); the command line reads its names from
+:data:`~simoun_lab.minigrid_study.probe_settings.PROBE_NAMES`"""
 
 COLUMNS = (
     "probe",
@@ -60,23 +61,6 @@ COLUMNS = (
     "novelty_corr_moving",
     "states_visited",
 )
-
-
-@dataclass(frozen=True)
-class ProbeSettings:
-    """What every probe shares."""
-
-    env_id: str = "MiniGrid-DoorKey-6x6-v0"
-    """the MiniGrid task"""
-    steps: int = 60_000
-    """env steps per probe (all sub-envs together)"""
-    n_envs: int = 8
-    """sub-envs, as the study's PPO"""
-    n_steps: int = 128
-    """vector steps per block (a block is one of the study's PPO rollouts)"""
-    seed: int = 100
-    """env, action and model seed: disjoint from the study's training seeds (0-4) and its
-    held-out evaluation seeds (1,000,000 on)"""
 
 
 def pearson(x: np.ndarray, y: np.ndarray) -> float:

@@ -7,11 +7,10 @@ between them and the report at the end.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from types import ModuleType
-from typing import Any, Literal
+from typing import Any
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
@@ -23,6 +22,7 @@ from simoun_lab.study.archive import GENERALIZATION_CSV
 from simoun_lab.study.checks import check_fixed_spec, check_study
 from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_lab.study.generalization import play_modes, playable, to_play
+from simoun_lab.study.options import StudyOptions
 from simoun_lab.study.plan import (
     EVALUATION,
     TUNING,
@@ -41,30 +41,6 @@ from simoun_lab.sweep.trainable import STOP_FILE, SacTrial
 STUDY_FILE = "study.json"
 """The study record, in the study directory and the archive: the spec (its file, text and
 parsed form) and each part's code version."""
-
-
-@dataclass
-class StudyOptions:
-    """Where and how :func:`run_study` runs a study (the options of ``simoun-study run``)."""
-
-    study_dir: Path
-    """where the runs and the report go; on a cluster, a directory every machine sees"""
-    archive: Path | None = None
-    """copy each finished run's CSVs, config.json and summary.json (no checkpoints, replays,
-    videos or tb/) here as it completes, with the study record, the selection and the report,
-    e.g. docs/studies/NAME; a resumed study counts archived runs as done"""
-    resume: bool = False
-    """continue the study: finished runs (in --study-dir, else in --archive) are kept, the
-    others go on from their checkpoints or start"""
-    allow_other_commit: bool = False
-    """resume even though the code is at another commit than the study started from"""
-    address: str | None = None
-    """run on a Ray cluster: auto (the one `ray start` made here), HOST:PORT or
-    ray://HOST:PORT; none: a local Ray instance"""
-    num_cpus: int | None = None
-    """CPUs of the local Ray instance (none: all)"""
-    verbose: Literal[0, 1, 2] = 1
-    """Tune's output"""
 
 
 def spec_from(path: str) -> StudySpec:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import re
 import sys
 import typing
@@ -120,6 +121,22 @@ def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
             raise SetupError(f"--grid {pair!r} repeats a value; list each value once")
         grid[key] = values
     return grid
+
+
+def gpus_wanted(wanted: str) -> float | None:
+    """``--gpus-per-trial``'s value as a number, None for ``auto``; read before Ray starts, so
+    a bad value is answered at once."""
+    if wanted == "auto":
+        return None
+    try:
+        gpus = float(wanted)
+    except ValueError:
+        raise SetupError(
+            f"--gpus-per-trial takes a number or auto, got {wanted!r}; e.g. --gpus-per-trial 1"
+        ) from None
+    if not (math.isfinite(gpus) and gpus >= 0):
+        raise SetupError(f"--gpus-per-trial must be a finite number, 0 or more, got {wanted}")
+    return gpus
 
 
 def path_part(text: str) -> str:

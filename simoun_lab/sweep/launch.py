@@ -9,7 +9,6 @@ Each trial is an ordinary run directory ``SWEEP_DIR/<variant>/<env>/s<seed>``; t
 
 from __future__ import annotations
 
-import math
 import signal
 import sys
 from collections.abc import Iterator, Sequence
@@ -22,24 +21,8 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.engine.launcher import run_trials
 from simoun_lab.engine.trial import Trial as EngineTrial
-from simoun_lab.sweep.grid import SweepSpec, Trial
+from simoun_lab.sweep.grid import SweepSpec, Trial, gpus_wanted
 from simoun_lab.sweep.trainable import ERROR_FILE, STOP_FILE, SacTrial, finished
-
-
-def gpus_wanted(wanted: str) -> float | None:
-    """``--gpus-per-trial``'s value as a number, None for ``auto``; read before Ray starts, so
-    a bad value is answered at once."""
-    if wanted == "auto":
-        return None
-    try:
-        gpus = float(wanted)
-    except ValueError:
-        raise SetupError(
-            f"--gpus-per-trial takes a number or auto, got {wanted!r}; e.g. --gpus-per-trial 1"
-        ) from None
-    if not (math.isfinite(gpus) and gpus >= 0):
-        raise SetupError(f"--gpus-per-trial must be a finite number, 0 or more, got {wanted}")
-    return gpus
 
 
 def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
