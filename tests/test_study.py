@@ -21,7 +21,7 @@ from simoun_lab.cli import study as cli
 from simoun_lab.study.plan import evaluation_runs, tuning_runs
 from simoun_lab.study.provenance import code_version
 from simoun_lab.study.report import RunResult, cost_curves, mean_cpu, read_result
-from simoun_lab.study.runner import StudyOptions, check_same_spec, open_study
+from simoun_lab.study.runner import StudyOptions, check_same_spec, open_study, spec_from
 from simoun_lab.study.spec import load_spec
 from simoun_lab.study.toml_lines import key_line
 
@@ -239,14 +239,14 @@ def test_a_spec_fixed_after_a_failure_resumes_keeping_the_finished_runs(study, t
     fixed = write_spec(
         tmp_path / "fixed" / "tiny.toml", SPEC.replace('seeds = "1-2"', 'seeds = "1-3"')
     )
-    record = open_study(cli.spec_from(str(fixed)), str(fixed), options)
-    assert record["spec"] == cli.spec_from(str(fixed)).to_json()
+    record = open_study(spec_from(str(fixed)), str(fixed), options)
+    assert record["spec"] == spec_from(str(fixed)).to_json()
     assert record["spec_text"] == fixed.read_text()
     assert record["parts"][-1]["spec_changed"]["keys"] == ["evaluation"]
     # a grid value added once the evaluation ran would select again
     regrid = write_spec(tmp_path / "regrid.toml", SPEC.replace("[1, 3]", "[1, 3, 5]"))
     with pytest.raises(SetupError, match=r"the evaluation of (sac|simoun) has started"):
-        open_study(cli.spec_from(str(regrid)), str(regrid), options)
+        open_study(spec_from(str(regrid)), str(regrid), options)
 
 
 @pytest.mark.parametrize(
@@ -379,7 +379,7 @@ def test_a_bad_spec_fails_naming_its_line_and_the_fix(case, tmp_path):
     text = SPEC.replace(old, new, 1)
     path = write_spec(tmp_path / "bad.toml", text)
     with pytest.raises(SetupError) as error:
-        cli.spec_from(str(path))
+        spec_from(str(path))
     line = text[: text.index(at or new) + len(at or new)].count("\n") + 1
     if new.startswith("#"):  # nothing left in [grid]: its header's line
         line = text.splitlines().index("[grid]") + 1
@@ -393,7 +393,7 @@ def test_grid_overrides_lets_the_grid_tune_a_key_a_recipe_fixes(tmp_path):
         'recipes = ["simoun", "sac"]\ngrid_overrides = ["agent.augmentation"]',
     )
     text = text.replace("agent.n_step = [1, 3]", 'agent.augmentation = ["none", "shift"]')
-    spec = cli.spec_from(str(write_spec(tmp_path / "tuned.toml", text)))
+    spec = spec_from(str(write_spec(tmp_path / "tuned.toml", text)))
     assert spec.grid == {"agent.augmentation": ["none", "shift"]}
     runs = tuning_runs(spec)
     assert "tuning/sac/agent.augmentation=shift/simoun-PointReach-v0/s101" in [r.name for r in runs]
@@ -404,7 +404,7 @@ def test_grid_overrides_lets_the_grid_tune_a_key_a_recipe_fixes(tmp_path):
     )
     path = write_spec(tmp_path / "unoffered.toml", overriding)
     with pytest.raises(SetupError, match="which the grid does not offer; add none to its values"):
-        cli.spec_from(str(path))
+        spec_from(str(path))
 
 
 def test_bad_toml_and_missing_parts_fail_before_ray_starts(tmp_path, capsys):
@@ -418,7 +418,7 @@ def test_bad_toml_and_missing_parts_fail_before_ray_starts(tmp_path, capsys):
     assert not (tmp_path / "s").exists()
     path = write_spec(tmp_path / "half.toml", SPEC[: SPEC.index("[evaluation]")])
     with pytest.raises(SetupError, match="no 'evaluation'; a study needs recipes, grid"):
-        cli.spec_from(str(path))
+        spec_from(str(path))
 
 
 def test_key_lines_follow_tables_dotted_keys_and_inline_tables():
@@ -444,7 +444,7 @@ def test_help_runs_for_the_command_and_each_subcommand(capsys):
 
 
 def test_the_dmc100k_spec_plans_its_runs():
-    spec = cli.spec_from("docs/studies/dmc100k.toml")
+    spec = spec_from("docs/studies/dmc100k.toml")
     assert spec.recipes == ["simoun", "drq", "drqv2", "rad", "curl"]
     assert spec.preset == "cpu" and spec.grid == {"agent.n_step": [1, 3]}
     assert spec.base == {"eval_every": 10_000, "eval_episodes": 10, "video": False}
@@ -464,8 +464,8 @@ def test_the_dmc100k_spec_plans_its_runs():
 
 
 def test_the_drqv2_easy_supplement_runs_the_dmc100k_protocol_on_its_cartpole_runs():
-    study = cli.spec_from("docs/studies/dmc100k.toml")
-    supplement = cli.spec_from("docs/studies/dmc100k-drqv2-easy.toml")
+    study = spec_from("docs/studies/dmc100k.toml")
+    supplement = spec_from("docs/studies/dmc100k-drqv2-easy.toml")
     assert supplement.recipes == ["drqv2_easy"]
     for key in ("selection", "preset", "base", "grid", "grid_overrides", "tuning"):
         assert getattr(supplement, key) == getattr(study, key), key
@@ -644,8 +644,8 @@ def test_update_cost_ratios_place_each_run_on_the_baselines_clock(dmc_study, tmp
 
 
 def test_the_dmc100k_v2_spec_reruns_the_protocol_on_five_seeds_per_task_with_diagnostics():
-    first = cli.spec_from("docs/studies/dmc100k.toml")
-    spec = cli.spec_from("docs/studies/dmc100k-v2.toml")
+    first = spec_from("docs/studies/dmc100k.toml")
+    spec = spec_from("docs/studies/dmc100k-v2.toml")
     for key in ("recipes", "selection", "preset", "base", "grid", "grid_overrides", "tuning"):
         assert getattr(spec, key) == getattr(first, key), key
     assert spec.task_config == first.task_config
@@ -666,7 +666,7 @@ def test_the_dmc100k_v2_spec_reruns_the_protocol_on_five_seeds_per_task_with_dia
 def test_a_study_record_saved_before_diagnostics_existed_reads_as_its_spec():
     record = json.loads(Path("docs/studies/dmc100k/study.json").read_text())
     assert "diagnostics" not in record["spec"]
-    spec = cli.spec_from("docs/studies/dmc100k.toml")
+    spec = spec_from("docs/studies/dmc100k.toml")
     check_same_spec(record, spec, "not the same", "fix it")  # raises when they differ
     with pytest.raises(SetupError, match="diagnostics differ"):
         check_same_spec(record, replace(spec, diagnostics={"simoun": ["simoun_no_aux"]}), "", "")

@@ -26,7 +26,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Union
+from typing import Annotated, Union
 
 import tyro
 
@@ -163,16 +163,6 @@ def check_outputs(options: Run) -> None:
     """Refuse an output directory that is a file, creating nothing."""
     for flag, path in outputs(options).items():
         refuse_a_file(path, flag)
-
-
-def __getattr__(name: str) -> Any:
-    """:func:`~simoun_lab.study.runner.spec_from`, readable from here too, imported on first use:
-    at the top it would bring torch into ``--help``."""
-    if name == "spec_from":
-        from simoun_lab.study.runner import spec_from
-
-        return spec_from
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def absolute(args: Run) -> Run:
