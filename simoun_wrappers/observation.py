@@ -11,7 +11,7 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec, WrapperSpec
 from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
-from simoun_wrappers._checks import check_positive_int, is_int
+from simoun_wrappers._checks import check_bool, check_positive_int, is_int
 from simoun_wrappers.frames import check_single_env, frame_stack_in
 
 # LUMA, frame_shape and to_frame (the per-frame step) are importable from this module too.
@@ -72,9 +72,7 @@ def check_stack_options(
     """Reject bad ``SimounObservation`` options (shared with ``SimounParallelObservation``)."""
     switches = {"grayscale": grayscale, "motion": motion, "fold_frames": fold_frames}
     for name, value in switches.items():
-        if not isinstance(value, (bool, np.bool_)):
-            # A truthy string such as "false" would otherwise switch the option on.
-            raise TypeError(f"{name} must be True or False, got {value!r}.")
+        check_bool(value, name)
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
     check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")

@@ -120,3 +120,41 @@ def test_a_replay_of_other_frames_or_a_word_for_a_reward_is_named():
     assert set(agent.update(replay, 10)) >= {"critic_loss"}
     with pytest.raises(ValueError, match="reward must be a number, got str 'a'"):
         replay.add(np.zeros(2), "a", np.zeros((3, SIZE, SIZE), np.uint8), False, False)
+
+
+@pytest.mark.parametrize("flag", ["no", 0, 1, None, np.array([True])])
+def test_a_bool_argument_that_is_not_a_bool_is_named(flag):
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    env = SimounObservation(gym.make("simoun/PointReach-v0"), size=None)
+    obs, _ = env.reset(seed=0)
+    with pytest.raises(TypeError, match=r"act\(deterministic=\.\.\.\) must be True or False"):
+        agent.act(obs["frames"], deterministic=flag)
+    assert agent.act(obs["frames"], deterministic=np.bool_(True)).shape == (2,)
+    replay = point_reach_replay(steps=2)
+    frame = obs["frames"][-1]
+    for name in ("terminated", "truncated"):
+        flags = {"terminated": False, "truncated": False, name: flag}
+        with pytest.raises(TypeError, match=rf"add\({name}=\.\.\.\) must be True or False"):
+            replay.add(np.zeros(2), 0.0, frame, **flags)
+    assert replay.episode_step == 2  # nothing stored, the episode still open
+    replay.add(np.zeros(2), 0.0, frame, np.bool_(False), False)
+    assert replay.episode_step == 3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "said"),
+    [
+        ({"size": 0}, "size must be a positive int, got 0"),
+        ({"size": -3}, "size must be a positive int, got -3"),
+        ({"size": 2.5}, "size must be a positive int, got 2.5"),
+        ({"max_steps": 0}, "max_steps must be a positive int, got 0"),
+        ({"max_steps": True}, "max_steps must be a positive int, got True"),
+        ({"step_size": float("nan")}, "step_size must be a finite number > 0, got nan"),
+        ({"step_size": -0.2}, "step_size must be a finite number > 0, got -0.2"),
+        ({"step_size": "0.2"}, "step_size must be a finite number > 0, got '0.2'"),
+    ],
+)
+def test_point_reach_names_a_bad_constructor_argument(kwargs, said):
+    with pytest.raises(ValueError, match=r"; pass .*, e\.g\. ") as raised:
+        gym.make("simoun/PointReach-v0", **kwargs)
+    assert said in str(raised.value)
