@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import broken_link
 from simoun_agent.run.layout import CHECKPOINT_NAME, LOCK_NAME, TENSORBOARD_DIR, TRAINER_FILES
 
 _held: dict[Path, IO[str]] = {}
@@ -120,7 +121,14 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
 
 
 def require_checkpoint(run_dir: Path) -> None:
-    """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint."""
+    """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint, or whose
+    checkpoint is a link to nothing."""
+    problem = broken_link(run_dir / CHECKPOINT_NAME)
+    if problem:
+        raise SetupError(
+            f"{run_dir / CHECKPOINT_NAME} is damaged: {problem}. Restore the file it stands for "
+            "from a copy (or point the link at it), or start a new run"
+        )
     if (run_dir / TRAINER_FILES[0]).exists() and not (run_dir / CHECKPOINT_NAME).exists():
         raise SetupError(
             f"{run_dir} has no {CHECKPOINT_NAME}: the run stopped before its first checkpoint, "
