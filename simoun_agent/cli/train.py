@@ -22,6 +22,7 @@ from typing import Annotated
 import tyro
 from tqdm import tqdm
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.config_flags import (
     PRESETS_LIST,
     RECIPES_HELP,
@@ -63,6 +64,7 @@ class TrainCommand:
 
     resume: Annotated[
         str | None,
+        PATH,
         tyro.conf.arg(
             metavar="RUN_DIR",
             help="continue a run from its last checkpoint (only "

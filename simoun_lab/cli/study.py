@@ -30,6 +30,7 @@ from typing import Annotated, Union
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import make_output_dir, refuse_a_file
@@ -66,7 +67,7 @@ class Plan:
     """List every run of both phases (phase, task, recipe, grid values, seed, env steps) and
     estimate the CPU time of each from a short probe measured here, running nothing."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     probe_updates: Annotated[int, tyro.conf.arg(metavar="N")] = 20
     """agent updates timed per configuration (0: no estimate)"""
@@ -77,7 +78,7 @@ class Run(StudyOptions):
     """Run the tuning phase, select each recipe's setting, run the evaluation phase on the
     held-out seeds and write the report into STUDY_DIR/report (on Ray Tune)."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     # the library's options, with the command line's metavars (their docs are StudyOptions')
     study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
@@ -93,7 +94,7 @@ class Report:
     """Write the report of a study's finished runs again, with this code, from its study
     directory or its archive (no Ray, nothing trained): into DIR/report."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
     """the study directory or its archive (e.g. docs/studies/NAME)"""

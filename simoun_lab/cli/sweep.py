@@ -22,6 +22,7 @@ from typing import Annotated, Any, Literal
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.config_flags import (
     ConfigFlags,
     config_default,
@@ -66,7 +67,7 @@ Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.
 class SweepCommand:
     """What ``simoun-sweep`` is asked: the grid, where and how to run it, and the base config."""
 
-    sweep_dir: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    sweep_dir: Annotated[str | None, PATH, tyro.conf.arg(metavar="DIR")] = None
     """where the runs and the report go (none: sweeps/<UTC time>; required with --resume); on a
     cluster, a directory every machine sees"""
     grid: Annotated[
