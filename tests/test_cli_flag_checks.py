@@ -283,3 +283,20 @@ def test_a_path_too_long_for_the_file_system_is_refused_naming_its_flag(main, ar
     err = refused(capsys, main, [*argv, path])
     limit = "4095; give a shorter path" if path == LONG_PATH else "255; give a shorter name"
     assert f"{flag} {path[:40]}...: " in err and f"past the file system's limit of {limit}" in err
+
+
+@pytest.mark.parametrize("seeds", ["0-100000", "0-99999999999999999999", "0-9999,20000-20001"])
+def test_a_seed_range_past_the_cap_is_refused_before_ray_starts(seeds, tmp_path, capsys):
+    argv = ["--preset", "cpu", "--sweep-dir", str(tmp_path / "s"), "--seeds", seeds]
+    err = refused(capsys, sweep_cli.main, argv)
+    assert f"--seeds {seeds!r} names" in err and "past the cap of 10,000; give fewer" in err
+    assert not (tmp_path / "s").exists()
+
+
+def test_a_study_spec_seed_range_past_the_cap_is_refused(tmp_path, capsys):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        Path("docs/studies/dmc100k.toml").read_text().replace('"101-102"', '"0-100000"')
+    )
+    err = refused(capsys, study_cli.main, ["plan", str(spec)])
+    assert "seeds '0-100000' names" in err and "past the cap of 10,000" in err
