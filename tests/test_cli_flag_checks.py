@@ -300,3 +300,18 @@ def test_a_study_spec_seed_range_past_the_cap_is_refused(tmp_path, capsys):
     )
     err = refused(capsys, study_cli.main, ["plan", str(spec)])
     assert "seeds '0-100000' names" in err and "past the cap of 10,000" in err
+
+
+@pytest.mark.parametrize("spec", ["docs/studies/dmc100k.toml",
+                                  "docs/studies/minigrid-v2/tuning/spec.json"])  # fmt: skip
+@pytest.mark.parametrize("archive", ["study", "study/", "other/../study"])
+def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
+    spec, archive, tmp_path, capsys, monkeypatch
+):
+    spec = Path(spec).absolute()
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "other").mkdir()
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", "study",
+                                           "--archive", archive])  # fmt: skip
+    assert f"--archive {tmp_path / archive} is the --study-dir itself" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["other"]

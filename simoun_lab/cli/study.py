@@ -156,9 +156,18 @@ def outputs(options: Run) -> dict[str, Path]:
 
 
 def check_outputs(options: Run) -> None:
-    """Refuse an output directory that is a file, creating nothing."""
+    """Refuse an output directory that is a file, and an archive that is the study directory
+    itself (the archive is the finished runs' copy, kept apart from the working records),
+    creating nothing."""
     for flag, path in outputs(options).items():
         refuse_a_file(path, flag)
+    archive = options.archive
+    if archive is not None and archive.resolve() == options.study_dir.resolve():
+        raise SetupError(
+            f"--archive {archive} is the --study-dir itself; the archive keeps a copy of the "
+            "finished runs apart from the study directory: pass another directory (e.g. "
+            "docs/studies/NAME), or leave --archive out"
+        )
 
 
 def absolute(args: Run) -> Run:
