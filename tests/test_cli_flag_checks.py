@@ -315,3 +315,18 @@ def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
                                            "--archive", archive])  # fmt: skip
     assert f"--archive {tmp_path / archive} is the --study-dir itself" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["other"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--env-kwargs", '{"a": 1, "a": 2}'], "--env-kwargs: the key 'a' is given twice"),
+        (['--env-kwargs={"x": {"b": 1, "b": 1}}'], "--env-kwargs: the key 'b' is given twice"),
+        (["--set", 'env_kwargs={"a": 1, "a": 2}'], "env_kwargs='{\"a\": 1, \"a\": 2}': the key "
+         "'a' is given twice"),
+        (["--env-kwargs", "nope"], "--env-kwargs: expected a JSON object"),
+    ],
+)  # fmt: skip
+def test_a_json_object_that_gives_a_key_twice_is_refused_naming_the_key(argv, said, capsys):
+    err = refused(capsys, train_cli.main, argv)
+    assert said in err, err

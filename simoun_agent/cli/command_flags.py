@@ -65,6 +65,8 @@ class Flag:
     mp4``)"""
     path: bool = False
     """names a file or directory"""
+    json: bool = False
+    """takes a JSON object (``--env-kwargs '{"a": 1}'``)"""
 
 
 @dataclass(frozen=True)
@@ -190,7 +192,8 @@ def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) ->
             isinstance(m, PrimitiveConstructorSpec) and m.nargs in ("*", "+", "?") for m in markers
         )
         path = _names_path(kind, markers) or (config and key in CONFIG_PATHS)
-        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path)
+        json = (typing.get_origin(kind) or kind) is dict
+        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path, json)
         if kind is bool and tyro.conf.FlagCreatePairsOff not in markers:
             section, dot, last = flag[2:].rpartition(".")
             negation = Flag(key, doc, False, False, config)

@@ -59,7 +59,7 @@ from simoun_agent.cli.command_flags import (
 )
 from simoun_agent.config import TrainConfig
 from simoun_agent.config.key_match import close_keys
-from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs
+from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs, json_value
 
 T = TypeVar("T")
 
@@ -124,19 +124,25 @@ def _default(field: dataclasses.Field, given: Any) -> Any:
     return MISSING_NONPROP
 
 
+def json_object(text: str) -> dict:
+    """The JSON object ``text`` (a dict option's value); ValueError when it is not one, or
+    gives a key twice (:func:`~simoun_agent.config.keys.json_value`)."""
+    try:
+        value = json_value(text)
+    except json.JSONDecodeError:
+        value = None
+    if not isinstance(value, dict):
+        raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {text!r}")
+    return value
+
+
 @REGISTRY.primitive_rule
 def _json_dict(info: PrimitiveTypeInfo) -> PrimitiveConstructorSpec | None:
     if (info.type_origin or info.type) is not dict:
         return None
 
     def read(args: list[str]) -> dict:
-        try:
-            value = json.loads(args[0])
-        except json.JSONDecodeError:
-            value = None
-        if not isinstance(value, dict):
-            raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {args[0]!r}")
-        return value
+        return json_object(args[0])
 
     return PrimitiveConstructorSpec(
         nargs=1,
@@ -410,6 +416,18 @@ def empty_value(flag: str, value: str, given: Flag | None = None) -> str:
     return f"{flag} is given an empty value ({value!r}); {fix}"
 
 
+def refuse_bad_json(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError naming the flag for a dict option's value that is not a JSON object, or
+    that gives a key twice (``--env-kwargs '{"a": 1, "a": 2}'``): tyro would keep the last
+    value without a word, or print a box of help."""
+    for value in given_values(argv, flags, command):
+        if value.flag is not None and value.value is not None and flags[value.flag].json:
+            try:
+                json_object(value.value)
+            except ValueError as err:
+                raise ValueError(f"{value.flag}: {err}") from None
+
+
 NAME_MAX = 255
 """Bytes in one file or directory name at most (Linux's file systems)."""
 
@@ -509,6 +527,7 @@ def parse(
         refuse_stray_arguments(argv, flags, cls, prog)
         refuse_empty_values(argv, flags, cls)
         refuse_long_paths(argv, flags, cls)
+        refuse_bad_json(argv, flags, cls)
         refuse_repeated(argv, flags)
         refuse_huge_numbers(argv, flags, prog)
     except ValueError as err:
