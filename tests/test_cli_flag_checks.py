@@ -5,6 +5,7 @@ named with the switch, an empty value, a switch given a value, a stray argument 
 too long for the file system are named; the driving references check every value before an
 episode."""
 
+import os
 from pathlib import Path
 
 import pytest
@@ -330,3 +331,31 @@ def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
 def test_a_json_object_that_gives_a_key_twice_is_refused_naming_the_key(argv, said, capsys):
     err = refused(capsys, train_cli.main, argv)
     assert said in err, err
+
+
+def test_an_output_directory_that_cannot_be_made_is_refused_before_ray(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    spec = Path("docs/studies/dmc100k.toml").absolute()
+    for main, argv, flag in [
+        (sweep_cli.main, ["--preset", "cpu", "--sweep-dir"], "--sweep-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir"], "--study-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir", str(tmp_path / "s"), "--archive"],
+         "--archive"),
+    ]:  # fmt: skip
+        err = refused(capsys, main, [*argv, str(blocker / "out")])
+        assert (
+            f"cannot write to the output directory {blocker / 'out'} ({blocker} is a file); "
+            f"pass a writable {flag}"
+        ) in err
+    assert sorted(tmp_path.iterdir()) == [blocker]
+
+
+def test_a_sweep_dir_without_write_permission_is_refused_before_ray(tmp_path, capsys):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    if os.access(locked, os.W_OK):
+        pytest.skip("this user writes into a read-only directory (root)")
+    argv = ["--preset", "cpu", "--sweep-dir", str(locked / "sweep")]
+    err = refused(capsys, sweep_cli.main, argv)
+    assert f"({locked} is not writable); pass a writable --sweep-dir" in err

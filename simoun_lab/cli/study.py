@@ -33,7 +33,7 @@ import tyro
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.run.rundir import make_output_dir, refuse_a_file
+from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.minigrid_study import study_command
 from simoun_lab.minigrid_study.study_command import is_ppo_spec
@@ -156,11 +156,11 @@ def outputs(options: Run) -> dict[str, Path]:
 
 
 def check_outputs(options: Run) -> None:
-    """Refuse an output directory that is a file, and an archive that is the study directory
-    itself (the archive is the finished runs' copy, kept apart from the working records),
-    creating nothing."""
+    """Refuse an output directory that cannot be written (:func:`check_output_dir`), and an
+    archive that is the study directory itself (the archive is the finished runs' copy, kept
+    apart from the working records), creating nothing."""
     for flag, path in outputs(options).items():
-        refuse_a_file(path, flag)
+        check_output_dir(path, flag)
     archive = options.archive
     if archive is not None and archive.resolve() == options.study_dir.resolve():
         raise SetupError(

@@ -31,6 +31,7 @@ from simoun_agent.cli.config_flags import (
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable
@@ -160,6 +161,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        check_output_dir(sweep_dir, "--sweep-dir")
         gpus_wanted(args.gpus_per_trial)
         ray = load_ray()
     except SetupError as err:
