@@ -359,3 +359,20 @@ def test_a_sweep_dir_without_write_permission_is_refused_before_ray(tmp_path, ca
     argv = ["--preset", "cpu", "--sweep-dir", str(locked / "sweep")]
     err = refused(capsys, sweep_cli.main, argv)
     assert f"({locked} is not writable); pass a writable --sweep-dir" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--settings.n-steps", "0"], "--settings.n-steps 0: must be 1 or more"),
+        (["--settings.n-envs", "-2"], "--settings.n-envs -2: must be 1 or more"),
+        (["--settings.steps", "0"], "--settings.steps 0: must be 1 or more"),
+        (["--settings.steps", "1000"], "--settings.steps 1000: fewer than two blocks of "
+         "--settings.n-envs x --settings.n-steps = 1024 transitions"),
+        (["--settings.seed", "-1"], "--settings.seed -1: must be 0 or more"),
+    ],
+)  # fmt: skip
+def test_a_probe_count_below_one_is_refused_naming_the_setting(argv, said, tmp_path, capsys):
+    err = refused(capsys, minigrid_cli.main, ["probe", "--out", str(tmp_path / "p"), *argv])
+    assert said in err
+    assert list(tmp_path.iterdir()) == []

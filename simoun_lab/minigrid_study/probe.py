@@ -33,7 +33,7 @@ from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import ARMS, consistency
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
 
-__all__ = ["PROBED", "ProbeSettings", "probe", "write_probe"]
+__all__ = ["PROBED", "ProbeSettings", "check_settings", "probe", "write_probe"]
 
 PROBED: dict[str, Callable[[VectorEnv, int, torch.device], VectorEnv]] = {
     "consistency": ARMS["consistency"],
@@ -77,6 +77,30 @@ class ProbeSettings:
     seed: int = 100
     """env, action and model seed: disjoint from the study's training seeds (0-4) and its
     held-out evaluation seeds (1,000,000 on)"""
+
+
+def check_settings(
+    settings: ProbeSettings, name: Callable[[str], str] = lambda field: f"settings.{field}"
+) -> None:
+    """Raise ValueError naming the first value of ``settings`` a probe cannot run with: a count
+    below 1, a seed below 0, or fewer ``steps`` than two blocks (the summary leaves the first
+    out). ``name`` spells a field where the user gave it (``settings.n_envs`` in Python,
+    ``--settings.n-envs`` on the command line)."""
+    for field in ("n_envs", "n_steps", "steps"):
+        if getattr(settings, field) < 1:
+            raise ValueError(
+                f"{name(field)} {getattr(settings, field)}: must be 1 or more "
+                f"(default {getattr(ProbeSettings(), field)})"
+            )
+    if settings.seed < 0:
+        raise ValueError(f"{name('seed')} {settings.seed}: must be 0 or more")
+    block = settings.n_envs * settings.n_steps
+    if settings.steps < 2 * block:
+        raise ValueError(
+            f"{name('steps')} {settings.steps}: fewer than two blocks of {name('n_envs')} x "
+            f"{name('n_steps')} = {block} transitions (the summary leaves the first block out); "
+            f"give {name('steps')} {2 * block} or more"
+        )
 
 
 def pearson(x: np.ndarray, y: np.ndarray) -> float:
@@ -135,6 +159,7 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     """Probe each of ``names`` and write ``out/probe.csv`` (every block) and ``out/probe.md``
     (per probe, means over blocks, the first left out: the reward's correlation with novelty
     over all and over moving transitions, its std / mean, its still / moving mean)."""
+    check_settings(settings)
     unknown = [n for n in names if n not in PROBED]
     if unknown:
         raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBED)}")
