@@ -225,6 +225,8 @@ def test_an_empty_positional_argument_is_refused_naming_it(main, argv, name, cap
         (study_cli.main, ["run", "s.toml", "--study-dir", "s", "--allow-other-commit=no"],
          "--allow-other-commit is a switch and takes no value"),
         (analyze_cli.main, ["masks", "RUN", "--overwrite=1"], "--overwrite is a switch"),
+        (train_cli.main, ["--overwrite", "true"], "--overwrite is a switch and takes no value"),
+        (sweep_cli.main, ["--resume", "yes"], "--resume is a switch and takes no value"),
     ],
 )  # fmt: skip
 def test_a_switch_given_a_value_says_it_takes_none(main, argv, said, capsys):

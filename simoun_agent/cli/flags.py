@@ -236,10 +236,13 @@ def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, pr
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
 
-def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: bool) -> None:
+def refuse_stray_words(
+    argv: Sequence[str], flags: dict[str, Flag], positional: bool, switches: Iterable[str] = ()
+) -> None:
     """Raise ValueError for a word after a switch in a command that takes no positional
-    argument (``--progress maybe``): tyro would name only the word, not the switch it was
-    meant for. :func:`bool_argv` already took true/false words."""
+    argument (``--progress maybe``, ``--overwrite true``): tyro would name only the word, not
+    the switch it was meant for. :func:`bool_argv` already took the true/false words of
+    ``switches``."""
     if positional:
         return
     for arg, following in itertools.pairwise(argv):
@@ -247,10 +250,21 @@ def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: 
             break
         flag = flags.get(arg)
         if flag is not None and flag.switch is not None and not following.startswith("-"):
-            raise ValueError(
-                f"{arg} is a switch: it takes true or false ({arg} true, {arg} false), or give "
-                f"{arg} alone; got {following!r}"
-            )
+            raise ValueError(f"{switch_use(arg, flag, switches)}; got {following!r}")
+
+
+def switch_use(name: str, flag: Flag, switches: Iterable[str]) -> str:
+    """How the switch ``name`` is given: with true or false when its flag is one of
+    ``switches`` (:func:`bool_argv` reads those), else alone."""
+    positive = "--" + flag.key.replace("_", "-")
+    if name == positive and positive in switches:
+        return (
+            f"{name} is a switch: it takes true or false ({name} true, {name} false), or give "
+            f"{name} / {negated(name)} alone"
+        )
+    if positive in switches:
+        return f"{name} takes no value; give {name} alone, or {positive}=true / {positive}=false"
+    return f"{name} is a switch and takes no value; give {name} alone, or leave it out"
 
 
 def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
@@ -375,24 +389,13 @@ def refuse_switch_values(
     """Raise ValueError for a switch given ``=VALUE`` (``--overwrite=false``,
     ``--no-progress=false``) that :func:`bool_argv` did not read: tyro would say only
     ``Unrecognized options: false``."""
-    switches = set(switches)
     for arg in argv:
         if arg == "--":
             break
         name, eq, _ = arg.partition("=")
         flag = flags.get(name)
-        if flag is None or flag.switch is None or not eq:
-            continue
-        positive = "--" + flag.key.replace("_", "-")
-        if positive in switches:
-            raise ValueError(
-                f"{name} takes no value; give {name} alone, or {positive}=true / "
-                f"{positive}=false; got {arg!r}"
-            )
-        raise ValueError(
-            f"{name} is a switch and takes no value; give {name} alone, or leave it out; "
-            f"got {arg!r}"
-        )
+        if flag is not None and flag.switch is not None and eq:
+            raise ValueError(f"{switch_use(name, flag, switches)}; got {arg!r}")
 
 
 def refuse_empty_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
@@ -522,7 +525,7 @@ def parse(
         argv = bool_argv(argv, switches)
         flags = command_flags(cls, argv)
         refuse_unknown(argv, flags, cls, prog)
-        refuse_stray_words(argv, flags, takes_positional(cls, argv))
+        refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
         refuse_switch_values(argv, flags, switches)
         refuse_stray_arguments(argv, flags, cls, prog)
         refuse_empty_values(argv, flags, cls)
