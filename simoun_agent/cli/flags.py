@@ -18,6 +18,12 @@ to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not
 * every command answers ``--version``; help printed to a pipe is not wrapped at 80 columns;
   output into a pipe that closed early (``simoun-report DIR | head``) ends the command
   quietly (:func:`quiet_pipe`).
+
+Before tyro reads the command line, :func:`parse` refuses in one line, naming the flag or
+argument: an unknown flag, a word after a switch, a switch given a value it does not take, a
+word no argument takes, an empty or blank value, a path the file system cannot hold, a dict's
+value that is not a JSON object (or gives a key twice), an option given twice with different
+values, and a number past int64.
 """
 
 from __future__ import annotations
@@ -515,7 +521,8 @@ def parse(
 ) -> T:
     """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
     ``switches`` are the boolean flags that also take the older ``--flag false``. Exits 0
-    after ``--version`` or ``--help``, 2 with tyro's message for input it cannot read."""
+    after ``--version`` or ``--help``, 2 with one line for input the checks above refuse, or
+    tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
     switches = list(switches)
     if "--version" in argv:
