@@ -36,6 +36,26 @@ def refuse_a_file(path: Path, flag: str) -> None:
         )
 
 
+def check_output_dir(path: Path, flag: str) -> None:
+    """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
+    written: it is a file, a folder on its way is a file, or the nearest folder of it that
+    exists is not writable by this process. Creates nothing, so a command can check before the
+    work whose set-up takes long (Ray) rather than fail after it."""
+    refuse_a_file(path, flag)
+    existing = path.absolute()
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        reason = f"{existing} is a file"
+    elif not os.access(existing, os.W_OK | os.X_OK):
+        reason = f"{existing} is not writable"
+    else:
+        return
+    raise SetupError(
+        f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
+    )
+
+
 def make_output_dir(path: Path, flag: str = "--out") -> bool:
     """Create ``path`` (with its parents) and check that it can be written. Returns True when
     it did not exist before, so a caller that stops later can remove what it made; raises
