@@ -1,9 +1,14 @@
 """Fixtures shared by several test modules."""
 
+import os
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
+
+TESTS = Path(__file__).parent
+PYTHONPATH = [part for part in os.environ.get("PYTHONPATH", "").split(os.pathsep) if part]
 
 
 @pytest.fixture
@@ -42,6 +47,8 @@ def ray_address() -> Iterator[str]:
         include_dashboard=False,
         log_to_driver=False,
         _system_config={"worker_niceness": 0},
+        # the workers import the tests' own env modules (broken_envs) as the tests do
+        runtime_env={"env_vars": {"PYTHONPATH": os.pathsep.join([str(TESTS), *PYTHONPATH])}},
     )
     yield ray.get_runtime_context().gcs_address
     ray.shutdown()

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
+from broken_envs import NAN_REACH_ID
 from flag_lists import override
 
 from benchmarks.sweep import tiny_flags
@@ -102,23 +103,36 @@ def test_trials_report_each_evaluation_to_tune(sweep_dir):
 
 
 def test_a_failing_trial_is_reported_and_the_others_finish(ray_address, tmp_path, capsys):
-    # A PointReach whose step is NaN passes every check before Ray (it is made and is fine until
-    # it steps) but returns NaN rewards: that trial stops inside Ray at its first step.
+    # NanReach (tests/broken_envs.py) with nan_reward is made, reset and rendered as PointReach
+    # is, so it passes every check before Ray, but its rewards are NaN: that trial stops inside
+    # Ray at its first step, the other one finishes.
     sweep_dir = tmp_path / "failing"
-    argv = [*TINY, "--grid", 'env_kwargs={"step_size": NaN},{}']
+    argv = override(TINY, "--env", f"broken_envs:{NAN_REACH_ID}")
+    argv += ["--grid", 'env_kwargs={"nan_reward": true},{}']
     argv += ["--seeds", "0", "--sweep-dir", str(sweep_dir)]
     assert cli.main([*argv, "--verbose", "0"]) == 1
     bad, good = sorted(sweep_dir.glob("env_kwargs=*"), key=lambda p: len(p.name), reverse=True)
-    assert (good / "simoun-PointReach-v0/s0/summary.json").is_file()
-    assert not (bad / "simoun-PointReach-v0/s0/summary.json").exists()
-    error = (bad / "simoun-PointReach-v0/s0/error.txt").read_text()
+    assert (good / "simoun-test-NanReach-v0/s0/summary.json").is_file()
+    assert not (bad / "simoun-test-NanReach-v0/s0/summary.json").exists()
+    error = (bad / "simoun-test-NanReach-v0/s0/error.txt").read_text()
     assert "the evaluation env returned the reward nan at step 1" in error
     assert "TypeError" not in error  # the trial's own error, not Ray's failure to copy it
     err = capsys.readouterr().err
-    assert 'FAILED env_kwargs={"step_size":NaN}/simoun-PointReach-v0/s0' in err
+    assert 'FAILED env_kwargs={"nan_reward":true}/simoun-test-NanReach-v0/s0' in err
     assert "--resume" in err
     assert [row["n"] for row in report_rows(sweep_dir)] == ["0", "1"]
     assert "## Failed runs" in (sweep_dir / "report.md").read_text()
+
+
+def test_an_env_kwarg_the_env_refuses_is_named_before_ray_starts(tmp_path, capsys):
+    sweep_dir = tmp_path / "refused"
+    argv = [*TINY, "--grid", 'env_kwargs={"step_size": NaN},{}', "--sweep-dir", str(sweep_dir)]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "simoun/PointReach-v0 refused them (step_size must be a finite number > 0" in err
+    assert "Traceback" not in err
 
 
 def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_path):

@@ -33,7 +33,9 @@ def dmc_task(env_id: str) -> str | None:
 
 def env_label(env_id: str) -> str:
     """The task's name in run and trial directories and in reports:
-    ``dm_control/cartpole-swingup-v0`` -> ``cartpole-swingup``; others with ``/`` as ``-``."""
+    ``dm_control/cartpole-swingup-v0`` -> ``cartpole-swingup``; others with ``/`` as ``-``, less
+    a ``MODULE:`` that names the package registering the id."""
+    env_id = env_id.rpartition(":")[2]
     return dmc_task(env_id) or env_id.replace("/", "-")
 
 

@@ -197,6 +197,14 @@ def _make_base(config: TrainConfig) -> gym.Env:
         raise SetupError(f"gymnasium.make({config.env!r}, ...) failed: {err}") from None
     except gym.error.DependencyNotInstalled as err:
         raise SetupError(f"{config.env} cannot be made: {err}") from None
+    except ValueError as err:
+        # an env that checks its own arguments refuses a bad value this way
+        if not config.env_kwargs:
+            raise SetupError(f"gymnasium.make({config.env!r}) failed: {err}") from None
+        raise SetupError(
+            f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({err}). "
+            "Fix or drop --env-kwargs"
+        ) from None
 
 
 def _check_env(env: gym.Env, env_id: str) -> None:

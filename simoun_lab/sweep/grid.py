@@ -223,6 +223,10 @@ class SweepSpec:
                 f"{both[0]} is given both as a base flag and in --grid; keep it in one place"
             )
         base_config = resolve(preset, base)
+        if envs is None and base_config.env_module is not None:
+            # each trial sets the bare id; the module that registers it (--env MODULE:ID) has
+            # to reach the trials' own processes too
+            base = {**base, "env_module": base_config.env_module}
         seed_list = parse_seeds(seeds) if seeds is not None else [base_config.seed]
         env_list = split_values(envs) if envs is not None else [base_config.env]
         if not all(env_list):
