@@ -1276,7 +1276,7 @@ EQ_REFUSED = [  # (command, argv builder, flag, value, what the refusal names)
     ("study", plan, "--probe-updates", "-1", None), ("study", study_run, "--num-cpus", "0", None),
     ("study", study_run, "--verbose", "3", None),
     ("minigrid", minigrid_run, "--concurrent", "0", None),
-    ("minigrid", probe, "--settings.steps", "0", None),
+    ("minigrid", probe, "--settings.steps", "0", ("--settings.steps", "steps")),
     ("minigrid", probe, "--probes", "rndd", "rndd"),
     ("driving", driving, "--episodes", "0", None), ("driving", driving, "--preset", "cpux", "cpux"),
     ("driving", driving, "--video", "x.txt", None),
