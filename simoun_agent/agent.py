@@ -30,6 +30,7 @@ from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Critic
 from simoun_agent.replay import FrameReplay
+from simoun_wrappers._checks import check_bool
 from simoun_wrappers.augment import random_conv, random_shift, shift_pad
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
 
@@ -222,6 +223,7 @@ class SimounAgent:
         mode when ``deterministic`` (evaluation), else its exploration. ``step``: the global env
         step, which sets the noise of a scheduled actor (DrQ-v2's); None: that of the latest
         :meth:`update`."""
+        check_bool(deterministic, "act(deterministic=...)")
         obs = self._check_obs(frames, batched=False).unsqueeze(0)
         step = self.env_step if step is None else step
         with torch.inference_mode():
@@ -391,6 +393,7 @@ class SimounAgent:
         with gradient and, when the target, L_tran or per-step curiosity reads it, at t+1
         without (each unique frame through each path once; per-frame f^a at t+1 when
         ``next_features``)."""
+        check_bool(next_features, "encode(next_features=...)")
         cfg = self.config
         k, views_m = cfg.num_frames, cfg.critic_augmentations
         windows = [w[:, : k + 1] for w in views.windows[:views_m]]

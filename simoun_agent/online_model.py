@@ -23,6 +23,7 @@ import gymnasium as gym
 import numpy as np
 import torch
 import torch.nn.functional as F
+from gymnasium import spaces
 from torch import nn
 
 from simoun_agent.config.shapes import check_channel_first
@@ -332,6 +333,35 @@ class OnlineModel(ABC):
             )
         return triplets
 
+    def _check_actions(self, actions: Any, batch: int) -> np.ndarray:
+        """``actions`` as an array of ``batch`` actions of the action space, or an error naming
+        the argument and the expected shape: finite numbers, and for Discrete, MultiDiscrete
+        and MultiBinary spaces integers within the space."""
+        space = self.action_space
+        shape = (batch, *space.shape) if space is not None and space.shape is not None else None
+        array = np.asarray(actions)
+        problem = None
+        if array.dtype.kind not in "biuf":
+            problem = f"{array.dtype} values, not numbers"
+        elif shape is not None and array.shape != shape:
+            problem = f"shape {array.shape}"
+        elif shape is None and (array.ndim == 0 or len(array) != batch):
+            problem = f"shape {array.shape}, not one action per transition"
+        elif not np.all(np.isfinite(array)):
+            problem = "a NaN or infinite value"
+        elif isinstance(space, (spaces.Discrete, spaces.MultiDiscrete, spaces.MultiBinary)):
+            if array.dtype.kind == "f" and np.any(array != np.round(array)):
+                problem = "a fractional value"
+            elif not all(space.contains(np.asarray(a).astype(space.dtype)) for a in array):
+                problem = "a value outside the space"
+        if problem is None:
+            return array
+        want = f"shape {shape}" if shape is not None else f"{batch} actions"
+        raise ValueError(
+            f"{type(self).__name__}.watch() expects actions of {want} in {space}, one per "
+            f"transition, got {problem}; pass the batch of actions that env.step took"
+        )
+
     def watch(
         self,
         triplets: np.ndarray,
@@ -349,6 +379,20 @@ class OnlineModel(ABC):
         self._raise_failure()
         triplets = self._check(triplets, "triplets")
         next_triplets = self._check(next_triplets, "next_triplets")
+        batch = len(triplets)
+        if batch == 0 or len(next_triplets) != batch:
+            raise ValueError(
+                f"{type(self).__name__}.watch() needs one or more transitions, with as many "
+                f"next_triplets as triplets; got {batch} triplets and {len(next_triplets)} "
+                "next_triplets (pass the batch of one vector step, or obs[None] for one env)"
+            )
+        actions = self._check_actions(actions, batch)
+        for name, flags in (("terminated", terminated), ("truncated", truncated)):
+            if np.shape(flags) != (batch,):
+                raise ValueError(
+                    f"{type(self).__name__}.watch() expects {name} of shape ({batch},), one flag "
+                    f"per transition, got shape {np.shape(flags)}"
+                )
         self._store(triplets, actions, next_triplets)
         self.watch_calls += 1
         if self.watch_calls % self.config.update_every == 0:

@@ -11,7 +11,7 @@ from typing import IO
 
 import numpy as np
 
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import check_bool, is_int
 
 _MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
 
@@ -151,6 +151,8 @@ class FrameReplay:
         truncated: bool,
     ) -> None:
         """Store one step: the action taken, the reward received and the frame it led to."""
+        for name, flag in (("terminated", terminated), ("truncated", truncated)):
+            check_bool(flag, f"add({name}=...)")
         if self.episode_step is None:
             raise RuntimeError(
                 "FrameReplay.add() called with no open episode; call start_episode(first_frame) "

@@ -34,3 +34,17 @@ def check_positive_int(value: Any, name: str, fix: str) -> None:
     ``fix`` says what to pass instead."""
     if not is_int(value) or value < 1:
         raise ValueError(f"{name} must be a positive int, got {value!r}; {fix}")
+
+
+def check_bool(value: Any, name: str) -> None:
+    """A TypeError for a ``value`` of the argument ``name`` that is not a Python or numpy bool:
+    a truthy stand-in such as ``"no"`` or ``"false"`` would otherwise switch the option on."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {value!r} ({type(value).__name__}).")
+
+
+def check_finite_positive(value: Any, name: str, fix: str) -> None:
+    """A ValueError for a ``value`` of the argument ``name`` that is not a finite real > 0;
+    ``fix`` says what to pass instead."""
+    if not (is_real(value) and np.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}; {fix}")

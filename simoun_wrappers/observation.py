@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import functools
 import operator
 from copy import deepcopy
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -11,7 +13,7 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec, WrapperSpec
 from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
-from simoun_wrappers._checks import check_positive_int, is_int
+from simoun_wrappers._checks import check_bool, check_positive_int, is_int
 from simoun_wrappers.frames import check_single_env, frame_stack_in
 
 # LUMA, frame_shape and to_frame (the per-frame step) are importable from this module too.
@@ -72,9 +74,7 @@ def check_stack_options(
     """Reject bad ``SimounObservation`` options (shared with ``SimounParallelObservation``)."""
     switches = {"grayscale": grayscale, "motion": motion, "fold_frames": fold_frames}
     for name, value in switches.items():
-        if not isinstance(value, (bool, np.bool_)):
-            # A truthy string such as "false" would otherwise switch the option on.
-            raise TypeError(f"{name} must be True or False, got {value!r}.")
+        check_bool(value, name)
     if source not in _SOURCES:
         raise ValueError(f"source must be one of {_SOURCES}, got {source!r}.")
     check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")
@@ -217,22 +217,62 @@ def pixel_env(
             f"gym.make(env_id, render_mode='rgb_array'), or wrap it so that it returns "
             f"(H, W, 3) uint8 images."
         )
-    pixels = AddRenderObservation(env, render_only=True)
-    frame = pixels.render()
-    if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8:
-        raise TypeError(
-            f"{owner} expects env.render() to return a uint8 image, got "
-            f"{getattr(frame, 'dtype', type(frame))}; use an env whose rgb_array render is "
-            f"an (H, W, 3) uint8 array."
-        )
-    if _rgba(pixels.observation_space):
-        pixels = _drop_alpha(pixels)
+    try:
+        pixels = AddRenderObservation(env, render_only=True)
+    except TypeError as err:
+        # gymnasium's error names neither the wrapper that needs the renders nor what they must
+        # be; its wrapper has reset the env, so rendering again shows what it got
+        if "expects env.render() to return" not in str(err):
+            raise
+        check_render(env.render(), owner)
+        raise
+    frame = check_render(pixels.render(), owner)
     if image_layout(pixels.observation_space) is None:
         raise ValueError(
             f"{owner} expects env.render() to return an (H, W, 3) image, got shape "
             f"{frame.shape}; check the env's render_mode and render_kwargs."
         )
+    # each step's render is checked too: the space above holds only the first one's shape
+    pixels = TransformObservation(
+        pixels,
+        functools.partial(check_render, owner=owner, shape=pixels.observation_space.shape),
+        pixels.observation_space,
+    )
+    if _rgba(pixels.observation_space):
+        pixels = _drop_alpha(pixels)
     return pixels, True
+
+
+def check_render(frame: Any, owner: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    """``frame``, an ``rgb_array`` render that ``owner`` takes its pixels from, or a TypeError
+    (not a uint8 array) or ValueError (a side of 0, or not ``shape``, the first render's) that
+    names the env's render and what it must return."""
+    if shape is None:
+        expected = "an (H, W, 3) uint8 image with H, W >= 1"
+    else:
+        expected = f"uint8 images of its first render's shape {shape}"
+    what = None
+    if not isinstance(frame, np.ndarray):
+        what = "None" if frame is None else f"a {type(frame).__name__}"
+    elif frame.dtype != np.uint8:
+        what = f"a {frame.dtype} array"
+    if what is not None:
+        raise TypeError(
+            f"{owner} takes its frames from the env's render() (render_mode='rgb_array'), which "
+            f"returned {what}; it must return {expected} at every step. Use an env whose "
+            "rgb_array render is such an image, or convert it in a wrapper's render()."
+        )
+    if shape is None and (frame.ndim not in (2, 3) or 0 in frame.shape):
+        what = f"an array of shape {frame.shape}"
+    elif shape is not None and frame.shape != shape:
+        what = f"an image of shape {frame.shape}"
+    if what is not None:
+        raise ValueError(
+            f"{owner} takes its frames from the env's render() (render_mode='rgb_array'), which "
+            f"returned {what}; it must return {expected} at every step. Give the env a fixed "
+            "render size (e.g. its render width and height), and check its render_kwargs."
+        )
+    return frame
 
 
 def _rebuilt(cls: type, source_env: gym.Env, kwargs: dict) -> gym.Env:

@@ -9,6 +9,8 @@ import pytest
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+from simoun_agent.curiosity_model import CuriosityModel
+from simoun_agent.rnd_model import RNDModel
 from simoun_wrappers import SimounObservation
 
 gym.register_envs(highway_env)
@@ -120,3 +122,97 @@ def test_a_replay_of_other_frames_or_a_word_for_a_reward_is_named():
     assert set(agent.update(replay, 10)) >= {"critic_loss"}
     with pytest.raises(ValueError, match="reward must be a number, got str 'a'"):
         replay.add(np.zeros(2), "a", np.zeros((3, SIZE, SIZE), np.uint8), False, False)
+
+
+@pytest.mark.parametrize("flag", ["no", 0, 1, None, np.array([True])])
+def test_a_bool_argument_that_is_not_a_bool_is_named(flag):
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    env = SimounObservation(gym.make("simoun/PointReach-v0"), size=None)
+    obs, _ = env.reset(seed=0)
+    with pytest.raises(TypeError, match=r"act\(deterministic=\.\.\.\) must be True or False"):
+        agent.act(obs["frames"], deterministic=flag)
+    assert agent.act(obs["frames"], deterministic=np.bool_(True)).shape == (2,)
+    replay = point_reach_replay(steps=2)
+    frame = obs["frames"][-1]
+    for name in ("terminated", "truncated"):
+        flags = {"terminated": False, "truncated": False, name: flag}
+        with pytest.raises(TypeError, match=rf"add\({name}=\.\.\.\) must be True or False"):
+            replay.add(np.zeros(2), 0.0, frame, **flags)
+    assert replay.episode_step == 2  # nothing stored, the episode still open
+    replay.add(np.zeros(2), 0.0, frame, np.bool_(False), False)
+    assert replay.episode_step == 3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "said"),
+    [
+        ({"size": 0}, "size must be a positive int, got 0"),
+        ({"size": -3}, "size must be a positive int, got -3"),
+        ({"size": 2.5}, "size must be a positive int, got 2.5"),
+        ({"max_steps": 0}, "max_steps must be a positive int, got 0"),
+        ({"max_steps": True}, "max_steps must be a positive int, got True"),
+        ({"step_size": float("nan")}, "step_size must be a finite number > 0, got nan"),
+        ({"step_size": -0.2}, "step_size must be a finite number > 0, got -0.2"),
+        ({"step_size": "0.2"}, "step_size must be a finite number > 0, got '0.2'"),
+    ],
+)
+def test_point_reach_names_a_bad_constructor_argument(kwargs, said):
+    with pytest.raises(ValueError, match=r"; pass .*, e\.g\. ") as raised:
+        gym.make("simoun/PointReach-v0", **kwargs)
+    assert said in str(raised.value)
+
+
+def intrinsic_model(model, action_space):
+    """``model`` (an intrinsic-reward model class) built for PointReach frames of 48x48 (RND's
+    convolutions need 36 or more)."""
+    env = SimounObservation(gym.make("simoun/PointReach-v0", size=48), size=None)
+    env.action_space = action_space
+    return model.for_env(env, device="cpu")
+
+
+TRIPLETS = np.zeros((4, 3, 3, 48, 48), np.uint8)
+NO = np.zeros(4, bool)
+
+
+@pytest.mark.parametrize("model", [RNDModel, CuriosityModel])
+@pytest.mark.parametrize(
+    ("call", "said"),
+    [
+        (lambda m: m(TRIPLETS[0]), "expects triplets as uint8 (B, 3, 3, 48, 48), got uint8 (3, 3"),
+        (lambda m: m(TRIPLETS.astype(np.float32)), "triplets as uint8 (B, 3, 3, 48, 48), got fl"),
+        (lambda m: m.watch(TRIPLETS, np.zeros((4, 2)), TRIPLETS[:, :2], NO, NO),
+         "expects next_triplets as uint8 (B, 3, 3, 48, 48)"),
+        (lambda m: m.watch(TRIPLETS, np.zeros((4, 2)), TRIPLETS[:2], NO, NO),
+         "got 4 triplets and 2 next_triplets"),
+        (lambda m: m.watch(TRIPLETS[:0], np.zeros((0, 2)), TRIPLETS[:0], NO[:0], NO[:0]),
+         "watch() needs one or more transitions"),
+        (lambda m: m.watch(TRIPLETS, np.zeros((4, 3)), TRIPLETS, NO, NO),
+         "expects actions of shape (4, 2) in Box(-1.0, 1.0, (2,), float32), one per transition, "
+         "got shape (4, 3)"),
+        (lambda m: m.watch(TRIPLETS, np.zeros(2), TRIPLETS, NO, NO), "got shape (2,)"),
+        (lambda m: m.watch(TRIPLETS, np.full((4, 2), np.nan), TRIPLETS, NO, NO),
+         "actions of shape (4, 2) in Box(-1.0, 1.0, (2,), float32), one per transition, got a NaN"),
+        (lambda m: m.watch(TRIPLETS, None, TRIPLETS, NO, NO), "got object values, not numbers"),
+        (lambda m: m.watch(TRIPLETS, np.zeros((4, 2)), TRIPLETS, NO[:3], NO),
+         "expects terminated of shape (4,), one flag per transition, got shape (3,)"),
+    ],
+)  # fmt: skip
+def test_intrinsic_models_name_a_bad_frame_or_action_argument(model, call, said):
+    built = intrinsic_model(model, gym.spaces.Box(-1.0, 1.0, (2,), np.float32))
+    with pytest.raises(ValueError) as raised:
+        call(built)
+    assert said in str(raised.value)
+    assert built.size == 0  # nothing stored
+    built.watch(TRIPLETS, np.zeros((4, 2)), TRIPLETS, NO, NO)
+    assert built.size == 4
+
+
+@pytest.mark.parametrize(
+    ("actions", "said"), [([0, 1, 2, 3], "outside the space"), ([0, 1, 0.5, 1], "fractional")]
+)
+def test_discrete_actions_outside_the_space_are_named(actions, said):
+    built = intrinsic_model(CuriosityModel, gym.spaces.Discrete(3))
+    with pytest.raises(ValueError, match=rf"actions of shape \(4,\) in Discrete\(3\).*{said}"):
+        built.watch(TRIPLETS, np.array(actions), TRIPLETS, NO, NO)
+    built.watch(TRIPLETS, np.array([0, 1, 2, 1]), TRIPLETS, NO, NO)
+    assert built.size == 4

@@ -1,8 +1,11 @@
 """Every command line, subcommands included, checks its flags the same way before anything
 runs: an unknown flag is named with the flags it most likely meant (by meaning as well as
 spelling), an option given twice with different values is refused, a word after a switch is
-named with the switch; the driving references check every value before an episode."""
+named with the switch, an empty value, a switch given a value, a stray argument and a path
+too long for the file system are named; the driving references check every value before an
+episode."""
 
+import os
 from pathlib import Path
 
 import pytest
@@ -150,10 +153,228 @@ def test_the_probe_takes_only_a_minigrid_task(tmp_path, capsys):
     assert "--settings.env-id Pendulum-v1: must be a registered MiniGrid id" in err
 
 
-@pytest.mark.parametrize(("value", "said"), [("", "takes a number or auto, got ''"),
+@pytest.mark.parametrize(("value", "said"), [("", "--gpus-per-trial is given an empty value"),
                                              ("nan", "must be a finite number"),
                                              ("inf", "must be a finite number")])  # fmt: skip
 def test_gpus_per_trial_is_read_before_ray_starts(value, said, tmp_path, capsys):
     argv = ["--preset", "cpu", "--sweep-dir", str(tmp_path / "s"), "--gpus-per-trial", value]
     assert said in refused(capsys, sweep_cli.main, argv)
     assert not (tmp_path / "s").exists()
+
+
+LONG_NAME = "a" * 300
+LONG_PATH = "/".join(["b" * 200] * 25)
+
+
+@pytest.mark.parametrize("blank", ["", "  "])
+@pytest.mark.parametrize(
+    ("main", "argv", "flag"),
+    [
+        (train_cli.main, ["--run-dir"], "--run-dir"),
+        (train_cli.main, ["--resume"], "--resume"),
+        (train_cli.main, ["--env"], "--env"),
+        (train_cli.main, ["--preset"], "--preset"),
+        (train_cli.main, ["--eval-distraction"], "--eval-distraction"),
+        (eval_cli.main, ["RUN", "--out"], "--out"),
+        (eval_cli.main, ["RUN", "--device"], "--device"),
+        (sweep_cli.main, ["--sweep-dir"], "--sweep-dir"),
+        (sweep_cli.main, ["--seeds"], "--seeds"),
+        (report_cli.main, ["DIR", "--out"], "--out"),
+        (study_cli.main, ["run", "s.toml", "--study-dir"], "--study-dir"),
+        (study_cli.main, ["run", "s.toml", "--study-dir", "s", "--archive"], "--archive"),
+        (analyze_cli.main, ["masks", "RUN", "--out"], "--out"),
+        (analyze_cli.main, ["bias", "RUN", "--out"], "--out"),
+        (minigrid_cli.main, ["run", "--archive"], "--archive"),
+        (minigrid_cli.main, ["probe", "--out"], "--out"),
+        (minigrid_cli.main, ["probe", "--settings.env-id"], "--settings.env-id"),
+    ],
+)  # fmt: skip
+def test_an_empty_or_blank_value_is_refused_naming_its_flag(main, argv, flag, blank, capsys,
+                                                            tmp_path, monkeypatch):  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    for given in ([*argv, blank], [*argv[:-1], f"{argv[-1]}={blank}"]):
+        err = refused(capsys, main, given)
+        assert f"{flag} is given an empty value ({blank!r}); give {flag} a value" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "name"),
+    [
+        (eval_cli.main, [""], "RUN"),
+        (report_cli.main, ["  "], "DIR"),
+        (study_cli.main, ["plan", ""], "SPEC"),
+        (analyze_cli.main, ["bias", "RUN", " "], "RUN"),
+    ],
+)
+def test_an_empty_positional_argument_is_refused_naming_it(main, argv, name, capsys):
+    assert f"{name} is given an empty value" in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (eval_cli.main, ["RUN", "--no-progress=false"], "--no-progress takes no value; give "
+         "--no-progress alone, or --progress=true / --progress=false"),
+        (train_cli.main, ["--agent.no-curiosity=true"], "--agent.no-curiosity takes no value"),
+        (sweep_cli.main, ["--no-video=1"], "--no-video takes no value"),
+        (train_cli.main, ["--overwrite=true"], "--overwrite is a switch and takes no value; "
+         "give --overwrite alone, or leave it out"),
+        (eval_cli.main, ["RUN", "--random-policy=1"], "--random-policy is a switch"),
+        (sweep_cli.main, ["--resume=false"], "--resume is a switch and takes no value"),
+        (study_cli.main, ["run", "s.toml", "--study-dir", "s", "--allow-other-commit=no"],
+         "--allow-other-commit is a switch and takes no value"),
+        (analyze_cli.main, ["masks", "RUN", "--overwrite=1"], "--overwrite is a switch"),
+        (train_cli.main, ["--overwrite", "true"], "--overwrite is a switch and takes no value"),
+        (sweep_cli.main, ["--resume", "yes"], "--resume is a switch and takes no value"),
+    ],
+)  # fmt: skip
+def test_a_switch_given_a_value_says_it_takes_none(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (train_cli.main, ["foo"], "unexpected argument 'foo': simoun-train takes no positional "
+         "argument"),
+        (sweep_cli.main, ["--seed", "1", "foo"], "unexpected argument 'foo': simoun-sweep"),
+        (report_cli.main, ["DIR", "extra"], "unexpected argument 'extra': simoun-report takes "
+         "only DIR"),
+        (eval_cli.main, ["A", "--episodes", "1", "B"], "unexpected argument 'B': simoun-eval "
+         "takes only RUN [RUN ...], all together before or after the flags"),
+        (study_cli.main, ["plan", "a.toml", "b.toml"], "unexpected argument 'b.toml': "
+         "simoun-study plan takes only SPEC"),
+        (analyze_cli.main, ["masks", "RUN", "extra"], "unexpected argument 'extra'"),
+        (minigrid_cli.main, ["report", "extra"], "unexpected argument 'extra'"),
+    ],
+)  # fmt: skip
+def test_a_stray_argument_is_refused_naming_it(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["masks", "RUN", "--video", "--steps", "2"], ["masks", "RUN", "--video", "mp4", "--steps",
+     "2"], ["masks", "--video", "RUN"], ["bias", "--out", "o", "RUN", "RUN2"]],
+)  # fmt: skip
+def test_an_option_whose_value_may_be_left_out_is_read_as_before(argv, capsys):
+    # refused for the missing run, so the arguments were read as meant
+    assert "RUN does not exist" in refused(capsys, analyze_cli.main, argv)
+
+
+@pytest.mark.parametrize("path", [LONG_NAME, LONG_PATH])
+@pytest.mark.parametrize(
+    ("main", "argv", "flag"),
+    [
+        (train_cli.main, ["--run-dir"], "--run-dir"),
+        (train_cli.main, ["--resume"], "--resume"),
+        (eval_cli.main, [], "RUN"),
+        (eval_cli.main, ["RUN", "--out"], "--out"),
+        (sweep_cli.main, ["--sweep-dir"], "--sweep-dir"),
+        (report_cli.main, [], "DIR"),
+        (report_cli.main, [".", "--out"], "--out"),
+        (study_cli.main, ["plan"], "SPEC"),
+        (study_cli.main, ["report", "s.toml", "--study-dir"], "--study-dir"),
+        (analyze_cli.main, ["bias"], "RUN"),
+        (minigrid_cli.main, ["report", "--archive"], "--archive"),
+        (minigrid_cli.main, ["probe", "--out"], "--out"),
+    ],
+)
+def test_a_path_too_long_for_the_file_system_is_refused_naming_its_flag(main, argv, flag, path,
+                                                                        capsys):  # fmt: skip
+    err = refused(capsys, main, [*argv, path])
+    limit = "4095; give a shorter path" if path == LONG_PATH else "255; give a shorter name"
+    assert f"{flag} {path[:40]}...: " in err and f"past the file system's limit of {limit}" in err
+
+
+@pytest.mark.parametrize("seeds", ["0-100000", "0-99999999999999999999", "0-9999,20000-20001"])
+def test_a_seed_range_past_the_cap_is_refused_before_ray_starts(seeds, tmp_path, capsys):
+    argv = ["--preset", "cpu", "--sweep-dir", str(tmp_path / "s"), "--seeds", seeds]
+    err = refused(capsys, sweep_cli.main, argv)
+    assert f"--seeds {seeds!r} names" in err and "past the cap of 10,000; give fewer" in err
+    assert not (tmp_path / "s").exists()
+
+
+def test_a_study_spec_seed_range_past_the_cap_is_refused(tmp_path, capsys):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        Path("docs/studies/dmc100k.toml").read_text().replace('"101-102"', '"0-100000"')
+    )
+    err = refused(capsys, study_cli.main, ["plan", str(spec)])
+    assert "seeds '0-100000' names" in err and "past the cap of 10,000" in err
+
+
+@pytest.mark.parametrize("spec", ["docs/studies/dmc100k.toml",
+                                  "docs/studies/minigrid-v2/tuning/spec.json"])  # fmt: skip
+@pytest.mark.parametrize("archive", ["study", "study/", "other/../study"])
+def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
+    spec, archive, tmp_path, capsys, monkeypatch
+):
+    spec = Path(spec).absolute()
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "other").mkdir()
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", "study",
+                                           "--archive", archive])  # fmt: skip
+    assert f"--archive {tmp_path / archive} is the --study-dir itself" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["other"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--env-kwargs", '{"a": 1, "a": 2}'], "--env-kwargs: the key 'a' is given twice"),
+        (['--env-kwargs={"x": {"b": 1, "b": 1}}'], "--env-kwargs: the key 'b' is given twice"),
+        (["--set", 'env_kwargs={"a": 1, "a": 2}'], "env_kwargs='{\"a\": 1, \"a\": 2}': the key "
+         "'a' is given twice"),
+        (["--env-kwargs", "nope"], "--env-kwargs: expected a JSON object"),
+    ],
+)  # fmt: skip
+def test_a_json_object_that_gives_a_key_twice_is_refused_naming_the_key(argv, said, capsys):
+    err = refused(capsys, train_cli.main, argv)
+    assert said in err, err
+
+
+def test_an_output_directory_that_cannot_be_made_is_refused_before_ray(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    spec = Path("docs/studies/dmc100k.toml").absolute()
+    for main, argv, flag in [
+        (sweep_cli.main, ["--preset", "cpu", "--sweep-dir"], "--sweep-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir"], "--study-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir", str(tmp_path / "s"), "--archive"],
+         "--archive"),
+    ]:  # fmt: skip
+        err = refused(capsys, main, [*argv, str(blocker / "out")])
+        assert (
+            f"cannot write to the output directory {blocker / 'out'} ({blocker} is a file); "
+            f"pass a writable {flag}"
+        ) in err
+    assert sorted(tmp_path.iterdir()) == [blocker]
+
+
+def test_a_sweep_dir_without_write_permission_is_refused_before_ray(tmp_path, capsys):
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    if os.access(locked, os.W_OK):
+        pytest.skip("this user writes into a read-only directory (root)")
+    argv = ["--preset", "cpu", "--sweep-dir", str(locked / "sweep")]
+    err = refused(capsys, sweep_cli.main, argv)
+    assert f"({locked} is not writable); pass a writable --sweep-dir" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--settings.n-steps", "0"], "--settings.n-steps 0: must be 1 or more"),
+        (["--settings.n-envs", "-2"], "--settings.n-envs -2: must be 1 or more"),
+        (["--settings.steps", "0"], "--settings.steps 0: must be 1 or more"),
+        (["--settings.steps", "1000"], "--settings.steps 1000: fewer than two blocks of "
+         "--settings.n-envs x --settings.n-steps = 1024 transitions"),
+        (["--settings.seed", "-1"], "--settings.seed -1: must be 0 or more"),
+    ],
+)  # fmt: skip
+def test_a_probe_count_below_one_is_refused_naming_the_setting(argv, said, tmp_path, capsys):
+    err = refused(capsys, minigrid_cli.main, ["probe", "--out", str(tmp_path / "p"), *argv])
+    assert said in err
+    assert list(tmp_path.iterdir()) == []

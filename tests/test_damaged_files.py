@@ -3,12 +3,19 @@ config's object belongs, a value of the wrong type; an empty or cut log) is name
 with the fix, instead of failing inside the code, and is left as it was."""
 
 import json
+import shutil
 
 import pytest
+from test_train_resume import TINY
 
+from simoun_agent import FrameReplay
+from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
 from simoun_agent.config import resolve, to_dict
+from simoun_agent.run import train
 from simoun_agent.run.logger import CsvLog, read_csv, read_log
+from simoun_lab.cli import analyze as analyze_cli
+from simoun_lab.cli import report as report_cli
 
 
 @pytest.mark.parametrize("text", ["[]", "null", "3", '"config"'])
@@ -51,7 +58,7 @@ def test_a_wrong_type_in_config_json_is_named_as_the_files_key(tmp_path, capsys)
         ("eval.csv", b"hello\nworld\n", "its first line has no env_step column"),
         ("eval.csv", b"env_step,return_mean\n20,1.5\n4", "line 3 has 1 fields"),
         ("eval.csv", b"env_step,return_mean\nabc,x\n", "line 2's env_step 'abc'"),
-        ("train.csv", b"env_step,return\n\xff\xfe\n", "it is not a CSV file"),
+        ("train.csv", b"env_step,return\n\xff\xfe\n", "line 2 is not UTF-8 text (byte 0xff)"),
         ("eval.csv", b"env_step,return_mean\n40,1\n20,2\n", "line 3's env_step 20 does not "
          "come after line 2's 40 (rows out of order or repeated)"),
         ("train.csv", b"env_step,return\n20,1\n20,1\n", "line 3's env_step 20 does not come"),
@@ -92,3 +99,147 @@ def test_a_log_saved_with_a_byte_order_mark_reads_as_written(tmp_path):
         [{"env_step": "20", "return_mean": "2.0"}],
     )
     assert read_csv(path) == [{"env_step": 20.0, "return_mean": 2.0}]
+
+
+@pytest.fixture(scope="module")
+def trained_run(tmp_path_factory):
+    """A tiny run trained to its first checkpoint, as simoun-train leaves it."""
+    run_dir = tmp_path_factory.mktemp("trained") / "run"
+    run = train.create_run(resolve(None, {**TINY, "total_env_steps": 60, "run_dir": str(run_dir)}))
+    train.train(run)
+    run.env.close()
+    run.eval_env.close()
+    train.release(run)
+    return run_dir
+
+
+COMMANDS = {
+    "simoun-train": lambda run: train_cli.main(["--resume", str(run), "--total-env-steps", "120"]),
+    "simoun-eval": lambda run: eval_cli.main([str(run), "--episodes", "1", "--no-video"]),
+    "simoun-analyze": lambda run: analyze_cli.main(
+        ["masks", str(run), "--steps", "2", "--out", str(run.parent / "masks")]
+    ),
+    "simoun-report": lambda run: report_cli.main([str(run), "--out", str(run.parent / "report")]),
+}
+
+
+def refusal(command, run_dir, capsys):
+    """What ``command`` says of ``run_dir``: it exits with status 2, without a traceback, and
+    changes nothing in the run."""
+    before = {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()}
+    with pytest.raises(SystemExit) as stop:
+        COMMANDS[command](run_dir)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.startswith(f"{command}")
+    after = {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()}
+    assert after == before
+    return err
+
+
+def zero_filled(path):
+    path.write_bytes(bytes(path.stat().st_size))
+
+
+def cut_short(path):
+    path.write_bytes(path.read_bytes()[:1000])
+
+
+def link_to_nothing(path):
+    path.unlink()
+    path.symlink_to(path.with_name("moved-away"))
+
+
+@pytest.mark.parametrize("command", ["simoun-train", "simoun-eval", "simoun-analyze"])
+@pytest.mark.parametrize(
+    ("damage", "problem"),
+    [
+        (zero_filled, "is corrupt or incomplete: all its {size} bytes are zero"),
+        (cut_short, "is corrupt or incomplete: it cannot be read (1000 bytes, cut short"),
+        (link_to_nothing, "is damaged: it is a symbolic link to {path}/moved-away, which does"),
+    ],
+)
+def test_a_damaged_checkpoint_is_named_by_every_command_that_reads_it(
+    trained_run, damage, problem, command, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    path = run_dir / "checkpoint.pt"
+    size = path.stat().st_size
+    damage(path)
+    err = refusal(command, run_dir, capsys)
+    assert f"{path} {problem.format(size=size, path=run_dir)}" in err
+    assert "Restore" in err and "start a new run" in err
+
+
+def test_a_replay_of_another_run_is_named_on_resume(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (replay,) = run_dir.glob("replay-*.npz")
+    FrameReplay(1000, (3, 40, 40), 2).save(replay)
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{replay} (the replay of the checkpoint) is damaged: it holds another run's " in err
+    assert "(frame_shape (3, 40, 40) in the file, (3, 32, 32) in the run's config)" in err
+    assert "Restore this run's own replay and checkpoint from a copy" in err
+
+
+def utf16(path):
+    path.write_text(path.read_text(), encoding="utf-16")
+
+
+def nul_in_first_line(path):
+    data = path.read_bytes()
+    path.write_bytes(data[:4] + b"\0" + data[4:])
+
+
+def huge_step(path):
+    text = path.read_text()
+    path.write_text(text + "1" * 40 + text.splitlines()[-1][text.splitlines()[-1].index(",") :])
+
+
+def finished_run(run_dir):
+    """A run directory as simoun-report and a resume read it before the checkpoint."""
+    saved_run(run_dir)
+    (run_dir / "eval.csv").write_text("env_step,return_mean,wall_time_s\n0,1.0,1.0\n60,2.0,2.0\n")
+    (run_dir / "train.csv").write_text("env_step,return\n20,1.0\n40,2.0\n")
+    summary = {"env_step": 60, "wall_time_s": 2.0, "final_eval": {"return_mean": 2.0}}
+    (run_dir / "summary.json").write_text(json.dumps(summary))
+    return run_dir
+
+
+STEP = "env_step 1111111111111111111111111111111111111111"
+KEPT_DAMAGES = [
+    ("config.json", utf16, "it is saved as UTF-16 text; runs write UTF-8"),
+    ("config.json", nul_in_first_line, "line 1 holds a NUL byte"),
+    ("config.json", link_to_nothing, "it is a symbolic link to "),
+    ("eval.csv", nul_in_first_line, "line 1 holds a NUL byte"),
+    ("eval.csv", huge_step, f"{STEP} is past 2**63"),
+    ("eval.csv", link_to_nothing, "it is a symbolic link to "),
+    ("summary.json", link_to_nothing, "it is a symbolic link to "),
+]
+"""file, damage, what is said of it; train.csv only on resume: simoun-report does not read it"""
+
+
+@pytest.mark.parametrize(
+    ("command", "file", "damage", "problem"),
+    [
+        *(("simoun-train", *damage) for damage in KEPT_DAMAGES),
+        ("simoun-train", "train.csv", nul_in_first_line, "line 1 holds a NUL byte"),
+        ("simoun-train", "train.csv", huge_step, f"{STEP} is past 2**63"),
+        *(("simoun-report", *damage) for damage in KEPT_DAMAGES),
+    ],
+)
+def test_a_damaged_config_or_log_is_named_on_resume_and_by_the_report(
+    command, file, damage, problem, tmp_path, capsys
+):
+    run_dir = finished_run(tmp_path / "run")
+    damage(run_dir / file)
+    err = refusal(command, run_dir, capsys)
+    if command == "simoun-report":
+        assert "every run is damaged: .: " in err and "restore those files from a copy" in err
+        if damage is huge_step:
+            assert f"{file} line 4: env_step 1.11111e+39 is past 2**63" in err
+        else:
+            assert f"{file} is damaged: {problem}" in err
+    else:
+        assert f"{run_dir / file} is damaged: " in err and problem in err
+        assert "Restore the file from a copy" in err

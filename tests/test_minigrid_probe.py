@@ -71,6 +71,20 @@ def test_an_unknown_probe_is_refused_with_the_choices(tmp_path):
         write_probe(ProbeSettings(), ["nope"], tmp_path)
 
 
+@pytest.mark.parametrize(
+    ("settings", "said"),
+    [
+        (ProbeSettings(n_steps=0), "settings.n_steps 0: must be 1 or more"),
+        (ProbeSettings(n_envs=0), "settings.n_envs 0: must be 1 or more"),
+        (ProbeSettings(steps=100), "settings.steps 100: fewer than two blocks"),
+    ],
+)
+def test_a_probe_count_that_makes_no_block_is_refused_naming_it(settings, said, tmp_path):
+    with pytest.raises(ValueError, match=said):
+        write_probe(settings, ["rnd"], tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_command_line_probes_the_consistency_model(tmp_path):
     command = [
         sys.executable,

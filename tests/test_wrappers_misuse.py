@@ -329,3 +329,42 @@ def test_check_sb3_policy_reads_a_vector_envs_single_observation_space():
     )
     with pytest.raises(ValueError, match="NatureCNN needs frames of at least 36x36, got 16x16"):
         check_sb3_policy(envs, "CnnPolicy")
+
+
+class BrokenRender(gym.Wrapper):
+    """PointReach whose render() returns ``broken(image, call)`` instead of its image."""
+
+    def __init__(self, broken):
+        super().__init__(gym.make("simoun/PointReach-v0", render_mode="rgb_array"))
+        self.broken, self.calls = broken, 0
+
+    def render(self):
+        self.calls += 1
+        return self.broken(self.env.render(), self.calls)
+
+
+@pytest.mark.parametrize("size", [32, None])
+@pytest.mark.parametrize(
+    ("broken", "error", "said"),
+    [
+        (lambda image, call: None, TypeError, "returned None; it must return an (H, W, 3) uint8"),
+        (lambda image, call: image.tolist(), TypeError, "returned a list; it must return an (H"),
+        (lambda image, call: image[:0, :10], ValueError,
+         "returned an array of shape (0, 10, 3); it must return an (H, W, 3) uint8 image with H, "
+         "W >= 1"),
+        (lambda image, call: np.zeros((32 + call, 32, 3), np.uint8), ValueError,
+         "it must return uint8 images of its first render's shape (33, 32, 3) at every step"),
+        (lambda image, call: None if call > 3 else image, TypeError,
+         "returned None; it must return uint8 images of its first render's shape (32, 32, 3)"),
+    ],
+)  # fmt: skip
+def test_a_render_that_is_no_image_of_one_size_is_named(broken, error, said, size):
+    import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+
+    with pytest.raises(error) as raised:
+        env = SimounObservation(BrokenRender(broken), size=size, source="render")
+        env.reset(seed=0)
+        for _ in range(3):
+            env.step(env.action_space.sample())
+    assert "SimounObservation takes its frames from the env's render() " in str(raised.value)
+    assert said in str(raised.value)

@@ -5,6 +5,10 @@ fields (``--agent.lr``) unless it is named ``""``, a switch also has its negatio
 flags are those of the subcommand that the command line names, so a subcommand's options are
 checked as a plain command's are (:func:`simoun_agent.cli.flags.parse` refuses an unknown flag
 with the ones it most likely meant, and an option given twice).
+
+A flag or positional argument that names a file or directory is typed ``Path``, or marked
+:data:`PATH` when the command reads it as a string: its value is checked against the file
+system's length limits before anything runs.
 """
 
 from __future__ import annotations
@@ -13,9 +17,11 @@ import dataclasses
 import typing
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, Any
 
 import tyro
+from tyro.constructors import PrimitiveConstructorSpec
 
 from simoun_agent.config import AgentConfig, TrainConfig
 from simoun_agent.config.keys import field_docs
@@ -27,6 +33,17 @@ and their keys given twice compared by value
 
 ARG = type(tyro.conf.arg())
 SUBCOMMAND = type(tyro.conf.subcommand())
+
+
+class PathMarker:
+    """The type of :data:`PATH`."""
+
+
+PATH = PathMarker()
+"""``Annotated[str, PATH]``: a string field that names a file or directory."""
+
+CONFIG_PATHS = frozenset({"run_dir"})
+"""The run config's keys that name a directory (the config keeps them as strings)."""
 
 
 @dataclass(frozen=True)
@@ -43,6 +60,25 @@ class Flag:
     """a list given by repeating the flag"""
     config: bool
     """a key of the run config (compared by value where it is read)"""
+    variadic: bool = False
+    """takes any number of words after it (``--probes a b``, ``--video`` alone or ``--video
+    mp4``)"""
+    path: bool = False
+    """names a file or directory"""
+    json: bool = False
+    """takes a JSON object (``--env-kwargs '{"a": 1}'``)"""
+
+
+@dataclass(frozen=True)
+class PositionalArg:
+    """One positional argument of a command."""
+
+    metavar: str
+    """its name in help: ``DIR``, ``RUN``"""
+    variadic: bool
+    """any number of words (``simoun-eval RUN [RUN ...]``)"""
+    path: bool
+    """names a file or directory"""
 
 
 def unwrap(hint: Any) -> tuple[Any, list[Any]]:
@@ -95,13 +131,39 @@ def command_flags(command: Any, argv: Sequence[str]) -> dict[str, Flag]:
 def takes_positional(command: Any, argv: Sequence[str]) -> bool:
     """Whether the dataclass ``argv`` runs has a positional argument (True when it names no
     subcommand: nothing is known yet)."""
+    found = positionals(command, argv)
+    return found is None or bool(found)
+
+
+def positionals(command: Any, argv: Sequence[str]) -> list[PositionalArg] | None:
+    """The positional arguments of the dataclass ``argv`` runs, in order (None when it names no
+    subcommand of a union)."""
     cls = chosen(command, argv)
     if cls is None:
-        return True
+        return None
     hints = typing.get_type_hints(cls, include_extras=True)
-    return any(
-        tyro.conf.Positional in unwrap(hints[field.name])[1] for field in dataclasses.fields(cls)
-    )
+    found = []
+    for field in dataclasses.fields(cls):
+        kind, markers = unwrap(hints[field.name])
+        if tyro.conf.Positional not in markers:
+            continue
+        metavar = next(
+            (m.metavar for m in markers if isinstance(m, ARG) and m.metavar), field.name.upper()
+        )
+        found.append(PositionalArg(metavar, _sequence(kind), _names_path(kind, markers)))
+    return found
+
+
+def _sequence(kind: Any) -> bool:
+    return typing.get_origin(kind) in (tuple, list) or kind in (tuple, list)
+
+
+def _names_path(kind: Any, markers: list[Any]) -> bool:
+    """Whether a field of type ``kind`` (optional or a sequence of it) names a path."""
+    if PATH in markers:
+        return True
+    inner = {arg for arg in typing.get_args(kind) if arg not in (type(None), Ellipsis)}
+    return kind is Path or inner == {Path}
 
 
 def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) -> None:
@@ -123,9 +185,15 @@ def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) ->
             continue
         key = prefix + name
         flag = "--" + key.replace("_", "-")
-        repeatable = typing.get_origin(kind) in (tuple, list) or kind in (tuple, list)
+        repeatable = _sequence(kind)
         switch = True if kind is bool else None
-        flags[flag] = Flag(key, doc, switch, repeatable, config)
+        appended = config or tyro.conf.UseAppendAction in markers
+        variadic = (repeatable and not appended) or any(
+            isinstance(m, PrimitiveConstructorSpec) and m.nargs in ("*", "+", "?") for m in markers
+        )
+        path = _names_path(kind, markers) or (config and key in CONFIG_PATHS)
+        json = (typing.get_origin(kind) or kind) is dict
+        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path, json)
         if kind is bool and tyro.conf.FlagCreatePairsOff not in markers:
             section, dot, last = flag[2:].rpartition(".")
             negation = Flag(key, doc, False, False, config)

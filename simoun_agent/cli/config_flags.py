@@ -21,7 +21,7 @@ from typing import Annotated, Any
 
 import tyro
 
-from simoun_agent.cli.flags import negated
+from simoun_agent.cli.flags import empty_value, negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import (
     FALSE_WORDS,
@@ -70,6 +70,9 @@ def preset_in(argv: Sequence[str]) -> str | None:
             names.append(argv[i + 1])
         if arg.startswith("--preset="):
             names.append(arg.partition("=")[2])
+    for name in names:
+        if not name.strip():
+            raise SetupError(empty_value("--preset", name))
     if len(set(names)) > 1:
         raise SetupError(f"--preset is given twice ({' and '.join(names)}); give it once")
     return names[0] if names else None

@@ -22,6 +22,7 @@ from typing import Annotated
 import tyro
 from tqdm import tqdm
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
@@ -68,13 +69,13 @@ example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10"
 class EvalCommand:
     """What ``simoun-eval`` is asked."""
 
-    checkpoint: Annotated[tuple[str, ...], tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    checkpoint: Annotated[tuple[str, ...], PATH, tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
     """a run directory or its checkpoint.pt (several with --distraction)"""
     episodes: int = 10
     """episodes to play"""
     seed: int | None = None
     """first episode seed (none: the run's eval seeds)"""
-    out: str | None = None
+    out: Annotated[str | None, PATH] = None
     """output directory (none: <run dir>/eval-<step>)"""
     video: bool = True
     """record the first episode to video.mp4"""
@@ -94,7 +95,7 @@ class EvalCommand:
     """evaluate under distraction modes instead, comma-separated from train, color_easy,
     color_hard, video_easy, video_hard (dm_control runs); writes a mean ± std table and a bar
     chart to <run dir>/generalization, or <common folder>/generalization for several runs"""
-    videos: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    videos: Annotated[str | None, PATH, tyro.conf.arg(metavar="DIR")] = None
     """with --distraction: a folder of video files (or of DAVIS-style folders of frames) for the
     video_* modes (none: a procedural moving background)"""
 

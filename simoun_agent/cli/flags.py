@@ -18,6 +18,12 @@ to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not
 * every command answers ``--version``; help printed to a pipe is not wrapped at 80 columns;
   output into a pipe that closed early (``simoun-report DIR | head``) ends the command
   quietly (:func:`quiet_pipe`).
+
+Before tyro reads the command line, :func:`parse` refuses in one line, naming the flag or
+argument: an unknown flag, a word after a switch, a switch given a value it does not take, a
+word no argument takes, an empty or blank value, a path the file system cannot hold, a dict's
+value that is not a JSON object (or gives a key twice), an option given twice with different
+values, and a number past int64.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ import re
 import sys
 import typing
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from typing import Annotated, Any, NoReturn, TypeVar
 
@@ -50,13 +57,15 @@ from tyro.constructors import (
 from simoun_agent.cli.command_flags import (
     CONFIG_SECTIONS,
     Flag,
+    PositionalArg,
     command_flags,
+    positionals,
     subcommands,
     takes_positional,
 )
 from simoun_agent.config import TrainConfig
 from simoun_agent.config.key_match import close_keys
-from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs
+from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs, json_value
 
 T = TypeVar("T")
 
@@ -121,19 +130,25 @@ def _default(field: dataclasses.Field, given: Any) -> Any:
     return MISSING_NONPROP
 
 
+def json_object(text: str) -> dict:
+    """The JSON object ``text`` (a dict option's value); ValueError when it is not one, or
+    gives a key twice (:func:`~simoun_agent.config.keys.json_value`)."""
+    try:
+        value = json_value(text)
+    except json.JSONDecodeError:
+        value = None
+    if not isinstance(value, dict):
+        raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {text!r}")
+    return value
+
+
 @REGISTRY.primitive_rule
 def _json_dict(info: PrimitiveTypeInfo) -> PrimitiveConstructorSpec | None:
     if (info.type_origin or info.type) is not dict:
         return None
 
     def read(args: list[str]) -> dict:
-        try:
-            value = json.loads(args[0])
-        except json.JSONDecodeError:
-            value = None
-        if not isinstance(value, dict):
-            raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {args[0]!r}")
-        return value
+        return json_object(args[0])
 
     return PrimitiveConstructorSpec(
         nargs=1,
@@ -227,10 +242,13 @@ def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, pr
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
 
-def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: bool) -> None:
+def refuse_stray_words(
+    argv: Sequence[str], flags: dict[str, Flag], positional: bool, switches: Iterable[str] = ()
+) -> None:
     """Raise ValueError for a word after a switch in a command that takes no positional
-    argument (``--progress maybe``): tyro would name only the word, not the switch it was
-    meant for. :func:`bool_argv` already took true/false words."""
+    argument (``--progress maybe``, ``--overwrite true``): tyro would name only the word, not
+    the switch it was meant for. :func:`bool_argv` already took the true/false words of
+    ``switches``."""
     if positional:
         return
     for arg, following in itertools.pairwise(argv):
@@ -238,10 +256,21 @@ def refuse_stray_words(argv: Sequence[str], flags: dict[str, Flag], positional: 
             break
         flag = flags.get(arg)
         if flag is not None and flag.switch is not None and not following.startswith("-"):
-            raise ValueError(
-                f"{arg} is a switch: it takes true or false ({arg} true, {arg} false), or give "
-                f"{arg} alone; got {following!r}"
-            )
+            raise ValueError(f"{switch_use(arg, flag, switches)}; got {following!r}")
+
+
+def switch_use(name: str, flag: Flag, switches: Iterable[str]) -> str:
+    """How the switch ``name`` is given: with true or false when its flag is one of
+    ``switches`` (:func:`bool_argv` reads those), else alone."""
+    positive = "--" + flag.key.replace("_", "-")
+    if name == positive and positive in switches:
+        return (
+            f"{name} is a switch: it takes true or false ({name} true, {name} false), or give "
+            f"{name} / {negated(name)} alone"
+        )
+    if positive in switches:
+        return f"{name} takes no value; give {name} alone, or {positive}=true / {positive}=false"
+    return f"{name} is a switch and takes no value; give {name} alone, or leave it out"
 
 
 def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
@@ -272,6 +301,175 @@ def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
             raise ValueError(
                 f"--{key.replace('_', '-')} is given twice with different values "
                 f"({' and '.join(values.values())}); give it once"
+            )
+
+
+@dataclass(frozen=True)
+class Given:
+    """One value of a command line as tyro will read it."""
+
+    flag: str | None
+    """the option's spelling (``--out``), None for a positional argument"""
+    value: str | None
+    """the value as written, None for a switch given alone"""
+    positional: PositionalArg | None = None
+    """the positional argument the value fills (None: an option's, or a stray word)"""
+
+
+def given_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> Iterator[Given]:
+    """The values of ``argv`` in order, each with its option or positional argument: an option
+    takes the word after it (a variadic one every word up to the next flag), ``--flag=VALUE``
+    its own; a word no option takes fills the next positional argument, and a variadic
+    positional argument takes one run of words (tyro reads no more after a flag between them).
+    Nothing before a named subcommand; ``--`` ends the walk; a word no argument takes comes
+    with ``positional`` None."""
+    slots = positionals(command, argv)
+    if slots is None:
+        return
+    named = subcommands(command)
+    subcommand_seen = not named
+    filled = 0  # positional arguments done
+    run = "none"  # of the variadic one: none, open (taking words), closed (a flag came after)
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg == "--":
+            return
+        name, eq, text = arg.partition("=")
+        flag = flags.get(name) if arg.startswith("--") else None
+        i += 1
+        if arg.startswith("-") and arg.strip("-") and run == "open":
+            run = "closed"
+        if flag is not None:
+            if eq or flag.switch is not None:
+                yield Given(name, text if eq else None)
+                continue
+            while i < len(argv) and not (argv[i].startswith("--") and argv[i] != "--"):
+                yield Given(name, argv[i])
+                i += 1
+                if not flag.variadic:
+                    break
+            continue
+        if arg.startswith("-") and arg.strip("-"):
+            continue  # --help, -h; an unknown flag was refused already
+        if not subcommand_seen and arg in named:
+            subcommand_seen = True
+            continue
+        slot = slots[filled] if filled < len(slots) else None
+        if slot is not None and slot.variadic:
+            if run == "closed":
+                slot = None
+            run = "open" if run == "none" else run
+        elif slot is not None:
+            filled += 1
+        yield Given(None, arg, slot)
+
+
+def refuse_stray_arguments(
+    argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str
+) -> None:
+    """Raise ValueError for a word that no option and no positional argument takes
+    (``simoun-train foo``, ``simoun-report DIR extra``, ``simoun-eval A --episodes 1 B``): tyro
+    would print a box of help."""
+    slots = positionals(command, argv) or []
+    sub = next((f" {arg}" for arg in argv if arg in subcommands(command)), "")
+    takes = "no positional argument (every value goes with its --flag)"
+    if slots:
+        takes = "only " + " ".join(
+            f"{slot.metavar} [{slot.metavar} ...], all together before or after the flags"
+            if slot.variadic
+            else slot.metavar
+            for slot in slots
+        )
+    for value in given_values(argv, flags, command):
+        if value.flag is None and value.positional is None:
+            raise ValueError(
+                f"unexpected argument {value.value!r}: {prog}{sub} takes {takes}; "
+                f"`{prog}{sub} --help` lists its flags"
+            )
+
+
+def refuse_switch_values(
+    argv: Sequence[str], flags: dict[str, Flag], switches: Iterable[str]
+) -> None:
+    """Raise ValueError for a switch given ``=VALUE`` (``--overwrite=false``,
+    ``--no-progress=false``) that :func:`bool_argv` did not read: tyro would say only
+    ``Unrecognized options: false``."""
+    for arg in argv:
+        if arg == "--":
+            break
+        name, eq, _ = arg.partition("=")
+        flag = flags.get(name)
+        if flag is not None and flag.switch is not None and eq:
+            raise ValueError(f"{switch_use(name, flag, switches)}; got {arg!r}")
+
+
+def refuse_empty_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError for an empty or blank value (``--out=``, ``--out ''``, ``--env '  '``,
+    ``simoun-report ''``): an empty path is the current directory, and no other value of the
+    commands is blank."""
+    for value in given_values(argv, flags, command):
+        if value.value is None or value.value.strip():
+            continue
+        if value.flag is None:
+            where = value.positional.metavar if value.positional else "an argument"
+            raise ValueError(f"{where} is given an empty value ({value.value!r}); give {where}")
+        raise ValueError(empty_value(value.flag, value.value, flags[value.flag]))
+
+
+def empty_value(flag: str, value: str, given: Flag | None = None) -> str:
+    """The refusal of an empty or blank ``value`` of ``flag``."""
+    fix = f"give {flag} a value, or leave it out for its default"
+    if given is not None and given.config and given.repeatable:
+        fix += f" (--set {given.key}= empties the list)"
+    return f"{flag} is given an empty value ({value!r}); {fix}"
+
+
+def refuse_bad_json(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError naming the flag for a dict option's value that is not a JSON object, or
+    that gives a key twice (``--env-kwargs '{"a": 1, "a": 2}'``): tyro would keep the last
+    value without a word, or print a box of help."""
+    for value in given_values(argv, flags, command):
+        if value.flag is not None and value.value is not None and flags[value.flag].json:
+            try:
+                json_object(value.value)
+            except ValueError as err:
+                raise ValueError(f"{value.flag}: {err}") from None
+
+
+NAME_MAX = 255
+"""Bytes in one file or directory name at most (Linux's file systems)."""
+
+PATH_MAX = 4096
+"""Bytes in a whole path at most, its final NUL included (Linux)."""
+
+
+def refuse_long_paths(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError for a path value the file system cannot hold: a name longer than
+    :data:`NAME_MAX` bytes, or a path of :data:`PATH_MAX` bytes or more. The operating system
+    would refuse it from inside whichever step touches it first, with a traceback."""
+    for value in given_values(argv, flags, command):
+        if value.value is None:
+            continue
+        if value.flag is not None:
+            where, path = value.flag, flags[value.flag].path
+        else:
+            where = value.positional.metavar if value.positional else ""
+            path = value.positional is not None and value.positional.path
+        if not path:
+            continue
+        size = len(os.fsencode(value.value))
+        longest = max((len(os.fsencode(name)) for name in value.value.split("/")), default=0)
+        short = value.value if len(value.value) <= 60 else value.value[:40] + "..."
+        if size >= PATH_MAX:
+            raise ValueError(
+                f"{where} {short}: the path is {size} bytes long, past the file system's limit "
+                f"of {PATH_MAX - 1}; give a shorter path"
+            )
+        if longest > NAME_MAX:
+            raise ValueError(
+                f"{where} {short}: a name in the path is {longest} bytes long, past the file "
+                f"system's limit of {NAME_MAX}; give a shorter name"
             )
 
 
@@ -323,8 +521,10 @@ def parse(
 ) -> T:
     """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
     ``switches`` are the boolean flags that also take the older ``--flag false``. Exits 0
-    after ``--version`` or ``--help``, 2 with tyro's message for input it cannot read."""
+    after ``--version`` or ``--help``, 2 with one line for input the checks above refuse, or
+    tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    switches = list(switches)
     if "--version" in argv:
         print(f"{prog} {installed_version()}")
         sys.exit(0)
@@ -332,7 +532,12 @@ def parse(
         argv = bool_argv(argv, switches)
         flags = command_flags(cls, argv)
         refuse_unknown(argv, flags, cls, prog)
-        refuse_stray_words(argv, flags, takes_positional(cls, argv))
+        refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
+        refuse_switch_values(argv, flags, switches)
+        refuse_stray_arguments(argv, flags, cls, prog)
+        refuse_empty_values(argv, flags, cls)
+        refuse_long_paths(argv, flags, cls)
+        refuse_bad_json(argv, flags, cls)
         refuse_repeated(argv, flags)
         refuse_huge_numbers(argv, flags, prog)
     except ValueError as err:

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.config_flags import (
     PRESETS_LIST,
     RECIPES_HELP,
@@ -61,6 +62,7 @@ class TrainCommand:
 
     resume: Annotated[
         str | None,
+        PATH,
         tyro.conf.arg(
             metavar="RUN_DIR",
             help="continue a run from its last checkpoint (only "

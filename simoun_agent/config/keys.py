@@ -125,11 +125,26 @@ def _parse_one(text: str, kind: Any) -> Any:
         return tuple(value) if origin is tuple else value
     if origin in (dict, list, tuple):
         try:
-            value = json.loads(text)
+            value = json_value(text)
         except json.JSONDecodeError:
             raise ValueError(f"expected JSON for a {origin.__name__}") from None
         return tuple(value) if origin is tuple else value
     raise ValueError(f"unsupported type {kind}")
+
+
+def json_value(text: str) -> Any:
+    """``json.loads(text)``, but a JSON object that gives a key twice (``{"a": 1, "a": 2}``,
+    which json reads as its last value without a word) raises ValueError naming the key."""
+
+    def unique(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        value: dict[str, Any] = {}
+        for key, item in pairs:
+            if key in value:
+                raise ValueError(f"the key {key!r} is given twice; give each key once")
+            value[key] = item
+        return value
+
+    return json.loads(text, object_pairs_hook=unique)
 
 
 HELP_FIX = "`simoun-train --help` lists every key"

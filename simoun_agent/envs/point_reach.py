@@ -8,6 +8,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from simoun_wrappers._checks import check_finite_positive, check_positive_int
+
 
 class PointReach(gym.Env):
     """Move a red dot to the green target at the centre of a 32x32 RGB image.
@@ -38,6 +40,13 @@ class PointReach(gym.Env):
     ):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        check_positive_int(size, "size", "pass the image's side in pixels, e.g. size=32")
+        check_positive_int(
+            max_steps, "max_steps", "pass the steps before truncation, e.g. max_steps=20"
+        )
+        check_finite_positive(
+            step_size, "step_size", "pass the distance of a full action, e.g. step_size=0.2"
+        )
         self.render_mode = render_mode
         self.size = size
         self.max_steps = max_steps

@@ -14,10 +14,8 @@ from __future__ import annotations
 
 import errno
 import io
-import pickle
 import random
 import shutil
-import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +26,7 @@ from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import atomic_write, dead_temporaries
+from simoun_agent.run.kept import binary_problem, broken_link
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
 from simoun_agent.run.seeds import SEED_SCHEME
 
@@ -157,6 +156,13 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
     problem and the fix for a missing, corrupt or foreign file.
     """
     path = Path(path)
+    for link in (path, path / CHECKPOINT_NAME):
+        problem = broken_link(link)
+        if problem:
+            raise SetupError(
+                f"{link} is damaged: {problem}. Restore the file it stands for from a copy "
+                f"(or point the link at it), or start a new run"
+            )
     if not path.exists():
         raise SetupError(
             f"{path} does not exist; pass a run directory that simoun-train created, or its "
@@ -184,10 +190,13 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
         # Checkpoints hold numpy RNG states and python objects, so they are full pickles:
         # load only files you wrote yourself.
         payload = torch.load(path, map_location="cpu", weights_only=False)
-    except (pickle.UnpicklingError, EOFError, RuntimeError, zipfile.BadZipFile, ValueError) as err:
+    except Exception as err:  # damaged bytes fail anywhere in torch.load (zeros: a KeyError)
+        problem = binary_problem(path)
+        if problem.startswith("it cannot be read"):
+            problem += f": {type(err).__name__}: {str(err).split('. ')[0]}"
         raise SetupError(
-            f"checkpoint {path} is corrupt or incomplete ({type(err).__name__}: {err}). "
-            "Delete it and start a new run, or restore a good copy."
+            f"checkpoint {path} is corrupt or incomplete: {problem}. Restore a good copy, or "
+            "delete it and start a new run."
         ) from None
     if not isinstance(payload, dict) or payload.get("format") != FORMAT:
         found = payload.get("format") if isinstance(payload, dict) else type(payload).__name__
@@ -246,8 +255,8 @@ def check_config(payload: dict, current: dict, path: Path, saved: Path | None = 
         if saved is not None:
             raise SetupError(
                 f"{saved} does not hold the config of the checkpoint in {path} ({listed}): the "
-                "file was edited or damaged. Restore it from a copy, or start a new run in "
-                "another directory."
+                "file was edited or damaged, or the checkpoint copied from another run. Restore "
+                "them from a copy, or start a new run in another directory."
             )
         raise SetupError(
             f"checkpoint {path} comes from another config ({listed}). Resume without those "

@@ -9,12 +9,14 @@ the whole run, resumed parts included.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import STEP_LIMIT, Damaged, read_text
 from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
 
@@ -67,9 +69,10 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
     the user's file stays as it is."""
     try:
-        with path.open(newline="", encoding="utf-8-sig") as f:  # a spreadsheet's BOM too
-            lines = list(csv.reader(f))
-    except (UnicodeDecodeError, csv.Error) as err:
+        lines = list(csv.reader(io.StringIO(read_text(path), newline="")))
+    except Damaged as err:
+        raise damaged_log(path, str(err)) from None
+    except csv.Error as err:
         raise damaged_log(path, f"it is not a CSV file ({err})") from None
     if not lines or "env_step" not in lines[0]:
         problem = "it is empty" if not lines else "its first line has no env_step column"
@@ -82,6 +85,9 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
             raise damaged_log(path, f"line {number} has {fields}")
         if not values[at].isdigit():
             raise damaged_log(path, f"line {number}'s env_step {values[at]!r} is not a step count")
+        if int(values[at]) >= STEP_LIMIT:
+            raise damaged_log(path, f"line {number}'s env_step {values[at]} is past 2**63, more "
+                              "steps than a run can count")  # fmt: skip
         if rows and int(values[at]) <= int(rows[-1]["env_step"]):
             raise damaged_log(path, f"line {number}'s env_step {values[at]} does not come after "
                               f"line {number - 1}'s {rows[-1]['env_step']} (rows out of order or "
@@ -101,9 +107,10 @@ def damaged_log(path: Path, problem: str) -> SetupError:
 
 
 def read_csv(path: Path) -> list[dict[str, float]]:
-    """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty)."""
-    with path.open(newline="", encoding="utf-8-sig") as f:
-        return [{k: float(v or "nan") for k, v in row.items()} for row in csv.DictReader(f)]
+    """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty);
+    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes."""
+    rows = csv.DictReader(io.StringIO(read_text(path), newline=""))
+    return [{k: float(v or "nan") for k, v in row.items()} for row in rows]
 
 
 def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:

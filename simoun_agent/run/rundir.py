@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import broken_link
 from simoun_agent.run.layout import CHECKPOINT_NAME, LOCK_NAME, TENSORBOARD_DIR, TRAINER_FILES
 
 _held: dict[Path, IO[str]] = {}
@@ -33,6 +34,26 @@ def refuse_a_file(path: Path, flag: str) -> None:
             f"the output directory {path} is a file, not a directory; pass a new or existing "
             f"directory to {flag}"
         )
+
+
+def check_output_dir(path: Path, flag: str) -> None:
+    """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
+    written: it is a file, a folder on its way is a file, or the nearest folder of it that
+    exists is not writable by this process. Creates nothing, so a command can check before the
+    work whose set-up takes long (Ray) rather than fail after it."""
+    refuse_a_file(path, flag)
+    existing = path.absolute()
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        reason = f"{existing} is a file"
+    elif not os.access(existing, os.W_OK | os.X_OK):
+        reason = f"{existing} is not writable"
+    else:
+        return
+    raise SetupError(
+        f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
+    )
 
 
 def make_output_dir(path: Path, flag: str = "--out") -> bool:
@@ -120,7 +141,14 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
 
 
 def require_checkpoint(run_dir: Path) -> None:
-    """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint."""
+    """Raise SetupError for ``--resume`` of a run that never wrote a checkpoint, or whose
+    checkpoint is a link to nothing."""
+    problem = broken_link(run_dir / CHECKPOINT_NAME)
+    if problem:
+        raise SetupError(
+            f"{run_dir / CHECKPOINT_NAME} is damaged: {problem}. Restore the file it stands for "
+            "from a copy (or point the link at it), or start a new run"
+        )
     if (run_dir / TRAINER_FILES[0]).exists() and not (run_dir / CHECKPOINT_NAME).exists():
         raise SetupError(
             f"{run_dir} has no {CHECKPOINT_NAME}: the run stopped before its first checkpoint, "

@@ -65,6 +65,7 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EvaluationStopped, NonFiniteReward, evaluate, metrics_json
+from simoun_agent.run.kept import Damaged, binary_problem, broken_link, read_text
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -74,7 +75,7 @@ from simoun_agent.run.layout import (
     TRAIN_CSV,
     VIDEO_NAME,
 )
-from simoun_agent.run.logger import RunLogger, read_log
+from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
@@ -186,6 +187,15 @@ def not_a_file(path: Path) -> SetupError:
     )
 
 
+def damaged_config(path: Path, problem: str) -> SetupError:
+    """The error for a run's damaged ``config.json`` or ``summary.json``: nothing was changed,
+    and the file comes back from a copy."""
+    return SetupError(
+        f"{path} is damaged: {problem}. Nothing in the run was changed. Restore the file from a "
+        "copy (simoun-train writes UTF-8 JSON), or start a new run"
+    )
+
+
 def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
@@ -196,17 +206,24 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"--resume {run_dir} {why}; pass the directory that simoun-train created (its "
             "path is printed as 'run directory: ...' when a run starts)"
         )
-    if config_path.exists() and not config_path.is_file():
-        raise not_a_file(config_path)
+    for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything is changed
+        path = run_dir / name
+        if path.exists() and not path.is_file():
+            raise not_a_file(path)
+        problem = broken_link(path)
+        if problem and name in (EVAL_CSV, TRAIN_CSV):
+            raise damaged_log(path, problem)
+        if problem:
+            raise damaged_config(path, problem)
     if not config_path.is_file():
         raise SetupError(
             f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "
             "that simoun-train created"
         )
     try:
-        saved = json.loads(config_path.read_text())
-    except json.JSONDecodeError as err:
-        raise SetupError(f"{config_path} is corrupt ({err}); start a new run") from None
+        saved = json.loads(read_text(config_path))
+    except (Damaged, json.JSONDecodeError) as err:
+        raise damaged_config(config_path, str(err)) from None
     fixed = {k: v for k, v in overrides.items() if k not in RESUMABLE_FIELDS}
     if fixed:
         raise SetupError(
@@ -215,9 +232,6 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         )
     config = from_dict(saved, str(config_path))
     as_saved = to_dict(config)
-    for name in (EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything in the run is changed
-        if (run_dir / name).exists() and not (run_dir / name).is_file():
-            raise not_a_file(run_dir / name)
     for log in (EVAL_CSV, TRAIN_CSV):
         if (run_dir / log).exists():
             read_log(run_dir / log)
@@ -244,7 +258,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"{payload['replay_path']} (the replay of the checkpoint) is missing; the run cannot "
             "continue exactly. Start a new run."
         )
-    env, eval_env, agent, _ = build(config, check)
+    env, eval_env, agent, empty = build(config, check)
     try:
         agent.load_state_dict(payload["agent"])
     except (RuntimeError, KeyError, ValueError) as err:
@@ -255,11 +269,25 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     try:
         replay = FrameReplay.load(payload["replay_path"])
     except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        problem = binary_problem(payload["replay_path"])
+        if problem.startswith("it cannot be read"):
+            problem += f": {type(err).__name__}: {err}"
         raise SetupError(
-            f"{payload['replay_path']} (the replay of the checkpoint) is damaged "
-            f"({type(err).__name__}: {err}); the run cannot continue exactly. Restore it from a "
-            "copy, or start a new run"
+            f"{payload['replay_path']} (the replay of the checkpoint) is damaged: {problem}; the "
+            "run cannot continue exactly. Restore it from a copy, or start a new run"
         ) from None
+    shapes = ("capacity", "frame_shape", "action_dim", "num_frames")
+    differ = [key for key in shapes if getattr(replay, key) != getattr(empty, key)]
+    if differ:
+        found = "; ".join(
+            f"{key} {getattr(replay, key)} in the file, {getattr(empty, key)} in the run's config"
+            for key in differ
+        )
+        raise SetupError(
+            f"{payload['replay_path']} (the replay of the checkpoint) is damaged: it holds another "
+            f"run's transitions ({found}), so it was copied from another run. Restore this run's "
+            "own replay and checkpoint from a copy, or start a new run"
+        )
     restore_rng(payload["rng"])
     rng = np.random.default_rng()
     rng.bit_generator.state = payload["state"]["trainer_rng"]

@@ -20,6 +20,7 @@ import numpy as np
 import tyro
 from tyro.constructors import PrimitiveConstructorSpec
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 
@@ -75,7 +76,7 @@ VIDEO_FORMAT = PrimitiveConstructorSpec(
 class Output:
     """The options both analyses take."""
 
-    out: str | None = None
+    out: Annotated[str | None, PATH] = None
     """output directory (none: <run dir>/analysis/<analysis>; required by bias with several
     runs)"""
     overwrite: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
@@ -91,7 +92,7 @@ class Masks(Output):
     of --query), plus the heat maps as .npz. Example: simoun-analyze masks
     runs/highway-highway-s1-... --steps 2,40 --query 42,126 --video"""
 
-    run: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    run: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
     """a run directory or its checkpoint.pt"""
     episodes: int = 1
     """episodes to play"""
@@ -115,7 +116,7 @@ class Bias(Output):
     chart), bias.json and bias.md. Example: simoun-analyze bias runs/stacked-... runs/flare-...
     runs/simoun-... --out docs/bias"""
 
-    runs: Annotated[tuple[str, ...], tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
+    runs: Annotated[tuple[str, ...], PATH, tyro.conf.Positional, tyro.conf.arg(metavar="RUN")]
     """run directories (or checkpoint.pt files)"""
     pairs: int = 256
     """pairs per factor"""

@@ -16,6 +16,7 @@ from typing import Annotated
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_lab.sweep.report import write_report
@@ -40,9 +41,9 @@ BUDGET = tyro.conf.create_mutex_group(required=False, title="equal budget (one o
 class ReportCommand:
     """What ``simoun-report`` is asked."""
 
-    root: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="DIR")]
+    root: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="DIR")]
     """a sweep directory or a directory of runs"""
-    out: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    out: Annotated[str | None, PATH, tyro.conf.arg(metavar="DIR")] = None
     """where to write the report (none: DIR; for a single run directory, report-<name> beside
     it, so the run directory is left as simoun-train wrote it)"""
     at_step: Annotated[int | None, BUDGET, tyro.conf.arg(metavar="N")] = None

@@ -30,9 +30,10 @@ from typing import Annotated, Union
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.run.rundir import make_output_dir, refuse_a_file
+from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.study.options import StudyOptions
 
@@ -62,7 +63,7 @@ class Plan:
     """List every run of both phases (phase, task, recipe, grid values, seed, env steps) and
     estimate the CPU time of each from a short probe measured here, running nothing."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     probe_updates: Annotated[int, tyro.conf.arg(metavar="N")] = 20
     """agent updates timed per configuration (0: no estimate)"""
@@ -73,7 +74,7 @@ class Run(StudyOptions):
     """Run the tuning phase, select each recipe's setting, run the evaluation phase on the
     held-out seeds and write the report into STUDY_DIR/report (on Ray Tune)."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     # the library's options, with the command line's metavars (their docs are StudyOptions')
     study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
@@ -89,7 +90,7 @@ class Report:
     """Write the report of a study's finished runs again, with this code, from its study
     directory or its archive (no Ray, nothing trained): into DIR/report."""
 
-    spec: Annotated[str, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
+    spec: Annotated[str, PATH, tyro.conf.Positional, tyro.conf.arg(metavar="SPEC")]
     """the study's TOML file"""
     study_dir: Annotated[Path, tyro.conf.arg(metavar="DIR")]
     """the study directory or its archive (e.g. docs/studies/NAME)"""
@@ -160,9 +161,18 @@ def outputs(options: Run) -> dict[str, Path]:
 
 
 def check_outputs(options: Run) -> None:
-    """Refuse an output directory that is a file, creating nothing."""
+    """Refuse an output directory that cannot be written (:func:`check_output_dir`), and an
+    archive that is the study directory itself (the archive is the finished runs' copy, kept
+    apart from the working records), creating nothing."""
     for flag, path in outputs(options).items():
-        refuse_a_file(path, flag)
+        check_output_dir(path, flag)
+    archive = options.archive
+    if archive is not None and archive.resolve() == options.study_dir.resolve():
+        raise SetupError(
+            f"--archive {archive} is the --study-dir itself; the archive keeps a copy of the "
+            "finished runs apart from the study directory: pass another directory (e.g. "
+            "docs/studies/NAME), or leave --archive out"
+        )
 
 
 def absolute(args: Run) -> Run:

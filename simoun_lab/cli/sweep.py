@@ -22,6 +22,7 @@ from typing import Annotated, Any, Literal
 
 import tyro
 
+from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.config_flags import (
     ConfigFlags,
     config_default,
@@ -30,6 +31,7 @@ from simoun_agent.cli.config_flags import (
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable, gpus_wanted
@@ -57,7 +59,7 @@ Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory.
 class SweepCommand:
     """What ``simoun-sweep`` is asked: the grid, where and how to run it, and the base config."""
 
-    sweep_dir: Annotated[str | None, tyro.conf.arg(metavar="DIR")] = None
+    sweep_dir: Annotated[str | None, PATH, tyro.conf.arg(metavar="DIR")] = None
     """where the runs and the report go (none: sweeps/<UTC time>; required with --resume); on a
     cluster, a directory every machine sees"""
     grid: Annotated[
@@ -150,6 +152,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        check_output_dir(sweep_dir, "--sweep-dir")
         gpus_wanted(args.gpus_per_trial)
         ray = load_ray()
     except SetupError as err:

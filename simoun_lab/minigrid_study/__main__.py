@@ -115,9 +115,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse(Command, argv, PROG, DESCRIPTION)
     if isinstance(args, Probe):
         from simoun_lab.minigrid_study.probe import write_probe
+        from simoun_lab.minigrid_study.probe_settings import check_settings
         from simoun_lab.minigrid_study.spec import MINIGRID_ID
 
         try:
+            check_settings(args.settings, lambda field: "--settings." + field.replace("_", "-"))
             if not args.out.parent.is_dir():
                 raise SetupError(
                     f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "

@@ -31,9 +31,9 @@ from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import ARMS, consistency
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
-from simoun_lab.minigrid_study.probe_settings import ProbeSettings
+from simoun_lab.minigrid_study.probe_settings import ProbeSettings, check_settings
 
-__all__ = ["PROBED", "ProbeSettings", "probe", "write_probe"]
+__all__ = ["PROBED", "ProbeSettings", "check_settings", "probe", "write_probe"]
 
 PROBED: dict[str, Callable[[VectorEnv, int, torch.device], VectorEnv]] = {
     "consistency": ARMS["consistency"],
@@ -119,6 +119,7 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     """Probe each of ``names`` and write ``out/probe.csv`` (every block) and ``out/probe.md``
     (per probe, means over blocks, the first left out: the reward's correlation with novelty
     over all and over moving transitions, its std / mean, its still / moving mean)."""
+    check_settings(settings)
     unknown = [n for n in names if n not in PROBED]
     if unknown:
         raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBED)}")

@@ -4,9 +4,10 @@ answered at once."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
-__all__ = ["PROBE_NAMES", "ProbeSettings"]
+__all__ = ["PROBE_NAMES", "ProbeSettings", "check_settings"]
 
 PROBE_NAMES = (
     "consistency",
@@ -34,3 +35,27 @@ class ProbeSettings:
     seed: int = 100
     """env, action and model seed: disjoint from the study's training seeds (0-4) and its
     held-out evaluation seeds (1,000,000 on)"""
+
+
+def check_settings(
+    settings: ProbeSettings, name: Callable[[str], str] = lambda field: f"settings.{field}"
+) -> None:
+    """Raise ValueError naming the first value of ``settings`` a probe cannot run with: a count
+    below 1, a seed below 0, or fewer ``steps`` than two blocks (the summary leaves the first
+    out). ``name`` spells a field where the user gave it (``settings.n_envs`` in Python,
+    ``--settings.n-envs`` on the command line)."""
+    for field in ("n_envs", "n_steps", "steps"):
+        if getattr(settings, field) < 1:
+            raise ValueError(
+                f"{name(field)} {getattr(settings, field)}: must be 1 or more "
+                f"(default {getattr(ProbeSettings(), field)})"
+            )
+    if settings.seed < 0:
+        raise ValueError(f"{name('seed')} {settings.seed}: must be 0 or more")
+    block = settings.n_envs * settings.n_steps
+    if settings.steps < 2 * block:
+        raise ValueError(
+            f"{name('steps')} {settings.steps}: fewer than two blocks of {name('n_envs')} x "
+            f"{name('n_steps')} = {block} transitions (the summary leaves the first block out); "
+            f"give {name('steps')} {2 * block} or more"
+        )

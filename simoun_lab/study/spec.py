@@ -69,7 +69,7 @@ from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
-from simoun_lab.sweep.grid import parse_seeds
+from simoun_lab.sweep.grid import MAX_SEEDS, parse_seeds
 
 try:
     import tomllib
@@ -592,6 +592,10 @@ class _Reader:
             raise self.fail(where, 'give non-negative integers: [1, 2, 3] or "1-3"')
         if not seeds:
             raise self.fail(where, "give at least one seed")
+        if len(seeds) > MAX_SEEDS:
+            raise self.fail(
+                where, f"{len(seeds):,} seeds, past the cap of {MAX_SEEDS:,}; give fewer"
+            )
         repeated = sorted({s for s in seeds if seeds.count(s) > 1})
         if repeated:
             raise self.fail(where, f"seed {repeated[0]} is listed twice; list each seed once")

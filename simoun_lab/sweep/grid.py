@@ -21,6 +21,7 @@ import math
 import re
 import sys
 import typing
+from collections import Counter
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -46,8 +47,14 @@ DEDICATED = {
 """Config keys a sweep sets itself, and the flag to use instead."""
 
 
+MAX_SEEDS = 10_000
+"""Seeds a sweep or study runs at most: more is a typo (``0-100000``), and a range that large
+would be built in memory before anything could refuse it."""
+
+
 def parse_seeds(text: str) -> list[int]:
-    """``"0-4"`` -> [0, 1, 2, 3, 4]; ``"0,2,5"`` and mixes like ``"0-2,7"`` work too."""
+    """``"0-4"`` -> [0, 1, 2, 3, 4]; ``"0,2,5"`` and mixes like ``"0-2,7"`` work too; at most
+    :data:`MAX_SEEDS` seeds."""
     seeds: list[int] = []
     for part in text.split(","):
         match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
@@ -62,8 +69,14 @@ def parse_seeds(text: str) -> list[int]:
                 f"--seeds {text!r}: the range {part.strip()!r} runs backwards; write it low-high, "
                 f"e.g. --seeds {last}-{first}"
             )
+        if len(seeds) + last - first + 1 > MAX_SEEDS:
+            raise SetupError(
+                f"--seeds {text!r} names {len(seeds) + last - first + 1:,} seeds or more, past the "
+                f"cap of {MAX_SEEDS:,}; give fewer, e.g. --seeds 0-4"
+            )
         seeds += range(first, last + 1)
-    duplicates = sorted({seed for seed in seeds if seeds.count(seed) > 1})
+    counts = Counter(seeds)
+    duplicates = sorted(seed for seed, count in counts.items() if count > 1)
     if duplicates:
         raise SetupError(f"--seeds {text!r} names seed {duplicates[0]} twice; list each seed once")
     return seeds

@@ -51,6 +51,7 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import STEP_LIMIT, Damaged, broken_link, read_text
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
@@ -161,7 +162,8 @@ def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
     whose config.json, eval.csv or summary.json cannot be read is left out and, when
     ``damaged`` is given, named there with the file and what is wrong with it."""
     records = []
-    for config_path in sorted(root.rglob(CONFIG_NAME)):
+    # a wildcard, as rglob(CONFIG_NAME) leaves out a config.json that links to nothing
+    for config_path in sorted(p for p in root.rglob("*.json") if p.name == CONFIG_NAME):
         relative = config_path.relative_to(root).parts
         if relative[0] == "tune" or any(part.startswith(".") for part in relative):
             continue
@@ -176,8 +178,10 @@ def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
 def read_json(path: Path) -> dict[str, Any]:
     """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it."""
     try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        data = json.loads(read_text(path))
+    except Damaged as err:
+        raise DamagedRun(f"{path.name} is damaged: {err}") from None
+    except (OSError, json.JSONDecodeError) as err:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
     if not isinstance(data, dict):
         raise DamagedRun(f"{path.name} holds {type(data).__name__}, not a JSON object")
@@ -188,11 +192,13 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     """eval.csv's :data:`CURVE_COLUMNS`, or :class:`DamagedRun`: a file with a column
     missing, a value that is not a number, or a NaN or infinite return would otherwise blank
     or bend the statistics of its whole row."""
-    if not path.is_file():
+    if not path.is_file() and not path.is_symlink():
         return {key: np.zeros(0) for key in CURVE_COLUMNS}
     try:
         rows = read_csv(path)
-    except (OSError, UnicodeDecodeError, ValueError, TypeError, csv.Error) as err:
+    except Damaged as err:
+        raise DamagedRun(f"{path.name} is damaged: {err}") from None
+    except (OSError, ValueError, TypeError, csv.Error) as err:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
     if path.stat().st_size and not rows and "env_step" not in path.read_text():
         raise DamagedRun(f"{path.name} has no header line")
@@ -204,6 +210,12 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         line = int(np.argmax(bad)) + 2  # 1-based, after the header
         raise DamagedRun(f"{path.name} line {line} has an empty, NaN or infinite value")
     steps = curve["env_step"]
+    if np.any(steps >= STEP_LIMIT):
+        line = int(np.argmax(steps >= STEP_LIMIT)) + 2
+        raise DamagedRun(
+            f"{path.name} line {line}: env_step {steps[line - 2]:g} is past 2**63, more steps "
+            "than a run can count"
+        )
     if len(steps) and (steps[0] < 0 or np.any(np.diff(steps) <= 0)):
         line = 2 if steps[0] < 0 else int(np.argmax(np.diff(steps) <= 0)) + 3
         raise DamagedRun(
@@ -222,7 +234,9 @@ def read_run(config_path: Path) -> RunRecord:
         raise DamagedRun(f"{CONFIG_NAME} has no {' or '.join(missing)}")
     curve = read_curve(run_dir / EVAL_CSV)
     summary_path = run_dir / SUMMARY_NAME
-    summary = read_json(summary_path) if summary_path.is_file() else None
+    summary = (
+        read_json(summary_path) if summary_path.is_file() or broken_link(summary_path) else None
+    )
     if summary is not None:
         final = summary.get("final_eval", {})
         value = final.get("return_mean") if isinstance(final, dict) else None
@@ -534,9 +548,14 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
     damaged: list[str] = []
     records = find_runs(root, damaged)
     if not records:
-        found = f"every run is damaged: {'; '.join(damaged)}" if damaged else "no config.json"
+        if damaged:
+            raise SetupError(
+                f"no runs under {root} that can be read (every run is damaged: "
+                f"{'; '.join(damaged)}); restore those files from a copy, or remove the damaged "
+                "runs"
+            )
         raise SetupError(
-            f"no runs under {root} ({found}); pass a sweep directory or a directory of "
+            f"no runs under {root} (no config.json); pass a sweep directory or a directory of "
             "simoun-train runs"
         )
     reasons: dict[Path, str] = {}
