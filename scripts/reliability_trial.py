@@ -1238,7 +1238,7 @@ def study_run(*f: str) -> list[str]:
 
 
 def minigrid_run(*f: str) -> list[str]:
-    return ["run", "--archive", "a", *f]
+    return ["run", "--archive", ".", "--spec", str(ROOT / "docs/studies/minigrid/spec.json"), *f]
 
 
 def probe(*f: str) -> list[str]:
@@ -1328,7 +1328,7 @@ ODD_TEXT = [  # unicode, whitespace and very long words
     ("sweep", sweep_tiny("--sweep-dir", "s" * 300), "--sweep-dir"),
     ("study", ["run", "spec.toml", "--study-dir", "s" * 300], "--study-dir"),
     ("train", tiny("--set", "agent.lr\u200b=1e-3"), "agent.lr"),
-    ("sweep", sweep_tiny("--grid", "agent.n_step=1,\u00a03"), "agent.n_step"),
+    ("sweep", sweep_tiny("--grid", "agent.n_step=1,\u00a03"), "agent.n_step", True),
     ("train", tiny("--env-kwargs", '{"size": 32}\u00a0'), "--env-kwargs"),
 ]
 ODD_ENVS = [
@@ -1374,7 +1374,7 @@ OUTPUTS = [  # one command given another's output: (command, argv, names, valid)
     ("minigrid", ["select", "--archive", REPORT_OUT], (REPORT_OUT, "--archive"), False),
     ("sweep", ["--resume", "--sweep-dir", REPORT_OUT], ("sweep.json",), False),
     ("train", tiny("--total-env-steps", "40", "--run-dir", REPORT_OUT), (REPORT_OUT, "--run-dir"),
-     False),
+     True),
     ("eval", ["{run}/tb", *EVAL], ("config.json", "/tb"), False),
     ("train", ["--resume", "{run}/tb"], ("config.json", "/tb"), False),
     ("eval", eval_argv("--episodes", "1", "--out", "{run}"), "--out", True),
@@ -1407,10 +1407,10 @@ MIXES = [  # report on a directory of runs: (the runs' changes, extra argv, name
     ((None, lambda run: (run.parent / "loop").symlink_to("loop")), [], "loop", True),
 ]
 BUDGETS = [  # (command, argv, names, valid)
-    ("report", report_argv("--at-step", "100000"), "--at-step", False),
+    ("report", report_argv("--at-step", "100000"), "--at-step", True),
     ("report", report_argv("--at-step", "40"), "", True),
-    ("report", report_argv("--at-wall-time", "1e9"), "--at-wall-time", False),
-    ("report", report_argv("--at-wall-time", "0.0001"), "--at-wall-time", False),
+    ("report", report_argv("--at-wall-time", "1e9"), "--at-wall-time", True),
+    ("report", report_argv("--at-wall-time", "0.0001"), "--at-wall-time", True),
     ("train", ["--resume", "{run}", "--total-env-steps", "40"], "total", False),
     ("train", ["--resume", "{run}", "--total-env-steps", "41"], "", True),
     ("train", tiny("--total-env-steps", "5", "--run-dir", "r"), "warmup", True),
@@ -1434,14 +1434,16 @@ THIRD_FLAG_CASES = [
     *(cli("flags", command, argv, "", ok=True) for command, argv in EQ_VALID),
     *(cli("flags", command, argv, names, ok=ok) for command, argv, names, ok in SWITCH_VALUES),
     *(cli("flags", command, argv, "extra") for command, argv in EXTRA_WORDS),
-    *(cli("flags", command, argv, names) for command, argv, names in BLANKS + ODD_TEXT),
+    *(cli("flags", command, argv, names, ok=bool(ok))
+      for command, argv, names, *ok in BLANKS + ODD_TEXT),
     *(cli("flags", "train", tiny("--env", env), names) for env, names in ODD_ENVS),
     cli("flags", "train", tiny("--env", "simoun_agent.envs:simoun/PointReach-v0", *SHORT), "",
         ok=True),
     cli("flags", "train", tiny("--env-module", "simoun_agent.envs:x"), "--env-module"),
     cli("flags", "train", tiny("--env-module", "..x"), ("--env-module", "..x")),
     cli("flags", "train", tiny("--env-module", "os.path.nope"), "os.path.nope"),
-    cli("flags", "sweep", sweep_tiny("--envs", "Pendulum-v1,Pendulum-v1"), ("--envs", "Pendulum")),
+    cli("flags", "sweep", [*sweep_tiny()[2:], "--envs", "Pendulum-v1,Pendulum-v1"],
+        ("--envs", "Pendulum")),
     *(cli("flags", "train", tiny("--env-kwargs", text), names) for text, names in ENV_KWARGS),
     cli("flags", "train", tiny("--set", 'env_kwargs={"size": 0}'), "size"),
     *(cli("flags", command, argv, names, ok=ok, setup=call(symlinks))
@@ -1567,7 +1569,7 @@ THIRD_SPEC_EDITS = [  # (text replaced, by, what the refusal names[, valid])
     ("cpus_per_trial = 1 ", "cpus_per_trial = 100000 ", "cpus_per_trial", True),
     ("max_concurrent_trials = 2", "max_concurrent_trials = 0", "max_concurrent_trials"),
     ('description = """', 'description = """' + "x" * 1_000_000, "", True),
-    ('selection = "auc"', 'sélection = "auc"', "sélection"),
+    ('selection = "auc"', 'sélection = "auc"', ("sélection", "spec.toml")),
     ('seeds = "101-102"', "seeds = 1.5", "seeds"),
     ('seeds = "101-102"', 'seeds = ""', "seeds"),
     ('seeds = "101-102"', 'seeds = "101-102-103"', "seeds"),
@@ -1607,15 +1609,15 @@ THIRD_MINIGRID_EDITS = [  # (a change to the spec's JSON value, what the refusal
     (lambda s: s["ppo"].update(gamma=float("nan")), "gamma"),
     (lambda s: s.update(arms=[]), "arms"),
     (lambda s: s.update(arms=["ppo", "ppo"]), "arms"),
-    (lambda s: s["ppo"].update(batch_size=100000), "batch_size"),
+    (lambda s: s["ppo"].update(batch_size=100000), "batch_size", True),
     (lambda s: s.update(eval_seed=-1), "eval_seed"),
     (lambda s: s["tasks"][0].update(env_id="MiniGrid-DoorKey-6x6-v0 "), ("env_id", "DoorKey")),
 ]
 
 
-def minigrid_spec_case(i: int, text: str, names, name: str = "spec.json", setup=None):
+def minigrid_spec_case(i: int, text: str, names, name: str = "spec.json", setup=None, ok=False):
     return cli("specs", "minigrid", [("report", "select")[i % 2], "--spec", name, "--archive",
-               "."], names, setup=setup or ("spec", (".json", text)))  # fmt: skip
+               "."], names, ok, setup=setup or ("spec", (".json", text)))  # fmt: skip
 
 
 for _old, _new, *_ in THIRD_SPEC_EDITS:
@@ -1627,8 +1629,8 @@ THIRD_SPEC_CASES = [
     *(spec_case(text, names, ok=bool(ok)) for text, names, *ok in THIRD_SPEC_TEXTS),
     *(cli("specs", "study", ["plan", name, "--probe-updates", "0"], name,
           setup=spec_file(name, make)) for name, make in SPEC_FILES),
-    *(minigrid_spec_case(i, minigrid_spec(change), names)
-      for i, (change, names) in enumerate(THIRD_MINIGRID_EDITS)),
+    *(minigrid_spec_case(i, minigrid_spec(change), names, ok=bool(ok))
+      for i, (change, names, *ok) in enumerate(THIRD_MINIGRID_EDITS)),
     minigrid_spec_case(0, MINIGRID_SPEC.replace('"arms": [', '"arms": ["rnd"],\n  "arms": [', 1),
                        "arms"),
     minigrid_spec_case(1, "", "spec16.json", "spec16.json", spec_file(
@@ -1773,11 +1775,11 @@ THIRD_CODES = [
     (AGENT + FILLED + "r.sample(0)", "batch_size"),
     (AGENT + FILLED + "r.sample(-1)", "batch_size"),
     (AGENT + FILLED + "r.sample(1.5)", "batch_size"),
-    (AGENT + "FrameReplay(100, (3, 32, 32), 1).sample(4)", ("empty", "start_episode", "add")),
+    (AGENT + "FrameReplay(100, (3, 32, 32), 1).sample(4)",
+     ("empty", "start_episode", "add", "holds 0")),
     (AGENT + FILLED + "r.save('nowhere/x.npz')", "nowhere"),
-    (AGENT + "FrameReplay.load(None, 'nope.npz')", "nope.npz"),
-    (AGENT + "open('x.npz', 'w').write('not a replay'); FrameReplay.load(None, 'x.npz')",
-     "x.npz"),
+    (AGENT + "FrameReplay.load('nope.npz')", "nope.npz"),
+    (AGENT + "open('x.npz', 'w').write('not a replay'); FrameReplay.load('x.npz')", "x.npz"),
     (AGENT + f"{A}.load_state_dict({{}})", "state"),
     (AGENT + "import dataclasses; b = SimounAgent((3, 32, 32), 1, dataclasses.replace(cfg, "
      f"feature_dim=16), device='cpu'); {A}.load_state_dict(b.state_dict())",
@@ -1811,7 +1813,7 @@ THIRD_CODES = [
     (f"w.MultiCamera({P}, cameras=(c for c in [0]))", "cameras"),
     ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8, dtype=torch.float64))", ""),
     ("import torch; w.random_conv(torch.zeros(2, 1, 8, 8))", ""),
-    ("import torch; w.random_conv(torch.zeros(1, 2, 3, 8, 8))", "batch"),
+    ("import torch; w.random_conv(torch.zeros(1, 2, 3, 8, 8))", "", True),
     ("w.residual_motion(np.zeros((3, 1, 0, 0), np.uint8))", "frames", True),
     (f"w.SimounObservation({P}, size=16).reset(seed=0, options={{'x': 1}})", ""),
 ]  # fmt: skip
