@@ -5,6 +5,7 @@ Python API and the files users keep, each classified by what the user is told.
     python scripts/reliability_trial.py --area files    # one area
     python scripts/reliability_trial.py --area flags --command sweep   # one command's cases
     python scripts/reliability_trial.py --markdown out.md
+    python scripts/reliability_trial.py --set third --only 0,5,12   # three of one trial's cases
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
 it needs one) and is stopped after 20 s (``--timeout``; spec cases that import Ray want about 90 s
@@ -13,7 +14,8 @@ A case is
 
 - clear: refused with status 2 (a command) or a ValueError/TypeError-like error (the API), the
   message naming the argument, flag or file the case is about, no traceback; or, for a case
-  marked ``ok`` (valid input, or a file the command does not need), it went on without error;
+  marked ``ok`` (valid input, or a file the command does not need), it went on without error,
+  or was refused naming what the case names (a case that names something allows either);
 - unclear: refused, but the message does not name what the case is about;
 - wrong: a traceback, an error from inside a library, accepted where it must be refused, or
   still running where it should have been refused (work started).
@@ -1158,7 +1160,675 @@ SECOND_COMMAND_CASES = SECOND_FLAG_CASES + SECOND_FILE_CASES + SECOND_SPEC_CASES
 for _case in SECOND_COMMAND_CASES + SECOND_API_CASES:
     _case["set"] = "second"
 
-CASES = FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES + SECOND_COMMAND_CASES + SECOND_API_CASES
+# the third trial's cases, new kinds in every area, run alone with --set third
+
+
+def eq(build, flag: str, value: str) -> list[str]:
+    """``build``'s argv with ``flag value`` given as the one word ``flag=value``."""
+    argv = build(flag, value)
+    at = len(argv) - 1 - argv[::-1].index(flag)
+    return [*argv[:at], f"{flag}={value}", *argv[at + 2 :]]
+
+
+def call(work):
+    """A setup that runs ``work`` on the case's directory (its copy of the tiny run in ``run``)."""
+    return ("call", work)
+
+
+def symlinks(here: Path) -> None:
+    """``loop`` points at itself, ``dangling`` at nothing, ``link`` at the run."""
+    (here / "loop").symlink_to("loop")
+    (here / "dangling").symlink_to("nowhere/x")
+    (here / "link").symlink_to("run")
+
+
+def report_output(here: Path) -> None:
+    """``output-of-report``: what simoun-report wrote for the run."""
+    from simoun_lab.cli import report
+
+    assert report.main([str(here / "run"), "--out", str(here / "output-of-report")]) == 0
+
+
+def runs_dir(*changes):
+    """A setup making ``mix``: a copy of the run per change, each change run on the copy."""
+
+    def make(here: Path) -> None:
+        (here / "mix").mkdir()
+        for i, change in enumerate(changes):
+            copy = here / "mix" / f"run{i}"
+            shutil.copytree(here / "run", copy)
+            if change is not None:
+                change(copy)
+
+    return make
+
+
+def config_edit(change):
+    """A change to a run copy's config.json value."""
+    return lambda run: edit_json(change)(run / "config.json")
+
+
+RUN = ["{run}"]
+EVAL = ["--episodes", "1", "--no-video"]
+SHORT = ["--total-env-steps", "40", "--run-dir", "r"]
+
+
+def masks(*f: str) -> list[str]:
+    return ["masks", "{run}", *f]
+
+
+def bias(*f: str) -> list[str]:
+    return ["bias", "{run}", *f]
+
+
+def eval_argv(*f: str) -> list[str]:
+    return ["{run}", "--no-video", *f]
+
+
+def report_argv(*f: str) -> list[str]:
+    return ["{run}", *f]
+
+
+def plan(*f: str) -> list[str]:
+    return ["plan", "spec.toml", *f]
+
+
+def study_run(*f: str) -> list[str]:
+    return ["run", "spec.toml", "--study-dir", "s", *f]
+
+
+def minigrid_run(*f: str) -> list[str]:
+    return ["run", "--archive", ".", "--spec", str(ROOT / "docs/studies/minigrid/spec.json"), *f]
+
+
+def probe(*f: str) -> list[str]:
+    return ["probe", "--out", "p", *f]
+
+
+def driving(*f: str) -> list[str]:
+    return list(f)
+
+
+EQ_REFUSED = [  # (command, argv builder, flag, value, what the refusal names)
+    ("train", tiny, "--seed", "-1", None), ("train", tiny, "--total-env-steps", "0", None),
+    ("train", tiny, "--agent.lr", "-1", None), ("train", tiny, "--image-size", "8", "image"),
+    ("train", tiny, "--agent.recipe", "curll", "recipe"), ("train", tiny, "--device", "tpu", None),
+    ("train", tiny, "--env", "Pendulum-v9", "Pendulum-v9"),
+    ("train", tiny, "--eval-distraction", "colour_hard", "colour_hard"),
+    ("train", tiny, "--action-repeat", "0", None), ("train", tiny, "--agent.batch-size", "0", None),
+    ("train", tiny, "--preset", "cpux", "cpux"),
+    ("train", tiny, "--env-kwargs", '{"nope": 1}', "nope"),
+    ("train", tiny, "--set", "agent.nope=1", "agent.nope"),
+    ("eval", eval_argv, "--episodes", "0", None), ("eval", eval_argv, "--seed", "-2", None),
+    ("eval", eval_argv, "--torch-threads", "0", None),
+    ("eval", eval_argv, "--distraction", "colour_hard", "colour_hard"),
+    ("eval", eval_argv, "--device", "tpu", None),
+    ("report", report_argv, "--at-step", "0", None),
+    ("report", report_argv, "--at-wall-time", "-5", None),
+    ("analyze", masks, "--steps", "-1", None), ("analyze", masks, "--query", "1", None),
+    ("analyze", masks, "--video", "avi", None), ("analyze", masks, "--episodes", "0", None),
+    ("analyze", bias, "--pairs", "0", None), ("analyze", bias, "--recolour", "paint", None),
+    ("sweep", sweep_tiny, "--seeds", "5-2", None),
+    ("sweep", sweep_tiny, "--grid", "agent.lr", None),
+    ("sweep", sweep_tiny, "--cpus-per-trial", "0", None),
+    ("sweep", sweep_tiny, "--verbose", "5", None),
+    ("sweep", sweep_tiny, "--gpus-per-trial", "-1", None),
+    ("study", plan, "--probe-updates", "-1", None), ("study", study_run, "--num-cpus", "0", None),
+    ("study", study_run, "--verbose", "3", None),
+    ("minigrid", minigrid_run, "--concurrent", "0", None),
+    ("minigrid", probe, "--settings.steps", "0", ("--settings.steps", "steps")),
+    ("minigrid", probe, "--probes", "rndd", "rndd"),
+    ("driving", driving, "--episodes", "0", None), ("driving", driving, "--preset", "cpux", "cpux"),
+    ("driving", driving, "--video", "x.txt", None),
+]  # fmt: skip
+EQ_VALID = [
+    ("report", report_argv("--at-step=20")),
+    ("eval", ["{run}", "--episodes=1", "--no-video"]),
+    ("study", ["plan", "spec.toml", "--probe-updates=0"]),
+    ("analyze", masks("--steps=1")),
+    ("train", tiny("--total-env-steps=40", "--run-dir=r")),
+]
+NO_VIDEO = [arg for arg in TINY if arg != "--no-video"]
+SWITCH_VALUES = [  # a switch given =value: (command, argv, the switch, valid)
+    ("train", [*NO_VIDEO, *SHORT, "--no-video=true"], "--no-video", True),
+    ("train", [*NO_VIDEO, *SHORT, "--video=false"], "--video", True),
+    ("eval", eval_argv("--episodes", "1", "--overwrite=yes"), "--overwrite", True),
+    ("eval", eval_argv("--episodes", "1", "--random-policy=false"), "--random-policy", True),
+    ("analyze", masks("--steps", "1", "--overwrite=no"), "--overwrite", True),
+    ("study", study_run("--resume=true"), ("--resume", "--study-dir"), False),
+    ("sweep", ["--resume=1", "--sweep-dir", "x"], ("--resume", "--sweep-dir"), False),
+]
+EXTRA_WORDS = [
+    ("report", ["{run}", "extra"]), ("study", ["plan", "spec.toml", "extra"]),
+    ("minigrid", ["report", "extra"]), ("driving", ["extra"]),
+    ("sweep", [*sweep_tiny(), "extra"]), ("train", [*tiny(), "extra"]),
+]  # fmt: skip
+BLANKS = [  # empty or blank option values
+    ("eval", eval_argv("--out", " "), "--out"), ("report", report_argv("--out", ""), "--out"),
+    ("sweep", sweep_tiny("--sweep-dir", " "), "--sweep-dir"),
+    ("study", ["run", "spec.toml", "--study-dir", ""], "--study-dir"),
+    ("minigrid", ["report", "--archive", " "], "--archive"),
+    ("analyze", masks("--out", " "), "--out"), ("driving", ["--json", ""], "--json"),
+    ("train", tiny("--total-env-steps", "40", "--run-dir", " "), "--run-dir"),
+]  # fmt: skip
+ODD_TEXT = [  # unicode, whitespace and very long words
+    ("train", tiny("--env", "Pendulum\u2011v1"), "Pendulum"),
+    ("train", tiny("--agent.recipe", "simoun "), "recipe"),
+    ("train", tiny("--agent.recipe", "\uff53\uff49\uff4d\uff4f\uff55\uff4e"), "recipe"),
+    ("train", tiny("--device", " cpu"), "device"),
+    ("train", tiny("--preset", "cpu\u200b"), "preset"),
+    ("train", [*tiny(), "\u2013-seed", "3"], "\u2013-seed"),
+    ("train", [*tiny(), "\u2014seed", "3"], "\u2014seed"),
+    ("train", [*tiny(), "--seed\u00a0", "3"], "--seed"),
+    ("train", [*tiny(), "--" + "a" * 3000], "--aaaa"),
+    ("train", tiny("--run-dir", "x" * 5000), "--run-dir"),
+    ("train", tiny("--run-dir", "a" * 300 + "/r"), "--run-dir"),
+    ("eval", eval_argv("--out", "o" * 5000), "--out"),
+    ("report", report_argv("--out", "o" * 300), "--out"),
+    ("sweep", sweep_tiny("--sweep-dir", "s" * 300), "--sweep-dir"),
+    ("study", ["run", "spec.toml", "--study-dir", "s" * 300], "--study-dir"),
+    ("train", tiny("--set", "agent.lr\u200b=1e-3"), "agent.lr"),
+    ("sweep", sweep_tiny("--grid", "agent.n_step=1,\u00a03"), "agent.n_step", True),
+    ("train", tiny("--env-kwargs", '{"size": 32}\u00a0'), "--env-kwargs"),
+]
+ODD_ENVS = [
+    ("Pendulum-v0", "Pendulum"), ("Pendulum", "Pendulum"),
+    ("dm_control/cartpole-swingup-v1", "cartpole-swingup"),
+    ("dm_control/cartpole_swingup-v0", "cartpole"), ("dm_control/Cartpole-swingup-v0", "Cartpole"),
+    ("gym/Pendulum-v1", "gym/Pendulum"), (":Pendulum-v1", ("--env", ":Pendulum")),
+    ("Pendulum-v1:", ("--env", "Pendulum-v1:")), ("dm_control/", "dm_control"),
+    ("minigrid:MiniGrid-Empty-5x5-v0", "MiniGrid"), ("Blackjack-v1", "Blackjack"),
+    ("Acrobot-v1", "Acrobot"), ("LunarLander-v3", "LunarLander"),
+    ("simoun/PointReach-v9", "PointReach"), ("simoun/pointreach-v0", "pointreach"),
+    ("dm_control/cartpole-swingup-v0/extra", "dm_control"),
+]  # fmt: skip
+ENV_KWARGS = [
+    ('"a"', "--env-kwargs"), ("null", "--env-kwargs"), ("3", "--env-kwargs"),
+    ('{"size": 1e400}', "size"), ('{"size": NaN}', "size"), ('{"max_steps": -5}', "max_steps"),
+    ('{"step_size": "big"}', "step_size"), ('{"render_mode": "human"}', "render_mode"),
+    ('{"size": {"a": 1}}', "size"), ('{"size": 99999999999999999999999}', "size"),
+    ('{"size": 32, "size": 16}', ("size", "--env-kwargs")), ("{} x", "--env-kwargs"),
+    ('{"size": 0}', "size"), ('{"": 1}', ("--env-kwargs", "''")),
+]  # fmt: skip
+SYMLINKS = [  # (command, argv, names, valid): loop -> itself, dangling -> nothing, link -> the run
+    ("train", tiny("--total-env-steps", "40", "--run-dir", "loop"), ("loop", "--run-dir"), False),
+    ("train", tiny("--total-env-steps", "40", "--run-dir", "dangling"), ("dangling", "--run-dir"),
+     False),
+    ("eval", ["loop", *EVAL], "loop", False), ("eval", ["link", *EVAL], "", True),
+    ("report", ["link"], "", True), ("analyze", ["masks", "loop"], "loop", False),
+    ("train", ["--resume", "loop"], "loop", False),
+    ("train", ["--resume", "link", "--total-env-steps", "60"], "", True),
+    ("sweep", sweep_tiny("--sweep-dir", "loop"), ("loop", "--sweep-dir"), False),
+    ("study", ["run", "spec.toml", "--study-dir", "loop"], ("loop", "--study-dir"), False),
+    ("minigrid", ["report", "--archive", "loop"], ("loop", "--archive"), False),
+    ("eval", eval_argv("--episodes", "1", "--out", "loop"), ("loop", "--out"), False),
+]  # fmt: skip
+REPORT_OUT = "output-of-report"
+OUTPUTS = [  # one command given another's output: (command, argv, names, valid)
+    ("eval", [REPORT_OUT, *EVAL], (REPORT_OUT, "config.json"), False),
+    ("train", ["--resume", REPORT_OUT], (REPORT_OUT, "config.json"), False),
+    ("analyze", ["masks", REPORT_OUT], (REPORT_OUT, "config.json"), False),
+    ("report", [REPORT_OUT], (REPORT_OUT,), False),
+    ("study", ["report", "spec.toml", "--study-dir", REPORT_OUT], (REPORT_OUT, "--study-dir"),
+     False),
+    ("minigrid", ["select", "--archive", REPORT_OUT], (REPORT_OUT, "--archive"), False),
+    ("sweep", ["--resume", "--sweep-dir", REPORT_OUT], ("sweep.json",), False),
+    ("train", tiny("--total-env-steps", "40", "--run-dir", REPORT_OUT), (REPORT_OUT, "--run-dir"),
+     True),
+    ("eval", ["{run}/tb", *EVAL], ("config.json", "/tb"), False),
+    ("train", ["--resume", "{run}/tb"], ("config.json", "/tb"), False),
+    ("eval", eval_argv("--episodes", "1", "--out", "{run}"), "--out", True),
+    ("report", report_argv("--out", "{run}"), "--out", True),
+    ("analyze", masks("--steps", "1", "--out", "{run}"), "--out", True),
+]  # fmt: skip
+
+
+def nest(run: Path) -> None:
+    """Move the run two directories deeper."""
+    (run.parent / "a" / "b").mkdir(parents=True)
+    shutil.move(run, run.parent / "a" / "b" / "run")
+
+
+def truncate_eval(run: Path) -> None:
+    path = run / "eval.csv"
+    path.write_text("\n".join(path.read_text().splitlines()[:2]) + "\n")
+
+
+MIXES = [  # report on a directory of runs: (the runs' changes, extra argv, names, valid)
+    ((None, config_edit(lambda c: c.update(env="Pendulum-v1"))), [], ("Pendulum", "env"), True),
+    ((None, config_edit(lambda c: c.update(image_size=48))), [], "image_size", True),
+    ((None, lambda run: (run.parent / "notes").mkdir()), [], "notes", True),
+    ((None, lambda run: (run.parent / "README.md").write_text("runs\n")), [], "README", True),
+    ((None, None), [], "seed", True),
+    ((nest,), [], "", True),
+    ((None, lambda run: (run / "eval.csv").unlink()), [], "eval.csv", True),
+    ((None, config_edit(lambda c: c["agent"].update(recipe="drq"))), [], "recipe", True),
+    ((None, truncate_eval), ["--at-step", "20"], "--at-step", True),
+    ((None, lambda run: (run.parent / "loop").symlink_to("loop")), [], "loop", True),
+]
+BUDGETS = [  # (command, argv, names, valid)
+    ("report", report_argv("--at-step", "100000"), "--at-step", True),
+    ("report", report_argv("--at-step", "40"), "", True),
+    ("report", report_argv("--at-wall-time", "1e9"), "--at-wall-time", True),
+    ("report", report_argv("--at-wall-time", "0.0001"), "--at-wall-time", True),
+    ("train", ["--resume", "{run}", "--total-env-steps", "40"], "total", False),
+    ("train", ["--resume", "{run}", "--total-env-steps", "41"], "", True),
+    ("train", tiny("--total-env-steps", "5", "--run-dir", "r"), "warmup", True),
+    ("train", tiny("--eval-every", "1000", *SHORT), "", True),
+    ("analyze", masks("--steps", "100000"), "--steps", False),
+    ("analyze", masks("--steps", "0"), "", True),
+    ("train", ["--resume", "{run}", "--total-env-steps", "60", "--eval-every", "0"], "eval_every",
+     False),
+]  # fmt: skip
+KINDS_IN_FIXING = [  # kinds other changes fix: (command, argv, names)
+    ("sweep", sweep_tiny("--seeds", "0-100000"), "--seeds"),
+    ("study", ["run", "spec.toml", "--study-dir", "s", "--archive", "s"], "--archive"),
+    ("study", ["run", "spec.toml", "--study-dir", "s", "--archive", "./s/"], "--archive"),
+    ("sweep", sweep_tiny("--sweep-dir", "/proc/x"), "--sweep-dir"),
+    ("minigrid", probe("--settings.n-steps", "0"), ("--settings.n-steps", "n_steps")),
+    ("minigrid", probe("--probes"), "--probes"),
+]
+THIRD_FLAG_CASES = [
+    *(cli("flags", command, eq(build, flag, value), names or flag_names(flag))
+      for command, build, flag, value, names in EQ_REFUSED),
+    *(cli("flags", command, argv, "", ok=True) for command, argv in EQ_VALID),
+    *(cli("flags", command, argv, names, ok=ok) for command, argv, names, ok in SWITCH_VALUES),
+    *(cli("flags", command, argv, "extra") for command, argv in EXTRA_WORDS),
+    *(cli("flags", command, argv, names, ok=bool(ok))
+      for command, argv, names, *ok in BLANKS + ODD_TEXT),
+    *(cli("flags", "train", tiny("--env", env), names) for env, names in ODD_ENVS),
+    cli("flags", "train", tiny("--env", "simoun_agent.envs:simoun/PointReach-v0", *SHORT), "",
+        ok=True),
+    cli("flags", "train", tiny("--env-module", "simoun_agent.envs:x"), "--env-module"),
+    cli("flags", "train", tiny("--env-module", "..x"), ("--env-module", "..x")),
+    cli("flags", "train", tiny("--env-module", "os.path.nope"), "os.path.nope"),
+    cli("flags", "sweep", [*sweep_tiny()[2:], "--envs", "Pendulum-v1,Pendulum-v1"],
+        ("--envs", "Pendulum")),
+    *(cli("flags", "train", tiny("--env-kwargs", text), names) for text, names in ENV_KWARGS),
+    cli("flags", "train", tiny("--set", 'env_kwargs={"size": 0}'), "size"),
+    *(cli("flags", command, argv, names, ok=ok, setup=call(symlinks))
+      for command, argv, names, ok in SYMLINKS),
+    *(cli("flags", command, argv, names, ok=ok, setup=call(report_output))
+      for command, argv, names, ok in OUTPUTS),
+    *(cli("flags", "report", ["mix", *extra], names, ok=ok, setup=call(runs_dir(*changes)))
+      for changes, extra, names, ok in MIXES),
+    cli("flags", "report", ["mix"], ("no run", "empty", "config.json", "eval.csv"),
+        setup=call(runs_dir())),
+    *(cli("flags", command, argv, names, ok=ok) for command, argv, names, ok in BUDGETS),
+    *(cli("flags", command, argv, names) for command, argv, names in KINDS_IN_FIXING),
+]  # fmt: skip
+
+
+def write_bytes(change):
+    """A damage that rewrites a file's bytes through ``change``."""
+    return lambda path: path.write_bytes(change(path.read_bytes()))
+
+
+def symlink_to(target: str):
+    """A damage that replaces a file by a symlink to ``target`` (relative to the run)."""
+
+    def link(path: Path) -> None:
+        path.unlink()
+        path.symlink_to(target)
+
+    return link
+
+
+def rename_replay(path: Path) -> None:
+    path.rename(path.with_name("replay-20.npz"))
+
+
+THIRD_DAMAGES = {
+    "eval.csv": {
+        "the header twice": csv_rows(lambda rows: [rows[0], rows[1], rows[0], *rows[2:]]),
+        "CRLF on one line only": edit_text(lambda text: text.replace("\n", "\r\n", 1)),
+        "trailing binary garbage": write_bytes(lambda data: data + b"\x00\xff\xfegarbage"),
+        "a NUL byte in the header": edit_text(lambda text: "\x00" + text),
+        "a 40-digit step": csv_rows(lambda rows: [*rows[:-1], ["9" * 40, *rows[-1][1:]]]),
+        "a dangling symlink": symlink_to("nowhere.csv"),
+        "a symlink to itself": symlink_to("eval.csv"),
+        "an inf return": csv_rows(lambda rows: [*rows[:-1], [rows[-1][0], "inf",
+                                                              *rows[-1][2:]]]),
+        "every cell quoted": csv_rows(lambda rows: [[f'"{c}"' for c in row] for row in rows]),
+        "a blank line after the header": edit_text(lambda text: text.replace("\n", "\n\n", 1)),
+    },
+    "train.csv": {
+        "the header twice": csv_rows(lambda rows: [rows[0], rows[1], rows[0], *rows[2:]]),
+    },
+    "summary.json": {
+        "a NaN step": edit_text(lambda text: text.replace('"env_step": 40', '"env_step": NaN')),
+        "trailing garbage": edit_text(lambda text: text + "}"),
+    },
+    "config.json": {
+        "one level deeper": edit_text(lambda text: json.dumps({"config": json.loads(text)})),
+        "an older version (env missing)": edit_json(lambda data: data.pop("env")),
+        "UTF-16": write_bytes(lambda data: data.decode().encode("utf-16")),
+        "a key twice": edit_text(lambda text: text.replace('"seed": 1,',
+                                                           '"seed": 1,\n  "seed": 2,')),
+        "another run's env": edit_json(lambda data: data.update(env="Pendulum-v1")),
+    },
+    "checkpoint.pt": {
+        "zero-filled": write_bytes(lambda data: bytes(len(data))),
+        "a dangling symlink": symlink_to("nowhere.pt"),
+    },
+    "replay": {
+        "named for another step": rename_replay,
+        "zero-filled": write_bytes(lambda data: bytes(len(data))),
+    },
+    ".lock": {"held by a live process (pid 1)": edit_text(lambda text: "1\n")},
+}  # fmt: skip
+THIRD_FILE_CASES = [
+    {**cli("files", command, argv, names, ok=True, setup=(name, how)), "what": f"{name} {way}"}
+    for name, ways in THIRD_DAMAGES.items()
+    for names in [(name, "in use") if name == ".lock" else name]
+    for way, how in ways.items()
+    for command, argv in FILE_COMMANDS.items()
+]
+
+EVAL_TASKS = 'tasks = ["dm_control/cartpole-swingup-v0", "dm_control/cheetah-run-v0"]'
+EVAL_SEEDS = (
+    'seeds = { "dm_control/cartpole-swingup-v0" = "1-5", "dm_control/cheetah-run-v0" = "1-3" }'
+)
+RECIPES = 'recipes = ["simoun", "drq", "drqv2", "rad", "curl"]'
+THIRD_SPEC_EDITS = [  # (text replaced, by, what the refusal names[, valid])
+    ("env_steps = 50_000", "env_steps = 1979-05-27", "env_steps"),
+    ('seeds = "101-102"', "seeds = 07:32:00", "seeds"),
+    ("[tuning]", "[[tuning]]", "tuning"),
+    ('selection = "auc"', 'selection = "auc"\nselection = "auc"', ("spec.toml", "selection")),
+    ("[resources]", "[base]\nseed = 3\n\n[resources]", ("spec.toml", "base")),
+    ("env_steps = 50_000", "env_steps = 99999999999999999999999", "env_steps"),
+    ("env_steps = 50_000", "env_steps = -50_000", "env_steps"),
+    ("env_steps = 100_000", "env_steps = -1", "env_steps"),
+    (EVAL_TASKS, "tasks = []", "tasks"),
+    (RECIPES, 'recipes = ["simon", "drq"]', "simon"),
+    (RECIPES, 'recipes = ["simoun", "drq-v2"]', "drq-v2"),
+    (RECIPES, 'recipes = ["simoun", "curl_sac"]', "curl_sac"),
+    (RECIPES, 'recipes = ["simoun", 3]', "recipes"),
+    ('selection = "auc"', 'selection = ""', "selection"),
+    ("eval_episodes = 10", "eval_episodes = -1", "eval_episodes"),
+    ("[base]\n", "[base]\nseed = 5\n", "seed"),
+    ("[base]\n", "[base]\ntotal_env_steps = 100\n", "total_env_steps"),
+    ("[base]\n", '[base]\nenv = "Pendulum-v1"\n', "env"),
+    ("[base]\n", '[base]\nrun_dir = "x"\n', "run_dir"),
+    ("[base]\n", "[base]\nagent.lr = -1\n", "lr"),
+    ("[base]\n", "[base]\nagent = 3\n", "agent"),
+    ("[base]\n", "[base]\nagent.n_step = 3\n", "n_step"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [3]", "n_step", True),
+    ("agent.n_step = [1, 3]", "agent.n-step = [1, 3]", "n-step"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nseed = [1, 2]", "seed"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [{a = 1}, 3]", "n_step"),
+    ('seeds = "101-102"', 'seeds = " 101 - 102 "', "seeds", True),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-5"', '"1-20000"'), "seeds"),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-3" }', '"1-3", "dm_control/walker-walk-v0" = "1-2" }'),
+     "walker"),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-3"', "3"), ("seeds", "cheetah")),
+    ("[resources]", '[tasks."dm_control/walker-walk-v0"]\naction_repeat = 2\n\n[resources]',
+     "walker-walk"),
+    ("action_repeat = 4", "action_repeat = 4\nimage_size = 0", "image_size"),
+    ("action_repeat = 4", "action_repeat = -4", "action_repeat"),
+    ("cpus_per_trial = 1 ", "cpus_per_trial = 100000 ", "cpus_per_trial", True),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 0", "max_concurrent_trials"),
+    ('description = """', 'description = """' + "x" * 1_000_000, "", True),
+    ('selection = "auc"', 'sélection = "auc"', ("sélection", "spec.toml")),
+    ('seeds = "101-102"', "seeds = 1.5", "seeds"),
+    ('seeds = "101-102"', 'seeds = ""', "seeds"),
+    ('seeds = "101-102"', 'seeds = "101-102-103"', "seeds"),
+    ("env_steps = 50_000", "env_steps = 200_000", "", True),
+    ('preset = "cpu"', 'preset = "cpu"\npreset = "highway"', ("spec.toml", "preset")),
+    ("[grid]\nagent.n_step = [1, 3]", "[grid]", "n_step"),
+    ('preset = "cpu"', 'preset = ""', "preset"),
+    ('"dm_control/cartpole-swingup-v0" = "1-5"',
+     '"dm_control/cartpole-swingup-v0" = "1-5", "dm_control/cartpole-swingup-v0" = "6-7"',
+     "spec.toml"),
+    ('selection = "auc"', 'selection = "a\x00uc"', "spec.toml"),
+]  # fmt: skip
+THIRD_SPEC_TEXTS = [  # whole specs: (text, names[, valid])
+    (SPEC + '\n[diagnostics]\ndrqq = ["simoun_no_aux"]\n', "drqq"),
+    (SPEC + '\n[diagnostics]\nsimoun = "simoun_no_aux"\n', ("diagnostics", "simoun_no_aux")),
+    (SPEC + '\n[generalization]\nmodes = ["color_hard"]\nepisodes = 0\n', "episodes"),
+    (SPEC + "\n[generalization]\nmodes = []\n", "modes", True),
+    ("# nothing here\n", "recipes"),
+]
+
+
+def spec_file(name: str, make):
+    """A setup that lays out ``name`` (a spec) with ``make(path)``."""
+    return call(lambda here: make(here / name))
+
+
+SPEC_FILES = [  # (file name, how it is made)
+    ("spec_dir.toml", lambda path: path.mkdir()),
+    ("dangling.toml", lambda path: path.symlink_to("nowhere.toml")),
+    ("spec16.toml", lambda path: path.write_bytes(SPEC.encode("utf-16"))),
+]
+THIRD_MINIGRID_EDITS = [  # (a change to the spec's JSON value, what the refusal names)
+    (lambda s: s["tasks"][0].update(seeds=[0, 0]), "seeds"),
+    (lambda s: s["tasks"][0].update(steps=-5), "steps"),
+    (lambda s: s.update(eval_episodes=0), "eval_episodes"),
+    (lambda s: s.update(evaluations=10**30), "evaluations"),
+    (lambda s: s["ppo"].update(gamma=float("nan")), "gamma"),
+    (lambda s: s.update(arms=[]), "arms"),
+    (lambda s: s.update(arms=["ppo", "ppo"]), "arms"),
+    (lambda s: s["ppo"].update(batch_size=100000), "batch_size", True),
+    (lambda s: s.update(eval_seed=-1), "eval_seed"),
+    (lambda s: s["tasks"][0].update(env_id="MiniGrid-DoorKey-6x6-v0 "), ("env_id", "DoorKey")),
+]
+
+
+def minigrid_spec_case(i: int, text: str, names, name: str = "spec.json", setup=None, ok=False):
+    return cli("specs", "minigrid", [("report", "select")[i % 2], "--spec", name, "--archive",
+               "."], names, ok, setup=setup or ("spec", (".json", text)))  # fmt: skip
+
+
+for _old, _new, *_ in THIRD_SPEC_EDITS:
+    assert _old in SPEC, _old
+
+THIRD_SPEC_CASES = [
+    *(spec_case(SPEC.replace(old, new, 1), names, ok=bool(ok))
+      for old, new, names, *ok in THIRD_SPEC_EDITS),
+    *(spec_case(text, names, ok=bool(ok)) for text, names, *ok in THIRD_SPEC_TEXTS),
+    *(cli("specs", "study", ["plan", name, "--probe-updates", "0"], name,
+          setup=spec_file(name, make)) for name, make in SPEC_FILES),
+    *(minigrid_spec_case(i, minigrid_spec(change), names, ok=bool(ok))
+      for i, (change, names, *ok) in enumerate(THIRD_MINIGRID_EDITS)),
+    minigrid_spec_case(0, MINIGRID_SPEC.replace('"arms": [', '"arms": ["rnd"],\n  "arms": [', 1),
+                       "arms"),
+    minigrid_spec_case(1, "", "spec16.json", "spec16.json", spec_file(
+        "spec16.json", lambda path: path.write_bytes(MINIGRID_SPEC.encode("utf-16")))),
+]  # fmt: skip
+
+BJ = "gym.make('Blackjack-v1', render_mode='rgb_array')"
+RENDERED = "gym.wrappers.AddRenderObservation(gym.make('CartPole-v1', render_mode='rgb_array'))"
+
+
+def image_env(change: str, space: str) -> str:
+    """CartPole whose observation is its render put through ``change`` into ``space``."""
+    return f"gym.wrappers.TransformObservation({RENDERED}, lambda o: {change}, {space})"
+
+
+IMAGE_4D = image_env("o[None]", "gym.spaces.Box(0, 255, (1, 400, 600, 3), np.uint8)")
+IMAGE_RGBA = image_env(
+    "np.concatenate([o, o[..., :1]], -1)", "gym.spaces.Box(0, 255, (400, 600, 4), np.uint8)"
+)
+IMAGE_CHW = image_env("o.transpose(2, 0, 1)", "gym.spaces.Box(0, 255, (3, 400, 600), np.uint8)")
+IMAGE_HW1 = image_env("o[..., :1]", "gym.spaces.Box(0, 255, (400, 600, 1), np.uint8)")
+MB = image_env("(o > 0).astype(np.int8)[0, :4, 0]", "gym.spaces.MultiBinary(4)")
+S40 = f"w.SimounObservation({P}, size=40, fold_frames=True)"
+S64 = f"w.SimounObservation({P}, size=64)"
+RND = "from simoun_agent.rnd_model import RNDModel; "
+CUR = "from simoun_agent.curiosity_model import CuriosityModel; "
+FRAMES = "np.zeros((3, 3, 32, 32), np.uint8)"
+FILLED = (
+    "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), np.uint8)); "
+    "[r.add(np.zeros(1), 0.0, np.zeros((3, 32, 32), np.uint8), False, False) for _ in range(9)]; "
+)
+ADD = (
+    "r = FrameReplay(100, (3, 32, 32), 1); r.start_episode(np.zeros((3, 32, 32), np.uint8)); "
+    "r.add({})"
+)
+FRAME = "np.zeros((3, 32, 32), np.uint8)"
+POINT = "import simoun_agent.envs; gym.make('simoun/PointReach-v0', {})"
+
+
+def vec1(
+    env: str = "Pendulum-v1", wrap: str = "w.SimounObservation(e, size=16)", mode: str = "sync"
+) -> str:
+    """A vector env of one ``env``, wrapped by ``wrap``."""
+    return (f"gym.make_vec('{env}', 1, vectorization_mode='{mode}', render_mode='rgb_array', "
+            f"wrappers=[lambda e: {wrap}])")  # fmt: skip
+
+
+STEPS3 = "v.reset(seed=0); [v.step(v.action_space.sample()) for _ in range(3)]"
+CLOSED = [  # wrappers closed twice, then one stepped or reset after close
+    f"w.FrameTriplet({P})", f"w.ActionRepeat({P}, 2)", f"w.RandomConvolution({P})",
+    f"import operator; w.MultiCamera({P}, cameras=[operator.methodcaller('render')], size=16)",
+    f"w.ConstantBonusReward({S}, 0.1)", NOV + f"w.RNDReward({S}, nov, warmup=0)",
+    DMC + "w.ColorShift(d, seed=0)",
+]  # fmt: skip
+RENDER_AS = "class R(gym.Wrapper):\n    def render(self):\n        return {}\n"
+# (code, the name the refusal must give, or "" for a valid input that must go on[, valid: the
+# input may go on, or be refused naming the name])
+THIRD_CODES = [
+    # every observation-space kind
+    (f"e = w.SimounObservation({BJ}, size=16); " + STEP, ""),
+    ("w.FrameTriplet(gym.make('Blackjack-v1'))", "Box"),
+    ("w.ResidualMotion(gym.make('Blackjack-v1'))", ("Box", "(k, C, H, W)")),
+    ("w.RandomConvolution(gym.make('Blackjack-v1'))", "render_mode"),
+    (f"w.FrameTriplet({MB})", "Box"),
+    (f"e = w.SimounObservation({MB}, size=16); " + STEP, ""),
+    (f"w.SimounObservation({MB}, source='observation')", ("observation", "image", "MultiBinary")),
+    *((f"w.SimounObservation({image_env(f'o.astype(np.{t})', space)}, source='observation')",
+       "uint8") for t, space in (
+        ("int32", "gym.spaces.Box(0, 255, (400, 600, 3), np.int32)"),
+        ("float16", "gym.spaces.Box(0, 255, (400, 600, 3), np.float16)"),
+        ("uint16", "gym.spaces.Box(0, 255, (400, 600, 3), np.uint16)"),
+        ("bool_", "gym.spaces.Box(0, 1, (400, 600, 3), np.bool_)"),
+    )),
+    (f"w.SimounObservation({IMAGE_4D}, source='observation')", ("shape", "(H, W", "rank")),
+    ("w.SimounObservation(gym.make('Pendulum-v1'), source='observation')",
+     ("uint8", "image", "observation")),
+    (f"e = w.SimounObservation({IMAGE_RGBA}, source='observation', size=16); " + STEP,
+     ("channel", "RGB", "4"), True),
+    (f"e = w.SimounObservation({IMAGE_CHW}, source='observation', size=16); " + STEP,
+     ("channel", "(H, W", "shape"), True),
+    (f"e = w.SimounObservation({IMAGE_HW1}, source='observation', size=16); " + STEP, ""),
+    ("w.FrameTriplet(gym.make('MiniGrid-Empty-5x5-v0'))", "Box"),
+    ("e = w.ActionRepeat(gym.make('Blackjack-v1'), 2); " + STEP, ""),
+    (f"e = w.ConstantBonusReward(w.SimounObservation({BJ}, size=16), 0.1); " + STEP, ""),
+    (f"w.check_sb3_policy(w.SimounObservation({BJ}, size=40, fold_frames=True), 'CnnPolicy')", ""),
+    ("w.check_sb3_policy(gym.spaces.Tuple((gym.spaces.Discrete(2), gym.spaces.Discrete(3))), "
+     "'MlpPolicy')", "Tuple"),
+    ("w.check_sb3_policy(gym.spaces.MultiBinary(4), 'MlpPolicy')", ""),
+    # vector envs of one env
+    (f"v = w.ConstantBonusVectorReward({vec1()}, 0.1); " + STEPS3, ""),
+    (NOV + f"v = w.RNDVectorReward({vec1('CartPole-v1')}, nov, warmup=0); " + STEPS3, ""),
+    (FEAT + f"v = w.ConsistencyCuriosityVectorReward({vec1('CartPole-v1')}, feat); " + STEPS3, ""),
+    (f"w.check_sb3_policy({vec1(wrap='w.SimounObservation(e, size=40, fold_frames=True)')}, "
+     "'CnnPolicy')", ""),
+    (f"v = w.ConstantBonusVectorReward({vec1(mode='async')}, 0.1); " + STEPS3 + "; v.close()", ""),
+    (f"w.ConstantBonusReward({vec1()}, 0.1)", ("Vector", "ConstantBonusVectorReward")),
+    (RND + f"m = RNDModel.for_env({vec1(wrap='w.SimounObservation(e, size=64)')}); m.close()", ""),
+    # close twice; step or reset after close
+    *((f"e = {made}; e.reset(seed=0); e.close(); e.close()" if "; " not in made else
+       f"{made.rpartition('; ')[0]}; e = {made.rpartition('; ')[2]}; e.reset(seed=0); e.close(); "
+       "e.close()", "") for made in CLOSED),
+    (PZ + "e = SPO(pz, size=16); e.reset(seed=0); e.close(); e.close()", ""),
+    (f"v = w.ConstantBonusVectorReward({vec('NEXT_STEP')}, 0.1); v.reset(seed=0); v.close(); "
+     "v.close()", ""),
+    (f"e = w.ConstantBonusReward({S}, 0.1); e.reset(seed=0); e.close(); "
+     "e.step(e.action_space.sample())", "close", True),
+    (RND + f"m = RNDModel.for_env({S64}); e = w.RNDReward({S64}, m, warmup=0); e.reset(seed=0); "
+     "e.step(e.action_space.sample()); m.close(); [e.step(e.action_space.sample()) for _ in "
+     "range(3)]", "close", True),
+    (DMC + "e = w.ColorShift(d, seed=0); e.reset(seed=0); e.close(); e.reset(seed=1)", "close",
+     True),
+    (PZ + "e = SPO(pz, size=16); e.reset(seed=0); e.close(); "
+     "e.step({a: e.action_space(a).sample() for a in e.agents})", "close", True),
+    (f"v = w.ConstantBonusVectorReward({vec('SAME_STEP')}, 0.1); v.reset(seed=0); v.close(); "
+     "v.step(v.action_space.sample())", "close", True),
+    # the agent's API: odd batches and dtypes
+    (AGENT + f"{A}.act({FRAMES}, deterministic='no')", "deterministic"),
+    (AGENT + f"{A}.act({FRAMES}, deterministic=None)", "deterministic"),
+    (AGENT + f"{A}.act({FRAMES}, step=-1)", "step"),
+    (AGENT + f"{A}.act({FRAMES}, step='a')", "step"),
+    (AGENT + f"{A}.act({FRAMES}, step=1.5)", "step"),
+    (AGENT + f"import torch; {A}.act(torch.zeros((3, 3, 32, 32), dtype=torch.uint8))", ""),
+    (AGENT + f"{A}.act(np.zeros((1, 3, 3, 32, 32), np.uint8))", "frames"),
+    (AGENT + f"{A}.act(np.zeros((32, 32, 3, 3), np.uint8).transpose(2, 3, 0, 1))", ""),
+    (AGENT + f"{A}.act(np.zeros((3, 3, 32, 32), np.int64))", "uint8"),
+    (AGENT + f"{A}.act({FRAMES}.tolist())", ("uint8", "frames")),
+    (AGENT + f"{A}.act({FRAMES}, True, None)", ""),
+    (AGENT + f"{A}.encoder_features({FRAMES})", ("(B,", "triplets", "frames")),
+    (AGENT + f"{A}.encoder_features(np.zeros((0, 3, 3, 32, 32), np.uint8))", ""),
+    (AGENT + f"{A}.encoder_features(np.zeros((2, 3, 3, 32, 32), np.float32))", "uint8"),
+    (AGENT + f"{A}.update(None, 0)", "replay"),
+    (AGENT + FILLED + f"{A}.update(r, -1)", "step"),
+    (AGENT + FILLED + f"{A}.update(r, 'a')", "step"),
+    (AGENT + FILLED + f"{A}.update(r, 9)", ""),
+    (AGENT + ADD.format(f"np.zeros(1), 0.0, {FRAME}, 'no', False"), "terminated"),
+    (AGENT + ADD.format(f"np.zeros(1), float('inf'), {FRAME}, False, False"), "reward"),
+    (AGENT + ADD.format(f"np.zeros(1, np.int64), 0.0, {FRAME}, False, False"), ""),
+    (AGENT + ADD.format(f"[0.5], np.float32(1), {FRAME}, False, False"), ""),
+    (AGENT + ADD.format(f"np.array([np.nan]), 0.0, {FRAME}, False, False"), "action"),
+    (AGENT + ADD.format("np.zeros(1), 0.0, np.zeros((3, 16, 16), np.uint8), False, False"),
+     ("(3, 32, 32)", "frame")),
+    (AGENT + FILLED + "r.sample(0)", "batch_size"),
+    (AGENT + FILLED + "r.sample(-1)", "batch_size"),
+    (AGENT + FILLED + "r.sample(1.5)", "batch_size"),
+    (AGENT + "FrameReplay(100, (3, 32, 32), 1).sample(4)",
+     ("empty", "start_episode", "add", "holds 0")),
+    (AGENT + FILLED + "r.save('nowhere/x.npz')", "nowhere"),
+    (AGENT + "FrameReplay.load('nope.npz')", "nope.npz"),
+    (AGENT + "open('x.npz', 'w').write('not a replay'); FrameReplay.load('x.npz')", "x.npz"),
+    (AGENT + f"{A}.load_state_dict({{}})", "state"),
+    (AGENT + "import dataclasses; b = SimounAgent((3, 32, 32), 1, dataclasses.replace(cfg, "
+     f"feature_dim=16), device='cpu'); {A}.load_state_dict(b.state_dict())",
+     ("feature_dim", "state", "shape")),
+    (AGENT + "AgentConfig(batch_size=10**30)", "batch_size"),
+    (AGENT + "AgentConfig(lr=float('inf'))", "lr"),
+    (AGENT + "AgentConfig(recipe='curll')", "recipe"),
+    (AGENT + "AgentConfig(actor='deterministicc')", "actor"),
+    (AGENT + "AgentConfig(conv_init='xavier')", "conv_init"),
+    (AGENT + "AgentConfig(critic_augmentations=2)", ("critic_augmentations", "augmentation")),
+    # renders, online models and PointReach: kinds other changes fix
+    (f"w.MultiCamera({P}, cameras=[lambda e: [[0, 0, 0]]], size=16).reset(seed=0)", "camera"),
+    (f"w.MultiCamera({P}, cameras=[lambda e: np.zeros((0, 4, 3), np.uint8)], size=16)"
+     ".reset(seed=0)", "camera"),
+    ("import itertools; c = itertools.count(); e = w.MultiCamera("
+     f"{P}, cameras=[lambda e: np.zeros((8 + next(c), 8, 3), np.uint8)], size=None); " + STEP,
+     "camera"),
+    (RENDER_AS.format("None") + f"w.SimounObservation(R({P}), size=16).reset(seed=0)", "render"),
+    (RENDER_AS.format("[[0, 0, 0]]") + f"w.SimounObservation(R({P}), size=16).reset(seed=0)",
+     "render"),
+    (RND + f"m = RNDModel.for_env({S64}); m(np.zeros((2, 3, 3, 16, 16), np.uint8))", "frame"),
+    (CUR + "m = CuriosityModel((3, 32, 32), gym.spaces.Box(-1, 1, (2,))); z = np.zeros((4, 3, 3, "
+     "32, 32), np.uint8); m.watch(z, np.zeros((4, 5)), z, np.zeros(4, bool), np.zeros(4, bool))",
+     "action"),
+    (POINT.format("size=0"), "size"),
+    (POINT.format("max_steps=0"), "max_steps"),
+    (POINT.format("step_size=float('nan')"), "step_size"),
+    (POINT.format("size='32'"), "size"),
+    # wrappers and functions given odd values
+    (f"w.ColorShift({M})", "dm_control"),
+    (f"w.MultiCamera({P}, cameras=(c for c in [0]))", "cameras"),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8, dtype=torch.float64))", ""),
+    ("import torch; w.random_conv(torch.zeros(2, 1, 8, 8))", ""),
+    ("import torch; w.random_conv(torch.zeros(1, 2, 3, 8, 8))", "", True),
+    ("w.residual_motion(np.zeros((3, 1, 0, 0), np.uint8))", "frames", True),
+    (f"w.SimounObservation({P}, size=16).reset(seed=0, options={{'x': 1}})", ""),
+]  # fmt: skip
+THIRD_API_CASES = [
+    api(code, names, ok=ok[0] if ok else not names) for code, names, *ok in THIRD_CODES
+]
+THIRD_COMMAND_CASES = THIRD_FLAG_CASES + THIRD_FILE_CASES + THIRD_SPEC_CASES
+for _case in THIRD_COMMAND_CASES + THIRD_API_CASES:
+    _case["set"] = "third"
+
+
+CASES = (
+    FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES + SECOND_COMMAND_CASES + SECOND_API_CASES
+    + THIRD_COMMAND_CASES + THIRD_API_CASES
+)  # fmt: skip
 
 
 def tiny_run(where: Path) -> Path:
@@ -1181,6 +1851,8 @@ def prepare(case: dict, here: Path, run: Path) -> list[str]:
         (here / f"spec{suffix}").write_text(text)
     elif setup and setup[0] == "sweep":
         (here / "sweep.json").write_bytes(setup[1])
+    elif setup and setup[0] == "call":
+        setup[1](here)
     elif setup:
         damage(here / "run", *setup)
     return [arg.replace("{run}", str(here / "run")) for arg in case["argv"]]
@@ -1235,13 +1907,13 @@ def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
     if "code" in case:
         if status == "0":
             return ("clear" if case["ok"] else "wrong"), "accepted"
-        if case["ok"]:
-            return "wrong", status
         kind, _, rest = status.partition(" from ")
         inside = "/site-packages/" in rest.partition(":")[0]
         if inside or kind not in {"ValueError", "TypeError", "ResetNeeded", "SetupError",
                                    "FileNotFoundError", "InvalidAction", "Error"}:  # fmt: skip
             return "wrong", status
+        if case["ok"]:  # valid input may be refused only where the case names what for
+            return ("clear" if case["names"] and named(case, status) else "wrong"), status
         return ("clear" if named(case, status) else "unclear"), status
     if status in ("0", "None"):
         return ("clear" if case["ok"] else "wrong"), "accepted"
@@ -1281,7 +1953,12 @@ def main() -> int:
         "--command", choices=(*COMMANDS, "api"), action="append", help="only its cases"
     )
     parser.add_argument(
-        "--set", choices=("first", "second"), help="only that trial's cases (default: all)"
+        "--set", choices=("first", "second", "third"), help="only that trial's cases (default: all)"
+    )
+    parser.add_argument(
+        "--only",
+        type=lambda text: {int(i) for i in text.split(",")},
+        help="only these cases, by their numbers in the selection, e.g. 0,5,12",
     )
     parser.add_argument(
         "--timeout", type=float, default=20.0, help="seconds a case may run (default: 20)"
@@ -1297,19 +1974,21 @@ def main() -> int:
         and (args.command is None or case.get("command", "api") in args.command)
         and (args.set is None or case.get("set", "first") == args.set)
     ]
+    numbers = [i for i in range(len(cases)) if args.only is None or i in args.only]
     counts = {"clear": 0, "unclear": 0, "wrong": 0}
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         run = tiny_run(work)
-        for index, case in enumerate(cases):
+        for index in numbers:
+            case = cases[index]
             start = time.monotonic()
             verdict, message = run_case(case, work, run, index, args.timeout)
             counts[verdict] += 1
             rows.append((index, case["area"], describe(case), verdict, message))
             print(f"{index}\t{case['area']}\t{verdict}\t{time.monotonic() - start:.0f} s\t"
                   f"{describe(case)[:110]}\t{message[:200]}", flush=True)  # fmt: skip
-    print(f"cases {len(cases)}: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    print(f"cases {len(numbers)}: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
     if args.markdown:
         from simoun_agent import table
 
