@@ -459,3 +459,42 @@ def test_frames_too_large_for_torch_to_size_are_refused_by_the_memory_check(tmp_
     assert "--image-size 100000 with --agent.batch-size 512" in err
     assert "Lower --image-size" in err
     assert not (tmp_path / "run").exists()
+
+
+# a resumed run's new values keep their fields' rules
+
+
+@pytest.mark.parametrize(
+    ("flags", "said"),
+    [
+        (["--eval-every", "0"], "--eval-every 0 (TrainConfig.eval_every) must be an int >= 1"),
+        (["--checkpoint-every", "0"], "--checkpoint-every 0 (TrainConfig.checkpoint_every) must"),
+        (["--torch-threads", "0"], "--torch-threads 0 (TrainConfig.torch_threads) must be an int"),
+    ],
+)
+def test_a_resumed_run_checks_the_values_it_may_change(flags, said, tmp_path, capsys):
+    from test_damaged_files import finished_run
+
+    run_dir = finished_run(tmp_path / "run")
+    before = {path.name: path.read_bytes() for path in run_dir.iterdir()}
+    argv = ["--resume", str(run_dir), "--total-env-steps", "90", *flags]
+    err = refused(capsys, train_cli.main, argv)
+    assert said in err and "Traceback" not in err
+    assert {path.name: path.read_bytes() for path in run_dir.iterdir()} == before
+
+
+@pytest.mark.parametrize(
+    ("module", "said"),
+    [
+        ("..x", "--env-module ..x (TrainConfig.env_module) must be an importable absolute module"),
+        ("simoun_agent.envs:x", "--env-module simoun_agent.envs:x (TrainConfig.env_module) must"),
+        ("os.path.nope", "'os' is installed but has no module 'os.path.nope'"),
+    ],
+)
+def test_an_env_module_that_cannot_be_imported_is_named_without_a_pip_hint(
+    module, said, tmp_path, capsys
+):
+    argv = [*TINY, "--env-module", module, "--run-dir", str(tmp_path / "r")]
+    err = refused(capsys, train_cli.main, argv)
+    assert said in err and "pip install" not in err and "Traceback" not in err
+    assert not (tmp_path / "r").exists()

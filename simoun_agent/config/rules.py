@@ -107,6 +107,21 @@ def text(optional: bool = False, fix: str = "") -> Rule:
     return Rule(need, lambda v: (optional and v is None) or (isinstance(v, str) and v != ""), fix)
 
 
+def module_name(optional: bool = False, fix: str = "") -> Rule:
+    """A module that ``importlib.import_module`` can be given: dotted Python identifiers, no
+    leading dot (a relative name needs a package) and no ``:ID`` (that form belongs to
+    ``--env``)."""
+    need = "an importable absolute module name (dotted identifiers, e.g. minigrid or ale_py)"
+    return Rule(
+        need + (" or none" if optional else ""),
+        lambda v: (
+            (optional and v is None)
+            or (isinstance(v, str) and all(part.isidentifier() for part in v.split(".")))
+        ),
+        fix,
+    )
+
+
 def json_object(fix: str = "") -> Rule:
     return Rule("a JSON object (a dict)", lambda v: isinstance(v, dict), fix)
 

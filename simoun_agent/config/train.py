@@ -21,6 +21,7 @@ from simoun_agent.config.rules import (
     integer,
     is_int,
     json_object,
+    module_name,
     setting,
     text,
     with_rule,
@@ -41,7 +42,7 @@ class TrainConfig:
     MODULE:ID (Gymnasium's form, e.g. minigrid:MiniGrid-DoorKey-6x6-v0) imports MODULE first and
     is saved as env ID plus env_module MODULE"""
     env_module: str | None = setting(
-        None, text(optional=True, fix="e.g. --env-module minigrid, or none")
+        None, module_name(optional=True, fix="e.g. --env-module minigrid, or none")
     )
     """module imported before the env is made, for ids that a package registers on import (e.g.
     ale_py, minigrid); saved with the run, so --resume and simoun-eval import it too"""

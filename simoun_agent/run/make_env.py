@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import importlib
+import importlib.util
 import inspect
 import json
 from collections.abc import Callable
@@ -60,20 +61,28 @@ _SUITES = {"dm_control/": ("shimmy", "dmc"), "": ("highway_env", "highway")}
 
 def import_env_module(module: str) -> None:
     """Import ``module`` (``--env-module`` or the MODULE of ``--env MODULE:ID``), whose import
-    registers ids; raise SetupError with the pip hint when it is not installed."""
+    registers ids; raise SetupError, with a pip hint only when a top-level package is missing
+    (a module missing inside an installed package is not fixed by installing anything)."""
     try:
         importlib.import_module(module)
     except ModuleNotFoundError as err:
         missing = err.name or module
+        top = missing.split(".")[0]
+        if importlib.util.find_spec(top) is not None:
+            raise SetupError(
+                f"--env-module {module!r} cannot be imported: {top!r} is installed but has no "
+                f"module {missing!r}; give the full dotted name of the module of {top} whose "
+                "import registers the ids, or drop the module from --env"
+            ) from None
         if not (module == missing or module.startswith(missing + ".")):
             raise SetupError(
                 f"importing --env-module {module!r} failed: it needs {missing!r}, which is not "
-                f"installed; pip install {missing.split('.')[0].replace('_', '-')}"
+                f"installed; pip install {top.replace('_', '-')}"
             ) from None
         raise SetupError(
             f"--env-module {module!r} is not installed, so the ids it registers are unknown; "
-            f"pip install {missing.split('.')[0].replace('_', '-')} (or the package that "
-            f"provides {module}), or drop the module from --env"
+            f"pip install {top.replace('_', '-')} (or the package that provides {module}), or "
+            "drop the module from --env"
         ) from None
 
 

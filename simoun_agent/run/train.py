@@ -49,7 +49,7 @@ import torch
 from simoun_agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
 from simoun_agent.config.envs import env_label
-from simoun_agent.config.train import RESUMABLE_FIELDS
+from simoun_agent.config.train import RESUMABLE_FIELDS, check_train_config
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.callback import TrainCallback
@@ -237,6 +237,10 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             read_log(run_dir / log)
     for key, value in overrides.items():
         setattr(config, key, value)
+    try:  # a resumed run's new values keep their fields' rules, as a new run's do
+        check_train_config(config)
+    except ValueError as err:
+        raise SetupError(str(err)) from None
     config.run_dir = str(run_dir)
     take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
