@@ -378,3 +378,48 @@ def test_a_probe_count_below_one_is_refused_naming_the_setting(argv, said, tmp_p
     err = refused(capsys, minigrid_cli.main, ["probe", "--out", str(tmp_path / "p"), *argv])
     assert said in err
     assert list(tmp_path.iterdir()) == []
+
+
+def loop(tmp_path: Path) -> Path:
+    """A symbolic link to itself."""
+    link = tmp_path / "loop"
+    link.symlink_to(link)
+    return link
+
+
+@pytest.mark.parametrize(
+    ("where", "said"),
+    [
+        (lambda tmp_path: Path("/proc/x"), "(/proc takes no new folder: "),
+        (loop, "is a symbolic link to {tmp_path}/loop: Too many levels of symbolic links"),
+        (lambda tmp_path: loop(tmp_path) / "deeper", "is a symbolic link to {tmp_path}/loop"),
+    ],
+)
+def test_an_output_directory_that_cannot_be_made_is_named_by_every_command(
+    where, said, tmp_path, capsys
+):
+    spec = Path("docs/studies/dmc100k.toml").absolute()
+    archive = tmp_path / "archive"
+    archive.mkdir()
+    out = where(tmp_path)
+    for main, argv, flag in [
+        (sweep_cli.main, ["--preset", "cpu", "--sweep-dir"], "--sweep-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir"], "--study-dir"),
+        (study_cli.main, ["run", str(spec), "--study-dir", str(tmp_path / "s"), "--archive"],
+         "--archive"),
+        (train_cli.main, ["--env", "simoun/PointReach-v0", "--run-dir"], "--run-dir"),
+        (minigrid_cli.main, ["probe", "--out"], "--out"),
+        (minigrid_cli.main, ["run", "--archive", str(archive), "--work-dir"], "--work-dir"),
+    ]:  # fmt: skip
+        err = refused(capsys, main, [*argv, str(out)])
+        assert f"cannot write to the output directory {out} (" in err
+        assert said.format(tmp_path=tmp_path) in err and f"pass a writable {flag}" in err
+    made = {archive, tmp_path / "loop"} if out != Path("/proc/x") else {archive}
+    assert set(tmp_path.iterdir()) == made and not any(archive.iterdir())
+
+
+def test_the_probe_refuses_an_empty_probe_list(tmp_path, capsys):
+    out = tmp_path / "probe"
+    err = refused(capsys, minigrid_cli.main, ["probe", "--probes", "--out", str(out)])
+    assert "--probes is given no probe" in err and "leave --probes out" in err
+    assert not out.exists()

@@ -15,6 +15,7 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import tempfile
 from pathlib import Path
 from typing import IO
 
@@ -38,22 +39,42 @@ def refuse_a_file(path: Path, flag: str) -> None:
 
 def check_output_dir(path: Path, flag: str) -> None:
     """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
-    written: it is a file, a folder on its way is a file, or the nearest folder of it that
-    exists is not writable by this process. Creates nothing, so a command can check before the
-    work whose set-up takes long (Ray) rather than fail after it."""
-    refuse_a_file(path, flag)
-    existing = path.absolute()
+    written: it is a file, a folder on its way is a file or a symbolic link that loops or leads
+    nowhere, a name is too long, or the nearest folder of it that exists takes no new folder
+    (not writable, a read-only mount, a kernel file system such as /proc). Leaves nothing
+    behind (its probe folder is removed at once), so a command can check before the work whose
+    set-up takes long (Ray) rather than fail after it."""
+    try:
+        refuse_a_file(path, flag)
+        reason = unwritable(path.absolute())
+    except (OSError, RuntimeError) as err:  # the path itself cannot be looked at
+        reason = getattr(err, "strerror", None) or str(err)
+    if reason:
+        raise SetupError(
+            f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
+        )
+
+
+def unwritable(path: Path) -> str | None:
+    """Why no directory can be made at the absolute ``path``, or None when one can."""
+    existing = path
     while not existing.exists() and existing != existing.parent:
+        if existing.is_symlink():  # exists() is False for a link that loops or leads nowhere
+            try:
+                existing.stat()
+            except OSError as err:
+                return f"{existing} is a symbolic link to {os.readlink(existing)}: {err.strerror}"
+            return f"{existing} is a symbolic link that cannot be followed"
         existing = existing.parent
     if not existing.is_dir():
-        reason = f"{existing} is a file"
-    elif not os.access(existing, os.W_OK | os.X_OK):
-        reason = f"{existing} is not writable"
-    else:
-        return
-    raise SetupError(
-        f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
-    )
+        return f"{existing} is a file"
+    if not os.access(existing, os.W_OK | os.X_OK):
+        return f"{existing} is not writable"
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".write-test-", dir=existing))
+    except OSError as err:
+        return f"{existing} takes no new folder: {err.strerror}"
+    return None
 
 
 def make_output_dir(path: Path, flag: str = "--out") -> bool:
@@ -61,7 +82,7 @@ def make_output_dir(path: Path, flag: str = "--out") -> bool:
     it did not exist before, so a caller that stops later can remove what it made; raises
     SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
     created = not path.exists()
-    refuse_a_file(path, flag)
+    check_output_dir(path, flag)
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / ".write-test"

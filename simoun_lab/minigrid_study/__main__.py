@@ -19,6 +19,7 @@ import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.minigrid_study.probe_settings import PROBE_NAMES, ProbeSettings
 
 # The study's modules (torch, SB3, MiniGrid) are imported once the flags are read: --help,
@@ -120,6 +121,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         try:
             check_settings(args.settings, lambda field: "--settings." + field.replace("_", "-"))
+            check_output_dir(args.out, "--out")
             if not args.out.parent.is_dir():
                 raise SetupError(
                     f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "
@@ -138,6 +140,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if isinstance(args, Run):
             from simoun_lab.minigrid_study.runner import run_study
 
+            check_output_dir(args.archive, "--archive")
+            check_output_dir(args.work_dir, "--work-dir")
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
             print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
             return 1 if outcome["failed"] else 0

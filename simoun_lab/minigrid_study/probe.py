@@ -120,6 +120,11 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     (per probe, means over blocks, the first left out: the reward's correlation with novelty
     over all and over moving transitions, its std / mean, its still / moving mean)."""
     check_settings(settings)
+    if not names:  # an empty table would replace the archived probe.csv and probe.md
+        raise ValueError(
+            f"--probes is given no probe, so there is nothing to probe; name one or more of "
+            f"{', '.join(PROBED)}, or leave --probes out to probe them all"
+        )
     unknown = [n for n in names if n not in PROBED]
     if unknown:
         raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBED)}")
