@@ -447,3 +447,22 @@ def test_an_equal_wall_time_budget_must_be_finite(runs_dir, capsys):
     with pytest.raises(SystemExit):
         report_cli.main([str(runs_dir), "--at-wall-time", "inf"])
     assert "--at-wall-time inf: give a positive finite number" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("key", ["env", "seed", "agent"])
+def test_a_config_without_a_key_every_run_records_is_named_and_left_out(key, tmp_path):
+    from test_input_checks import write_run
+
+    for seed in range(2):
+        write_run(tmp_path, f"s{seed}", "dm_control/cartpole-swingup-v0", seed, 500.0 + seed)
+    point = write_run(tmp_path, "point", "simoun/PointReach-v0", 5, 3.0)
+    config = json.loads((point / "config.json").read_text())
+    del config[key]
+    (point / "config.json").write_text(json.dumps(config))
+    report.write_report(tmp_path)
+    text = (tmp_path / "report.md").read_text()
+    assert "## Damaged runs (not counted)" in text
+    assert f"- point: config.json has no {key}, which every run records" in text
+    with (tmp_path / "report.csv").open() as f:
+        (row,) = csv.DictReader(f)
+    assert row["n"] == "2" and float(row["final_return_mean"]) == pytest.approx(500.5)

@@ -225,13 +225,24 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     return curve
 
 
+RECORDED_KEYS = ("env", "seed", "agent")
+"""Keys every saved config.json holds, with no default that could stand in for them: the task,
+the seed and the agent's settings (keys added later are filled in by :func:`with_defaults`)."""
+
+
 def read_run(config_path: Path) -> RunRecord:
     """The run of ``config_path``'s directory, or :class:`DamagedRun`."""
     run_dir = config_path.parent
-    config = flatten(with_defaults(read_json(config_path)))
-    missing = [key for key in ("env", "seed") if key not in config]
+    saved = read_json(config_path)
+    # checked before the defaults fill them in: a run without them would be reported as the
+    # default task, seed or agent
+    missing = [key for key in RECORDED_KEYS if key not in saved]
     if missing:
-        raise DamagedRun(f"{CONFIG_NAME} has no {' or '.join(missing)}")
+        raise DamagedRun(
+            f"{CONFIG_NAME} has no {' or '.join(missing)}, which every run records; its task and "
+            "settings cannot be told"
+        )
+    config = flatten(with_defaults(saved))
     curve = read_curve(run_dir / EVAL_CSV)
     summary_path = run_dir / SUMMARY_NAME
     summary = (
