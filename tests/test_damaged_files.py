@@ -208,7 +208,7 @@ def finished_run(run_dir):
 
 STEP = "env_step 1111111111111111111111111111111111111111"
 KEPT_DAMAGES = [
-    ("config.json", utf16, "it is saved as UTF-16 text; runs write UTF-8"),
+    ("config.json", utf16, "it is saved as UTF-16 text, not UTF-8"),
     ("config.json", nul_in_first_line, "line 1 holds a NUL byte"),
     ("config.json", link_to_nothing, "it is a symbolic link to "),
     ("eval.csv", nul_in_first_line, "line 1 holds a NUL byte"),

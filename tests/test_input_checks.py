@@ -498,3 +498,55 @@ def test_an_env_module_that_cannot_be_imported_is_named_without_a_pip_hint(
     err = refused(capsys, train_cli.main, argv)
     assert said in err and "pip install" not in err and "Traceback" not in err
     assert not (tmp_path / "r").exists()
+
+
+def utf16(text: str) -> bytes:
+    return text.encode("utf-16")
+
+
+def nul_byte(text: str) -> bytes:
+    return text.encode().replace(b"\n", b"\n\0", 1)
+
+
+def latin1(text: str) -> bytes:
+    return ("# r\xe9sum\xe9\n" + text).encode("latin-1")
+
+
+@pytest.mark.parametrize(
+    ("encode", "said"),
+    [
+        (utf16, "it is saved as UTF-16 text, not UTF-8"),
+        (nul_byte, "line 2 holds a NUL byte"),
+        (latin1, "line 1 is not UTF-8 text (byte 0xe9)"),
+    ],
+)
+def test_a_spec_that_is_not_utf8_is_named_by_every_spec_reader(encode, said, tmp_path, capsys):
+    from simoun_lab.cli import study as study_cli
+    from simoun_lab.cli import sweep as sweep_cli
+
+    toml = tmp_path / "spec16.toml"
+    toml.write_bytes(encode(Path("docs/studies/dmc100k.toml").read_text()))
+    err = refused(capsys, study_cli.main, ["plan", str(toml)])
+    assert f"the study spec {toml} is not UTF-8 text: {said}" in err and "save it as UTF-8" in err
+    spec = tmp_path / "spec16.json"
+    spec.write_bytes(encode(json.dumps(MINIGRID_SPEC, indent=1)))
+    for argv in (["select", "--spec", str(spec), "--archive", "."], ["plan", str(spec)]):
+        main = minigrid_cli.main if argv[0] == "select" else study_cli.main
+        err = refused(capsys, main, argv)
+        assert f"--spec {spec} is not UTF-8 text: {said}" in err and "save it as UTF-8" in err
+    sweep = tmp_path / "sweep"
+    sweep.mkdir()
+    (sweep / "sweep.json").write_bytes(encode('{\n"base": {},\n"grid": {}\n}'))
+    err = refused(capsys, sweep_cli.main, ["--resume", "--sweep-dir", str(sweep)])
+    assert f"{sweep / 'sweep.json'} is damaged ({said}" in err
+
+
+def test_a_minigrid_spec_that_gives_a_key_twice_is_refused_naming_it(tmp_path, capsys):
+    from simoun_lab.cli import study as study_cli
+
+    spec = tmp_path / "spec.json"
+    text = json.dumps(MINIGRID_SPEC, indent=1)
+    spec.write_text(text.replace('"arms": [', '"arms": ["rnd"],\n "arms": [', 1))
+    said = f"--spec {spec}: the key 'arms' is given twice; give each key once"
+    assert said in refused(capsys, minigrid_cli.main, ["select", "--spec", str(spec)])
+    assert said in refused(capsys, study_cli.main, ["plan", str(spec)])

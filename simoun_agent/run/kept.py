@@ -39,7 +39,7 @@ def read_text(path: Path) -> str:
         raise Damaged(problem)
     data = path.read_bytes()
     if data.startswith(_UTF16_MARKS):
-        raise Damaged("it is saved as UTF-16 text; runs write UTF-8")
+        raise Damaged("it is saved as UTF-16 text, not UTF-8")
     if b"\0" in data:
         line = data[: data.index(b"\0")].count(b"\n") + 1
         raise Damaged(f"line {line} holds a NUL byte (zero bytes from a disk or copy failure)")

@@ -17,7 +17,9 @@ from typing import Any
 import gymnasium as gym
 
 from simoun_agent.config import SetupError
+from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
+from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.minigrid_study.arms import ARMS, parse_arm
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
@@ -228,11 +230,15 @@ def json_kind(value: Any) -> str:
 def load_spec(path: Path) -> StudySpec:
     """The spec in the JSON file ``path``."""
     try:
-        values = json.loads(Path(path).read_text())
+        values = json_value(read_text(Path(path)))
     except FileNotFoundError:
         raise SetupError(f"--spec {path}: no such file") from None
+    except Damaged as err:
+        raise SetupError(f"--spec {path} is not UTF-8 text: {err}; save it as UTF-8") from None
     except json.JSONDecodeError as err:
         raise SetupError(f"--spec {path}: not valid JSON ({err})") from None
+    except ValueError as err:  # a key given twice
+        raise SetupError(f"--spec {path}: {err}") from None
     if not isinstance(values, dict):
         raise SetupError(
             f"--spec {path} holds {json_kind(values)}, not the object of a study spec "

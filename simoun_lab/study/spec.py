@@ -67,6 +67,7 @@ from simoun_agent.config.keys import (
 )
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
+from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
 from simoun_lab.sweep.grid import MAX_SEEDS, parse_seeds
@@ -263,11 +264,15 @@ def load_spec(path: Path | str) -> StudySpec:
     """Read and check the study spec at ``path``; raises SetupError naming the line and the fix."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = read_text(path)
     except OSError as err:
         raise SetupError(
             f"cannot read the study spec {path} ({err.strerror}); pass a TOML file, "
             "e.g. docs/studies/dmc100k.toml"
+        ) from None
+    except Damaged as err:
+        raise SetupError(
+            f"the study spec {path} is not UTF-8 text: {err}; save it as UTF-8 (TOML is UTF-8)"
         ) from None
     try:
         data = tomllib.loads(text)

@@ -31,6 +31,7 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import Damaged, read_text
 
 SWEEP_FILE = "sweep.json"
 """The sweep's grid and base config, written once in the sweep directory."""
@@ -330,8 +331,8 @@ class SweepSpec:
                 "a sweep that simoun-sweep started, or drop --resume to start one"
             )
         try:
-            spec = cls(**json.loads(path.read_text()))
-        except (json.JSONDecodeError, UnicodeDecodeError, TypeError) as err:
+            spec = cls(**json.loads(read_text(path)))
+        except (json.JSONDecodeError, Damaged, TypeError) as err:
             problem = str(err)
         else:
             problem = "" if isinstance(spec.grid, dict) else "its grid is not a JSON object"
