@@ -423,3 +423,29 @@ def test_the_probe_refuses_an_empty_probe_list(tmp_path, capsys):
     err = refused(capsys, minigrid_cli.main, ["probe", "--probes", "--out", str(out)])
     assert "--probes is given no probe" in err and "leave --probes out" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "word",
+    [
+        "\u2013-seed",
+        "\u2014seed",
+        "\uff0d\uff0d\uff53\uff45\uff45\uff44",
+        "--\uff53\uff45\uff45\uff44",
+        "\u2212\u2212seed=3",
+    ],
+)
+@pytest.mark.parametrize(
+    ("main", "argv"),
+    [
+        (train_cli.main, ["--env", "simoun/PointReach-v0", "--no-video"]),
+        (train_cli.main, ["--env", "simoun/PointReach-v0", "--run-dir"]),
+        (eval_cli.main, ["run", "--no-video"]),
+        (sweep_cli.main, ["--preset", "cpu", "--resume"]),
+        (minigrid_cli.main, ["probe", "--out", "p"]),
+    ],
+)  # fmt: skip
+def test_a_flag_typed_with_a_unicode_dash_is_shown_in_ascii(main, argv, word, capsys):
+    err = refused(capsys, main, [*argv, word, "3"])
+    assert f"{word!r} looks like a flag typed with a non-ASCII dash or letters" in err
+    assert err.rstrip().endswith("type it in ASCII: --seed" + "=3" * word.endswith("=3"))

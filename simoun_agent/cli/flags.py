@@ -37,6 +37,7 @@ import os
 import re
 import sys
 import typing
+import unicodedata
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
@@ -237,6 +238,8 @@ def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, pr
         name = arg.partition("=")[0]
         if not name.startswith("--") or name in flags or name in ("--help", "--version"):
             continue
+        if spelled := ascii_flag(arg):
+            raise lookalike_error(arg, spelled)
         matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
         hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
@@ -255,7 +258,8 @@ def refuse_stray_words(
         if arg == "--":
             break
         flag = flags.get(arg)
-        if flag is not None and flag.switch is not None and not following.startswith("-"):
+        meant_as_flag = following.startswith("-") or ascii_flag(following)
+        if flag is not None and flag.switch is not None and not meant_as_flag:
             raise ValueError(f"{switch_use(arg, flag, switches)}; got {following!r}")
 
 
@@ -304,6 +308,33 @@ def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
             )
 
 
+LOOKALIKE_DASHES = "\u2010\u2011\u2012\u2013\u2014\u2015\u2212\ufe58\ufe63"
+"""Dashes a word processor, autocorrect or a web page puts where ``-`` was typed (hyphens, en
+and em dashes, the minus sign); NFKC turns the fullwidth ones into ASCII itself."""
+
+
+def ascii_flag(word: str) -> str | None:
+    """The ASCII spelling (``--seed``) of a word typed as a flag with look-alike characters
+    (``–-seed``, ``—seed``, fullwidth ``－－ｓｅｅｄ``), else None: such a word is no flag to
+    the shell or to tyro, so it would be taken for a value."""
+    if word.isascii():
+        return None
+    spelled = unicodedata.normalize("NFKC", word).translate(
+        dict.fromkeys(map(ord, LOOKALIKE_DASHES), "-")
+    )
+    name, eq, value = spelled.partition("=")
+    if not re.fullmatch(r"-{1,2}[A-Za-z][A-Za-z0-9_.-]*", name):
+        return None
+    return "--" + name.lstrip("-") + eq + value
+
+
+def lookalike_error(word: str, spelled: str) -> ValueError:
+    return ValueError(
+        f"{word!r} looks like a flag typed with a non-ASCII dash or letters (as autocorrect or "
+        f"a web page writes them); type it in ASCII: {spelled}"
+    )
+
+
 @dataclass(frozen=True)
 class Given:
     """One value of a command line as tyro will read it."""
@@ -335,6 +366,8 @@ def given_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> I
         arg = argv[i]
         if arg == "--":
             return
+        if spelled := ascii_flag(arg):  # whatever it would fill, it was meant as a flag
+            raise lookalike_error(arg, spelled)
         name, eq, text = arg.partition("=")
         flag = flags.get(name) if arg.startswith("--") else None
         i += 1
@@ -345,6 +378,8 @@ def given_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> I
                 yield Given(name, text if eq else None)
                 continue
             while i < len(argv) and not (argv[i].startswith("--") and argv[i] != "--"):
+                if spelled := ascii_flag(argv[i]):
+                    raise lookalike_error(argv[i], spelled)
                 yield Given(name, argv[i])
                 i += 1
                 if not flag.variadic:
