@@ -449,3 +449,20 @@ def test_a_flag_typed_with_a_unicode_dash_is_shown_in_ascii(main, argv, word, ca
     err = refused(capsys, main, [*argv, word, "3"])
     assert f"{word!r} looks like a flag typed with a non-ASCII dash or letters" in err
     assert err.rstrip().endswith("type it in ASCII: --seed" + "=3" * word.endswith("=3"))
+
+
+@pytest.mark.parametrize(
+    ("envs", "said"),
+    [
+        ("Pendulum-v1,Pendulum-v1", "--envs 'Pendulum-v1,Pendulum-v1' names Pendulum-v1 twice; "
+         "list each env once"),
+        ("simoun/PointReach-v0,simoun_agent.envs:simoun/PointReach-v0",
+         "--envs gives simoun/PointReach-v0 and simoun_agent.envs:simoun/PointReach-v0, one task "
+         "by its name (simoun-PointReach-v0); keep one of them"),
+    ],
+)  # fmt: skip
+def test_an_env_given_twice_in_envs_is_named_as_such(envs, said, tmp_path, capsys):
+    argv = ["--preset", "cpu", "--envs", envs, "--sweep-dir", str(tmp_path / "s")]
+    err = refused(capsys, sweep_cli.main, argv)
+    assert said in err and "--grid" not in err
+    assert not (tmp_path / "s").exists()

@@ -232,6 +232,9 @@ class SweepSpec:
         env_list = split_values(envs) if envs is not None else [base_config.env]
         if not all(env_list):
             raise SetupError(f"--envs {envs!r} has an empty id; e.g. --envs simoun/PointReach-v0")
+        twice = [env for env, count in Counter(env_list).items() if count > 1]
+        if twice:
+            raise SetupError(f"--envs {envs!r} names {twice[0]} twice; list each env once")
         spec = cls(preset, _plain(base), _plain(grid), seed_list, env_list, cpus_per_trial)
         spec.check_trials()
         return spec
@@ -266,19 +269,25 @@ class SweepSpec:
     def check_trials(self) -> None:
         """Resolve every trial's config now (unknown recipe, a value its key refuses, a preset
         meant for another env...), before anything runs; two trials may not share a directory."""
-        seen: dict[str, str] = {}
+        seen: dict[str, Trial] = {}
         for trial in self.trials("."):
             try:
                 resolve(trial.preset, trial.overrides)
             except SetupError as err:
                 raise SetupError(f"trial {trial.name} (from --grid / --envs): {err}") from None
             if trial.run_dir in seen:
+                first = seen[trial.run_dir]
+                fix = "make their --grid values differ in letters or digits"
+                if first.env != trial.env:
+                    fix = (
+                        f"--envs gives {first.env} and {trial.env}, one task by its name "
+                        f"({env_label(trial.env)}); keep one of them"
+                    )
                 raise SetupError(
-                    f"trials {seen[trial.run_dir]} and {trial.name} would share the run "
-                    f"directory {trial.run_dir}; make their --grid values differ in letters or "
-                    "digits"
+                    f"trials {first.name} and {trial.name} would share the run directory "
+                    f"{trial.run_dir}; {fix}"
                 )
-            seen[trial.run_dir] = trial.name
+            seen[trial.run_dir] = trial
 
     def describe_differences(self, other: SweepSpec) -> list[str]:
         """What differs from ``other`` (the saved sweep), one line per flag."""
