@@ -670,3 +670,19 @@ def test_a_study_record_saved_before_diagnostics_existed_reads_as_its_spec():
     check_same_spec(record, spec, "not the same", "fix it")  # raises when they differ
     with pytest.raises(SetupError, match="diagnostics differ"):
         check_same_spec(record, replace(spec, diagnostics={"simoun": ["simoun_no_aux"]}), "", "")
+
+
+def test_a_task_given_as_module_id_reaches_every_run_with_its_module(tmp_path):
+    from broken_envs import NAN_REACH_ID
+
+    from simoun_agent.config import resolve
+
+    task = f"broken_envs:{NAN_REACH_ID}"
+    spec = load_spec(write_spec(tmp_path / "spec.toml", SPEC.replace("simoun/PointReach-v0", task)))
+    runs = tuning_runs(spec) + evaluation_runs(spec, {r: {"agent.n_step": 1} for r in spec.recipes})
+    for run in runs:
+        # the trial's process resolves these overrides: the module must be among them
+        trial = run.trial(spec, tmp_path)
+        config = resolve(trial.preset, trial.overrides)
+        assert (config.env, config.env_module) == (NAN_REACH_ID, "broken_envs")
+        assert "/simoun-test-NanReach-v0/" in trial.run_dir
