@@ -527,13 +527,13 @@ def test_a_spec_that_is_not_utf8_is_named_by_every_spec_reader(encode, said, tmp
     toml = tmp_path / "spec16.toml"
     toml.write_bytes(encode(Path("docs/studies/dmc100k.toml").read_text()))
     err = refused(capsys, study_cli.main, ["plan", str(toml)])
-    assert f"the study spec {toml} is not UTF-8 text: {said}" in err and "save it as UTF-8" in err
+    assert f"cannot read the study spec {toml} ({said}" in err and "saved as UTF-8 text" in err
     spec = tmp_path / "spec16.json"
     spec.write_bytes(encode(json.dumps(MINIGRID_SPEC, indent=1)))
     for argv in (["select", "--spec", str(spec), "--archive", "."], ["plan", str(spec)]):
         main = minigrid_cli.main if argv[0] == "select" else study_cli.main
         err = refused(capsys, main, argv)
-        assert f"--spec {spec} is not UTF-8 text: {said}" in err and "save it as UTF-8" in err
+        assert f"--spec {spec} cannot be read ({said}" in err and "saved as UTF-8 text" in err
     sweep = tmp_path / "sweep"
     sweep.mkdir()
     (sweep / "sweep.json").write_bytes(encode('{\n"base": {},\n"grid": {}\n}'))

@@ -234,7 +234,9 @@ def load_spec(path: Path) -> StudySpec:
     except FileNotFoundError:
         raise SetupError(f"--spec {path}: no such file") from None
     except Damaged as err:
-        raise SetupError(f"--spec {path} is not UTF-8 text: {err}; save it as UTF-8") from None
+        raise SetupError(
+            f"--spec {path} cannot be read ({err}); pass a JSON spec saved as UTF-8 text"
+        ) from None
     except json.JSONDecodeError as err:
         raise SetupError(f"--spec {path}: not valid JSON ({err})") from None
     except ValueError as err:  # a key given twice

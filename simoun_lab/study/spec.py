@@ -272,7 +272,8 @@ def load_spec(path: Path | str) -> StudySpec:
         ) from None
     except Damaged as err:
         raise SetupError(
-            f"the study spec {path} is not UTF-8 text: {err}; save it as UTF-8 (TOML is UTF-8)"
+            f"cannot read the study spec {path} ({err}); pass a TOML file saved as UTF-8 text, "
+            "e.g. docs/studies/dmc100k.toml"
         ) from None
     try:
         data = tomllib.loads(text)
