@@ -71,6 +71,13 @@ def test_an_unknown_probe_is_refused_with_the_choices(tmp_path):
         write_probe(ProbeSettings(), ["nope"], tmp_path)
 
 
+def test_an_empty_probe_list_is_refused_and_leaves_the_archived_table(tmp_path):
+    (tmp_path / "probe.csv").write_text("probe,seed\nrnd,0\n")
+    with pytest.raises(ValueError, match=r"--probes is given no probe.*leave --probes out"):
+        write_probe(ProbeSettings(), [], tmp_path)
+    assert (tmp_path / "probe.csv").read_text() == "probe,seed\nrnd,0\n"
+
+
 @pytest.mark.parametrize(
     ("settings", "said"),
     [
