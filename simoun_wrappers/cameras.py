@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Iterable, Mapping
-from typing import Any
+from typing import Any, SupportsFloat
 
 import cv2
 import gymnasium as gym
@@ -12,6 +12,7 @@ import numpy as np
 from gymnasium import spaces
 
 from simoun_wrappers.augment import RandomConvolution
+from simoun_wrappers.distractors._dm_control import check_open
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import check_image, parse_size
 
@@ -139,6 +140,8 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         # wrapper, and would be empty when read again
         cameras = tuple(cameras)
         self._hw = parse_size(size)
+        self._dm_control = any(isinstance(c, (int, np.integer, str)) for c in cameras)
+        """whether a view renders the physics of a dm_control task, which close() frees"""
         gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
         gym.ObservationWrapper.__init__(self, env)
         refuse_over_frame_stack(
@@ -210,9 +213,24 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     def render_mode(self) -> str:
         return "rgb_array"
 
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        self._check_open()
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        self._check_open()
+        return super().step(action)
+
     def render(self) -> np.ndarray:
         """The current views side by side, as in the observation."""
+        self._check_open()
         return self.observation(None)
+
+    def _check_open(self) -> None:
+        if self._dm_control:
+            check_open(self.env, "MultiCamera")
 
     def observation(self, observation: Any) -> np.ndarray:
         return np.concatenate([view() for view in self._views], axis=1)
