@@ -448,6 +448,7 @@ class SimounAgent:
         intrinsic return, plus gamma * discount * V of the next state (the actor's
         :meth:`next_value`), V averaged over the target views (DrQ's K)."""
         cfg = self.config
+        step = self._check_step(step, "td_target")
         with torch.no_grad():
             policy_state, value_state = self.next_states(views, following)
             value = self.actor.next_value(
@@ -491,6 +492,7 @@ class SimounAgent:
         encoded here), without gradient. The running maxima are raised with the batch first
         (the distances of steps past the episode's end count as 0)."""
         cfg = self.config
+        step = self._check_step(step, "intrinsic_reward")
         batch = len(extrinsic)
         steps = 1 if return_mask is None else return_mask.shape[1]
         motion, appearance = [enc.motion[:batch]], [enc.appearance[:batch]]
