@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 import functools
 import math
+from collections.abc import Mapping
 from dataclasses import asdict
 from typing import NamedTuple
 
@@ -30,7 +31,7 @@ from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Critic
 from simoun_agent.replay import FrameReplay
-from simoun_wrappers._checks import check_bool
+from simoun_wrappers._checks import check_bool, check_nonnegative_int
 from simoun_wrappers.augment import random_conv, random_shift, shift_pad
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
 
@@ -199,33 +200,59 @@ class SimounAgent:
 
     # -- acting --------------------------------------------------------------------------------
 
-    def _check_obs(self, frames: np.ndarray | torch.Tensor, batched: bool) -> torch.Tensor:
+    def _check_obs(
+        self, frames: np.ndarray | torch.Tensor, batched: bool, name: str
+    ) -> torch.Tensor:
+        """``frames`` (the argument ``name``) as a tensor on the device, or an error naming the
+        argument and the uint8 array of the shape it must be."""
         if isinstance(frames, dict):
             raise ValueError(
                 f"expected the uint8 frames array, got SimounObservation's whole dict (keys "
                 f"{sorted(frames)}); pass its 'frames' entry: agent.act(obs['frames'])"
             )
+        want = ("(B, " if batched else "(") + ", ".join(map(str, self.obs_shape)) + ")"
+        if not isinstance(frames, (np.ndarray, torch.Tensor)):
+            # a list would be converted slowly and with a guessed dtype, never uint8
+            raise TypeError(
+                f"{name} must be a uint8 numpy array (or torch tensor) of shape {want} (frames "
+                f"t-2, t-1, t, channel-first), got a {type(frames).__name__}; pass the 'frames' "
+                "entry of SimounObservation unchanged, or np.asarray(frames, np.uint8)"
+            )
         expected = ((-1,) if batched else ()) + self.obs_shape
         shape = tuple(frames.shape)
         ok_shape = len(shape) == len(expected) and shape[-4:] == self.obs_shape
         if not ok_shape or str(frames.dtype).split(".")[-1] != "uint8":
-            want = ("(B, " if batched else "(") + ", ".join(map(str, self.obs_shape)) + ")"
             raise ValueError(
-                f"expected uint8 frames of shape {want} (frames t-2, t-1, t, channel-first), got "
-                f"{frames.dtype} {shape}; pass the 'frames' entry of SimounObservation unchanged"
+                f"{name}: expected uint8 frames of shape {want} (frames t-2, t-1, t, "
+                f"channel-first), got {frames.dtype} {shape}; pass the 'frames' entry of "
+                "SimounObservation unchanged"
             )
         return torch.as_tensor(frames, device=self.device)
 
+    def _check_step(self, step: int | None, owner: str) -> int:
+        """``step``, the global env step given to ``owner``, or that of the latest update for
+        None; a ValueError for anything but None or an int >= 0 (numpy ints included), which
+        would otherwise reach the exploration and curiosity schedules."""
+        if step is None:
+            return self.env_step
+        check_nonnegative_int(
+            step, f"{owner}(step=...)", "pass the global env step, e.g. step=0, or None"
+        )
+        return int(step)
+
     def act(
-        self, frames: np.ndarray, deterministic: bool = False, step: int | None = None
+        self,
+        frames: np.ndarray | torch.Tensor,
+        deterministic: bool = False,
+        step: int | None = None,
     ) -> np.ndarray:
-        """Action in [-1, 1]^action_dim for one observation ``uint8 (3, C, H, W)``: the policy's
-        mode when ``deterministic`` (evaluation), else its exploration. ``step``: the global env
-        step, which sets the noise of a scheduled actor (DrQ-v2's); None: that of the latest
-        :meth:`update`."""
+        """Action in [-1, 1]^action_dim for one observation ``uint8 (3, C, H, W)``, a numpy array
+        or a torch tensor: the policy's mode when ``deterministic`` (evaluation), else its
+        exploration. ``step``: the global env step (an int >= 0), which sets the noise of a
+        scheduled actor (DrQ-v2's); None: that of the latest :meth:`update`."""
         check_bool(deterministic, "act(deterministic=...)")
-        obs = self._check_obs(frames, batched=False).unsqueeze(0)
-        step = self.env_step if step is None else step
+        step = self._check_step(step, "act")
+        obs = self._check_obs(frames, batched=False, name="act(frames)").unsqueeze(0)
         with torch.inference_mode():
             action = self.actor.act(self.encoder(obs).state, deterministic, step)
         return action[0].cpu().numpy()
@@ -241,7 +268,7 @@ class SimounAgent:
                 f"encoder_features needs a dual-path encoder; this agent uses "
                 f"{self.config.encoder!r} (set AgentConfig.encoder to 'dual' or 'dual_interactive')"
             )
-        obs = self._check_obs(triplets, batched=True)
+        obs = self._check_obs(triplets, batched=True, name="encoder_features(triplets)")
         with torch.no_grad():
             enc = self.encoder(obs, frame_features=True)
         return enc.motion.detach(), enc.appearance
@@ -251,10 +278,12 @@ class SimounAgent:
     def update(self, replay: FrameReplay, step: int) -> dict[str, torch.Tensor]:
         """One gradient step on ``config.batch_size`` transitions sampled from ``replay``.
 
-        ``step`` is the global environment step (curiosity decay, exploration schedule). Returns
-        detached 0-d tensors (no host sync here); call ``float()`` on the ones you log.
+        ``step`` is the global environment step, an int >= 0 (curiosity decay, exploration
+        schedule). Returns detached 0-d tensors (no host sync here); call ``float()`` on the ones
+        you log.
         """
         cfg = self.config
+        step = self._check_step(step, "update")
         stored = (getattr(replay, "frame_shape", None), getattr(replay, "action_dim", None))
         if stored != (self.frame_shape, self.action_dim):
             raise ValueError(
@@ -316,7 +345,7 @@ class SimounAgent:
         ``contrastive_step`` (CURL), :meth:`update_contrastive`.
         """
         cfg = self.config
-        self.env_step = step
+        self.env_step = step = self._check_step(step, "update_window")
         steps = 1 if return_mask is None else return_mask.shape[1]
         self.check_window(window, steps)
         bootstrap_obs, n_return = bootstrap if bootstrap is not None else (None, reward)
@@ -419,6 +448,7 @@ class SimounAgent:
         intrinsic return, plus gamma * discount * V of the next state (the actor's
         :meth:`next_value`), V averaged over the target views (DrQ's K)."""
         cfg = self.config
+        step = self._check_step(step, "td_target")
         with torch.no_grad():
             policy_state, value_state = self.next_states(views, following)
             value = self.actor.next_value(
@@ -462,6 +492,7 @@ class SimounAgent:
         encoded here), without gradient. The running maxima are raised with the batch first
         (the distances of steps past the episode's end count as 0)."""
         cfg = self.config
+        step = self._check_step(step, "intrinsic_reward")
         batch = len(extrinsic)
         steps = 1 if return_mask is None else return_mask.shape[1]
         motion, appearance = [enc.motion[:batch]], [enc.appearance[:batch]]
@@ -571,7 +602,7 @@ class SimounAgent:
         """The actor's loss (Eq. 11 for SAC's) on detached features, then the temperature when
         the actor has one; the critic is held fixed. ``step``: the global env step (None: that
         of the latest update)."""
-        step = self.env_step if step is None else step
+        step = self._check_step(step, "update_actor")
         self.critic.requires_grad_(False)
         l_pi, log_prob, extra = self.actor.loss(self.critic, state, self.alpha, step)
         self.critic.requires_grad_(True)
@@ -635,8 +666,76 @@ class SimounAgent:
             state["contrastive_optimizers"] = [o.state_dict() for o in self.contrastive_optimizers]
         return state
 
+    def check_state(self, state: dict) -> None:
+        """A ValueError (TypeError for no dict) that names what of ``state`` does not fit this
+        agent: a part missing, a part this agent has no network for, or a tensor of another
+        shape, with the config fields that differ; nothing is loaded."""
+        if not isinstance(state, Mapping):
+            raise TypeError(
+                f"state must be the dict SimounAgent.state_dict() returns, got "
+                f"{type(state).__name__}; e.g. agent.load_state_dict(other.state_dict())"
+            )
+        nets = self.modules()
+        required = [*nets, "critic_optimizer", "actor_optimizer", "running_max", "num_updates"]
+        if self.log_alpha is not None:
+            required += ["log_alpha", "alpha_optimizer"]
+        if self.contrastive_optimizers:
+            required.append("contrastive_optimizers")
+        problems = []
+        missing = [key for key in required if key not in state]
+        if missing:
+            problems.append(f"it lacks {', '.join(missing)}")
+        extra = [
+            key
+            for key in ("reward_model", "similarity", "transition", "contrastive_optimizers")
+            if key in state and key not in required
+        ]
+        if extra:
+            problems.append(f"it holds {', '.join(extra)}, which this agent has none of")
+        for name, net in nets.items():
+            saved = state.get(name)
+            if saved is None:
+                continue
+            if not isinstance(saved, Mapping):
+                problems.append(f"its {name} is a {type(saved).__name__}, not a state dict")
+                continue
+            own = net.state_dict()
+            lacking = [key for key in own if key not in saved]
+            if lacking:
+                problems.append(f"its {name} lacks {', '.join(lacking)}")
+            for key, tensor in own.items():
+                shape = getattr(saved.get(key), "shape", None)
+                if shape is not None and tuple(shape) != tuple(tensor.shape):
+                    problems.append(
+                        f"{name}.{key} is {tuple(shape)} there, {tuple(tensor.shape)} here"
+                    )
+        if not problems:
+            return
+        config = state.get("config")
+        differ = (
+            [
+                f"{key} {config[key]!r} there, {value!r} here"
+                for key, value in asdict(self.config).items()
+                if key in config and config[key] != value
+            ]
+            if isinstance(config, Mapping)
+            else []
+        )
+        more = len(problems) - 4
+        shown = "; ".join(problems[:4]) + (f"; {more} more" if more > 0 else "")
+        raise ValueError(
+            f"this state does not fit this agent: {shown}"
+            + (f" (the state's config differs: {', '.join(differ)})" if differ else "")
+            + ". The state must come from SimounAgent.state_dict() of an agent of the same "
+            f"config, frame_shape {self.frame_shape} and action_dim {self.action_dim}; build "
+            "this agent with the config the state was saved with"
+        )
+
     def load_state_dict(self, state: dict) -> None:
-        """Restore what :meth:`state_dict` saved (into an agent built with the same config)."""
+        """Restore what :meth:`state_dict` saved (into an agent built with the same config,
+        frame shape and action_dim); a state that does not fit is refused by
+        :meth:`check_state` before anything is loaded."""
+        self.check_state(state)
         for name, net in self.modules().items():
             net.load_state_dict(state[name])
         if self.log_alpha is not None:

@@ -6,12 +6,15 @@ import functools
 import inspect
 import json
 import os
+import zipfile
 from collections.abc import Callable
+from pathlib import Path
 from typing import IO
 
 import numpy as np
 
-from simoun_wrappers._checks import check_bool, is_int
+from simoun_agent.run.kept import binary_problem
+from simoun_wrappers._checks import check_bool, check_positive_int, is_int, is_real
 
 _MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
 
@@ -223,8 +226,13 @@ class FrameReplay:
         k+1 frames are ``window``; frame t+m is repeated after t+m, so it never holds a frame of
         another episode), whose k frames ending at t+j are s_{t+j}.
         """
-        if n_step < 1:
-            raise ValueError(f"n_step must be >= 1, got {n_step}")
+        check_positive_int(batch_size, "sample(batch_size=...)", "e.g. sample(128)")
+        check_positive_int(n_step, "sample(n_step=...)", "use 1, or the n of n-step returns")
+        if not (is_real(discount) and 0 <= discount <= 1):
+            raise ValueError(
+                f"sample(discount=...) must be a number in [0, 1], got {discount!r}; pass the "
+                "agent's discount, e.g. 0.99"
+            )
         available = len(self)
         if batch_size > available:
             raise ValueError(
@@ -339,14 +347,17 @@ class FrameReplay:
         ``replay.load(path)`` loads the file into ``replay`` and returns it; ``replay`` must have
         the file's capacity, frame_shape, action_dim and num_frames, else ValueError names both.
         """
-        with np.load(path) as data:
-            meta = json.loads(data["meta"].tobytes().decode())
-            built = {
-                "capacity": meta["capacity"],
-                "frame_shape": tuple(meta["frame_shape"]),
-                "action_dim": meta["action_dim"],
-                "num_frames": meta["num_frames"],
-            }
+        with _open_replay(path) as data:
+            try:
+                meta = json.loads(data["meta"].tobytes().decode())
+                built = {
+                    "capacity": meta["capacity"],
+                    "frame_shape": tuple(meta["frame_shape"]),
+                    "action_dim": meta["action_dim"],
+                    "num_frames": meta["num_frames"],
+                }
+            except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as err:
+                raise _damaged(path, f"its 'meta' record cannot be read ({err})") from None
             if into is not None:
                 differ = [key for key, value in built.items() if getattr(into, key) != value]
                 if differ:
@@ -367,14 +378,67 @@ class FrameReplay:
             )
             if slots != replay.slots:
                 replay._allocate(slots)
-            used = data["frames"].shape[0]
-            for name in ("frames", "actions", "rewards", "terminated", "truncated", "steps"):
-                getattr(replay, name)[:used] = data[name]
-        replay.written = meta["written"]
-        replay.transitions = meta["transitions"]
-        replay.episode_step = meta["episode_step"]
-        replay.rng.bit_generator.state = meta["rng"]
+            try:
+                used = data["frames"].shape[0]
+                for name in ("frames", "actions", "rewards", "terminated", "truncated", "steps"):
+                    getattr(replay, name)[:used] = data[name]
+                replay.written = meta["written"]
+                replay.transitions = meta["transitions"]
+                replay.episode_step = meta["episode_step"]
+                replay.rng.bit_generator.state = meta["rng"]
+            except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as err:
+                raise _damaged(path, f"{type(err).__name__}: {err}") from None
         if into is None:
             return replay
         vars(into).update(vars(replay))
         return into
+
+
+def _name(path: str | os.PathLike | IO[bytes]) -> str:
+    return str(getattr(path, "name", path))
+
+
+def _damaged(path: str | os.PathLike | IO[bytes], problem: str) -> ValueError:
+    """The error for a replay file that :meth:`FrameReplay.save` wrote but that was damaged
+    since: what is wrong (``problem``, or an empty or all-zero file) and the fix."""
+    if not hasattr(path, "read"):
+        seen = binary_problem(Path(path))
+        if not seen.startswith("it cannot be read"):
+            problem = seen
+    return ValueError(
+        f"replay file {_name(path)} is damaged: {problem}. Restore it from a copy, or collect "
+        "a new replay"
+    )
+
+
+def _open_replay(path: str | os.PathLike | IO[bytes]) -> np.lib.npyio.NpzFile:
+    """``path`` opened as an ``.npz`` without pickled data, or an error that names the file as
+    missing, damaged, or not a replay (numpy's own advice, ``allow_pickle``, would load code)."""
+    if not hasattr(path, "read") and not os.path.isfile(path):
+        raise FileNotFoundError(
+            f"replay file {_name(path)} does not exist (or is not a file); pass the path "
+            "FrameReplay.save wrote"
+        )
+    try:
+        data = np.load(path)
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        if hasattr(path, "read"):
+            path.seek(0)
+            head = path.read(4)
+        else:
+            with open(path, "rb") as f:
+                head = f.read(4)
+        if head.startswith(b"PK") or not head.strip(b"\0"):
+            raise _damaged(path, f"it is no readable .npz archive ({err})") from None
+        raise ValueError(
+            f"{_name(path)} is not a replay saved by FrameReplay.save (it is no .npz archive); "
+            "pass the file that replay.save(path) wrote"
+        ) from None
+    if not isinstance(data, np.lib.npyio.NpzFile) or "meta" not in data.files:
+        if isinstance(data, np.lib.npyio.NpzFile):
+            data.close()
+        raise ValueError(
+            f"{_name(path)} is not a replay saved by FrameReplay.save (it holds no 'meta' "
+            "record); pass the file that replay.save(path) wrote"
+        )
+    return data

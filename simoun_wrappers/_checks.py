@@ -36,6 +36,14 @@ def check_positive_int(value: Any, name: str, fix: str) -> None:
         raise ValueError(f"{name} must be a positive int, got {value!r}; {fix}")
 
 
+def check_nonnegative_int(value: Any, name: str, fix: str) -> None:
+    """A ValueError for a ``value`` of the argument ``name`` that is not an int >= 0 (a count or
+    a step: a float, a string or a bool would fail later, far from the call, or count wrong);
+    ``fix`` says what to pass instead."""
+    if not is_int(value) or value < 0:
+        raise ValueError(f"{name} must be an int >= 0, got {value!r}; {fix}")
+
+
 def check_bool(value: Any, name: str) -> None:
     """A TypeError for a ``value`` of the argument ``name`` that is not a Python or numpy bool:
     a truthy stand-in such as ``"no"`` or ``"false"`` would otherwise switch the option on."""

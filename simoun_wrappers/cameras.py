@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any, SupportsFloat
 
 import cv2
 import gymnasium as gym
@@ -12,8 +12,9 @@ import numpy as np
 from gymnasium import spaces
 
 from simoun_wrappers.augment import RandomConvolution
+from simoun_wrappers.distractors._dm_control import check_open
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
-from simoun_wrappers.observation import parse_size
+from simoun_wrappers.observation import check_image, parse_size
 
 Camera = int | str | Mapping[str, Any] | Callable[[gym.Env], np.ndarray]
 """A dm_control camera id or name, a highway-env viewport dict, or a callable env -> image."""
@@ -116,17 +117,31 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     def __init__(
         self,
         env: gym.Env,
-        cameras: Sequence[Camera],
+        cameras: Iterable[Camera],
         size: int | tuple[int, int] | None = (84, 84),
     ) -> None:
         """Wrap ``env``.
 
         Args:
             env: the environment to render views of.
-            cameras: one entry per view (see the class docstring), left to right.
-            size: every view's ``(H, W)`` (an int means square); None keeps each view's size.
+            cameras: one entry per view (see the class docstring), left to right: a list, a
+                tuple or any other iterable, read once here (a generator is fine).
+            size: every view's ``(H, W)`` (an int means square); None keeps each view's size,
+                which every view must then keep at every step.
         """
         check_single_env(env, "MultiCamera")
+        if isinstance(cameras, (str, bytes, Mapping)) or not isinstance(cameras, Iterable):
+            raise TypeError(
+                f"cameras must be a list of views (or another iterable of them), got "
+                f"{cameras!r}; e.g. ['side', 'back'] or [0, 1] for dm_control, a list of "
+                "viewport dicts for highway-env."
+            )
+        # read once, here: a generator cannot be recorded (deep-copied) or pickled with the
+        # wrapper, and would be empty when read again
+        cameras = tuple(cameras)
+        self._hw = parse_size(size)
+        self._dm_control = any(isinstance(c, (int, np.integer, str)) for c in cameras)
+        """whether a view renders the physics of a dm_control task, which close() frees"""
         gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
         gym.ObservationWrapper.__init__(self, env)
         refuse_over_frame_stack(
@@ -137,22 +152,23 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
             "SimounObservation(MultiCamera(env, cameras), size=None) stacks the side-by-side views",
         )
         refuse_over_random_convolution(env)
-        if isinstance(cameras, (str, bytes, Mapping)) or not isinstance(cameras, Sequence):
-            raise TypeError(
-                f"cameras must be a list of views, got {cameras!r}; e.g. ['side', 'back'] or "
-                f"[0, 1] for dm_control, a list of viewport dicts for highway-env."
-            )
         if len(cameras) == 0:
             raise ValueError("cameras is empty; pass at least one view, e.g. [0].")
-        self._hw = parse_size(size)
-        self._views = [self._make_view(camera) for camera in cameras]
+        self._shape: tuple[int, ...] | None = None
+        """the views' shape under ``size=None`` (the first images'), which every later image
+        must keep: the observation space holds it; None while the constructor reads it"""
+        self._views = [
+            functools.partial(self._checked, camera, self._make_view(camera)) for camera in cameras
+        ]
         self.env.reset()
-        shapes = [np.shape(view()) for view in self._views]
-        if len(set(shapes)) != 1 or len(shapes[0]) != 3 or shapes[0][2] != 3:
+        shapes = [view().shape for view in self._views]
+        if len(set(shapes)) != 1:
             raise ValueError(
-                f"views of different sizes or not (H, W, 3): {shapes}; pass size=(H, W) so "
-                f"that every view is rendered or resized to the same size."
+                f"views of different sizes: {shapes}; pass size=(H, W) so that every view is "
+                f"rendered or resized to the same size."
             )
+        if self._hw is None:
+            self._shape = shapes[0]
         height, width, _ = shapes[0]
         self.observation_space = spaces.Box(
             0, 255, (height, width * len(cameras), 3), dtype=np.uint8
@@ -165,21 +181,30 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         if isinstance(camera, Mapping):
             return _highway_view(self.env, camera, self._hw)
         if callable(camera):
-            return functools.partial(self._view_of, camera)
+            return functools.partial(camera, self.env)
         raise TypeError(
             f"camera {camera!r} not understood; use a dm_control camera id or name, a "
             f"highway-env viewport dict, or a callable env -> (H, W, 3) uint8 image."
         )
 
-    def _view_of(self, camera: Callable) -> np.ndarray:
-        return self._checked(camera(self.env), camera)
-
-    def _checked(self, image: Any, camera: Callable) -> np.ndarray:
-        if not isinstance(image, np.ndarray) or image.dtype != np.uint8:
-            raise TypeError(
-                f"camera {camera!r} returned {getattr(image, 'dtype', type(image))}; a camera "
-                f"callable must return an (H, W, 3) uint8 image."
-            )
+    def _checked(self, camera: Camera, view: Callable[[], Any]) -> np.ndarray:
+        """The image of ``view`` (the view of ``camera``), checked as ``SimounObservation``
+        checks renders (uint8, ``(H, W, 3)``, no side of 0 and, under ``size=None``, the first
+        image's shape at every step), then resized to ``size``."""
+        size_fix = "Make the camera return such an image" + (
+            " (under size=None every view keeps its first size; pass size=(H, W) to resize "
+            "them to one)."
+            if self._hw is None
+            else "."
+        )
+        image = check_image(
+            view(),
+            "MultiCamera",
+            f"camera {camera!r}",
+            ("Make the camera return such an image, e.g. np.asarray(image, np.uint8).", size_fix),
+            self._shape,
+            rgb=True,
+        )
         if self._hw is not None and image.shape[:2] != self._hw:
             image = cv2.resize(image, self._hw[::-1], interpolation=cv2.INTER_AREA)
         return image
@@ -188,18 +213,27 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     def render_mode(self) -> str:
         return "rgb_array"
 
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        self._check_open()
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        self._check_open()
+        return super().step(action)
+
     def render(self) -> np.ndarray:
         """The current views side by side, as in the observation."""
+        self._check_open()
         return self.observation(None)
 
+    def _check_open(self) -> None:
+        if self._dm_control:
+            check_open(self.env, "MultiCamera")
+
     def observation(self, observation: Any) -> np.ndarray:
-        views = [view() for view in self._views]
-        if len({v.shape for v in views}) != 1:
-            raise ValueError(
-                f"views of different sizes: {[v.shape for v in views]}; pass size=(H, W) so "
-                f"that every view is resized to the same size."
-            )
-        return np.concatenate(views, axis=1)
+        return np.concatenate([view() for view in self._views], axis=1)
 
 
 def refuse_over_random_convolution(env: gym.Env) -> None:

@@ -247,10 +247,39 @@ def check_render(frame: Any, owner: str, shape: tuple[int, ...] | None = None) -
     """``frame``, an ``rgb_array`` render that ``owner`` takes its pixels from, or a TypeError
     (not a uint8 array) or ValueError (a side of 0, or not ``shape``, the first render's) that
     names the env's render and what it must return."""
+    return check_image(
+        frame,
+        owner,
+        "the env's render() (render_mode='rgb_array')",
+        (
+            "Use an env whose rgb_array render is such an image, or convert it in a wrapper's "
+            "render().",
+            "Give the env a fixed render size (e.g. its render width and height), and check its "
+            "render_kwargs.",
+        ),
+        shape,
+        noun="render",
+    )
+
+
+def check_image(
+    frame: Any,
+    owner: str,
+    source: str,
+    fixes: tuple[str, str],
+    shape: tuple[int, ...] | None = None,
+    rgb: bool = False,
+    noun: str = "image",
+) -> np.ndarray:
+    """``frame``, an image ``owner`` takes from ``source`` (an env's render, a camera), or a
+    TypeError (not a uint8 array) or ValueError (a side of 0; not 2-D or 3-D, a gray image
+    being taken; not ``(H, W, 3)`` when ``rgb``; or not ``shape``, the first image's) that names
+    the source and what it must return. ``fixes`` holds the fix of each error, in that order;
+    ``noun`` is what the source returns (a "render", an "image")."""
     if shape is None:
         expected = "an (H, W, 3) uint8 image with H, W >= 1"
     else:
-        expected = f"uint8 images of its first render's shape {shape}"
+        expected = f"uint8 images of its first {noun}'s shape {shape}"
     what = None
     if not isinstance(frame, np.ndarray):
         what = "None" if frame is None else f"a {type(frame).__name__}"
@@ -258,19 +287,19 @@ def check_render(frame: Any, owner: str, shape: tuple[int, ...] | None = None) -
         what = f"a {frame.dtype} array"
     if what is not None:
         raise TypeError(
-            f"{owner} takes its frames from the env's render() (render_mode='rgb_array'), which "
-            f"returned {what}; it must return {expected} at every step. Use an env whose "
-            "rgb_array render is such an image, or convert it in a wrapper's render()."
+            f"{owner} takes its frames from {source}, which returned {what}; it must return "
+            f"{expected} at every step. {fixes[0]}"
         )
-    if shape is None and (frame.ndim not in (2, 3) or 0 in frame.shape):
-        what = f"an array of shape {frame.shape}"
-    elif shape is not None and frame.shape != shape:
+    if shape is None:
+        layout = frame.ndim == 3 and frame.shape[2] == 3 if rgb else frame.ndim in (2, 3)
+        if not layout or 0 in frame.shape:
+            what = f"an array of shape {frame.shape}"
+    elif frame.shape != shape:
         what = f"an image of shape {frame.shape}"
     if what is not None:
         raise ValueError(
-            f"{owner} takes its frames from the env's render() (render_mode='rgb_array'), which "
-            f"returned {what}; it must return {expected} at every step. Give the env a fixed "
-            "render size (e.g. its render width and height), and check its render_kwargs."
+            f"{owner} takes its frames from {source}, which returned {what}; it must return "
+            f"{expected} at every step. {fixes[1]}"
         )
     return frame
 
@@ -393,6 +422,8 @@ class SimounObservation(ChainWrapper):
                 ``"observation"`` or ``"render"``.
         """
         check_single_env(env, "SimounObservation")
+        # parsed before it is recorded: recording deep-copies it, which a generator refuses
+        hw = parse_size(size)
         gym.utils.RecordConstructorArgs.__init__(
             self,
             size=size,
@@ -403,7 +434,6 @@ class SimounObservation(ChainWrapper):
             source=source,
         )
         check_stack_options(num_frames, motion, fold_frames, source, grayscale)
-        hw = parse_size(size)
         stack = frame_stack_in(env)
         if stack is not None:
             raise TypeError(

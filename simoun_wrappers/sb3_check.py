@@ -31,6 +31,75 @@ SB3_POLICIES = ("CnnPolicy", "MlpPolicy", "MultiInputPolicy")
 ``KeyError`` inside SB3)."""
 
 
+_SB3_LEAVES = (spaces.Box, spaces.Discrete, spaces.MultiDiscrete, spaces.MultiBinary)
+"""The observation spaces SB3's policies and buffers take (its ``get_obs_shape``), alone or as
+the values of a Dict."""
+
+
+def _fix_for(space: spaces.Space) -> str:
+    """What makes ``space`` one an SB3 policy takes: flattening, where gymnasium can."""
+    try:
+        flat = spaces.utils.flatten_space(space)
+    except (NotImplementedError, TypeError, ValueError):
+        flat = None
+    if isinstance(flat, spaces.Box):
+        return (
+            "wrap the env in gymnasium.wrappers.FlattenObservation (a 1-D Box, for "
+            "'MlpPolicy'), or give it a Dict of those spaces (for 'MultiInputPolicy')"
+        )
+    return (
+        "convert the observation in a wrapper of your own to a Box (for 'MlpPolicy') or a Dict "
+        "of those spaces (for 'MultiInputPolicy')"
+    )
+
+
+def _kind_name(space: spaces.Space) -> str:
+    return type(space).__name__
+
+
+def _unsupported(space: spaces.Space) -> str | None:
+    """Why no SB3 policy takes ``space`` (a kind SB3 refuses, or a Dict nesting one), else None."""
+    leaves = ", ".join(kind.__name__ for kind in _SB3_LEAVES)
+    if isinstance(space, spaces.Dict):
+        for key, sub in space.spaces.items():
+            if isinstance(sub, (spaces.Dict, spaces.Tuple)):
+                return (
+                    f"its Dict holds a {_kind_name(sub)} under {key!r}, and SB3 takes no nested "
+                    f"spaces (only {leaves} in a Dict)"
+                )
+            if not isinstance(sub, _SB3_LEAVES):
+                return (
+                    f"its Dict holds a {_kind_name(sub)} under {key!r}, which SB3 takes in no "
+                    f"policy (only {leaves})"
+                )
+        return None
+    if not isinstance(space, _SB3_LEAVES):
+        return (
+            f"it is a {_kind_name(space)} space, which SB3 takes in no policy (it takes {leaves}, "
+            "and a Dict of those)"
+        )
+    return None
+
+
+def _is_image(space: spaces.Space) -> bool:
+    """SB3's ``is_image_space``: a 3-D uint8 Box of bounds 0 .. 255, the only input NatureCNN
+    (CnnPolicy, and MultiInputPolicy's image keys) convolves."""
+    return (
+        isinstance(space, spaces.Box)
+        and len(space.shape) == 3
+        and space.dtype == np.uint8
+        and bool(np.all(space.low == 0) and np.all(space.high == 255))
+    )
+
+
+def _image_sides(space: spaces.Box) -> tuple[int, int]:
+    """Height and width of an image space as SB3 reads it: the channels are its smallest
+    dimension (``is_image_space_channels_first``), first or last."""
+    shape = list(space.shape)
+    del shape[int(np.argmin(shape))]
+    return shape[0], shape[1]
+
+
 def _policy_kind(policy: str | type) -> str:
     name = policy if isinstance(policy, str) else getattr(policy, "__name__", str(policy))
     for kind in ("MultiInput", "Cnn", "Mlp"):
@@ -42,11 +111,19 @@ def _policy_kind(policy: str | type) -> str:
 def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type:
     """Return ``policy`` if SB3 would see ``env``'s frames as images, else raise ValueError.
 
+    Every space is checked against what SB3's policies take: Box, Discrete, MultiDiscrete and
+    MultiBinary (``MlpPolicy``; ``CnnPolicy`` for a 3-D uint8 image), or a Dict of those
+    (``MultiInputPolicy`` only); a Tuple, a nested Dict or another kind is refused for every
+    policy, custom classes included, and a policy that does not fit is named with the one that
+    does.
+
     Args:
-        env: an env (or vector env, or its observation space) built with ``SimounObservation``.
+        env: an env (or vector env, or its observation space), usually built with
+            ``SimounObservation``.
         policy: the policy given to the SB3 algorithm, a name (``"CnnPolicy"``: one of
             :data:`SB3_POLICIES`, a misspelling is refused with its close match) or a class;
-            custom policy classes (neither Cnn, Mlp nor MultiInput in the name) pass unchecked.
+            custom policy classes (neither Cnn, Mlp nor MultiInput in the name) are checked only
+            for a space that no SB3 policy takes.
 
     Example:
         >>> import gymnasium as gym
@@ -80,10 +157,16 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
             "env must be a gymnasium Env, a VectorEnv or an observation space, got "
             f"{type(env).__name__}"
         )
+    name = policy if isinstance(policy, str) else policy.__name__
+    problem = _unsupported(space)
+    if problem:
+        raise ValueError(
+            f"no Stable-Baselines3 policy ({name} included) takes this observation space: "
+            f"{problem}; {_fix_for(space)}. Space: {space}"
+        )
     kind = _policy_kind(policy)
     if not kind:
         return policy
-    name = policy if isinstance(policy, str) else policy.__name__
     frames = space.spaces.get("frames") if isinstance(space, spaces.Dict) else None
     if isinstance(frames, spaces.Box) and len(frames.shape) == 4:
         if kind == "MultiInput":
@@ -97,18 +180,47 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
             f"{frames.shape} frame stack (SB3 would then ask for MultiInputPolicy, which "
             f"flattens the pixels into an MLP). {_FIX}"
         )
-    folded = isinstance(space, spaces.Box) and len(space.shape) == 3 and space.dtype == np.uint8
-    if not folded:
+    if isinstance(space, spaces.Dict):
+        if kind != "MultiInput":
+            raise ValueError(
+                f"{name} does not take a Dict observation ({space}); SB3 takes a Dict only with "
+                f"'MultiInputPolicy'. Pass 'MultiInputPolicy', or flatten the Dict with "
+                "gymnasium.wrappers.FlattenObservation for 'MlpPolicy'"
+            )
+        for key, sub in space.spaces.items():
+            if _is_image(sub) and min(_image_sides(sub)) < NATURE_CNN_MIN_SIZE:
+                height, width = _image_sides(sub)
+                raise ValueError(
+                    f"{name} convolves the image {key!r} of this Dict with NatureCNN, which "
+                    f"needs at least {NATURE_CNN_MIN_SIZE}x{NATURE_CNN_MIN_SIZE}, got "
+                    f"{height}x{width}; resize that image to {NATURE_CNN_MIN_SIZE}x"
+                    f"{NATURE_CNN_MIN_SIZE} or larger, or pass a smaller features_extractor_class "
+                    "in policy_kwargs."
+                )
+        return policy
+    if kind == "MultiInput":
+        fits = "'CnnPolicy'" if _is_image(space) else "'MlpPolicy'"
+        raise ValueError(
+            f"{name} needs a Dict observation, but this one is a {_kind_name(space)} ({space}); "
+            f"use {fits}"
+        )
+    if not _is_image(space):
+        if kind == "Cnn":
+            raise ValueError(
+                f"{name} convolves only a 3-D uint8 Box of bounds 0 .. 255 (an image to SB3), "
+                f"but this observation is {space}; use 'MlpPolicy'"
+            )
         return policy
     if kind != "Cnn":
         raise ValueError(
             f"{name} does not convolve the {space.shape} uint8 image (MlpPolicy flattens it "
             f"into an MLP on raw pixels, MultiInputPolicy needs a Dict); use 'CnnPolicy'."
         )
-    if min(space.shape[1:]) < NATURE_CNN_MIN_SIZE:
+    height, width = _image_sides(space)
+    if min(height, width) < NATURE_CNN_MIN_SIZE:
         raise ValueError(
             f"CnnPolicy's NatureCNN needs frames of at least {NATURE_CNN_MIN_SIZE}x"
-            f"{NATURE_CNN_MIN_SIZE}, got {space.shape[1]}x{space.shape[2]}; use "
+            f"{NATURE_CNN_MIN_SIZE}, got {height}x{width}; use "
             f"SimounObservation(env, size={NATURE_CNN_MIN_SIZE}) or larger, or a smaller "
             f"features_extractor_class in policy_kwargs."
         )

@@ -1,11 +1,14 @@
 """SimounAgent and FrameReplay misuse: each a clear error
 or the right result, on real environments."""
 
+import dataclasses
+
 import gymnasium as gym
 import highway_env
 import minigrid
 import numpy as np
 import pytest
+import torch
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
@@ -216,3 +219,64 @@ def test_discrete_actions_outside_the_space_are_named(actions, said):
         built.watch(TRIPLETS, np.array(actions), TRIPLETS, NO, NO)
     built.watch(TRIPLETS, np.array([0, 1, 2, 1]), TRIPLETS, NO, NO)
     assert built.size == 4
+
+
+@pytest.mark.parametrize("step", [-1, "a", 1.5, True, None])
+def test_a_step_that_is_not_an_int_of_zero_or_more_is_named(step):
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    replay = point_reach_replay(steps=10)
+    frames = np.zeros((3, 3, SIZE, SIZE), np.uint8)
+    calls = [
+        ("act", lambda: agent.act(frames, step=step)),
+        ("update", lambda: agent.update(replay, step)),
+        ("update_actor", lambda: agent.update_actor(torch.zeros(2, agent.encoder.repr_dim), step)),
+    ]
+    for name, call in calls:
+        if step is None and name != "update_actor":
+            continue
+        if step is None:
+            call()  # None: the step of the latest update
+            continue
+        with pytest.raises(ValueError, match=rf"{name}\(step=\.\.\.\) must be an int >= 0, got"):
+            call()
+    assert agent.num_updates == 0  # nothing learned from a refused step
+    assert agent.act(frames, step=np.int64(3)).shape == (2,)
+    agent.update(replay, np.int64(10))
+    assert agent.env_step == 10 and type(agent.env_step) is int
+
+
+@pytest.mark.parametrize("frames", [np.zeros((3, 3, SIZE, SIZE), np.uint8).tolist(), None, 7])
+def test_an_observation_that_is_no_array_is_named_with_the_array_it_must_be(frames):
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    with pytest.raises(TypeError, match=r"act\(frames\) must be a uint8 numpy array \(or torch "
+                       r"tensor\) of shape \(3, 3, 32, 32\)"):  # fmt: skip
+        agent.act(frames)
+    with pytest.raises(TypeError, match=r"encoder_features\(triplets\) must be a uint8 numpy "
+                       r"array \(or torch tensor\) of shape \(B, 3, 3, 32, 32\)"):  # fmt: skip
+        agent.encoder_features([frames])
+    assert agent.act(torch.zeros((3, 3, SIZE, SIZE), dtype=torch.uint8)).shape == (2,)
+
+
+def test_a_state_of_another_agent_or_none_is_named_before_anything_loads():
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    before = {k: v.clone() for k, v in agent.encoder.state_dict().items()}
+    with pytest.raises(ValueError, match=r"does not fit this agent: it lacks encoder, "
+                       r"encoder_target, .*same config"):  # fmt: skip
+        agent.load_state_dict({})
+    with pytest.raises(TypeError, match=r"state must be the dict SimounAgent\.state_dict"):
+        agent.load_state_dict(None)
+    wider = SimounAgent((3, SIZE, SIZE), 2, dataclasses.replace(SMALL, num_filters=8), "cpu")
+    state = wider.state_dict()
+    with pytest.raises(ValueError) as raised:
+        agent.load_state_dict(state)
+    message = str(raised.value)
+    assert "encoder.appearance.0.weight is (8, 3, 3, 3) there, (4, 3, 3, 3) here" in message
+    assert "(the state's config differs: num_filters 8 there, 4 here)" in message
+    assert "must come from SimounAgent.state_dict() of an agent of the same config" in message
+    for key, value in agent.encoder.state_dict().items():
+        assert torch.equal(value, before[key]), key  # nothing loaded
+    other_actions = SimounAgent((3, SIZE, SIZE), 3, SMALL, "cpu").state_dict()
+    with pytest.raises(ValueError, match=r"critic\.q1\.0\.weight is \(16, 19\) there, "
+                       r"\(16, 18\) here; .*; \d+ more\. The state must"):  # fmt: skip
+        agent.load_state_dict(other_actions)
+    agent.load_state_dict(SimounAgent((3, SIZE, SIZE), 2, SMALL, "cpu").state_dict())

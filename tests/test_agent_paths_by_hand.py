@@ -287,7 +287,7 @@ def test_checkpoint_without_env_step_loads_as_step_0_and_one_without_a_network_i
     resumed.env_step = 5
     resumed.load_state_dict(old)
     assert (resumed.env_step, resumed.num_updates) == (0, 1)
-    with pytest.raises(KeyError, match="critic_target"):
+    with pytest.raises(ValueError, match="does not fit this agent: it lacks critic_target"):
         resumed.load_state_dict({k: v for k, v in state.items() if k != "critic_target"})
 
 

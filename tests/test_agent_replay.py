@@ -109,6 +109,65 @@ def test_bad_inputs_are_refused_with_a_fix():
         replay.sample(2)
 
 
+@pytest.mark.parametrize(
+    ("kwargs", "said"),
+    [
+        ({"batch_size": 0}, "sample(batch_size=...) must be a positive int, got 0"),
+        ({"batch_size": -1}, "sample(batch_size=...) must be a positive int, got -1"),
+        ({"batch_size": 1.5}, "sample(batch_size=...) must be a positive int, got 1.5"),
+        ({"batch_size": "4"}, "sample(batch_size=...) must be a positive int, got '4'"),
+        ({"batch_size": 4, "n_step": 0}, "sample(n_step=...) must be a positive int, got 0"),
+        ({"batch_size": 4, "n_step": 2.0}, "sample(n_step=...) must be a positive int, got 2.0"),
+        ({"batch_size": 4, "discount": 1.5}, "sample(discount=...) must be a number in [0, 1]"),
+        ({"batch_size": 4, "discount": "0.9"}, "sample(discount=...) must be a number in [0, 1]"),
+    ],
+)
+def test_a_sample_size_or_n_step_that_is_not_a_positive_int_is_named(kwargs, said):
+    replay = FrameReplay(capacity=40, frame_shape=(3, SIZE, SIZE), action_dim=1, seed=0)
+    collect(replay, steps=10)
+    state = replay.rng.bit_generator.state
+    with pytest.raises(ValueError) as raised:
+        replay.sample(**kwargs)
+    assert said in str(raised.value)
+    assert replay.rng.bit_generator.state == state  # nothing drawn
+    assert replay.sample(np.int64(4), n_step=np.int64(2))["obs"].shape == (4, 3, 3, SIZE, SIZE)
+
+
+def test_a_file_that_is_no_replay_or_a_damaged_one_is_named(tmp_path):
+    replay = FrameReplay(capacity=40, frame_shape=(3, SIZE, SIZE), action_dim=1, seed=0)
+    collect(replay, steps=10)
+    saved = tmp_path / "replay.npz"
+    replay.save(saved)
+    data = saved.read_bytes()
+    files = {
+        "text.npz": b"not a replay",
+        "other.npz": None,
+        "cut.npz": data[: len(data) // 2],
+        "zeros.npz": bytes(len(data)),
+        "empty.npz": b"",
+    }
+    for name, content in files.items():
+        if content is None:
+            np.savez(tmp_path / name, frames=np.zeros(3))
+        else:
+            (tmp_path / name).write_bytes(content)
+    said = {
+        "text.npz": "text.npz is not a replay saved by FrameReplay.save (it is no .npz archive)",
+        "other.npz": "other.npz is not a replay saved by FrameReplay.save (it holds no 'meta'",
+        "cut.npz": "cut.npz is damaged: it is no readable .npz archive",
+        "zeros.npz": f"zeros.npz is damaged: all its {len(data)} bytes are zero",
+        "empty.npz": "empty.npz is damaged: it is empty",
+    }
+    for name, words in said.items():
+        with pytest.raises(ValueError) as raised:
+            FrameReplay.load(tmp_path / name)
+        assert words in str(raised.value)
+        assert "allow_pickle" not in str(raised.value)
+    with pytest.raises(FileNotFoundError, match=r"replay file .*nope\.npz does not exist"):
+        FrameReplay.load(tmp_path / "nope.npz")
+    assert len(FrameReplay.load(saved)) == len(replay)
+
+
 def episodes_replay(lengths_and_ends, n_frames=3):
     """Episodes of the given (length, "terminated" | "truncated" | "open") whose frame j of
     episode e holds the value 10 e + j and whose step j has reward j + e / 10."""

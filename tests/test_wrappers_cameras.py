@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import shimmy
 
-from simoun_wrappers import MultiCamera
+from simoun_wrappers import MultiCamera, SimounObservation
 
 gym.register_envs(shimmy)
 gym.register_envs(highway_env)
@@ -111,3 +111,60 @@ def test_error_bad_cameras():
         MultiCamera(cartpole, "side")
     with pytest.raises(TypeError, match=r"must return an \(H, W, 3\) uint8 image"):
         MultiCamera(cartpole, [lambda e: np.zeros((4, 4, 3), np.float32)], size=4)
+
+
+def test_camera_images_are_checked_as_renders_are_at_every_step():
+    env = gym.make("CartPole-v1", render_mode="rgb_array")
+    bad = [
+        (lambda e: np.zeros((0, 4, 3), np.uint8), 16, ValueError, "an array of shape (0, 4, 3)"),
+        (lambda e: [[0, 0, 0]], 16, TypeError, "returned a list; it must return an (H, W, 3)"),
+        (lambda e: np.zeros((4, 4), np.uint8), 16, ValueError, "an array of shape (4, 4)"),
+        (lambda e: np.zeros((4, 4, 4), np.uint8), None, ValueError, "an array of shape (4, 4, 4)"),
+    ]
+    for camera, size, error, said in bad:
+        with pytest.raises(error) as raised:
+            MultiCamera(env, [camera], size=size)
+        assert f"MultiCamera takes its frames from camera {camera!r}, which returned" in str(
+            raised.value
+        )
+        assert said in str(raised.value)
+    sides = iter(range(8, 100))
+
+    def growing(e):
+        return np.zeros((next(sides), 8, 3), np.uint8)
+
+    cams = MultiCamera(env, [growing], size=None)
+    assert cams.observation_space.shape == (8, 8, 3)
+    changed = r"returned an image of shape \(9, 8, 3\); it must return uint8 images of its first "
+    with pytest.raises(ValueError, match=changed + r"image's shape \(8, 8, 3\).*size=\(H, W\)"):
+        cams.reset(seed=0)
+    resized = MultiCamera(env, [growing], size=8)
+    for _ in range(3):
+        assert resized.reset(seed=0)[0].shape == (8, 8, 3)
+
+
+def rendered(env: gym.Env) -> np.ndarray:
+    """A camera that pickles: the env's own render."""
+    return env.render()
+
+
+def test_cameras_from_a_generator_are_read_once_and_the_wrapper_copies_and_pickles():
+    import pickle
+
+    import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0, which pickles)
+
+    point = gym.make("simoun/PointReach-v0", render_mode="rgb_array")
+    env = MultiCamera(point, (camera for camera in [rendered, rendered]), size=16)
+    assert env.spec.kwargs is not None and env._saved_kwargs["cameras"] == (rendered, rendered)
+    for copied in (pickle.loads(pickle.dumps(env)), gym.make(env.spec), env):
+        assert copied.reset(seed=0)[0].shape == (16, 32, 3)
+    dmc = MultiCamera(gym.make("dm_control/cartpole-swingup-v0"), iter([0, 1]), size=16)
+    assert dmc.reset(seed=0)[0].shape == (16, 32, 3)
+    assert gym.make(dmc.spec).reset(seed=0)[0].shape == (16, 32, 3)
+    cartpole = gym.make("CartPole-v1", render_mode="rgb_array")
+    for wrap in (
+        lambda size: MultiCamera(cartpole, [rendered], size),
+        lambda size: SimounObservation(cartpole, size),
+    ):
+        with pytest.raises(ValueError, match=r"size must be a positive int or an \(H, W\) pair"):
+            wrap(size=(n for n in [8, 8]))

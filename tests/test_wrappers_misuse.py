@@ -26,6 +26,7 @@ from simoun_wrappers import (
     ConstantBonusVectorReward,
     FrameTriplet,
     MovingBackground,
+    MultiCamera,
     RandomConvolution,
     RNDReward,
     SimounObservation,
@@ -368,3 +369,30 @@ def test_a_render_that_is_no_image_of_one_size_is_named(broken, error, said, siz
             env.step(env.action_space.sample())
     assert "SimounObservation takes its frames from the env's render() " in str(raised.value)
     assert said in str(raised.value)
+
+
+@pytest.mark.parametrize(
+    ("wrap", "owner"),
+    [
+        (lambda d: ColorShift(d, seed=0), "ColorShift"),
+        (lambda d: MovingBackground(d, seed=0), "MovingBackground"),
+        (lambda d: MultiCamera(d, [0], size=16), "MultiCamera"),
+        (lambda d: SimounObservation(ColorShift(d, seed=0), size=16), "ColorShift"),
+    ],
+)
+def test_a_closed_dm_control_task_is_named_as_closed_at_reset_step_and_render(wrap, owner):
+    for use in (
+        lambda e: e.reset(seed=1),
+        lambda e: e.step(e.action_space.sample()),
+        lambda e: e.render(),
+    ):
+        env = wrap(gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array"))
+        env.reset(seed=0)
+        env.close()
+        env.close()
+        with pytest.raises(ValueError) as raised:
+            use(env)
+        message = str(raised.value)
+        assert f"{owner} cannot reset, step or render" in message
+        assert "the env was closed (close() freed its dm_control physics)" in message
+        assert "gym.make('dm_control/cartpole-swingup-v0', render_mode='rgb_array')" in message

@@ -2,6 +2,7 @@
 SB3 does with the Dict form, and ``check_sb3_policy`` saying why and what to use."""
 
 import gymnasium as gym
+import minigrid
 import numpy as np
 import pytest
 import stable_baselines3 as sb3
@@ -9,6 +10,8 @@ import torch
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_wrappers import SimounObservation, check_sb3_policy
+
+gym.register_envs(minigrid)
 
 FIX = r"SimounObservation\(env, fold_frames=True\) with 'CnnPolicy'"
 
@@ -60,3 +63,55 @@ def test_mlp_policy_on_the_folded_image_and_frames_too_small_for_nature_cnn():
         check_sb3_policy(small, "CnnPolicy")
     with pytest.raises(RuntimeError):  # what SB3 alone does with them
         sb3.PPO("CnnPolicy", small, device="cpu")
+
+
+def test_a_space_sb3_takes_in_no_policy_is_refused_for_every_policy():
+    blackjack = gym.make("Blackjack-v1")  # a Tuple of Discretes
+    with pytest.raises(NotImplementedError, match="Tuple"):  # what SB3 alone does with it
+        sb3.PPO("MlpPolicy", blackjack, device="cpu")
+    for policy in ("MlpPolicy", "CnnPolicy", "MultiInputPolicy", sb3.PPO):
+        with pytest.raises(ValueError, match=r"takes this observation space: it is a Tuple "
+                           r"space.*gymnasium\.wrappers\.FlattenObservation"):  # fmt: skip
+            check_sb3_policy(blackjack, policy)
+    flat = gym.wrappers.FlattenObservation(blackjack)
+    assert check_sb3_policy(flat, "MlpPolicy") == "MlpPolicy"
+    sb3.PPO("MlpPolicy", flat, n_steps=16, batch_size=16, device="cpu")
+    minigrid_env = gym.make("MiniGrid-Empty-5x5-v0")  # a Dict holding a MissionSpace
+    with pytest.raises(TypeError):
+        sb3.PPO("MultiInputPolicy", minigrid_env, device="cpu")
+    with pytest.raises(ValueError, match=r"its Dict holds a MissionSpace under 'mission'"):
+        check_sb3_policy(minigrid_env, "MultiInputPolicy")
+    nested = gym.spaces.Dict(inner=gym.spaces.Dict(a=gym.spaces.Discrete(2)))
+    with pytest.raises(ValueError, match=r"holds a Dict under 'inner'.*no nested spaces"):
+        check_sb3_policy(nested, "MultiInputPolicy")
+
+
+def minigrid_image_and_direction() -> gym.Env:
+    """MiniGrid's Dict observation without its mission text: a 7x7 image and a direction."""
+    env = gym.make("MiniGrid-Empty-5x5-v0")
+    return gym.wrappers.FilterObservation(env, ["image", "direction"])
+
+
+@pytest.mark.parametrize(
+    ("make", "policy", "said", "fitting"),
+    [
+        (lambda: gym.make("CartPole-v1"), "MultiInputPolicy", "use 'MlpPolicy'", "MlpPolicy"),
+        (lambda: gym.make("CartPole-v1"), "CnnPolicy", "use 'MlpPolicy'", "MlpPolicy"),
+        (lambda: point_reach(fold_frames=True), "MultiInputPolicy", "use 'CnnPolicy'", None),
+        (minigrid_image_and_direction, "MlpPolicy", "Pass 'MultiInputPolicy'", None),
+        (minigrid_image_and_direction, "MultiInputPolicy", "'image' of this Dict with NatureCNN, "
+         "which needs at least 36x36, got 7x7", None),
+    ],
+)  # fmt: skip
+def test_a_policy_that_does_not_fit_the_space_is_named_with_the_one_that_does(
+    make, policy, said, fitting
+):
+    env = make()
+    with pytest.raises((ValueError, AttributeError, AssertionError, RuntimeError)):
+        sb3.PPO(policy, env, n_steps=16, batch_size=16, device="cpu")  # SB3 refuses it too
+    with pytest.raises(ValueError) as raised:
+        check_sb3_policy(env, policy)
+    assert policy in str(raised.value) and said in str(raised.value)
+    if fitting:
+        assert check_sb3_policy(env, fitting) == fitting
+        sb3.PPO(fitting, env, n_steps=16, batch_size=16, device="cpu")

@@ -12,13 +12,31 @@ from simoun_wrappers._checks import check_reset_seed, is_int
 LEVELS = ("easy", "hard")
 
 
+def check_open(env: gym.Env, owner: str) -> None:
+    """A ValueError (as Python's closed files give) naming ``close()`` when ``env`` is a
+    dm_control task whose ``close()`` freed its physics. ``owner`` calls it before each reset,
+    step and render: shimmy's own error then is an AttributeError deep in dm_control."""
+    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
+    if physics is not None and not hasattr(physics, "model"):
+        # shimmy's close() frees the physics but keeps it: its model is gone
+        spec = env.unwrapped.spec
+        env_id = spec.id if spec is not None else "dm_control/cartpole-swingup-v0"
+        raise ValueError(
+            f"{owner} cannot reset, step or render {env.unwrapped}: the env was closed "
+            f"(close() freed its dm_control physics). Make the env anew, "
+            f"gym.make({env_id!r}, render_mode='rgb_array'), and wrap it again."
+        )
+
+
 def dm_control_physics(env: gym.Env, owner: str) -> Any:
     """The ``dm_control.mujoco.Physics`` of a dm_control task made through shimmy.
 
-    Raises a TypeError that names what works instead for any other env.
+    Raises a TypeError that names what works instead for any other env, and the ValueError of
+    :func:`check_open` for a task that was closed.
     """
+    check_open(env, owner)
     physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
-    if physics is None or not hasattr(physics, "model"):
+    if physics is None:
         raise TypeError(
             f"{owner} needs a dm_control task made through shimmy (it changes the MuJoCo model "
             f"or reads its segmentation), got {env.unwrapped}; make one with "

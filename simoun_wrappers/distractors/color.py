@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
 
 from simoun_wrappers.distractors._dm_control import (
     check_level,
+    check_open,
     check_seed,
     dm_control_physics,
     episode_rng,
@@ -165,6 +166,14 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
         }
         self._apply(dm_control_physics(self.env, "ColorShift"))
         return self.env.reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_open(self.env, "ColorShift")
+        return self.env.step(action)
+
+    def render(self) -> Any:
+        check_open(self.env, "ColorShift")
+        return self.env.render()
 
     def _apply(self, physics: Any) -> None:
         import mujoco

@@ -10,6 +10,7 @@ import numpy as np
 
 from simoun_wrappers.distractors._dm_control import (
     check_level,
+    check_open,
     check_seed,
     dm_control_physics,
     episode_rng,
@@ -100,12 +101,14 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        check_open(self.env, "MovingBackground")
         self._rng = episode_rng(self.seed, seed, self._rng, "MovingBackground")
         self._source.start(self._rng)
         self._t = 0
         return self.env.reset(seed=seed, options=options)
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_open(self.env, "MovingBackground")
         result = self.env.step(action)
         self._t += 1
         return result
