@@ -1825,9 +1825,657 @@ for _case in THIRD_COMMAND_CASES + THIRD_API_CASES:
     _case["set"] = "third"
 
 
+# the fourth trial's cases, run alone with --set fourth: flags in combination, environment
+# variables, device forms, paths users type, runs damaged in new ways, spec values at their
+# boundaries and the API's arguments at theirs
+
+
+def environ(**values: str):
+    """A setup that sets environment variables in the case's process only."""
+    return call(lambda here: os.environ.update(values))
+
+
+SHORT_TINY = tiny(*SHORT)
+# agent fields at a bad value through their flag: (flag, value, the config key)
+AGENT_FLAG_VALUES = [
+    ("--agent.critic-tau", "0", "critic_tau"), ("--agent.critic-tau", "1.5", "critic_tau"),
+    ("--agent.encoder-tau", "-0.1", "encoder_tau"), ("--agent.alpha-lr", "0", "alpha_lr"),
+    ("--agent.actor-update-every", "0", "actor_update_every"),
+    ("--agent.target-update-every", "-2", "target_update_every"),
+    ("--agent.update-every-steps", "0", "update_every_steps"),
+    ("--agent.exploration-std-start", "-1", "exploration_std_start"),
+    ("--agent.exploration-steps", "0", "exploration_steps"),
+    ("--agent.noise-clip", "-0.3", "noise_clip"),
+    ("--agent.init-temperature", "0", "init_temperature"),
+    ("--agent.log-std-min", "nan", "log_std_min"), ("--agent.log-std-max", "inf", "log_std_max"),
+    ("--agent.curiosity-scale", "-0.2", "curiosity_scale"),
+    ("--agent.curiosity-decay", "nan", "curiosity_decay"),
+    ("--agent.r-e-max-init", "0", "r_e_max_init"), ("--agent.r-i-max-init", "-1", "r_i_max_init"),
+    ("--agent.transition-weight", "-1", "transition_weight"),
+    ("--agent.contrastive-weight", "inf", "contrastive_weight"),
+    ("--agent.reward-weight", "nan", "reward_weight"), ("--agent.num-frames", "0", "num_frames"),
+    ("--agent.reduce-kernel", "0", "reduce_kernel"),
+    ("--agent.reduce-stride", "-3", "reduce_stride"),
+    ("--agent.random-conv-kernel", "4", "random_conv_kernel"),
+    ("--agent.shift-pad", "-4", "shift_pad"),
+    ("--agent.critic-augmentations", "0", "critic_augmentations"),
+    ("--agent.target-augmentations", "0", "target_augmentations"),
+    ("--agent.next-state-encoder", "online-ish", "next_state_encoder"),
+    ("--agent.contrastive-view", "shiftt", "contrastive_view"),
+    ("--agent.similarity-init", "random", "similarity_init"),
+    ("--agent.encoder", "resnet", "encoder"), ("--agent.pixel-offset", "nan", "pixel_offset"),
+    ("--agent.feature-dim", "0", "feature_dim"), ("--agent.num-filters", "0", "num_filters"),
+    ("--agent.hidden-dim", "-16", "hidden_dim"), ("--agent.aux-hidden-dim", "0", "aux_hidden_dim"),
+    ("--agent.alpha-beta", "inf", "alpha_beta"), ("--agent.actor", "tanh", "actor"),
+    ("--warmup-agent-steps", "-1", "warmup_agent_steps"),
+    ("--updates-per-step", "0", "updates_per_step"),
+    ("--replay-capacity", "0", "replay_capacity"), ("--cameras", "0", "cameras"),
+]  # fmt: skip
+# a run resumed with a flag it may not change: (the flag and its value, what the refusal names)
+RESUME_FIXED = [
+    (["--image-size", "48"], "image_size"),
+    (["--grayscale"], "grayscale"),
+    (["--cameras", "2"], "cameras"),
+    (["--action-repeat", "2"], "action_repeat"),
+    (["--env-kwargs", '{"size": 32}'], "env_kwargs"),
+    (["--agent.recipe", "drq"], "recipe"),
+    (["--warmup-agent-steps", "5"], "warmup_agent_steps"),
+    (["--replay-capacity", "100"], "replay_capacity"),
+    (["--agent.batch-size", "4"], "batch_size"),
+    (["--set", "agent.n_step=3"], "n_step"),
+    (["--env-module", "minigrid"], "env_module"),
+    (["--updates-per-step", "2"], "updates_per_step"),
+    (["--run-dir", "elsewhere"], "run"),
+    (["--agent.no-curiosity"], "curiosity"),
+    (["--eval-episodes", "2"], "eval_episodes"),
+]
+RESUME_ALLOWED = [  # every flag --resume may change, each given with the new total
+    ["--eval-every", "20"],
+    ["--checkpoint-every", "20"],
+    ["--no-progress"],
+    ["--no-video"],
+    ["--torch-threads", "1"],
+    ["--progress"],
+    ["--no-env-process"],
+]
+# flags that conflict or make no sense together: (command, argv, names[, valid])
+COMBOS = [
+    ("train", tiny("--agent.log-std-min", "3", "--agent.log-std-max", "2"), "log_std"),
+    ("train", tiny("--agent.exploration-std-start", "0.1", "--agent.exploration-std-end", "1.0",
+                   *SHORT), "exploration_std", True),
+    ("train", tiny("--eval-every", "30", "--total-env-steps", "20", "--run-dir", "r"),
+     ("eval_every", "total_env_steps"), True),
+    ("train", tiny("--checkpoint-every", "1000", *SHORT), "checkpoint_every", True),
+    ("train", tiny("--agent.batch-size", "64", "--agent.replay-capacity", "16"),
+     ("batch_size", "replay")),
+    ("train", tiny("--replay-capacity", "16", "--agent.batch-size", "64"),
+     ("batch_size", "replay_capacity")),
+    ("train", tiny("--agent.recipe", "drqv2", "--agent.actor", "gaussian", *SHORT), "actor", True),
+    ("train", tiny("--agent.recipe", "simoun_no_curiosity", "--agent.curiosity", *SHORT),
+     "curiosity", True),
+    ("train", tiny("--agent.augmentation", "none", "--agent.shift-pad", "4", *SHORT),
+     "shift_pad", True),
+    ("train", tiny("--agent.num-frames", "1", "--agent.encoder", "dual_interactive"),
+     ("num_frames", "encoder")),
+    ("train", tiny("--grayscale", "--agent.recipe", "curl", *SHORT), "grayscale", True),
+    ("train", tiny("--image-size", "33", *SHORT), "image_size", True),
+    ("train", tiny("--cameras", "3", *SHORT), "cameras", True),
+    ("train", tiny("--set", "agent.lr=1e-3", "--agent.lr", "2e-3", *SHORT), "agent.lr", True),
+    ("train", tiny("--set", "seed=2", "--set", "seed=3", *SHORT), "seed", True),
+    ("train", tiny("--env-module", "minigrid", "--env", "simoun/PointReach-v0", *SHORT),
+     "env_module", True),
+    ("train", tiny("--overwrite", *SHORT), "--overwrite", True),
+    ("train", tiny("--overwrite", "--run-dir", "{run}"), ("--overwrite", "checkpoint", "--resume")),
+    ("train", tiny("--eval-distraction", "color_easy"), ("color_easy", "dm_control")),
+    ("train", tiny("--env-process", *SHORT), "env_process", True),
+    ("train", tiny("--action-repeat", "none", *SHORT), "", True),
+    ("train", tiny("--agent.shift-pad", "none", *SHORT), "", True),
+    ("train", tiny("--preset", "cheetah-run", *SHORT), ("preset", "cheetah"), True),
+    ("train", tiny("--preset", "highway-cpu", *SHORT), ("preset", "highway"), True),
+    ("train", tiny("--preset", "walker-walk", "--env", "Pendulum-v1", *SHORT),
+     ("preset", "walker"), True),
+    ("train", ["--preset", "cpu", "--env", "MiniGrid-Empty-5x5-v0", "--env-module", "minigrid"],
+     "MiniGrid"),
+    ("eval", eval_argv("--videos", "somewhere"), ("--videos", "--distraction")),
+    ("eval", eval_argv("--distraction", "color_easy,color_easy"), ("color_easy", "dm_control")),
+    ("eval", eval_argv("--distraction", ""), "--distraction"),
+    ("eval", eval_argv("--random-policy", "--episodes", "1"), "", True),
+    ("eval", eval_argv("--episodes", "1", "--out", "{run}", "--overwrite"), "--out", True),
+    ("eval", eval_argv("--seed", str(2**32), "--episodes", "1"), "seed", True),
+    ("report", report_argv("--at-wall-time", "nan"), "--at-wall-time"),
+    ("report", report_argv("--at-wall-time", "inf"), "--at-wall-time"),
+    ("report", report_argv("--at-step", "20", "--out", "{run}/eval.csv"), "--out"),
+    ("sweep", sweep_tiny("--grid", "seed=1,2", "--seeds", "0-1"), "seed"),
+    ("sweep", sweep_tiny("--grid", "run_dir=a,b"), "run_dir"),
+    ("sweep", sweep_tiny("--grid", "total_env_steps=40,60", "--grid", "total_env_steps=80"),
+     "total_env_steps"),
+    ("sweep", sweep_tiny("--grid", "env=Pendulum-v1,Acrobot-v1"), ("env", "--envs")),
+    ("sweep", sweep_tiny("--cpus-per-trial", "2", "--num-cpus", "1"),
+     ("--cpus-per-trial", "--num-cpus")),
+    ("sweep", sweep_tiny("--address", "auto", "--num-cpus", "2"), ("--address", "--num-cpus")),
+    ("sweep", ["--resume", "--sweep-dir", "nowhere", "--grid", "agent.lr=1,2"],
+     ("--grid", "--resume", "nowhere")),
+    ("sweep", sweep_tiny("--grid", "agent.n_step=1,3", "--sweep-dir", "{run}/tb"), "--sweep-dir"),
+    ("sweep", sweep_tiny("--gpus-per-trial", "1", "--device", "cpu"),
+     ("--gpus-per-trial", "GPU")),
+    ("minigrid", probe("--probes", "rnd", "rnd"), ("rnd", "--probes")),
+    ("minigrid", probe("--settings.seed", "-1"), ("seed", "--settings.seed")),
+    ("minigrid", probe("--settings.n-envs", "2.5"), ("n-envs", "n_envs")),
+    ("minigrid", probe("--out", "{run}/config.json"), "--out"),
+    ("minigrid", ["run", "--archive", "/proc/nope", "--concurrent", "1"], ("/proc/nope",
+                                                                           "--archive")),
+    ("driving", driving("--json", "/proc/x.json"), "--json"),
+    ("driving", driving("--json", "."), "--json"),
+    ("driving", driving("--seed", str(2**64)), "--seed"),
+    ("driving", driving("--video", "v.gif", "--json", "v.gif"), ("--video", "--json")),
+]  # fmt: skip
+WRONG_SUBCOMMAND = [  # a flag given to a command or subcommand it belongs to another
+    ("analyze", masks("--pairs", "8"), "--pairs"), ("analyze", bias("--query", "1,2"), "--query"),
+    ("analyze", bias("--steps", "1"), "--steps"), ("analyze", masks("--recolour", "conv"),
+                                                   "--recolour"),
+    ("analyze", bias("--video", "gif"), "--video"),
+    ("study", plan("--study-dir", "s"), "--study-dir"), ("study", plan("--archive", "a"),
+                                                         "--archive"),
+    ("study", plan("--num-cpus", "1"), "--num-cpus"),
+    ("minigrid", ["report", "--archive", ".", "--concurrent", "2"], "--concurrent"),
+    ("minigrid", probe("--archive", "."), "--archive"),
+    ("minigrid", ["select", "--archive", ".", "--probes", "rnd"], "--probes"),
+    ("minigrid", ["report", "--archive", ".", "--settings.steps", "5"], "--settings.steps"),
+    ("eval", eval_argv("--pairs", "8"), "--pairs"), ("eval", eval_argv("--at-step", "20"),
+                                                      "--at-step"),
+    ("eval", eval_argv("--agent.lr", "0.1"), "--agent.lr"), ("eval", eval_argv("--preset", "cpu"),
+                                                             "--preset"),
+    ("report", report_argv("--episodes", "1"), "--episodes"),
+    ("report", report_argv("--device", "cpu"), "--device"),
+    ("train", tiny("--episodes", "1"), "--episodes"), ("train", tiny("--grid", "agent.lr=1,2"),
+                                                        "--grid"),
+    ("train", tiny("--sweep-dir", "s"), "--sweep-dir"), ("driving", driving("--device", "cpu"),
+                                                         "--device"),
+    ("driving", driving("--env", "highway-v0"), "--env"),
+    ("sweep", sweep_tiny("--resume-from", "x"), "--resume"),
+    ("sweep", sweep_tiny("--episodes", "2"), "--episodes"),
+]  # fmt: skip
+DEVICES = [  # (command, argv builder) x device forms a user types
+    ("train", tiny),
+    ("eval", eval_argv),
+    ("analyze", masks),
+]
+DEVICE_FORMS = [  # (value, what the refusal names[, valid])
+    ("cuda:0", ("cuda", "device")),
+    ("mps", ("mps", "device")),
+    ("cpu:1", "device", True),
+    ("cuda:-1", ("cuda", "device")),
+    ("gpu", ("gpu", "device")),
+    ("meta", ("meta", "device")),
+]
+SET_TYPES = [  # --set of every config section with a wrong type: (text, names[, valid])
+    ("env_kwargs=3", "env_kwargs"),
+    ("agent.curiosity=maybe", "curiosity"),
+    ("video=2", "video"),
+    ("device=3", "device"),
+    ("action_repeat=none", "", True),
+    ("total_env_steps=1e5", "total_env_steps"),
+    ("agent.lr=1e-3e", "agent.lr"),
+    ("eval_distraction=[]", "eval_distraction"),
+    ("agent.shift_pad=none", "", True),
+    ("progress=yes", "progress"),
+    ("agent.actor=null", "actor"),
+    ("image_size=-1", "image_size"),
+    ("cameras=1.5", "cameras"),
+    ("agent.n_step=[1,3]", "n_step"),
+    ('agent={"lr": 1}', "agent"),
+    ("grayscale=1", "grayscale", True),
+    ("env_module=", "env_module", True),
+    ("run_dir=none", "", True),
+    ("agent.recipe=none", "", True),
+    ("torch_threads=-1", "torch_threads"),
+]
+ENV_VARS = [  # environment variables users set: (command, argv, variables, names[, valid])
+    ("train", tiny(*SHORT), {"OMP_NUM_THREADS": "0"}, "OMP_NUM_THREADS", True),
+    ("train", tiny(*SHORT), {"OMP_NUM_THREADS": "abc"}, "OMP_NUM_THREADS", True),
+    ("train", tiny("--device", "cuda"), {"CUDA_VISIBLE_DEVICES": ""}, ("cuda", "device")),
+    (
+        "train",
+        tiny(*SHORT, "--env", "dm_control/cartpole-swingup-v0"),
+        {"MUJOCO_GL": "bogus"},
+        "MUJOCO_GL",
+        True,
+    ),
+    ("eval", eval_argv("--episodes", "1"), {"MUJOCO_GL": "bogus"}, "MUJOCO_GL", True),
+    (
+        "train",
+        tiny(*SHORT),
+        {"PYTORCH_ENABLE_MPS_FALLBACK": "1", "CUDA_VISIBLE_DEVICES": "-1"},
+        "",
+        True,
+    ),
+    (
+        "sweep",
+        sweep_tiny("--sweep-dir", "s"),
+        {"RAY_ADDRESS": "nohost:1"},
+        ("RAY_ADDRESS", "nohost"),
+    ),
+    (
+        "train",
+        tiny("--run-dir", "$HOME/runs/x", "--total-env-steps", "40"),
+        {},
+        ("$HOME", "--run-dir"),
+        True,
+    ),
+    (
+        "train",
+        tiny("--run-dir", "~/runs/x", "--total-env-steps", "40"),
+        {"HOME": "/proc"},
+        ("~", "--run-dir", "/proc"),
+        True,
+    ),
+    ("eval", ["~/no-such-run", *EVAL], {}, ("~/no-such-run", "no-such-run")),
+    ("report", ["~/no-such-run"], {}, ("~/no-such-run", "no-such-run")),
+]
+PATHS = [  # paths users type: (command, argv, names[, valid])
+    ("train", tiny("--run-dir", "a\nb", "--total-env-steps", "40"), "--run-dir", True),
+    ("train", tiny("--run-dir", 'it\'s "quoted"', "--total-env-steps", "40"), "", True),
+    (
+        "train",
+        tiny("--run-dir", "{run}/sub", "--total-env-steps", "40"),
+        ("--run-dir", "run"),
+        True,
+    ),
+    ("train", tiny("--run-dir", "{run}/tb", "--total-env-steps", "40"), ("--run-dir", "tb"), True),
+    ("train", tiny("--run-dir", "./r/../r2/", "--total-env-steps", "40"), "", True),
+    ("train", tiny("--run-dir", "-r", "--total-env-steps", "40"), "--run-dir", True),
+    ("train", tiny("--run-dir", "/dev/null", "--total-env-steps", "40"), "--run-dir"),
+    ("train", tiny("--run-dir", ".", "--total-env-steps", "40"), ("--run-dir", "."), True),
+    ("eval", ["{run}/", *EVAL, "--episodes", "1"], "", True),
+    ("eval", ["{run}/./tb/..", *EVAL, "--episodes", "1"], "", True),
+    ("eval", eval_argv("--episodes", "1", "--out", "o\nut"), "--out", True),
+    ("eval", eval_argv("--episodes", "1", "--out", "/dev/null"), "--out"),
+    ("report", ["{run}", "--out", "{run}/tb"], "--out", True),
+    ("report", ["{run}", "--out", "-"], "--out", True),
+    ("analyze", masks("--steps", "1", "--out", "/dev/null"), "--out"),
+    ("study", ["run", "spec.toml", "--study-dir", "{run}"], ("--study-dir", "run")),
+    ("minigrid", ["report", "--archive", "{run}/tb"], ("--archive", "tb", "spec.json")),
+    ("sweep", sweep_tiny("--sweep-dir", "/dev/null"), "--sweep-dir"),
+]
+FOURTH_FLAG_CASES = [
+    *(cli("flags", "train", tiny(flag, value), (flag, key)) for flag, value, key in
+      AGENT_FLAG_VALUES),
+    *(cli("flags", "train", ["--resume", "{run}", "--total-env-steps", "60", *flags],
+          (names, flags[0])) for flags, names in RESUME_FIXED),
+    *(cli("flags", "train", ["--resume", "{run}", "--total-env-steps", "60", *flags], "", ok=True)
+      for flags in RESUME_ALLOWED),
+    *(cli("flags", command, argv, names, ok=bool(ok)) for command, argv, names, *ok in COMBOS),
+    *(cli("flags", command, argv, names) for command, argv, names in WRONG_SUBCOMMAND),
+    *(cli("flags", command, build("--device", value), names, ok=bool(ok))
+      for command, build in DEVICES for value, names, *ok in DEVICE_FORMS),
+    *(cli("flags", "train", tiny("--set", text, *(SHORT if ok else ())), names or "",
+          ok=bool(ok)) for text, names, *ok in SET_TYPES),
+    *({**cli("flags", command, argv, names, ok=bool(ok), setup=environ(**variables)),
+       "what": " ".join(f"{key}={value}" for key, value in variables.items()) or "no variable"}
+      for command, argv, variables, names, *ok in ENV_VARS),
+    *(cli("flags", command, argv, names, ok=bool(ok)) for command, argv, names, *ok in PATHS),
+]  # fmt: skip
+
+
+def fifo(path: Path) -> None:
+    path.unlink()
+    os.mkfifo(path)
+
+
+def checkpoint_edit(change):
+    """A damage that loads the checkpoint, changes its payload and saves it back."""
+
+    def edit(path: Path) -> None:
+        import torch
+
+        payload = torch.load(path, weights_only=False)
+        change(payload)
+        torch.save(payload, path)
+
+    return edit
+
+
+def replay_edit(change):
+    """A damage that rewrites the replay's arrays through ``change`` (a dict, in place)."""
+
+    def edit(path: Path) -> None:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = dict(data)
+        change(arrays)
+        with open(path, "wb") as f:
+            np.savez(f, **arrays)
+
+    return edit
+
+
+def copy_replay(path: Path) -> None:
+    shutil.copy(path, path.with_name("replay-20.npz"))
+
+
+def cut_mid_row(path: Path) -> None:
+    data = path.read_bytes().rstrip(b"\n")
+    path.write_bytes(data[: data.rfind(b",") + 1])
+
+
+FOURTH_DAMAGES = {
+    "eval.csv": {
+        "rows past total_env_steps": csv_rows(lambda rows: [*rows, ["100000", *rows[-1][1:]]]),
+        "truncated mid-row": cut_mid_row,
+        "a FIFO": fifo,
+        "only the header of another run's columns": edit_text(lambda text: "step,score\n"),
+        "a row of empty cells": csv_rows(lambda rows: [*rows, [""] * len(rows[0])]),
+    },
+    "train.csv": {
+        "truncated mid-row": cut_mid_row,
+        "a directory": into_directory,
+        "rows past total_env_steps": csv_rows(lambda rows: [*rows, ["100000", *rows[-1][1:]]]),
+    },
+    "summary.json": {
+        "steps the logs do not have": edit_json(lambda data: data.update(env_step=100000)),
+        "a negative step": edit_json(lambda data: data.update(env_step=-40)),
+        "a JSON string": write_bytes(lambda data: b'"done"'),
+    },
+    "config.json": {
+        "another run's image size": edit_json(lambda data: data.update(image_size=48)),
+        "another run's network": edit_json(lambda data: data["agent"].update(num_filters=8)),
+        "a total below the checkpoint's step": edit_json(
+            lambda data: data.update(total_env_steps=20)),
+        "a FIFO": fifo,
+        "a null seed": edit_json(lambda data: data.update(seed=None)),
+    },
+    "checkpoint.pt": {
+        "an older format (rng missing)": checkpoint_edit(lambda p: p.pop("rng")),
+        "an older format (format missing)": checkpoint_edit(lambda p: p.pop("format")),
+        "a format from the future": checkpoint_edit(lambda p: p.update(format=999)),
+        "the agent missing": checkpoint_edit(lambda p: p.pop("agent")),
+        "another step in its state": checkpoint_edit(lambda p: p["state"].update(env_step=20)),
+        "a replay file named that is not there": checkpoint_edit(
+            lambda p: p.update(replay_file="replay-99.npz")),
+        "an empty dict": checkpoint_edit(lambda p: p.clear()),
+        "a symlink to config.json": symlink_to("config.json"),
+    },
+    "replay": {
+        "an array missing": replay_edit(lambda a: a.pop(sorted(a)[0])),
+        "a directory": into_directory,
+        "a second replay file beside it": copy_replay,
+    },
+}  # fmt: skip
+FOURTH_FILE_CASES = [
+    {**cli("files", command, argv, name, ok=True, setup=(name, how)), "what": f"{name} {way}"}
+    for name, ways in FOURTH_DAMAGES.items()
+    for way, how in ways.items()
+    for command, argv in FILE_COMMANDS.items()
+]
+
+FOURTH_SPEC_EDITS = [  # (text replaced, by, what the refusal names[, valid])
+    ("eval_every = 10_000", "eval_every = 0", "eval_every"),
+    ("eval_every = 10_000", "eval_every = 1", "eval_every", True),
+    ("eval_episodes = 10", "eval_episodes = 1", "", True),
+    ("eval_episodes = 10", "eval_episodes = 2.5", "eval_episodes"),
+    ("eval_episodes = 10", "eval_episodes = true", "eval_episodes"),
+    ("video = false", "video = 1", "video"),
+    ('preset = "cpu"', 'preset = "highway-cpu"', ("preset", "highway"), True),
+    ('preset = "cpu"', "preset = 3", "preset"),
+    ('seeds = "101-102"', 'seeds = "101-101"', "", True),
+    ('seeds = "101-102"', "seeds = [101, 102]", "seeds", True),
+    ('seeds = "101-102"', 'seeds = "0-0"', "seeds", True),
+    ("env_steps = 50_000", "env_steps = 1", "env_steps", True),
+    ("env_steps = 50_000", "env_steps = 50_000.5", "env_steps"),
+    ("env_steps = 50_000", 'env_steps = "50000"', "env_steps"),
+    ("env_steps = 100_000", "env_steps = 0", "env_steps"),
+    ("env_steps = 100_000", "env_steps = 1e5", "env_steps"),
+    ("env_steps = 100_000", "env_steps = 10_000", "env_steps", True),
+    ("action_repeat = 8", "action_repeat = true", "action_repeat"),
+    ("action_repeat = 8", 'action_repeat = "8"', "action_repeat"),
+    ("action_repeat = 8", "action_repeat = 1", "", True),
+    ("action_repeat = 4", "action_repeat = 1000", "action_repeat", True),
+    ("cpus_per_trial = 1 ", "cpus_per_trial = 0.5 ", "cpus_per_trial", True),
+    ("cpus_per_trial = 1 ", "cpus_per_trial = true ", "cpus_per_trial"),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 1.5", "max_concurrent_trials"),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = true", "max_concurrent_trials"),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 2\ngpus_per_trial = 0.5",
+     "gpus_per_trial", True),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 2\nnum_cpus = 0", "num_cpus"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.lr = [0.0]", "lr"),
+    ("agent.n_step = [1, 3]", 'agent.n_step = ["1", "3"]', "n_step"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.discount = [1.5]", "discount"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.batch_size = [true]", "batch_size"),
+    ("agent.n_step = [1, 3]", 'agent.n_step = [1, 3]\nagent.recipe = ["drq"]', "recipe"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.lr = [1e-3, 3e-4]", "agent.lr", True),
+    ("agent.n_step = [1, 3]", 'agent.n_step = [1, 3]\nenv = ["Pendulum-v1"]', "env"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [1, 3]\nagent.lr = []", "lr"),
+    ("agent.n_step = [1, 3]", "agent.n_step = [0, 3]", "n_step"),
+    (RECIPES, 'recipes = ["simoun", "simoun_no_aux"]', "simoun_no_aux", True),
+    (RECIPES, 'recipes = ["sac"]', "", True),
+    (RECIPES, 'recipes = [""]', "recipes"),
+    (RECIPES, 'recipes = ["simoun", "SAC"]', "SAC"),
+    ('selection = "auc"', 'selection = "final"', "selection", True),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["simoun/PointReach-v0"]',
+     "PointReach", True),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["highway-fast-v0"]', "highway", True),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["ALE/Pong-v5"]', "ALE"),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["CartPole-v1"]', "CartPole"),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]',
+     'tasks = ["dm_control/cartpole-swingup-v0", "dm_control/cartpole-swingup-v0"]',
+     "cartpole-swingup"),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["FrozenLake-v1"]', "FrozenLake"),
+    ('tasks = ["dm_control/cartpole-swingup-v0"]', 'tasks = ["dm_control/walker-walk-v0"]',
+     "walker", True),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-5"', '"1-1"'), "", True),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-5"', '"101-105"'), ("101", "seed")),
+    (EVAL_SEEDS, EVAL_SEEDS.replace('"1-3"', '""'), ("seeds", "cheetah")),
+]  # fmt: skip
+FOURTH_MINIGRID_EDITS = [  # (a change to the spec's JSON value, what the refusal names[, valid])
+    *((lambda s, arm=arm: s.update(arms=["ppo", arm]), names) for arm, names in (
+        ("consistency,normalization=paperx,scale=0.01", "paperx"),
+        ("consistency,scale=-1", "scale"), ("consistency,scale=nan", "scale"),
+        ("consistency,scale=0.01,scale=0.02", "scale"), ("consistency,nope=1", "nope"),
+        ("consistency,", "consistency,"), ("ppo,scale=0.1", "scale"),
+        ("rnd,progress=2", "progress"), ("consistency,scale=", "scale"),
+        ("consistency,scale=1e400", "scale"), ("Consistency", "Consistency"),
+        ("rnd,normalization=", "normalization"), ("consistency,progress=-0.5", "progress"),
+        ("consistency,normalization=standardize,scale=0.01,", "consistency"),
+        ("consistency, scale=0.01", "scale"), ("rnd,scale=true", "scale"),
+    )),
+    (lambda s: s.update(arms=["ppo", "consistency,normalization=raw"]), "", True),
+    (lambda s: s.update(arms=["ppo", "consistency,scale=0.01,normalization=standardize",
+                              "consistency,normalization=standardize,scale=0.01"]), "arms"),
+    (lambda s: s["ppo"].update(n_steps=1), "n_steps", True),
+    (lambda s: s["ppo"].update(n_epochs=0), "n_epochs"),
+    (lambda s: s["ppo"].update(clip_range=0), "clip_range", True),
+    (lambda s: s["ppo"].update(ent_coef=-1), "ent_coef"),
+    (lambda s: s["ppo"].update(gae_lambda=1.5), "gae_lambda"),
+    (lambda s: s["ppo"].update(batch_size=0), "batch_size"),
+    (lambda s: s["ppo"].update(learning_rate=0), "learning_rate"),
+    (lambda s: s["ppo"].update(n_envs=1.5), "n_envs"),
+    (lambda s: s["ppo"].update(n_envs=True), "n_envs"),
+    (lambda s: s.update(evaluations=True), "evaluations"),
+    (lambda s: s.update(eval_episodes="32"), "eval_episodes"),
+    (lambda s: s["tasks"][0].update(seeds=[True]), "seeds"),
+    (lambda s: s["tasks"][0].update(steps=0), "steps"),
+    (lambda s: s["tasks"][0].update(env_id="MiniGrid-Empty-5x5-v0"), "", True),
+    (lambda s: s.update(device="cuda:0"), ("device", "cuda"), True),
+    (lambda s: s.pop("ppo"), "ppo", True),
+    (lambda s: s["tasks"].append(s["tasks"][0]), ("DoorKey-6x6", "tasks")),
+]  # fmt: skip
+for _old, _new, *_ in FOURTH_SPEC_EDITS:
+    assert _old in SPEC, _old
+
+
+def spec_change(change) -> str:
+    """What ``change`` does to the MiniGrid spec, for the table: each top-level key it changes."""
+    old, new = json.loads(MINIGRID_SPEC), json.loads(minigrid_spec(change))
+    return "; ".join(
+        f"{key}={json.dumps(new[key])}" if key in new else f"no {key}"
+        for key in sorted(old.keys() | new.keys())
+        if old.get(key) != new.get(key)
+    )
+
+
+FOURTH_SPEC_CASES = [
+    *({**spec_case(SPEC.replace(old, new, 1), names, ok=bool(ok)), "what": new}
+      for old, new, names, *ok in FOURTH_SPEC_EDITS),
+    *({**minigrid_spec_case(i, minigrid_spec(change), names, ok=bool(ok)),
+       "what": spec_change(change)}
+      for i, (change, names, *ok) in enumerate(FOURTH_MINIGRID_EDITS)),
+]  # fmt: skip
+
+TS = f"w.SimounObservation({M}, size=16)"  # triplets of a discrete-action env
+FOURTH_REFUSED = [  # (code with one {}, the name the refusal must give, the values)
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, normalization={{}})", "normalization",
+     "'Paper'", "''", "None", "3", "'paper '"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, scale={{}})", "scale",
+     "-1", "True", "np.float32('nan')", "'0.2'", "float('inf')"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, progress={{}})", "progress",
+     "-1", "float('nan')", "'half'"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, warmup={{}})", "warmup", "-1", "2.5"),
+    (FEAT + f"w.ConsistencyCuriosityReward({S}, feat, decay={{}})", "decay",
+     "float('nan')", "'0'"),
+    (NOV + f"w.RNDReward({S}, nov, decay={{}})", "decay", "-0.1", "float('inf')"),
+    (NOV + f"w.RNDReward({S}, nov, scale={{}})", "scale", "float('inf')", "np.float64('nan')"),
+    (NOV + f"w.RNDReward({S}, nov, progress={{}})", "progress", "float('nan')", "-0.5"),
+    (NOV + f"w.RNDReward({S}, nov, normalization={{}})", "normalization", "'Reward_Std'"),
+    (f"w.SimounObservation({P}, {{}})", "grayscale", "grayscale='false'", "grayscale=0.0"),
+    (f"w.SimounObservation({P}, {{}})", "fold_frames", "fold_frames=[True]", "fold_frames=None"),
+    (f"w.SimounObservation({P}, {{}})", "motion", "motion=0", "motion='true'"),
+    (f"w.SimounObservation({P}, size={{}})", "size", "(16, 16.0)", "(-16, 16)", "(16, 16, 16)",
+     "'16x16'"),
+    (f"w.FrameTriplet({P}, num_frames={{}})", "num_frames", "np.float64(3)", "[3]"),
+    (f"w.RandomConvolution({P}, kernel_size={{}})", "kernel_size", "np.float32(3)", "[3]", "0"),
+    (f"w.RandomConvolution({P}, source={{}})", "source", "None", "'Auto'"),
+    (f"w.ActionRepeat({P}, {{}})", "repeat", "np.nan", "float('inf')", "-np.int64(2)"),
+    (f"w.MultiCamera({P}, cameras=[lambda e: e.render()], size={{}})", "size",
+     "(16,)", "(16, 0)", "1.5", "'16'"),
+    (DMC + "w.ColorShift(d, {})", "level", "level=1", "level=''"),
+    (DMC + "w.MovingBackground(d, {})", "level", "level=None", "level='Easy'"),
+    (DMC + "w.MovingBackground(d, {})", "seed", "seed=1.5", "seed='0'"),
+    (AGENT + "AgentConfig({})", "encoder", "encoder='resnet'"),
+    (AGENT + "AgentConfig({})", "shift_pad", "shift_pad=-1", "shift_pad=2.5"),
+    (AGENT + "AgentConfig({})", "critic_augmentations", "critic_augmentations=0"),
+    (AGENT + "AgentConfig({})", "target_augmentations", "target_augmentations=-1"),
+    (AGENT + "AgentConfig({})", "next_state_encoder", "next_state_encoder='x'"),
+    (AGENT + "AgentConfig({})", "independent_next_shift", "independent_next_shift='yes'"),
+    (AGENT + "AgentConfig({})", "separate_trunks", "separate_trunks=2"),
+    (AGENT + "AgentConfig({})", "pixel_offset", "pixel_offset=float('nan')"),
+    (AGENT + "AgentConfig({})", "contrastive_view", "contrastive_view='crop'"),
+    (AGENT + "AgentConfig({})", "contrastive_step", "contrastive_step=None"),
+    (AGENT + "AgentConfig({})", "similarity_init", "similarity_init='zeros'"),
+    (AGENT + "AgentConfig({})", "num_filters", "num_filters='32'", "num_filters=0"),
+    (AGENT + "AgentConfig({})", "hidden_dim", "hidden_dim=-1"),
+    (AGENT + "AgentConfig({})", "aux_hidden_dim", "aux_hidden_dim=0"),
+    (AGENT + "AgentConfig({})", "alpha_lr", "alpha_lr=0"),
+    (AGENT + "AgentConfig({})", "discount", "discount=-0.1"),
+    (AGENT + "AgentConfig({})", "n_step", "n_step=True"),
+    (AGENT + "AgentConfig({})", "critic_tau", "critic_tau=0", "critic_tau=1.5"),
+    (AGENT + "AgentConfig({})", "encoder_tau", "encoder_tau=-0.5"),
+    (AGENT + "AgentConfig({})", "actor_update_every", "actor_update_every=0"),
+    (AGENT + "AgentConfig({})", "exploration_std_start", "exploration_std_start=-1"),
+    (AGENT + "AgentConfig({})", "exploration_steps", "exploration_steps=0"),
+    (AGENT + "AgentConfig({})", "noise_clip", "noise_clip=float('nan')"),
+    (AGENT + "AgentConfig({})", "init_temperature", "init_temperature=0"),
+    (AGENT + "AgentConfig({})", "log_std_min", "log_std_min=float('inf')"),
+    (AGENT + "AgentConfig({})", "curiosity_scale", "curiosity_scale=-1"),
+    (AGENT + "AgentConfig({})", "r_e_max_init", "r_e_max_init=0"),
+    (AGENT + "AgentConfig({})", "transition_weight", "transition_weight=float('nan')"),
+    (AGENT + "AgentConfig({})", "num_frames", "num_frames=0"),
+    (AGENT + "AgentConfig({})", "reduce_kernel", "reduce_kernel=0"),
+    (AGENT + "AgentConfig({})", "reduce_stride", "reduce_stride=0"),
+    (AGENT + "AgentConfig({})", "random_conv_kernel", "random_conv_kernel=2"),
+    (AGENT + "AgentConfig({})", "detach_past_frames", "detach_past_frames=None"),
+    (AGENT + "AgentConfig({})", "channels_last", "channels_last='x'"),
+    (AGENT + "AgentConfig({})", "log_std", "log_std_min=3.0, log_std_max=2.0"),
+]  # fmt: skip
+STATE = "e.state_dict()"
+FOURTH_CODES = [  # (code, the name the refusal must give, or "" for valid input[, valid])
+    # wrapping twice, and in an order the docs do not show
+    (NOV + f"e = w.RNDReward(w.RNDReward({S}, nov, warmup=0), nov, warmup=0); " + STEP, ""),
+    (f"e = w.SimounObservation(w.ActionRepeat({P}, 2), size=16); " + STEP, ""),
+    (f"e = w.ActionRepeat({S}, 2); " + STEP, "ActionRepeat"),
+    (f"w.ConstantBonusReward({P}, 0.1)", ("triplet", "SimounObservation")),
+    (NOV + f"w.RNDReward({P}, nov)", ("triplet", "SimounObservation")),
+    (f"e = w.RandomConvolution(w.ConstantBonusReward({S}, 0.1)); " + STEP, "RandomConvolution"),
+    (f"e = w.ResidualMotion(w.ConstantBonusReward({S}, 0.1)); " + STEP, "ResidualMotion"),
+    (f"e = w.FrameTriplet(w.FrameTriplet({P})); " + STEP, ""),
+    (f"w.ResidualMotion(w.ResidualMotion({S}))", ("ResidualMotion", "frame", "(k, C, H, W)"),
+     True),
+    (f"e = w.SimounObservation(w.ConstantBonusReward({S}, 0.1), size=16); " + STEP,
+     "SimounObservation", True),
+    (f"e = w.ConstantBonusReward({TS}, 0.1); e.reset(seed=0); e.step(2)", ""),
+    # state_dict / load_state_dict round trips, good and bad
+    (FEAT + f"e = w.ConsistencyCuriosityReward({S}, feat); {STEP}; "
+     f"e.load_state_dict({STATE})", ""),
+    (NOV + f"e = w.RNDReward({S}, nov, warmup=0); {STEP}; e.load_state_dict({STATE})", ""),
+    (f"e = w.ConstantBonusReward({S}, 0.1); {STEP}; e.load_state_dict({STATE})", ""),
+    (FEAT + f"e = w.ConsistencyCuriosityReward({S}, feat); e.load_state_dict({{}})", "state"),
+    (FEAT + f"e = w.ConsistencyCuriosityReward({S}, feat); e.load_state_dict(None)", "state"),
+    (FEAT + f"e = w.ConsistencyCuriosityReward({S}, feat); f = w.ConsistencyCuriosityReward("
+     f"{S}, feat, normalization='standardize'); {STEP}; f.load_state_dict({STATE})",
+     ("normalization", "paper", "standardize")),
+    (NOV + f"e = w.RNDReward({S}, nov, warmup=0); {STEP}; s = {STATE}; "
+     "s[next(iter(s))] = 'garbage'; e.load_state_dict(s)", "state"),
+    (NOV + f"e = w.RNDReward({S}, nov, warmup=0); {STEP}; s = {STATE}; s['nope'] = 1; "
+     "e.load_state_dict(s)", ("nope", "state"), True),
+    (f"e = w.ConstantBonusReward({S}, 0.1); e.load_state_dict([1, 2])", "state"),
+    (FEAT + f"e = w.ConsistencyCuriosityReward({S}, feat); {STEP}; "
+     f"pickle.loads(pickle.dumps({STATE}))", ""),
+    # rewards that are NaN or inf from the env, in every reward wrapper and mode
+    (FEAT + f"e = w.ConsistencyCuriosityReward(w.SimounObservation({NAN}, size=16), feat, "
+     "normalization='standardize'); " + STEP, "NaN"),
+    (NOV + f"e = w.RNDReward(w.SimounObservation({INF}, size=16), nov, warmup=0, "
+     "normalization='paper'); " + STEP, "inf"),
+    (f"e = w.ConstantBonusReward(w.SimounObservation({INF}, size=16), 0.1); " + STEP, "inf"),
+    (f"e = w.FrameTriplet({NAN}); " + STEP, ""),
+    # the vector forms in both autoreset modes
+    *((FEAT + f"v = w.ConsistencyCuriosityVectorReward({vec(mode, 'CartPole-v1')}, feat, "
+       "normalization='paperx')", "paperx") for mode in ("NEXT_STEP", "SAME_STEP")),
+    *((NOV + f"v = w.RNDVectorReward({vec(mode, 'CartPole-v1')}, nov, warmup=0, "
+       "normalization='return_std'); " + STEPS3, "") for mode in ("NEXT_STEP", "SAME_STEP")),
+    *((FEAT + f"v = w.ConsistencyCuriosityVectorReward({vec(mode, 'CartPole-v1')}, feat, "
+       "progress=0.5); " + STEPS3 + "; [v.step(v.action_space.sample()) for _ in range(300)]", "")
+      for mode in ("NEXT_STEP", "SAME_STEP")),
+    *((f"v = w.ConstantBonusVectorReward({vec(mode)}, 0.1, decay=-1)", "decay")
+      for mode in ("NEXT_STEP", "SAME_STEP")),
+    (f"v = w.ConstantBonusVectorReward(w.ConstantBonusVectorReward({vec('NEXT_STEP')}, 0.1), "
+     "0.1); " + STEPS3, ""),
+    (f"v = w.ConstantBonusVectorReward({vec('NEXT_STEP', wrap='e')}, 0.1)",
+     ("triplet", "SimounObservation")),
+    (f"w.ConstantBonusVectorReward({S}, 0.1)", ("vector", "ConstantBonusReward")),
+    (NOV + f"v = w.RNDVectorReward({vec('SAME_STEP')}, nov, warmup=0); v.reset(seed=0); "
+     "v.step(np.zeros((2, 1), np.float32)); v.reset(seed=1); v.step(np.zeros((2, 1), "
+     "np.float32))", ""),
+    # observations and wrappers at their boundaries
+    (f"e = w.SimounObservation({P}, size=1); " + STEP, "size", True),
+    (f"e = w.SimounObservation({P}, size=(16, 64)); " + STEP, ""),
+    (f"e = w.SimounObservation({P}, size=16, grayscale=np.bool_(True)); " + STEP, ""),
+    (f"e = w.SimounObservation({P}, size=16, num_frames=np.int64(3)); " + STEP, ""),
+    (f"e = w.FrameTriplet({P}, num_frames=1); " + STEP, ""),
+    (f"e = w.RandomConvolution({P}, kernel_size=1); " + STEP, ""),
+    (f"e = w.ActionRepeat({P}, 10**9); " + STEP, ""),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), kernel_size=-3)", "kernel_size"),
+    ("import torch; w.random_conv(torch.zeros(2, 3, 8, 8), clamp=(0,))", "clamp"),
+    ("w.residual_motion(np.zeros((0, 3, 8, 8), np.uint8))", "frames"),
+    (f"w.MultiCamera({P}, cameras='render')", "cameras"),
+    (f"w.MultiCamera({P}, cameras=[lambda e: e.render(), lambda e: e.render()], size=16)"
+     ".reset(seed=0)", ""),
+    (DMC + "w.MovingBackground(d, level='easy', videos='.')", ("videos", "video")),
+    (DMC + "w.ColorShift(d, level='hard', seed=np.int64(3)).reset(seed=0)", ""),
+]  # fmt: skip
+FOURTH_API_CASES = [
+    *(
+        api(code.format(value), names)
+        for code, names, *values in FOURTH_REFUSED
+        for value in values
+    ),
+    *(api(code, names, ok=ok[0] if ok else not names) for code, names, *ok in FOURTH_CODES),
+]
+FOURTH_COMMAND_CASES = FOURTH_FLAG_CASES + FOURTH_FILE_CASES + FOURTH_SPEC_CASES
+for _case in FOURTH_COMMAND_CASES + FOURTH_API_CASES:
+    _case["set"] = "fourth"
+
+
 CASES = (
     FLAG_CASES + FILE_CASES + SPEC_CASES + API_CASES + SECOND_COMMAND_CASES + SECOND_API_CASES
-    + THIRD_COMMAND_CASES + THIRD_API_CASES
+    + THIRD_COMMAND_CASES + THIRD_API_CASES + FOURTH_COMMAND_CASES + FOURTH_API_CASES
 )  # fmt: skip
 
 
@@ -1953,7 +2601,9 @@ def main() -> int:
         "--command", choices=(*COMMANDS, "api"), action="append", help="only its cases"
     )
     parser.add_argument(
-        "--set", choices=("first", "second", "third"), help="only that trial's cases (default: all)"
+        "--set",
+        choices=("first", "second", "third", "fourth"),
+        help="only that trial's cases (default: all)",
     )
     parser.add_argument(
         "--only",
