@@ -1900,7 +1900,7 @@ RESUME_ALLOWED = [  # every flag --resume may change, each given with the new to
 ]
 # flags that conflict or make no sense together: (command, argv, names[, valid])
 COMBOS = [
-    ("train", tiny("--agent.log-std-min", "3", "--agent.log-std-max", "2"), "log_std"),
+    ("train", tiny("--agent.log-std-min", "3", "--agent.log-std-max", "2"), ("log_std", "log-std")),
     ("train", tiny("--agent.exploration-std-start", "0.1", "--agent.exploration-std-end", "1.0",
                    *SHORT), "exploration_std", True),
     ("train", tiny("--eval-every", "30", "--total-env-steps", "20", "--run-dir", "r"),
@@ -1909,7 +1909,7 @@ COMBOS = [
     ("train", tiny("--agent.batch-size", "64", "--agent.replay-capacity", "16"),
      ("batch_size", "replay")),
     ("train", tiny("--replay-capacity", "16", "--agent.batch-size", "64"),
-     ("batch_size", "replay_capacity")),
+     ("batch_size", "replay_capacity", "--agent.batch-size", "--replay-capacity")),
     ("train", tiny("--agent.recipe", "drqv2", "--agent.actor", "gaussian", *SHORT), "actor", True),
     ("train", tiny("--agent.recipe", "simoun_no_curiosity", "--agent.curiosity", *SHORT),
      "curiosity", True),
@@ -2016,7 +2016,7 @@ SET_TYPES = [  # --set of every config section with a wrong type: (text, names[,
     ("action_repeat=none", "", True),
     ("total_env_steps=1e5", "total_env_steps"),
     ("agent.lr=1e-3e", "agent.lr"),
-    ("eval_distraction=[]", "eval_distraction"),
+    ("eval_distraction=[]", "", True),
     ("agent.shift_pad=none", "", True),
     ("progress=yes", "progress"),
     ("agent.actor=null", "actor"),
@@ -2201,7 +2201,17 @@ FOURTH_DAMAGES = {
     },
 }  # fmt: skip
 FOURTH_FILE_CASES = [
-    {**cli("files", command, argv, name, ok=True, setup=(name, how)), "what": f"{name} {way}"}
+    {
+        **cli(
+            "files",
+            command,
+            argv,
+            (name, "replay") if "replay" in way else name,
+            ok=True,
+            setup=(name, how),
+        ),
+        "what": f"{name} {way}",
+    }
     for name, ways in FOURTH_DAMAGES.items()
     for way, how in ways.items()
     for command, argv in FILE_COMMANDS.items()
@@ -2315,7 +2325,7 @@ def spec_change(change) -> str:
 FOURTH_SPEC_CASES = [
     *({**spec_case(SPEC.replace(old, new, 1), names, ok=bool(ok)), "what": new}
       for old, new, names, *ok in FOURTH_SPEC_EDITS),
-    *({**minigrid_spec_case(i, minigrid_spec(change), names, ok=bool(ok)),
+    *({**minigrid_spec_case(1 if ok else i, minigrid_spec(change), names, ok=bool(ok)),
        "what": spec_change(change)}
       for i, (change, names, *ok) in enumerate(FOURTH_MINIGRID_EDITS)),
 ]  # fmt: skip
