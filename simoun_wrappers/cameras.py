@@ -12,7 +12,7 @@ import numpy as np
 from gymnasium import spaces
 
 from simoun_wrappers.augment import RandomConvolution
-from simoun_wrappers.distractors._dm_control import check_open
+from simoun_wrappers.distractors._dm_control import check_open, dm_control_physics
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import check_image, parse_size
 
@@ -23,13 +23,13 @@ _VIEWPORT_KEYS = ("centering_position", "scaling")
 
 
 def _dm_control_view(env: gym.Env, camera: int | str, hw: tuple[int, int] | None) -> Callable:
-    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
-    if physics is None:
-        raise TypeError(
-            f"camera {camera!r} is a dm_control camera id or name, but {env.unwrapped} is not a "
-            f"dm_control env through shimmy; for other envs pass callables env -> (H, W, 3) "
-            f"uint8 image, or viewport dicts for highway-env."
-        )
+    physics = dm_control_physics(
+        env,
+        "MultiCamera",
+        f"camera {camera!r} is a dm_control camera id or name, but {env.unwrapped} is not a "
+        f"dm_control env through shimmy; for other envs pass callables env -> (H, W, 3) uint8 "
+        f"image, or viewport dicts for highway-env.",
+    )
     model = physics.model
     names = [model.id2name(i, "camera") for i in range(model.ncam)]
     if isinstance(camera, str) and camera not in names:

@@ -28,18 +28,20 @@ def check_open(env: gym.Env, owner: str) -> None:
         )
 
 
-def dm_control_physics(env: gym.Env, owner: str) -> Any:
+def dm_control_physics(env: gym.Env, owner: str, refusal: str | None = None) -> Any:
     """The ``dm_control.mujoco.Physics`` of a dm_control task made through shimmy.
 
-    Raises a TypeError that names what works instead for any other env, and the ValueError of
-    :func:`check_open` for a task that was closed.
+    Raises a TypeError for any other env, with ``refusal`` as its message (by default one that
+    names what works instead for a distractor), and the ValueError of :func:`check_open` for a
+    task that was closed.
     """
     check_open(env, owner)
     physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
     if physics is None:
         raise TypeError(
-            f"{owner} needs a dm_control task made through shimmy (it changes the MuJoCo model "
-            f"or reads its segmentation), got {env.unwrapped}; make one with "
+            refusal
+            or f"{owner} needs a dm_control task made through shimmy (it changes the MuJoCo "
+            f"model or reads its segmentation), got {env.unwrapped}; make one with "
             f"gym.make('dm_control/cartpole-swingup-v0', render_mode='rgb_array'). For other "
             f"envs, RandomConvolution(env) randomises the appearance of any pixel env."
         )
