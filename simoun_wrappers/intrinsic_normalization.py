@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
@@ -100,8 +101,69 @@ class Normalization(ABC):
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what :meth:`state_dict` returned."""
 
+    bounds: ClassVar[dict[str, str]] = {}
+    """statistics with a sign: key -> ``">= 0"`` or ``"> 0"``"""
+
+    def state_problems(self, state: Any) -> list[str]:
+        """What keeps ``state`` from being loaded here, empty when it fits: not a dict, the
+        statistics of another normalization (named), keys missing or unknown, or a value of the
+        wrong type, not finite or of the wrong sign. The keys and types expected are those of
+        this normalization's own :meth:`state_dict`."""
+        own = self.state_dict()
+        if not isinstance(state, Mapping):
+            return [f"its normalization statistics are a {type(state).__name__}, not a dict"]
+        if set(state) != set(own):
+            saved = saved_with(state)
+            if saved and normalization_name(self) not in saved:
+                return [
+                    f"it was saved with normalization {' or '.join(map(repr, saved))}, but this "
+                    f"wrapper's is {normalization_name(self)!r}"
+                ]
+            problems = []
+            missing = [key for key in own if key not in state]
+            if missing:
+                problems.append(f"its normalization statistics lack {', '.join(missing)}")
+            unknown = [str(key) for key in state if key not in own]
+            if unknown:
+                problems.append(
+                    f"its normalization statistics hold {', '.join(unknown)}, which "
+                    f"{normalization_name(self)!r} has none of"
+                )
+            return problems
+        problems = []
+        for key, mine in own.items():
+            value = state[key]
+            if is_real(mine):
+                if not (is_real(value) and math.isfinite(value)):
+                    problems.append(f"its {key} is {value!r}, not a finite number")
+                elif self.bounds.get(key) == "> 0" and not value > 0:
+                    problems.append(f"its {key} is {value!r}, not > 0")
+                elif self.bounds.get(key) == ">= 0" and not value >= 0:
+                    problems.append(f"its {key} is {value!r}, not >= 0")
+            elif isinstance(mine, list):
+                if not (
+                    isinstance(value, (list, tuple, np.ndarray))
+                    and all(is_real(v) and math.isfinite(v) for v in value)
+                ):
+                    problems.append(f"its {key} is {value!r}, not a list of finite numbers")
+            elif not isinstance(value, type(mine)):
+                problems.append(
+                    f"its {key} is a {type(value).__name__}, not a {type(mine).__name__}"
+                )
+        return problems
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
+
+
+def normalization_name(normalization: Normalization) -> str:
+    """The name ``normalization`` is registered under, or its class name for one of the user's."""
+    return getattr(normalization, "name", type(normalization).__name__)
+
+
+def saved_with(state: Mapping) -> list[str]:
+    """The registered normalizations whose statistics have exactly the keys of ``state``."""
+    return [name for name, cls in NORMALIZATIONS.items() if set(cls().state_dict()) == set(state)]
 
 
 class PaperMaxima(Normalization):
@@ -121,6 +183,7 @@ class PaperMaxima(Normalization):
     """
 
     name = "paper"
+    bounds: ClassVar[dict[str, str]] = {"r_e_max": "> 0", "r_i_max": "> 0"}
 
     def __init__(self, r_e_max_init: float = 1.0, r_i_max_init: float = 1.0) -> None:
         for name, value in (("r_e_max_init", r_e_max_init), ("r_i_max_init", r_i_max_init)):
@@ -157,6 +220,7 @@ class RewardStd(Normalization):
     """
 
     name = "reward_std"
+    bounds: ClassVar[dict[str, str]] = {"var": ">= 0", "count": ">= 0"}
     centred: ClassVar[bool] = False
     """subtract the running mean before dividing (:class:`Standardize`)"""
 
@@ -199,6 +263,7 @@ class ReturnStd(Normalization):
     """
 
     name = "return_std"
+    bounds: ClassVar[dict[str, str]] = {"var": ">= 0", "count": ">= 0"}
 
     def __init__(self, gamma: float = 0.99) -> None:
         if not (isinstance(gamma, (int, float)) and 0 <= gamma < 1):

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar, NamedTuple, SupportsFloat
 
 import gymnasium as gym
@@ -24,7 +24,11 @@ from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
 from simoun_wrappers._checks import is_int, is_real
 from simoun_wrappers.frames import check_single_env
-from simoun_wrappers.intrinsic_normalization import Normalization, make_normalization
+from simoun_wrappers.intrinsic_normalization import (
+    Normalization,
+    make_normalization,
+    normalization_name,
+)
 
 __all__ = [
     "ConstantBonusReward",
@@ -326,13 +330,41 @@ class IntrinsicMechanism(ABC):
             )
         return raw
 
+    def check_state(self, state: Any) -> None:
+        """A TypeError for a ``state`` that is no dict, a ValueError naming what else keeps it
+        from this wrapper: ``scored`` or ``normalization`` missing or bad, or statistics of
+        another normalization than this wrapper's (named both)."""
+        name = type(self).__name__
+        normalization = normalization_name(self.normalization)
+        fix = (
+            f"the state must come from state_dict() of a {name} with "
+            f"normalization={normalization!r}, e.g. env.load_state_dict(other.state_dict())"
+        )
+        if not isinstance(state, Mapping):
+            raise TypeError(
+                f"{name}.load_state_dict got a {type(state).__name__}, not a dict; {fix}."
+            )
+        problems = [f"it lacks {key!r}" for key in ("scored", "normalization") if key not in state]
+        scored = state.get("scored", 0)
+        if not (is_real(scored) and math.isfinite(scored) and scored >= 0 and scored % 1 == 0):
+            problems.append(f"its scored is {scored!r}, not an int >= 0")
+        if "normalization" in state:
+            problems += self.normalization.state_problems(state["normalization"])
+        if problems:
+            raise ValueError(
+                f"{name}.load_state_dict cannot load this state: {'; '.join(problems)}; {fix}. "
+                "Nothing was loaded."
+            )
+
     def state_dict(self) -> dict[str, Any]:
         """The transitions scored and the normalization's statistics (the source keeps its own
         state)."""
         return {"scored": self.scored, "normalization": self.normalization.state_dict()}
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned."""
+        """Restore what :meth:`state_dict` returned; a state that does not fit this wrapper (see
+        :meth:`check_state`) is refused and nothing is loaded."""
+        self.check_state(state)
         self.normalization.load_state_dict(state["normalization"])
         self.scored = int(state["scored"])
 

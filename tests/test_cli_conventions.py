@@ -345,3 +345,19 @@ def test_resume_of_a_read_only_run_directory_is_one_clear_error(finished):
     assert "Traceback" not in done.stderr
     assert f"cannot write to the run directory {finished} (Read-only file system)" in done.stderr
     assert "Make it writable" in done.stderr and "--resume the copy" in done.stderr
+
+
+def test_an_unknown_mujoco_gl_is_refused_in_one_line(tmp_path):
+    run_dir = tmp_path / "run"
+    argv = run_flags(run_dir, 40, "--env", "dm_control/cartpole-swingup-v0")
+    done = subprocess.run(
+        [sys.executable, "-m", "simoun_agent.cli.train", *argv],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "MUJOCO_GL": "bogus"},
+    )
+    assert done.returncode == 2, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    assert "MUJOCO_GL='bogus'" in done.stderr and "egl or osmesa or glfw" in done.stderr
+    assert not run_dir.exists()

@@ -10,7 +10,11 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 from simoun_wrappers import SimounObservation
 from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
-from simoun_wrappers.intrinsic_reward import triplet_shape
+from simoun_wrappers.intrinsic_reward import (
+    ConstantBonusReward,
+    ConstantBonusVectorReward,
+    triplet_shape,
+)
 from simoun_wrappers.rnd import RNDReward, RNDVectorReward
 
 
@@ -224,3 +228,56 @@ def test_reset_hands_its_seeds_to_the_env():
     single = cartpole()
     single.reset(seed=7)
     np.testing.assert_array_equal(env.unwrapped.state, single.unwrapped.state)
+
+
+def pendulum() -> gym.Env:
+    return SimounObservation(gym.make("Pendulum-v1", render_mode="rgb_array"), size=16)
+
+
+def intrinsic_wrappers():
+    """Every intrinsic wrapper, single and vector, each stepped so its statistics are not the
+    initial ones."""
+    vec = SyncVectorEnv([pendulum, pendulum])
+    return [
+        ConsistencyCuriosityReward(pendulum(), Features()),
+        RNDReward(pendulum(), Recorder(), normalization="return_std"),
+        ConstantBonusReward(pendulum(), scale=0.1),
+        RNDVectorReward(vec, Recorder(), normalization="standardize"),
+        ConstantBonusVectorReward(SyncVectorEnv([pendulum]), scale=0.1),
+    ]
+
+
+def test_load_state_dict_refuses_a_state_that_does_not_fit_and_loads_nothing():
+    for env in intrinsic_wrappers():
+        name = type(env).__name__
+        env.reset(seed=0)
+        for _ in range(3):
+            env.step(env.action_space.sample())
+        before = env.state_dict()
+        own = env.normalization.name
+        other = "paper" if own != "paper" else "return_std"
+        foreign = RNDReward(pendulum(), Recorder(), normalization=other).state_dict()
+        wanted = f"state_dict\\(\\) of a {name} with normalization='{env.normalization.name}'"
+        with pytest.raises(
+            TypeError, match=f"got a NoneType, not a dict; the state must come from {wanted}"
+        ):
+            env.load_state_dict(None)
+        with pytest.raises(TypeError, match="got a list"):
+            env.load_state_dict([before])
+        cases = {
+            "it lacks 'scored'; it lacks 'normalization'": {},
+            f"saved with normalization '{other}', but this wrapper's is '{own}'": foreign,
+            "its scored is 'x', not an int >= 0": {**before, "scored": "x"},
+            "its normalization statistics are a NoneType": {**before, "normalization": None},
+        }
+        if before["normalization"]:
+            key = next(iter(before["normalization"]))
+            damaged = {**before["normalization"], key: "nan"}
+            cases[f"its {key} is 'nan', not a finite number"] = {**before, "normalization": damaged}
+        for message, state in cases.items():
+            with pytest.raises(ValueError, match=f"{message}.*{wanted}.*Nothing was loaded"):
+                env.load_state_dict(state)
+            assert env.state_dict() == before
+        env.load_state_dict(before)
+        assert env.state_dict() == before
+        env.close()

@@ -13,6 +13,7 @@ import importlib
 import importlib.util
 import inspect
 import json
+import os
 from collections.abc import Callable
 
 import gymnasium as gym
@@ -182,8 +183,28 @@ def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
     )
 
 
+MUJOCO_GL_WORKING = ("egl", "osmesa", "glfw")
+"""the ``MUJOCO_GL`` rendering back-ends dm_control and mujoco render with"""
+
+
 def _make_base(config: TrainConfig) -> gym.Env:
-    """``gym.make`` the env with rgb_array rendering at the run's image size."""
+    """``gym.make`` the env with rgb_array rendering at the run's image size; a SetupError for a
+    ``MUJOCO_GL`` that dm_control or mujoco refuse (they read it on import, when the env's suite
+    registers or the env is made)."""
+    try:
+        return _make_rendering_env(config)
+    except RuntimeError as err:
+        if "MUJOCO_GL" not in str(err):
+            raise
+        value = os.environ.get("MUJOCO_GL", "")
+        raise SetupError(
+            f"MUJOCO_GL={value!r} is not a rendering back-end dm_control and mujoco know, so "
+            f"{config.env} cannot be made; set MUJOCO_GL to {' or '.join(MUJOCO_GL_WORKING)} "
+            "(egl on a machine without a display), or unset it"
+        ) from None
+
+
+def _make_rendering_env(config: TrainConfig) -> gym.Env:
     ensure_registered(config.env, config.env_module)
     check_env_kwargs(config.env, config.env_kwargs)
     kwargs = dict(config.env_kwargs)
