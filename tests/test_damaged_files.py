@@ -3,6 +3,7 @@ config's object belongs, a value of the wrong type; an empty or cut log) is name
 with the fix, instead of failing inside the code, and is left as it was."""
 
 import json
+import os
 import shutil
 
 import pytest
@@ -196,6 +197,11 @@ def huge_step(path):
     path.write_text(text + "1" * 40 + text.splitlines()[-1][text.splitlines()[-1].index(",") :])
 
 
+def named_pipe(path):
+    path.unlink()
+    os.mkfifo(path)
+
+
 def finished_run(run_dir):
     """A run directory as simoun-report and a resume read it before the checkpoint."""
     saved_run(run_dir)
@@ -226,6 +232,8 @@ KEPT_DAMAGES = [
         ("simoun-train", "train.csv", nul_in_first_line, "line 1 holds a NUL byte"),
         ("simoun-train", "train.csv", huge_step, f"{STEP} is past 2**63"),
         *(("simoun-report", *damage) for damage in KEPT_DAMAGES),
+        # a resume refuses a config.json that is not a file before reading it
+        ("simoun-report", "config.json", named_pipe, "it is a named pipe (FIFO), not a regular"),
     ],
 )
 def test_a_damaged_config_or_log_is_named_on_resume_and_by_the_report(

@@ -71,6 +71,13 @@ def test_the_minigrid_report_outside_the_clone_writes_nothing(tmp_path, capsys, 
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_probe_named_twice_is_refused_before_probing(tmp_path, capsys):
+    out = tmp_path / "probe"
+    err = refused(capsys, minigrid_cli.main, ["probe", "--probes", "rnd", "rnd", "--out", str(out)])
+    assert "--probes names rnd more than once; name each probe once" in err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     ("text", "kind"), [("[]", "an array"), ("null", "null"), ("3", "a number")]
 )

@@ -30,7 +30,11 @@ def test_arm_names_carry_checked_settings():
     for name, problem in (
         ("consistensy", r"unknown arm 'consistensy' \(did you mean 'consistency'\?\)"),
         ("rnd,scael=0.1", r"'scael=0.1' is not KEY=VALUE.*did you mean 'scale'"),
-        ("rnd,scale=-1", r"scale='-1' must be a number >= 0"),
+        ("rnd,scale=-1", r"scale='-1' is not valid: scale must be a finite number >= 0"),
+        ("consistency,scale=1e400", r"scale='1e400' is not valid.*got inf"),
+        ("rnd,progress=2", r"'rnd,progress=2': progress='2' is not valid.*in \(0, 1\]"),
+        ("consistency,progress=-0.5", r"progress='-0.5' is not valid"),
+        ("rnd,normalization=[1]", r"normalization=\[1\] is not one of"),
         ("rnd,scale=0.1,scale=0.2", r"'scale' is given twice"),
         ("rnd,normalization=std", r"normalization='std' is not one of"),
         ("consistency,lr=0.1", r"'lr=0.1' is not KEY=VALUE"),  # model settings are not arms'
@@ -40,6 +44,21 @@ def test_arm_names_carry_checked_settings():
             parse_arm(name)
     with pytest.raises(SetupError, match="an arm is listed twice"):
         spec_from_dict({"arms": ["ppo", "ppo"]}, "spec")
+
+
+def test_one_arm_or_task_listed_twice_is_refused():
+    same = [
+        "consistency,scale=0.01,normalization=paper",
+        "consistency,normalization=paper,scale=0.01",
+    ]
+    for arms in (same, ["rnd", "rnd,scale=0.05"]):
+        with pytest.raises(SetupError) as refused:
+            spec_from_dict({"arms": ["ppo", *arms]}, "spec")
+        assert f"{arms[0]!r} and {arms[1]!r} are one arm spelled two ways" in str(refused.value)
+    spec_from_dict({"arms": ["rnd", "rnd,scale=0.01"]}, "spec")
+    task = {"env_id": TASK, "steps": 4096, "seeds": [0]}
+    with pytest.raises(SetupError, match=f"spec tasks: {TASK} is listed 2 times; list it once"):
+        spec_from_dict({"tasks": [task, {**task, "seeds": [1]}]}, "spec")
 
 
 def test_the_area_is_the_trapezoid_of_success_over_the_budget():

@@ -10,6 +10,7 @@ each caller adds the fix that fits its command.
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 STEP_LIMIT = 2**63
@@ -30,11 +31,34 @@ def broken_link(path: Path) -> str | None:
     return None
 
 
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISSOCK, "a socket"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+)
+
+
+def not_a_file(path: Path) -> str | None:
+    """What is wrong with ``path`` when it is there but is not a regular file, else None: a
+    read of a named pipe waits for a writer forever, and a device can give bytes without end."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None  # missing or unreadable: the read that follows names it
+    if stat.S_ISREG(mode):
+        return None
+    kind = next((name for test, name in _KINDS if test(mode)), "something else")
+    return f"it is {kind}, not a regular file"
+
+
 def read_text(path: Path) -> str:
     """The UTF-8 text of ``path`` (a leading byte order mark dropped, as a spreadsheet writes
-    it); :class:`Damaged` for a link to nothing, text in another encoding or NUL bytes, which no
-    run writes. OSError for a file that cannot be read."""
-    problem = broken_link(path)
+    it); :class:`Damaged` for a link to nothing, something that is not a regular file (checked
+    before it is opened), text in another encoding or NUL bytes, which no run writes. OSError
+    for a file that cannot be read."""
+    problem = broken_link(path) or not_a_file(path)
     if problem:
         raise Damaged(problem)
     data = path.read_bytes()

@@ -115,11 +115,11 @@ DESCRIPTION = (
 def main(argv: Sequence[str] | None = None) -> int:
     args = parse(Command, argv, PROG, DESCRIPTION)
     if isinstance(args, Probe):
-        from simoun_lab.minigrid_study.probe import write_probe
-        from simoun_lab.minigrid_study.probe_settings import check_settings
+        from simoun_lab.minigrid_study.probe_settings import check_probes, check_settings
         from simoun_lab.minigrid_study.spec import MINIGRID_ID
 
         try:
+            check_probes(args.probes)
             check_settings(args.settings, lambda field: "--settings." + field.replace("_", "-"))
             check_output_dir(args.out, "--out")
             if not args.out.parent.is_dir():
@@ -131,6 +131,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 raise SetupError(
                     f"--settings.env-id {args.settings.env_id}: must be {MINIGRID_ID.need}"
                 )
+            from simoun_lab.minigrid_study.probe import write_probe  # torch, once the flags pass
+
             print(write_probe(args.settings, args.probes, args.out))
         except ValueError as err:
             fail(PROG, err)

@@ -21,10 +21,14 @@ from simoun_agent.curiosity_model import CuriosityConfig, CuriosityModel
 from simoun_agent.rnd_model import RNDConfig, RNDModel
 from simoun_wrappers import ConsistencyCuriosityVectorReward
 from simoun_wrappers.intrinsic_normalization import NORMALIZATIONS
-from simoun_wrappers.intrinsic_reward import ConstantBonusVectorReward
+from simoun_wrappers.intrinsic_reward import (
+    ConstantBonusVectorReward,
+    check_scale,
+    check_weighting,
+)
 from simoun_wrappers.rnd import RNDVectorReward
 
-__all__ = ["ARMS", "arm_name", "build_arm", "parse_arm"]
+__all__ = ["ARMS", "arm_name", "arm_settings", "build_arm", "parse_arm"]
 
 
 def no_intrinsic(envs: VectorEnv, seed: int, device: torch.device) -> VectorEnv:
@@ -87,6 +91,13 @@ the device of the intrinsic-reward model and the arm's settings"""
 FIXED = ("envs", "seed", "device")
 """the arguments every entry takes from the run, not from the arm's name"""
 
+SETTING_CHECKS: dict[str, Callable[[Any], object]] = {
+    "scale": check_scale,
+    "progress": lambda progress: check_weighting(0.0, 0, progress),
+}
+"""an arm setting -> the wrappers' own check of it, so a value they would refuse when the run
+starts is refused when the spec is read"""
+
 
 def parse_arm(name: str) -> tuple[str, dict[str, Any]]:
     """The entry and the settings an arm's name gives, each value checked against the entry's
@@ -118,17 +129,30 @@ def parse_arm(name: str) -> tuple[str, dict[str, Any]]:
             value = json.loads(text)
         except json.JSONDecodeError:
             value = text
-        default = parameters[key].default
-        if key == "normalization" and value not in NORMALIZATIONS:
+        if key == "normalization" and (not isinstance(value, str) or value not in NORMALIZATIONS):
             raise SetupError(
                 f"arm {name!r}: normalization={value!r} is not one of {list(NORMALIZATIONS)}"
             )
-        if isinstance(default, float) and not (
-            isinstance(value, (int, float)) and not isinstance(value, bool) and value >= 0
-        ):
-            raise SetupError(f"arm {name!r}: {key}={text!r} must be a number >= 0")
+        if key in SETTING_CHECKS:
+            try:
+                SETTING_CHECKS[key](value)
+            except ValueError as err:
+                raise SetupError(f"arm {name!r}: {key}={text!r} is not valid: {err}") from None
         settings[key] = value
     return entry, settings
+
+
+def arm_settings(name: str) -> tuple[str, dict[str, Any]]:
+    """The entry and every setting the arm ``name`` runs with, its entry's defaults filled in:
+    two names of one arm (keys in another order, a default spelled out) give the same."""
+    entry, settings = parse_arm(name)
+    parameters = inspect.signature(ARMS[entry]).parameters
+    defaults = {
+        key: parameter.default
+        for key, parameter in parameters.items()
+        if key not in FIXED and parameter.kind is not parameter.VAR_KEYWORD
+    }
+    return entry, {**defaults, **settings}
 
 
 def arm_name(entry: str, settings: dict[str, Any]) -> str:

@@ -31,7 +31,7 @@ from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import ARMS, consistency
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, pixel_vector_env
-from simoun_lab.minigrid_study.probe_settings import ProbeSettings, check_settings
+from simoun_lab.minigrid_study.probe_settings import ProbeSettings, check_probes, check_settings
 
 __all__ = ["PROBED", "ProbeSettings", "check_settings", "probe", "write_probe"]
 
@@ -120,14 +120,7 @@ def write_probe(settings: ProbeSettings, names: list[str], out: Path) -> Path:
     (per probe, means over blocks, the first left out: the reward's correlation with novelty
     over all and over moving transitions, its std / mean, its still / moving mean)."""
     check_settings(settings)
-    if not names:  # an empty table would replace the archived probe.csv and probe.md
-        raise ValueError(
-            f"--probes is given no probe, so there is nothing to probe; name one or more of "
-            f"{', '.join(PROBED)}, or leave --probes out to probe them all"
-        )
-    unknown = [n for n in names if n not in PROBED]
-    if unknown:
-        raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBED)}")
+    check_probes(names)
     rows = [row for name in names for row in probe(name, settings)]
     out.mkdir(parents=True, exist_ok=True)
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-__all__ = ["PROBE_NAMES", "ProbeSettings", "check_settings"]
+__all__ = ["PROBE_NAMES", "ProbeSettings", "check_probes", "check_settings"]
 
 PROBE_NAMES = (
     "consistency",
@@ -59,3 +59,20 @@ def check_settings(
             f"{name('n_steps')} = {block} transitions (the summary leaves the first block out); "
             f"give {name('steps')} {2 * block} or more"
         )
+
+
+def check_probes(names: list[str]) -> None:
+    """Raise ValueError naming ``--probes`` when it names no probe (an empty table would replace
+    the archived probe.csv and probe.md), an unknown one, or one twice (its rows would be written
+    twice under one name, mixed in its means)."""
+    if not names:
+        raise ValueError(
+            f"--probes is given no probe, so there is nothing to probe; name one or more of "
+            f"{', '.join(PROBE_NAMES)}, or leave --probes out to probe them all"
+        )
+    unknown = [n for n in names if n not in PROBE_NAMES]
+    if unknown:
+        raise ValueError(f"--probes {unknown}: unknown; choose from {list(PROBE_NAMES)}")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"--probes names {', '.join(twice)} more than once; name each probe once")

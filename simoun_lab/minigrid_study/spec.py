@@ -20,7 +20,7 @@ from simoun_agent.config import SetupError
 from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
 from simoun_agent.run.kept import Damaged, read_text
-from simoun_lab.minigrid_study.arms import ARMS, parse_arm
+from simoun_lab.minigrid_study.arms import ARMS, arm_settings
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -139,10 +139,25 @@ class StudySpec:
     def __post_init__(self) -> None:
         if not self.arms:
             raise SetupError(f"spec arms: none given; choose from {list(ARMS)}")
-        for arm in self.arms:
-            parse_arm(arm)
         if len(set(self.arms)) != len(self.arms):
             raise SetupError(f"spec arms {list(self.arms)}: an arm is listed twice")
+        seen: dict[tuple, str] = {}
+        for arm in self.arms:
+            entry, settings = arm_settings(arm)
+            same = (entry, tuple(sorted(settings.items())))
+            if same in seen:
+                raise SetupError(
+                    f"spec arms: {seen[same]!r} and {arm!r} are one arm spelled two ways "
+                    "(the same settings); list it once"
+                )
+            seen[same] = arm
+        tasks = [task.env_id for task in self.tasks]
+        for env_id in tasks:
+            if tasks.count(env_id) > 1:
+                raise SetupError(
+                    f"spec tasks: {env_id} is listed {tasks.count(env_id)} times; list it once "
+                    "(its runs share one directory per arm and seed), with all its seeds"
+                )
         for task in self.tasks:
             if task.steps < self.ppo.n_envs * self.ppo.n_steps:
                 raise SetupError(
