@@ -69,3 +69,37 @@ def test_a_local_ray_instance_of_no_cpu_is_refused_before_ray_starts():
     ):
         connect(ray, None, 0)
     assert not ray.is_initialized()
+
+
+@pytest.mark.parametrize(
+    ("address", "environment", "said"),
+    [
+        ("auto", None, r"--num-cpus 2 with --address auto: .*drop --num-cpus.*drop --address"),
+        ("10.0.0.1:6379", None, r"with --address 10\.0\.0\.1:6379"),
+        (None, "nohost:1", r"with RAY_ADDRESS=nohost:1: .*unset RAY_ADDRESS to run on a local"),
+    ],
+)
+def test_cpus_of_a_local_instance_with_a_cluster_address_are_refused(
+    address, environment, said, monkeypatch
+):
+    if environment is None:
+        monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    else:
+        monkeypatch.setenv("RAY_ADDRESS", environment)
+    ray = load_ray()
+    with pytest.raises(SetupError, match=said):
+        connect(ray, address, 2)
+    assert not ray.is_initialized()
+
+
+@pytest.mark.parametrize("address", [None, "auto"])
+def test_a_ray_address_in_the_environment_that_does_not_answer_fails_within_seconds(
+    address, monkeypatch
+):
+    monkeypatch.setenv("RAY_ADDRESS", "nohost:1")
+    ray = load_ray()
+    with pytest.raises(
+        SetupError, match=r"RAY_ADDRESS=nohost:1: no Ray cluster answers .*unset RAY_ADDRESS"
+    ):
+        connect(ray, address, None)
+    assert not ray.is_initialized()

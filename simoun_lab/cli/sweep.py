@@ -77,10 +77,10 @@ class SweepCommand:
     """GPUs per trial, fractions allowed; auto: 1 when the cluster has GPUs and --device is not
     cpu, else 0"""
     address: Annotated[str | None, tyro.conf.arg(metavar="auto|HOST:PORT|ray://HOST:PORT")] = None
-    """run on a Ray cluster (auto: the one `ray start` made on this machine); none: a local Ray
-    instance"""
+    """run on a Ray cluster (auto: the one `ray start` made on this machine); none: the cluster
+    that RAY_ADDRESS names, or a local Ray instance without it"""
     num_cpus: Annotated[int | None, tyro.conf.arg(metavar="N")] = None
-    """CPUs of the local Ray instance (none: this machine's)"""
+    """CPUs of the local Ray instance (none: this machine's); not with a cluster's address"""
     resume: Annotated[bool, tyro.conf.FlagCreatePairsOff] = False
     """continue the sweep in --sweep-dir: finished trials are skipped, the others go on from
     their checkpoints; with a larger --total-env-steps every trial, finished ones too, trains on

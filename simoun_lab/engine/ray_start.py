@@ -3,6 +3,7 @@ fast with a fix when none does; and Ray itself, or how to install it."""
 
 from __future__ import annotations
 
+import os
 import socket
 from types import ModuleType
 
@@ -31,6 +32,10 @@ def connect(ray: ModuleType, address: str | None, num_cpus: int | None) -> bool:
     """Start a local Ray instance (``address`` None) or join a cluster (``auto``, ``HOST:PORT``,
     ``ray://HOST:PORT``); an address where no Ray cluster answers fails within seconds.
 
+    As in ``ray.init``, the ``RAY_ADDRESS`` environment variable stands for a missing or ``auto``
+    address, and is probed the same way. ``num_cpus`` sizes a local instance only: with a
+    cluster it is refused, since the cluster's own CPUs run the trials.
+
     Returns whether Ray was started here (False when this process had already initialized it,
     e.g. a notebook that called ``ray.init`` itself): only then does the sweep shut it down.
     """
@@ -38,6 +43,17 @@ def connect(ray: ModuleType, address: str | None, num_cpus: int | None) -> bool:
         raise SetupError(
             f"--num-cpus {num_cpus}: a local Ray instance needs at least 1 CPU to run a trial; "
             "drop --num-cpus to give it this machine's, or pass 1 or more"
+        )
+    source = f"--address {address}"
+    from_environment = os.environ.get("RAY_ADDRESS", "").strip()
+    if from_environment and address in (None, "auto"):
+        address, source = from_environment, f"RAY_ADDRESS={from_environment}"
+    if address is not None and num_cpus is not None:
+        unset = "unset RAY_ADDRESS" if source.startswith("RAY_") else "drop --address"
+        raise SetupError(
+            f"--num-cpus {num_cpus} with {source}: --num-cpus sizes a local Ray instance, and a "
+            f"cluster runs trials on its own CPUs; drop --num-cpus to run on the cluster, or "
+            f"{unset} to run on a local instance of {num_cpus} CPUs"
         )
     if ray.is_initialized():
         return False
@@ -52,21 +68,22 @@ def connect(ray: ModuleType, address: str | None, num_cpus: int | None) -> bool:
             _system_config={"worker_niceness": 0},
         )
         return True
+    local = "unset RAY_ADDRESS" if source.startswith("RAY_") else "drop --address"
     fix = (
         "start a cluster with `ray start --head` (and `ray start --address HEAD:6379` on the "
-        "other machines), or drop --address to run on a local Ray instance"
+        f"other machines), or {local} to run on a local Ray instance"
     )
     if address != "auto":
         host, _, port = address.removeprefix("ray://").rpartition(":")
         if not host or not port.isdigit():
-            raise SetupError(f"--address {address!r} is not HOST:PORT, ray://HOST:PORT or auto")
+            raise SetupError(f"{source}: {address!r} is not HOST:PORT, ray://HOST:PORT or auto")
         problem = probe_tcp(host, int(port)) if address.startswith("ray://") else probe_gcs(address)
         if problem:
-            raise SetupError(f"--address {address}: no Ray cluster answers ({problem}); {fix}")
+            raise SetupError(f"{source}: no Ray cluster answers ({problem}); {fix}")
     try:
         ray.init(address=address)
     except (ConnectionError, RuntimeError, ValueError) as err:
-        raise SetupError(f"--address {address}: cannot join a Ray cluster ({err}); {fix}") from None
+        raise SetupError(f"{source}: cannot join a Ray cluster ({err}); {fix}") from None
     return True
 
 
