@@ -424,6 +424,12 @@ def test_a_damaged_sweep_json_is_named_with_its_fix(runs_dir, text, tmp_path, ca
         ("eval.csv", lambda rows: [*rows, rows[-1]], "does not come after the line before"),
         ("eval.csv", lambda rows: [rows[0], ["-20", *rows[1][1:]], *rows[2:]], "is negative"),
         ("summary.json", {"env_step": "forty"}, "summary.json: env_step is 'forty', not a number"),
+        (
+            "summary.json",
+            {"env_step": 100000},
+            "summary.json says the run ended at env step 100000, but the last evaluation in "
+            "eval.csv is at",
+        ),
     ],
 )
 def test_a_run_with_steps_out_of_order_or_a_summary_of_the_wrong_type_is_named(
@@ -466,3 +472,13 @@ def test_a_config_without_a_key_every_run_records_is_named_and_left_out(key, tmp
     with (tmp_path / "report.csv").open() as f:
         (row,) = csv.DictReader(f)
     assert row["n"] == "2" and float(row["final_return_mean"]) == pytest.approx(500.5)
+
+
+def test_an_archive_of_the_minigrid_study_is_sent_to_its_own_report(capsys):
+    root = Path(__file__).resolve().parents[1] / "docs/studies/minigrid"
+    with pytest.raises(SystemExit):
+        report_cli.main([str(root), "--out", "never-written"])
+    err = capsys.readouterr().err
+    assert "holds runs of the MiniGrid study, which simoun-report does not read" in err
+    assert f"python -m simoun_lab.minigrid_study report --archive {root}" in err
+    assert not Path("never-written").exists()

@@ -230,10 +230,20 @@ RECORDED_KEYS = ("env", "seed", "agent")
 the seed and the agent's settings (keys added later are filled in by :func:`with_defaults`)."""
 
 
+MINIGRID_RUN_KEYS = frozenset({"run", "spec", "seeds"})
+"""Keys of a run of the MiniGrid study (SB3 PPO), which this report does not read."""
+MINIGRID_RUN = (
+    "a run of the MiniGrid study, which simoun-report does not read; report it with `python -m "
+    "simoun_lab.minigrid_study report --archive DIR`"
+)
+
+
 def read_run(config_path: Path) -> RunRecord:
     """The run of ``config_path``'s directory, or :class:`DamagedRun`."""
     run_dir = config_path.parent
     saved = read_json(config_path)
+    if MINIGRID_RUN_KEYS <= saved.keys():
+        raise DamagedRun(MINIGRID_RUN)
     # checked before the defaults fill them in: a run without them would be reported as the
     # default task, seed or agent
     missing = [key for key in RECORDED_KEYS if key not in saved]
@@ -260,6 +270,13 @@ def read_run(config_path: Path) -> RunRecord:
                 )
         if not len(curve["env_step"]):
             raise DamagedRun(f"{EVAL_CSV} holds no evaluation, but the run finished")
+        # the run's final evaluation is the last row of eval.csv: a summary that claims another
+        # step would put the run at a budget it never trained to
+        if summary["env_step"] != curve["env_step"][-1]:
+            raise DamagedRun(
+                f"{SUMMARY_NAME} says the run ended at env step {summary['env_step']:g}, but the "
+                f"last evaluation in {EVAL_CSV} is at {curve['env_step'][-1]:g}"
+            )
     error_path = run_dir / ERROR_FILE
     error = None
     if error_path.is_file() and summary is None:
@@ -559,6 +576,11 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
     damaged: list[str] = []
     records = find_runs(root, damaged)
     if not records:
+        if damaged and all(line.endswith(MINIGRID_RUN) for line in damaged):
+            raise SetupError(
+                f"{root} holds runs of the MiniGrid study, which simoun-report does not read; "
+                f"report them with `python -m simoun_lab.minigrid_study report --archive {root}`"
+            )
         if damaged:
             raise SetupError(
                 f"no runs under {root} that can be read (every run is damaged: "
