@@ -110,7 +110,10 @@ def test_bad_value_names_the_flag(key):
         ({"action_repeat": 0}, ["--action-repeat 0", "int >= 1"]),
         ({"total_env_steps": 10**30}, ["--total-env-steps 1" + "0" * 30, "below 2**63"]),
         ({"eval_every": 2**63}, [f"--eval-every {2**63}", "below 2**63"]),
-        ({"image_size": 7}, ["--image-size 7", "too small", "--image-size 19 or more"]),
+        (
+            {"image_size": 7},
+            ["--image-size 7", "too small", "--image-size 19 (TrainConfig.image_size=19) or more"],
+        ),
         ({"replay_capacity": 100, "agent.batch_size": 512}, ["--replay-capacity 100", "512"]),
         ({"agent.log_std_min": 3.0}, ["--agent.log-std-min 3", "--agent.log-std-max 2"]),
     ],
@@ -124,7 +127,7 @@ def test_messages_give_the_value_and_the_fix(overrides, words):
 
 @pytest.mark.skipif(torch.cuda.is_available(), reason="needs a torch that sees no CUDA GPU")
 def test_device_cuda_without_a_gpu_names_the_flag_and_cpu():
-    with pytest.raises(SetupError, match=r"--device cuda: .*no CUDA GPU.*--device cpu"):
+    with pytest.raises(SetupError, match=r"--device cuda .*: .*no CUDA GPU.*--device cpu"):
         resolve(None, {"device": "cuda"})
 
 
@@ -152,6 +155,41 @@ def test_a_field_without_a_rule_is_refused_when_the_config_is_built():
 def test_agent_config_in_python_names_the_field_too():
     with pytest.raises(ValueError, match=r"--agent\.batch-size 0 \(AgentConfig\.batch_size\)"):
         AgentConfig(batch_size=0)
+
+
+@pytest.mark.parametrize(
+    ("build", "fields"),
+    [
+        (
+            lambda: AgentConfig(log_std_min=3.0, log_std_max=2.0),
+            ["AgentConfig.log_std_min", "AgentConfig.log_std_max=2.0"],
+        ),
+        (
+            lambda: AgentConfig(augmentation="none", critic_augmentations=2),
+            ["AgentConfig.augmentation='shift'", "AgentConfig.critic_augmentations=1"],
+        ),
+        (lambda: AgentConfig(num_frames=2), ["AgentConfig.num_frames=3"]),
+        (
+            lambda: AgentConfig(encoder="single", curiosity=True, num_frames=1),
+            ["AgentConfig.curiosity=False"],
+        ),
+        (
+            lambda: AgentConfig(separate_trunks=True),
+            ["AgentConfig.encoder='single'", "AgentConfig.separate_trunks=False"],
+        ),
+        (
+            lambda: TrainConfig(replay_capacity=4),
+            ["AgentConfig.batch_size=512", "TrainConfig.replay_capacity=512"],
+        ),
+        (lambda: TrainConfig(image_size=8), ["TrainConfig.image_size=19"]),
+    ],
+)
+def test_a_cross_field_refusal_names_each_setting_to_change_in_python_too(build, fields):
+    """Built in Python, a refusal names the fields as Python writes them beside the flags."""
+    with pytest.raises(ValueError) as error:
+        build()
+    for name in fields:
+        assert name in str(error.value), str(error.value)
 
 
 @pytest.mark.parametrize("preset", list(PRESETS))

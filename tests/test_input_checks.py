@@ -407,6 +407,8 @@ def test_at_step_counts_a_resumed_run_at_its_nearest_evaluation_and_says_so(tmp_
         (run_dir / "config.json").write_text(json.dumps({**config, "eval_every": 100}))
         csv_text = f"env_step,return_mean,wall_time_s\n0,0.0,1.0\n{last},500,2.0\n"
         (run_dir / "eval.csv").write_text(csv_text)
+        summary = json.loads((run_dir / "summary.json").read_text())
+        (run_dir / "summary.json").write_text(json.dumps({**summary, "env_step": last}))
 
     for seed in range(3):
         run(seed, 100)

@@ -16,6 +16,7 @@ from simoun_agent.config.rules import (
     finite,
     integer,
     is_real,
+    knob,
     one_of,
     real,
     setting,
@@ -204,40 +205,41 @@ def check_agent_config(config: Any) -> None:
     check_fields(config, AGENT)
     if config.log_std_min >= config.log_std_max:
         raise fail(
+            config,
             AGENT,
             "log_std_min",
-            config.log_std_min,
-            f"must be below --agent.log-std-max {config.log_std_max:g}; e.g. -10 and 2",
+            f"must be below {knob(config, AGENT, 'log_std_max', config.log_std_max)}; e.g. -10 "
+            "and 2",
         )
     for name in ("critic_augmentations", "target_augmentations"):
         if getattr(config, name) > 1 and config.augmentation == "none":
             raise fail(
+                config,
                 AGENT,
                 name,
-                getattr(config, name),
                 "several views of one sample need a random augmentation, and augmentation is "
-                f"'none' (every view would be the same); set --agent.augmentation shift or "
-                f"--agent.{name.replace('_', '-')} 1",
+                f"'none' (every view would be the same); set "
+                f"{knob(config, AGENT, 'augmentation', 'shift')} or {knob(config, AGENT, name, 1)}",
             )
     if config.separate_trunks:
         check_separate_trunks(config)
     motion_path = ENCODER_SHAPES[config.encoder].motion_path
     if config.num_frames != 3 and motion_path:
         raise fail(
+            config,
             AGENT,
             "num_frames",
-            config.num_frames,
             f"the dual-path encoder {config.encoder!r} needs 3 frames (o_t-2, o_t-1, o_t); "
-            "set --agent.num-frames 3 (AgentConfig(num_frames=3))",
+            f"set {knob(config, AGENT, 'num_frames', 3)}",
         )
     if config.curiosity and not motion_path:
         raise fail(
+            config,
             AGENT,
             "curiosity",
-            True,
             f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
-            f"{config.encoder!r} does not have; set --agent.curiosity false "
-            "(AgentConfig(curiosity=False)) or use a dual encoder",
+            f"{config.encoder!r} does not have; set {knob(config, AGENT, 'curiosity', False)} "
+            "or use a dual encoder",
         )
 
 
@@ -246,21 +248,22 @@ def check_separate_trunks(config: Any) -> None:
     loss reading the state (it would read the 10^4-wide maps)."""
     if not ENCODER_SHAPES[config.encoder].conv_state:
         usable = [name for name, shape in ENCODER_SHAPES.items() if shape.conv_state]
+        encoders = " or ".join(knob(config, AGENT, "encoder", name) for name in usable)
         raise fail(
+            config,
             AGENT,
             "separate_trunks",
-            True,
             f"the actor's and critic's own trunks need an encoder that ends at its convs, and "
-            f"{config.encoder!r} does not; use --agent.encoder {' or '.join(usable)}, or "
-            "--agent.separate-trunks false",
+            f"{config.encoder!r} does not; use {encoders}, or "
+            f"{knob(config, AGENT, 'separate_trunks', False)}",
         )
     for name in ("transition_weight", "contrastive_weight", "reward_weight"):
         if getattr(config, name):
             raise fail(
+                config,
                 AGENT,
                 name,
-                getattr(config, name),
                 "the auxiliary losses read the encoder's state, which with separate trunks is "
-                f"the flat conv maps; set --agent.{name.replace('_', '-')} 0 or "
-                "--agent.separate-trunks false",
+                f"the flat conv maps; set {knob(config, AGENT, name, 0.0)} or "
+                f"{knob(config, AGENT, 'separate_trunks', False)}",
             )

@@ -36,12 +36,12 @@ def gpu_problem(kind: str, index: int | None) -> str | None:
 
     if kind == "mps":
         if not torch.backends.mps.is_available():
-            return "MPS is not available on this machine; use --device cpu"
+            return "MPS is not available on this machine; use --device cpu (device='cpu')"
         return None
     if not torch.cuda.is_available():
         return (
-            f"this torch ({torch.__version__}) sees no CUDA GPU; use --device cpu, or leave "
-            "--device unset to pick cuda only when there is one"
+            f"this torch ({torch.__version__}) sees no CUDA GPU; use --device cpu (device='cpu'), "
+            "or leave the device unset (none) to pick cuda only when there is one"
         )
     count = torch.cuda.device_count()
     if index is not None and index >= count:

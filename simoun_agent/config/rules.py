@@ -203,6 +203,21 @@ def check_fields(config: Any, prefix: str) -> None:
             )
 
 
-def fail(prefix: str, name: str, value: Any, problem: str) -> ValueError:
-    """A ValueError for a cross-field problem: ``--flag value: problem``."""
-    return ValueError(f"{flag_name(prefix, name)} {show(value)}: {problem}")
+def fail(config: Any, prefix: str, name: str, problem: str) -> ValueError:
+    """A ValueError for a cross-field problem of ``config``'s field ``name``, named as a flag and
+    as the field: ``--flag value (Config.name): problem``."""
+    value = getattr(config, name)
+    return ValueError(
+        f"{flag_name(prefix, name)} {show(value)} ({type(config).__name__}.{name}): {problem}"
+    )
+
+
+def knob(config: Any, prefix: str, name: str, value: Any) -> str:
+    """A setting to change, for the command line and for Python alike.
+
+    Example:
+        >>> from simoun_agent.config import AgentConfig
+        >>> knob(AgentConfig(), "agent.", "num_frames", 3)
+        '--agent.num-frames 3 (AgentConfig.num_frames=3)'
+    """
+    return f"{flag_name(prefix, name)} {show(value)} ({type(config).__name__}.{name}={value!r})"

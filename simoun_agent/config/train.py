@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from simoun_agent.config.agent import AgentConfig
+from simoun_agent.config.agent import AGENT, AgentConfig
 from simoun_agent.config.device import device_problem
 from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, split_env_id
 from simoun_agent.config.presets import PRESETS
@@ -21,6 +21,7 @@ from simoun_agent.config.rules import (
     integer,
     is_int,
     json_object,
+    knob,
     module_name,
     setting,
     text,
@@ -164,20 +165,23 @@ def check_train_config(config: TrainConfig) -> None:
     """Every field of a ``TrainConfig``, then the constraints between fields."""
     check_fields(config, "")
     if config.device is not None and (problem := device_problem(config.device)):
-        raise fail("", "device", config.device, problem)
+        raise fail(config, "", "device", problem)
     if config.replay_capacity < config.agent.batch_size:
+        batch = config.agent.batch_size
         raise fail(
+            config,
             "",
             "replay_capacity",
-            config.replay_capacity,
-            f"the replay must hold at least one batch (--agent.batch-size "
-            f"{config.agent.batch_size}); raise --replay-capacity or lower the batch size",
+            f"the replay must hold at least one batch "
+            f"({knob(config.agent, AGENT, 'batch_size', batch)}); set "
+            f"{knob(config, '', 'replay_capacity', batch)} or more, or lower the batch size",
         )
     if not frame_fits(config.agent, config.image_size, config.image_size * config.cameras):
         raise fail(
+            config,
             "",
             "image_size",
-            config.image_size,
             f"too small for the conv trunk of encoder {config.agent.encoder!r}; it needs "
-            f"--image-size {min_image_size(config.agent)} or more (the paper uses 84)",
+            f"{knob(config, '', 'image_size', min_image_size(config.agent))} or more (the paper "
+            "uses 84)",
         )
