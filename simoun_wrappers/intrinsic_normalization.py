@@ -97,9 +97,21 @@ class Normalization(ABC):
     def state_dict(self) -> dict[str, Any]:
         """The running statistics."""
 
-    @abstractmethod
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        """Restore what :meth:`state_dict` returned."""
+        """Restore what :meth:`state_dict` returned; a state that does not fit (see
+        :meth:`state_problems`) is refused with a ValueError and nothing is loaded."""
+        problems = self.state_problems(state)
+        if problems:
+            raise ValueError(
+                f"{type(self).__name__}.load_state_dict cannot load this state: "
+                f"{'; '.join(problems)}; pass what state_dict() of a "
+                f"{normalization_name(self)!r} normalization returned. Nothing was loaded."
+            )
+        self.restore(state)
+
+    @abstractmethod
+    def restore(self, state: dict[str, Any]) -> None:
+        """Load a state :meth:`load_state_dict` has checked."""
 
     bounds: ClassVar[dict[str, str]] = {}
     """statistics with a sign: key -> ``">= 0"`` or ``"> 0"``"""
@@ -113,7 +125,8 @@ class Normalization(ABC):
         if not isinstance(state, Mapping):
             return [f"its normalization statistics are a {type(state).__name__}, not a dict"]
         if set(state) != set(own):
-            saved = saved_with(state)
+            # an empty dict is the state of 'none', but far more often a state never filled in
+            saved = saved_with(state) if state else []
             if saved and normalization_name(self) not in saved:
                 return [
                     f"it was saved with normalization {' or '.join(map(repr, saved))}, but this "
@@ -203,7 +216,7 @@ class PaperMaxima(Normalization):
     def state_dict(self) -> dict[str, Any]:
         return self.maxima.state_dict()
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
+    def restore(self, state: dict[str, Any]) -> None:
         self.maxima.load_state_dict(state)
 
 
@@ -238,7 +251,7 @@ class RewardStd(Normalization):
     def state_dict(self) -> dict[str, Any]:
         return moments_state(self.moments)
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
+    def restore(self, state: dict[str, Any]) -> None:
         load_moments(self.moments, state)
 
 
@@ -294,7 +307,7 @@ class ReturnStd(Normalization):
     def state_dict(self) -> dict[str, Any]:
         return {**moments_state(self.moments), "returns": self.returns.tolist()}
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
+    def restore(self, state: dict[str, Any]) -> None:
         load_moments(self.moments, state)
         self.returns = np.asarray(state["returns"], dtype=np.float64)
 
@@ -339,7 +352,7 @@ class Raw(Normalization):
     def state_dict(self) -> dict[str, Any]:
         return {}
 
-    def load_state_dict(self, state: dict[str, Any]) -> None:
+    def restore(self, state: dict[str, Any]) -> None:
         return None
 
 

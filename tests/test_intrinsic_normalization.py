@@ -248,3 +248,36 @@ def test_return_std_in_a_vector_env_follows_each_sub_env():
         expected = hand(raw, np.ones(2), np.array([0, 1]), np.ones(2, bool))
         np.testing.assert_allclose(info["reward_intrinsic"], expected, rtol=1e-12)
     np.testing.assert_allclose(envs.normalization.returns, hand.returns)
+
+
+@pytest.mark.parametrize(
+    ("normalization", "state", "said"),
+    [
+        (Standardize(), {}, "lack mean, var, count"),
+        (Standardize(), None, "a NoneType, not a dict"),
+        (ReturnStd(), {"r_e_max": 1.0, "r_i_max": 1.0}, "saved with normalization 'paper'"),
+        (PaperMaxima(), {"r_e_max": float("nan"), "r_i_max": 1.0}, "r_e_max is nan"),
+        (PaperMaxima(), {"r_e_max": 0.0, "r_i_max": 1.0}, "r_e_max is 0.0, not > 0"),
+        (
+            ReturnStd(),
+            {"mean": 0.0, "var": 1.0, "count": 2.0, "returns": ["a"]},
+            "returns is ['a'], not a list of finite numbers",
+        ),
+    ],
+)
+def test_a_normalization_refuses_a_state_that_does_not_fit_and_keeps_its_own(
+    normalization, state, said
+):
+    before = normalization.state_dict()
+    with pytest.raises(ValueError, match="cannot load this state") as error:
+        normalization.load_state_dict(state)
+    assert said in str(error.value) and "Nothing was loaded" in str(error.value)
+    assert normalization.state_dict() == before
+
+
+def test_a_normalization_loads_its_own_state():
+    source = ReturnStd(gamma=0.5)
+    source(np.array([2.0, 4.0]), np.zeros(2), np.array([0, 1]), np.ones(2, bool))
+    copy = ReturnStd(gamma=0.5)
+    copy.load_state_dict(source.state_dict())
+    assert copy.state_dict() == source.state_dict()
