@@ -143,8 +143,8 @@ def test_runs_without_the_driving_columns_get_no_driving_section(tmp_path):
 @pytest.mark.parametrize(
     ("text", "said"),
     [
-        ("{not json", "is not JSON"),
-        ("[1, 2]", "holds a JSON list, not an object"),
+        ("{not json", "is damaged: it is not JSON"),
+        ("[1, 2]", "is damaged: it holds an array, not a JSON object"),
         ('{"command": "c", "preset": "highway-cpu"}', "lacks episodes, seed, drivers"),
         (
             '{"command": "c", "preset": "p", "episodes": 1, "seed": 0, '

@@ -326,9 +326,9 @@ def test_raw_returns_enter_no_statistic_across_tasks(tmp_path):
 
 
 DAMAGES = {
-    "config.json": ('{"env": ', "config.json cannot be read"),
-    "config.json ": ("", "config.json cannot be read"),
-    "config.json  ": ("[1]", "config.json holds list, not a JSON object"),
+    "config.json": ('{"env": ', "config.json is damaged: it is not JSON (Expecting value"),
+    "config.json ": ("", "config.json is damaged: it is empty"),
+    "config.json  ": ("[1]", "config.json is damaged: it holds an array, not a JSON object"),
     "eval.csv": ("", "eval.csv holds no evaluation, but the run finished"),
     "eval.csv ": ("env_step,return_mean,wall_time_s\nx,1,2\n", "eval.csv cannot be read"),
     "eval.csv  ": (

@@ -2,16 +2,24 @@
 
 ``simoun-train --resume``, ``simoun-eval``, ``simoun-analyze`` and ``simoun-report`` read the
 files a run keeps (``config.json``, ``eval.csv``, ``train.csv``, ``summary.json``,
-``checkpoint.pt``); each names a damaged one by its path, what is wrong and the fix, rather than
-failing inside a parser or taking the damage for data. :class:`Damaged` carries what is wrong;
-each caller adds the fix that fits its command.
+``checkpoint.pt``), and the lab's commands the files studies and sweeps keep (``study.json``,
+``spec.json``, ``trial.json``, ``references.json``, ``generalization.csv`` ...); each names a
+damaged one by its path, what is wrong and the fix, rather than failing inside a parser or taking
+the damage for data. :class:`Damaged` carries what is wrong; each caller adds the fix that fits
+its command.
 """
 
 from __future__ import annotations
 
+import csv
+import io
+import json
+import math
 import os
 import stat
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 STEP_LIMIT = 2**63
 """Steps at or past it are damage: counters, TensorBoard and numpy hold steps as int64."""
@@ -72,6 +80,68 @@ def read_text(path: Path) -> str:
     except UnicodeDecodeError as err:
         line = data[: err.start].count(b"\n") + 1
         raise Damaged(f"line {line} is not UTF-8 text (byte {data[err.start]:#04x})") from None
+
+
+def present(path: Path) -> bool:
+    """Whether anything is at ``path``: a file, a directory, a named pipe or a symbolic link,
+    even one to nothing. A kept file is read when present, so that what stands in its place is
+    named rather than taken for a file not written yet."""
+    return path.is_symlink() or path.exists()
+
+
+def json_kind(value: Any) -> str:
+    """What JSON calls ``value``'s kind (an array, null, a number...), for messages."""
+    kinds = {list: "an array", dict: "an object", type(None): "null", bool: "true/false"}
+    return kinds.get(type(value), "a string" if isinstance(value, str) else "a number")
+
+
+def read_json_object(path: Path) -> dict[str, Any]:
+    """The JSON object in ``path``; :class:`Damaged` for what :func:`read_text` refuses, an
+    empty file, text that is not JSON (cut short, say) or JSON that is not an object. OSError
+    for a file that cannot be read."""
+    text = read_text(path)
+    if not text.strip():
+        raise Damaged("it is empty")
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise Damaged(f"it is not JSON ({err})") from None
+    if not isinstance(value, dict):
+        raise Damaged(f"it holds {json_kind(value)}, not a JSON object")
+    return value
+
+
+def read_csv_rows(path: Path, columns: Sequence[str] = ()) -> list[dict[str, str]]:
+    """The rows of the CSV file ``path`` under its header line, values as text (blank lines
+    skipped); :class:`Damaged` for what :func:`read_text` refuses, text that is not CSV, no
+    header line, a header without one of ``columns``, or a row whose fields do not fit the
+    header (a line cut short or two run together). OSError for a file that cannot be read."""
+    try:
+        lines = list(csv.reader(io.StringIO(read_text(path), newline="")))
+    except csv.Error as err:
+        raise Damaged(f"it is not a CSV file ({err})") from None
+    if not any(lines):
+        raise Damaged("it is empty")
+    header = lines[0]
+    missing = [column for column in columns if column not in header]
+    if missing:
+        raise Damaged(f"its first line has no {', '.join(missing)} column")
+    for number, values in enumerate(lines[1:], start=2):
+        if values and len(values) != len(header):
+            fields = f"{len(values)} fields where the header has {len(header)}"
+            raise Damaged(f"line {number} has {fields}")
+    return [dict(zip(header, values, strict=True)) for values in lines[1:] if values]
+
+
+def csv_number(text: str, column: str, line: int) -> float:
+    """The value ``text`` of ``column`` on ``line`` of a CSV file as a float, NaN where empty (a
+    value the run did not measure); :class:`Damaged` naming the line when it is not a number."""
+    if text == "":
+        return math.nan
+    try:
+        return float(text)
+    except ValueError:
+        raise Damaged(f"line {line}: {column} is {text!r}, not a number") from None
 
 
 def binary_problem(path: Path) -> str:

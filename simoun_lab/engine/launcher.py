@@ -25,7 +25,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import Damaged, present, read_text
 from simoun_lab.engine.trial import SUMMARY, Trial, summary_written
 
 __all__ = ["archive_files", "changed_keys", "read_run_files", "run_trials"]
@@ -41,8 +43,22 @@ def changed_keys(saved: dict[str, Any], wanted: dict[str, Any]) -> list[str]:
 
 
 def read_run_files(run_dir: Path, names: Sequence[str]) -> dict[str, str]:
-    """The text of each file of ``names`` that ``run_dir`` holds, in the order of ``names``."""
-    return {name: (run_dir / name).read_text() for name in names if (run_dir / name).is_file()}
+    """The text of each file of ``names`` that ``run_dir`` holds, in the order of ``names``;
+    SetupError naming a damaged one, which the archive must not take for the run's."""
+    files = {}
+    for name in names:
+        path = run_dir / name
+        if not present(path):
+            continue
+        try:
+            files[name] = read_text(path)
+        except Damaged as err:
+            raise SetupError(
+                f"{path} is damaged: {err}; restore it from a copy, or move the run directory "
+                f"aside (mv {run_dir} {run_dir}.damaged) and run the study again to train the run "
+                "anew"
+            ) from None
+    return files
 
 
 def archive_files(

@@ -37,7 +37,8 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     archive that holds them (``archive`` is ARCHIVE, or ``new``: a ``run`` may start a study in
     an empty directory). An archive that is not there is refused rather than made up: a
     mistyped ``--archive`` would otherwise start the whole study, or report on nothing."""
-    from simoun_lab.minigrid_study.runner import SPEC_FILE
+    from simoun_agent.run.kept import present
+    from simoun_lab.minigrid_study.runner import SPEC_FILE, load_saved_spec
     from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 
     if not archive.is_dir():
@@ -47,8 +48,8 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
         raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
     if spec is not None:
         return load_spec(spec)
-    if (archive / SPEC_FILE).is_file():
-        return load_spec(archive / SPEC_FILE)
+    if present(archive / SPEC_FILE):
+        return load_saved_spec(archive / SPEC_FILE)
     if new and (archive == ARCHIVE or not any(archive.iterdir())):
         return StudySpec()
     raise SetupError(

@@ -11,7 +11,6 @@ stopped part way compares the arms on the same seeds; the runs left out are coun
 
 from __future__ import annotations
 
-import csv
 import json
 import warnings
 from pathlib import Path
@@ -22,7 +21,16 @@ from matplotlib.figure import Figure  # no pyplot: no backend or global figure s
 from matplotlib.ticker import EngFormatter
 
 from simoun_agent import table
+from simoun_agent.config import SetupError
+from simoun_agent.config.rules import is_real
 from simoun_agent.run.checkpoint import atomic_write
+from simoun_agent.run.kept import (
+    Damaged,
+    csv_number,
+    present,
+    read_csv_rows,
+    read_json_object,
+)
 from simoun_lab import stats
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
 from simoun_lab.minigrid_study.spec import Run, StudySpec
@@ -37,31 +45,75 @@ MIN_SEEDS = 3
 bootstrap over one or two runs gives an interval that looks precise and is not"""
 
 
-def read_rows(path: Path) -> list[dict[str, float]]:
-    with path.open() as file:
+EVAL_COLUMNS = ("env_step", "wall_s", "success_rate", "return_mean")
+"""the eval.csv columns the report and the selection read"""
+SUMMARY_KEYS = ("env_steps", "env_s", "update_s", "steps_per_s")
+"""the summary.json numbers the report reads"""
+
+
+def damaged(path: Path, problem: str) -> SetupError:
+    """The error for a finished run's damaged file: what is wrong, and the two fixes."""
+    run_dir = path.parent
+    return SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (git checkout -- {path}, for a "
+        f"committed archive), or move its run aside (mv {run_dir} {run_dir}.damaged) and run the "
+        "study again, which trains that run anew"
+    )
+
+
+def read_rows(path: Path, columns: tuple[str, ...] = ("env_step",)) -> list[dict[str, float]]:
+    """The rows of a finished run's ``eval.csv`` or ``train.csv``, values as floats; SetupError
+    naming the file when it is damaged, lacks one of ``columns`` or holds no row."""
+    try:
+        rows = read_csv_rows(path, columns)
+        if not rows:
+            raise Damaged("it holds no row after its header, but its run finished")
         return [
-            {k: float(v) if v not in ("", None) else np.nan for k, v in row.items()}
-            for row in csv.DictReader(file)
+            {key: csv_number(text, key, line) for key, text in row.items()}
+            for line, row in enumerate(rows, start=2)
         ]
+    except Damaged as err:
+        raise damaged(path, str(err)) from None
+    except OSError as err:
+        raise damaged(path, f"it cannot be read ({err.strerror})") from None
+
+
+def read_summary(path: Path) -> dict[str, Any]:
+    """A finished run's ``summary.json``; SetupError naming the file when it is damaged or
+    lacks one of :data:`SUMMARY_KEYS` as a number > 0."""
+    try:
+        summary = read_json_object(path)
+    except Damaged as err:
+        raise damaged(path, str(err)) from None
+    except OSError as err:
+        raise damaged(path, f"it cannot be read ({err.strerror})") from None
+    for key in SUMMARY_KEYS:
+        value = summary.get(key)
+        if not (is_real(value) and value > 0):
+            raise damaged(path, f"{key} is {json.dumps(value)}, not a number > 0")
+    return summary
 
 
 class Records:
     """The archive's runs of the seeds every arm has finished (``finished``: all finished
-    runs): ``eval``, ``train`` rows and ``summary`` by run."""
+    runs): ``eval``, ``train`` rows and ``summary`` by run. A run is finished once anything is
+    at its ``summary.json``: a damaged one is named, not taken for a run still to train."""
 
     def __init__(self, spec: StudySpec, archive: Path) -> None:
         self.spec, self.archive = spec, archive
-        self.finished = [r for r in spec.runs() if (archive / r.name / SUMMARY).is_file()]
+        self.finished = [r for r in spec.runs() if present(archive / r.name / SUMMARY)]
         done = {(r.task.env_id, r.seed, r.arm) for r in self.finished}
         self.used = [
             r
             for r in self.finished
             if all((r.task.env_id, r.seed, arm) in done for arm in spec.arms)
         ]
-        self.eval = {r.name: read_rows(archive / r.name / EVAL_CSV) for r in self.used}
-        self.train = {r.name: read_rows(archive / r.name / TRAIN_CSV) for r in self.used}
-        self.summary = {
-            r.name: json.loads((archive / r.name / SUMMARY).read_text()) for r in self.used
+        self.summary = {r.name: read_summary(archive / r.name / SUMMARY) for r in self.used}
+        self.eval = {
+            r.name: read_rows(archive / r.name / EVAL_CSV, EVAL_COLUMNS) for r in self.used
+        }
+        self.train = {
+            r.name: read_rows(archive / r.name / TRAIN_CSV, TRAIN_COLUMNS) for r in self.used
         }
 
     def runs(self, env_id: str, arm: str) -> list[Run]:
@@ -156,6 +208,8 @@ INTRINSIC_KEYS = (
     "still_fraction",
     "states_visited",
 )
+TRAIN_COLUMNS = ("env_step", *INTRINSIC_KEYS)
+"""the train.csv columns the report reads"""
 
 
 PARTS = {

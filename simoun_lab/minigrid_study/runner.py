@@ -9,19 +9,20 @@ when that is still there, else from the archive's ``<run>/checkpoint.pt``, else 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
+from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.engine.trial import summary_written
-from simoun_lab.minigrid_study.spec import StudySpec
+from simoun_lab.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_lab.minigrid_study.training import write_json
 from simoun_lab.minigrid_study.trial import MiniGridTrial
 from simoun_lab.study.provenance import code_version
 
-__all__ = ["SPEC_FILE", "finished_runs", "run_study"]
+__all__ = ["SPEC_FILE", "finished_runs", "load_saved_spec", "run_study"]
 
 SPEC_FILE = "spec.json"
 """the spec the archive's runs were trained with"""
@@ -32,13 +33,33 @@ def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
     return [run.name for run in spec.runs() if summary_written(archive / run.name)]
 
 
+def read_saved_spec(path: Path) -> dict[str, Any]:
+    """The archive's ``spec.json`` as saved; SetupError naming the file when it is damaged: the
+    finished runs cannot be checked against the spec given without it."""
+    try:
+        return read_json_object(path)
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    raise SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (git checkout -- {path}, for a "
+        "committed archive): it records the spec the archive's runs were trained with"
+    )
+
+
+def load_saved_spec(path: Path) -> StudySpec:
+    """The spec in the archive's ``spec.json``; SetupError naming the file when it is damaged."""
+    return spec_from_dict(read_saved_spec(path), str(path))
+
+
 def record_spec(spec: StudySpec, archive: Path) -> None:
     """Write the spec into the archive, or refuse a spec that differs from the one there (the
     finished runs would be compared with runs of another design)."""
     path = archive / SPEC_FILE
     wanted = spec.to_json()
-    if path.is_file():
-        changed = sorted(changed_keys(json.loads(path.read_text()), wanted))
+    if present(path):
+        changed = sorted(changed_keys(read_saved_spec(path), wanted))
         if changed:
             raise SetupError(
                 f"--archive {archive} holds runs of another spec (keys {changed} differ from "

@@ -21,7 +21,7 @@ import numpy as np
 from simoun_agent import table
 from simoun_agent.run.atomic import atomic_write
 from simoun_lab.minigrid_study.arms import parse_arm
-from simoun_lab.minigrid_study.report import read_rows
+from simoun_lab.minigrid_study.report import EVAL_COLUMNS, read_rows
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY
 from simoun_lab.minigrid_study.spec import StudySpec
 
@@ -47,7 +47,7 @@ def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
     for arm in spec.arms:
         runs = [r for r in spec.runs() if r.arm == arm]
         areas = {
-            r.name: run_auc(read_rows(archive / r.name / EVAL_CSV), r.task.steps)
+            r.name: run_auc(read_rows(archive / r.name / EVAL_CSV, EVAL_COLUMNS), r.task.steps)
             for r in runs
             if (archive / r.name / SUMMARY).is_file()
         }

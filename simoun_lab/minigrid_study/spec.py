@@ -19,7 +19,7 @@ import gymnasium as gym
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
-from simoun_agent.run.kept import Damaged, read_text
+from simoun_agent.run.kept import Damaged, json_kind, read_text
 from simoun_lab.minigrid_study.arms import ARMS, arm_settings
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
@@ -234,12 +234,6 @@ def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
     if "ppo" in values:
         values["ppo"] = build(PPOSettings, values["ppo"], f"{where}: ppo")
     return build(StudySpec, values, where)
-
-
-def json_kind(value: Any) -> str:
-    """What JSON calls ``value``'s kind (an array, null, a number...), for messages."""
-    kinds = {list: "an array", type(None): "null", bool: "true/false", str: "a string"}
-    return kinds.get(type(value), "a number")
 
 
 def load_spec(path: Path) -> StudySpec:

@@ -16,6 +16,7 @@ from pathlib import Path
 import tomllib
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import Damaged, present, read_text
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
 from simoun_lab.study.runner import StudyOptions
 
@@ -26,8 +27,8 @@ def _toml(path: Path) -> dict | None:
     """The TOML file's tables, or None when it cannot be read or parsed (the SAC reader then
     names the problem)."""
     try:
-        return tomllib.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return tomllib.loads(read_text(path))
+    except (OSError, Damaged, tomllib.TOMLDecodeError):
         return None
 
 
@@ -74,7 +75,7 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
         )
     runner = _runner()
     archive = options.archive if options.archive is not None else options.study_dir
-    started = (archive / runner.SPEC_FILE).is_file()
+    started = present(archive / runner.SPEC_FILE)
     if started and not options.resume:
         raise SetupError(
             f"{archive} already holds a MiniGrid study ({runner.SPEC_FILE}); pass --resume to "
@@ -104,7 +105,7 @@ def report(spec: StudySpec, study_dir: Path) -> Path:
 
     runner = _runner()
     saved = study_dir / runner.SPEC_FILE
-    if saved.is_file() and load_spec(saved) != spec:
+    if present(saved) and runner.load_saved_spec(saved) != spec:
         raise SetupError(
             f"--study-dir {study_dir} holds runs of another spec ({saved}); pass the spec it "
             "was run with"

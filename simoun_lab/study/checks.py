@@ -20,11 +20,12 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
+from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
 from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
-from simoun_lab.study.spec import Source, StudySpec
+from simoun_lab.study.spec import Source, StudySpec, spec_text
 
 MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
 """The keys a memory refusal asks to change, looked up in the spec to name their line."""
@@ -67,7 +68,7 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
     each configuration's memory; SetupError naming the spec's line, the task and the fix for
     the first that cannot run (the tasks first: they take a second each, a memory estimate
     several)."""
-    source = Source(Path(spec_path), Path(spec_path).read_text())
+    source = Source(Path(spec_path), spec_text(Path(spec_path)))
     made: dict[str, int | None] = {}
     found = configs(spec)
     for phase, recipe, _, config in found:
@@ -109,9 +110,26 @@ def finished_config(name: str, places: list[Path]) -> dict[str, Any] | None:
     """The saved config of the run ``name`` if it finished in one of ``places``, else None."""
     for where in places:
         run_dir = where / name
-        if (run_dir / SUMMARY_NAME).is_file() and (run_dir / CONFIG_NAME).is_file():
-            return json.loads((run_dir / CONFIG_NAME).read_text())
+        if (run_dir / SUMMARY_NAME).is_file() and present(run_dir / CONFIG_NAME):
+            return read_config(run_dir / CONFIG_NAME)
     return None
+
+
+def read_config(path: Path) -> dict[str, Any]:
+    """A finished run's saved ``config.json``; SetupError naming the file, what is wrong and the
+    fix when it is damaged: the run cannot be checked against the fixed spec without it."""
+    try:
+        return read_json_object(path)
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    run_dir = path.parent
+    raise SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (the study directory and its "
+        f"archive each keep one), or move the run aside in both (mv {run_dir} "
+        f"{run_dir}.damaged) and resume: the run is then trained again"
+    )
 
 
 def flat(config: dict[str, Any], prefix: str = "") -> dict[str, Any]:

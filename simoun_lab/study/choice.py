@@ -6,15 +6,19 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import present
+from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_lab.study.plan import StudyRun, tuning_runs
 from simoun_lab.study.selection import SELECTION_RULES, TIE_RULE, best_setting
 from simoun_lab.study.spec import StudySpec
+from simoun_lab.sweep import report as sweep_report
 
 SELECTION_FILE = "selection.json"
 
@@ -40,18 +44,38 @@ class Choice:
     candidates: list
 
 
+def read_finished(run_dir: Path) -> tuple[dict[str, Any], dict[str, np.ndarray], list[dict]]:
+    """A finished run's ``summary.json``, its ``eval.csv`` curve (raw returns) and rows, checked
+    as ``simoun-report`` checks them (:func:`~simoun_lab.sweep.report.check_summary`);
+    SetupError naming the run, the file, what is wrong and the fix when one is damaged."""
+    try:
+        summary = sweep_report.read_json(run_dir / SUMMARY_NAME)
+        curve = sweep_report.read_curve(run_dir / EVAL_CSV)
+        sweep_report.check_summary(summary, curve)
+        rows = read_csv(run_dir / EVAL_CSV)
+    except sweep_report.DamagedRun as err:
+        problem = str(err)
+    except ValueError as err:  # a column the curve does not hold
+        problem = f"{EVAL_CSV} holds a value that is not a number ({err})"
+    else:
+        return summary, curve, rows
+    raise SetupError(
+        f"the finished run {run_dir}: {problem}. Restore the run's files from a copy (the study "
+        f"directory and its archive each keep one), or move the run aside in both (mv {run_dir} "
+        f"{run_dir}.damaged) and resume the study: the run is then trained again"
+    )
+
+
 def run_score(spec: StudySpec, study_dir: Path, run: StudyRun) -> float:
     """The selection rule's score of one finished tuning run, from its ``eval.csv``."""
     run_dir = Path(study_dir, run.name)
-    if not run.finished(study_dir):
+    if not present(run_dir / SUMMARY_NAME):  # a damaged summary is named, not taken for none
         raise SetupError(
             f"the tuning run {run.name} has not finished, so no setting can be selected yet; "
             "resume the study to finish it"
         )
-    rows = read_csv(run_dir / EVAL_CSV)
-    steps = np.array([row["env_step"] for row in rows])
-    returns = np.array([row["return_mean"] for row in rows])
-    return SELECTION_RULES[spec.selection].score(run.task, steps, returns)
+    _, curve, _ = read_finished(run_dir)
+    return SELECTION_RULES[spec.selection].score(run.task, curve["env_step"], curve["return_mean"])
 
 
 def choose(spec: StudySpec, study_dir: Path) -> dict[str, Choice]:

@@ -10,12 +10,12 @@ cost minutes.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.driving_metrics import columns
+from simoun_agent.run.kept import Damaged, present, read_json_object
 
 MEASURES = columns(
     "return_mean", "crash_rate", "distance_m", "mean_speed", "mean_abs_steer", "brake_fraction"
@@ -51,18 +51,22 @@ def read_references(study_dir: Path) -> dict[str, Any] | None:
     """The study directory's :data:`REFERENCES_JSON`, None when there is none; SetupError when
     it is not one that the reference command wrote (not JSON, a key or a measure missing)."""
     path = study_dir / REFERENCES_JSON
-    if not path.is_file():
+    if not present(path):
         return None
     fix = f"write it again with `{REFERENCE_COMMAND.replace('DIR', str(study_dir))}`"
     try:
-        references = json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise SetupError(f"{path} is not JSON ({err}); {fix}") from None
-    if not isinstance(references, dict):
-        raise SetupError(f"{path} holds a JSON {type(references).__name__}, not an object; {fix}")
+        references = read_json_object(path)
+    except Damaged as err:
+        raise SetupError(f"{path} is damaged: {err}; {fix}") from None
+    except OSError as err:
+        raise SetupError(f"{path} cannot be read ({err.strerror}); {fix}") from None
     if missing := [key for key in REFERENCE_KEYS if key not in references]:
         raise SetupError(f"{path} lacks {', '.join(missing)}; {fix}")
+    if not isinstance(references["drivers"], dict):
+        raise SetupError(f"{path}: drivers is not a JSON object of drivers; {fix}")
     for driver, metrics in references["drivers"].items():
+        if not isinstance(metrics, dict):
+            raise SetupError(f"{path}: driver {driver!r} is not a JSON object of measures; {fix}")
         if lacking := [key for key, _, _ in MEASURES if key not in metrics]:
             raise SetupError(f"{path}: driver {driver!r} lacks {', '.join(lacking)}; {fix}")
     return references

@@ -8,17 +8,20 @@ be played and is reported as missing.
 
 from __future__ import annotations
 
-import csv
 from dataclasses import asdict
 from pathlib import Path
 
 from simoun_agent import table
+from simoun_agent.config import SetupError
 from simoun_agent.generalization.evaluation import evaluate_runs
+from simoun_agent.run.kept import Damaged, csv_number, present, read_csv_rows
 from simoun_agent.run.layout import CHECKPOINT_NAME
 from simoun_lab.study.archive import GENERALIZATION_CSV, copy_file
 
 COLUMNS = ("mode", "return_mean", "return_std", "episodes", "first_seed", "env_step")
 """The columns of ``generalization.csv``: one row per mode, ``train`` first."""
+MODE_COLUMNS = ("mode", "env_step", "return_mean")
+"""The columns of ``generalization.csv`` the report reads."""
 
 
 def play_modes(run_dir: str, modes: list[str], episodes: int) -> str:
@@ -34,13 +37,26 @@ def read_modes(run_dir: Path, env_step: int) -> dict[str, float] | None:
     """Mode -> mean return of the run's ``generalization.csv``; None when it has none, or when
     its agent was not the final one (a checkpoint at another env step than ``env_step``)."""
     path = run_dir / GENERALIZATION_CSV
-    if not path.is_file():
+    if not present(path):
         return None
-    with path.open(newline="") as f:
-        rows = list(csv.DictReader(f))
-    if any(int(float(row["env_step"])) != env_step for row in rows):
-        return None
-    return {row["mode"]: float(row["return_mean"]) for row in rows}
+    try:
+        played = [
+            (row["mode"], *(csv_number(row[key], key, line) for key in ("env_step", "return_mean")))
+            for line, row in enumerate(read_csv_rows(path, MODE_COLUMNS), start=2)
+        ]
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    else:
+        if any(step != env_step for _, step, _ in played):
+            return None
+        return {mode: value for mode, _, value in played}
+    raise SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (the study directory and its "
+        f"archive each keep one), or move it aside in both (mv {path} {path}.damaged) and "
+        "resume the study: the run's final agent is then played again"
+    )
 
 
 def to_play(study_dir: Path, archive: Path | None, names: list[str]) -> list[str]:

@@ -33,7 +33,6 @@ known maximum).
 from __future__ import annotations
 
 import csv
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -43,15 +42,15 @@ from typing import Any
 import numpy as np
 
 from simoun_agent import table
-from simoun_agent.config import RECIPES, resolve, to_dict
+from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_lab import stats
-from simoun_lab.study.choice import SELECTION_FILE, Choice
+from simoun_lab.study.choice import SELECTION_FILE, Choice, read_finished
 from simoun_lab.study.driving import (
     MEASURES,
     REFERENCE_COMMAND,
@@ -117,15 +116,10 @@ class RunResult:
 def read_result(study_dir: Path, run: StudyRun) -> RunResult | None:
     """The run's result, None when it has not finished."""
     run_dir = Path(study_dir, run.name)
-    if not (run_dir / SUMMARY_NAME).is_file():
+    if not present(run_dir / SUMMARY_NAME):
         return None
-    summary = json.loads((run_dir / SUMMARY_NAME).read_text())
-    rows = read_csv(run_dir / EVAL_CSV)
-    curve = {
-        "env_step": np.array([row["env_step"] for row in rows]),
-        "return_mean": stats.normalize(run.task, [row["return_mean"] for row in rows]),
-        "wall_time_s": np.array([row.get("wall_time_s", math.nan) for row in rows]),
-    }
+    summary, curve, rows = read_finished(run_dir)
+    curve["return_mean"] = stats.normalize(run.task, curve["return_mean"])
     final = float(summary["final_eval"]["return_mean"])
     parts = read_trial_parts(run_dir)
     cpu = sum(part.get("cpu_s", math.nan) for part in parts) if parts else math.nan
@@ -700,10 +694,45 @@ def generalization_section(spec: StudySpec, results: list[RunResult]) -> list[st
     return lines
 
 
+UPDATE_COST_KEYS = (
+    "baseline",
+    "ratio",
+    "ms_per_update",
+    "task",
+    "action_repeat",
+    "command",
+    "commit",
+    "machine",
+)
+"""The keys of :data:`UPDATE_COST_JSON` the report reads."""
+
+
 def read_update_costs(study_dir: Path) -> dict[str, Any] | None:
-    """The study's ``update_cost.json`` (:data:`UPDATE_COST_JSON`), None when there is none."""
+    """The study's ``update_cost.json`` (:data:`UPDATE_COST_JSON`), None when there is none;
+    SetupError naming the file, what is wrong and how to write it again when it is damaged or
+    lacks a key the report reads."""
     path = study_dir / UPDATE_COST_JSON
-    return json.loads(path.read_text()) if path.is_file() else None
+    if not present(path):
+        return None
+    try:
+        costs = read_json_object(path)
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    else:
+        missing = [key for key in UPDATE_COST_KEYS if key not in costs]
+        tables = [key for key in ("ratio", "ms_per_update") if not isinstance(costs.get(key), dict)]
+        if not missing and not tables:
+            return costs
+        problem = (
+            f"it has no {', '.join(missing)}" if missing else f"its {tables[0]} is not an object"
+        )
+    raise SetupError(
+        f"{path} is damaged: {problem}. Write it again with `python benchmarks/recipe_update.py "
+        f"--selection {study_dir / SELECTION_FILE} --json {path}`, or move it aside (mv {path} "
+        f"{path}.damaged) to report the runs' own wall times"
+    )
 
 
 def baseline_clock(results: list[RunResult], baseline: str) -> dict[str, tuple]:

@@ -14,6 +14,7 @@ from typing import Any
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import Damaged, json_kind, present, read_json_object
 from simoun_agent.run.layout import CHECKPOINT_NAME
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect
@@ -34,7 +35,7 @@ from simoun_lab.study.plan import (
 )
 from simoun_lab.study.provenance import code_version, same_code
 from simoun_lab.study.report import REPORT_DIR, REPORT_MD, write_study_report
-from simoun_lab.study.spec import StudySpec, load_spec
+from simoun_lab.study.spec import StudySpec, load_spec, spec_text
 from simoun_lab.sweep import launch
 from simoun_lab.sweep.trainable import STOP_FILE, SacTrial
 
@@ -54,8 +55,8 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
     with the advice of the command asked (``run --resume``, or ``report``: ``resuming``
     False) when neither holds one."""
     for where in (study_dir, archive):
-        if where is not None and (where / STUDY_FILE).is_file():
-            return json.loads((where / STUDY_FILE).read_text())
+        if where is not None and present(where / STUDY_FILE):
+            return read_record(where / STUDY_FILE)
     places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
     missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
     if not resuming:
@@ -67,6 +68,43 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
         f"no study to resume: {places} holds no {STUDY_FILE}{missing}; drop --resume to start "
         "the study, or pass the --study-dir (or --archive) of the study to continue"
     )
+
+
+RECORD_KEYS = ("spec_file", "spec_text", "spec", "parts")
+"""Keys every study record holds (:func:`open_study`)."""
+
+
+def read_record(path: Path) -> dict[str, Any]:
+    """The study record at ``path``; SetupError naming the file, what is wrong and the fix when
+    it is damaged (:func:`record_problem`)."""
+    try:
+        record = read_json_object(path)
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    else:
+        problem = record_problem(record)
+        if problem is None:
+            return record
+    raise SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (the study directory and its "
+        f"archive each keep one, e.g. docs/studies/NAME/{STUDY_FILE})"
+    )
+
+
+def record_problem(record: dict[str, Any]) -> str | None:
+    """What is wrong with a study record that :func:`open_study` could not have written: a key
+    of :data:`RECORD_KEYS` missing, a spec that is not an object, no parts; None if nothing."""
+    missing = [key for key in RECORD_KEYS if key not in record]
+    if missing:
+        return f"it has no {', '.join(missing)}, which every study record holds"
+    if not isinstance(record["spec"], dict):
+        return f"its spec is {json_kind(record['spec'])}, not a JSON object"
+    parts = record["parts"]
+    if not (isinstance(parts, list) and parts and all(isinstance(p, dict) for p in parts)):
+        return "its parts are not an array of JSON objects, one per part the study ran"
+    return None
 
 
 def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: str) -> None:
@@ -95,13 +133,13 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
                 )
         if study_dir.exists() and any(study_dir.iterdir()):
             raise SetupError(f"{study_dir} is not empty; pass a new --study-dir")
-        text = Path(spec_path).read_text()
+        text = spec_text(Path(spec_path))
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
     changed = check_fixed_spec(record, spec, spec_path, [p for p in (study_dir, archive) if p])
     if changed:  # a fix that leaves every finished run as it ran: the study goes on under it
         part["spec_changed"] = {"keys": changed, "before": record["spec_text"]}
-        record.update(spec_file=spec_path, spec_text=Path(spec_path).read_text())
+        record.update(spec_file=spec_path, spec_text=spec_text(Path(spec_path)))
         record["spec"] = spec.to_json()
     first = record["parts"][0]
     if not same_code(first, code) and not options.allow_other_commit:

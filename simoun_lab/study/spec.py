@@ -263,8 +263,19 @@ def _name(where: tuple[str, ...]) -> str:
 def load_spec(path: Path | str) -> StudySpec:
     """Read and check the study spec at ``path``; raises SetupError naming the line and the fix."""
     path = Path(path)
+    text = spec_text(path)
     try:
-        text = read_text(path)
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SetupError(f"{path}: not valid TOML ({err}); fix the syntax there") from None
+    return _Reader(Source(path, text)).spec(data, path.stem)
+
+
+def spec_text(path: Path) -> str:
+    """The text of the study spec at ``path``; SetupError naming the file, what is wrong and
+    the fix when it cannot be read as UTF-8 text."""
+    try:
+        return read_text(path)
     except OSError as err:
         raise SetupError(
             f"cannot read the study spec {path} ({err.strerror}); pass a TOML file, "
@@ -275,11 +286,6 @@ def load_spec(path: Path | str) -> StudySpec:
             f"cannot read the study spec {path} ({err}); pass a TOML file saved as UTF-8 text, "
             "e.g. docs/studies/dmc100k.toml"
         ) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise SetupError(f"{path}: not valid TOML ({err}); fix the syntax there") from None
-    return _Reader(Source(path, text)).spec(data, path.stem)
 
 
 class _Reader:

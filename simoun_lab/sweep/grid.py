@@ -31,7 +31,7 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, read_text
+from simoun_agent.run.kept import Damaged, present, read_json_object
 
 SWEEP_FILE = "sweep.json"
 """The sweep's grid and base config, written once in the sweep directory."""
@@ -334,15 +334,17 @@ class SweepSpec:
     @classmethod
     def load(cls, sweep_dir: Path) -> SweepSpec:
         path = sweep_dir / SWEEP_FILE
-        if not path.is_file():
+        if not present(path):
             raise SetupError(
                 f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing); pass the --sweep-dir of "
                 "a sweep that simoun-sweep started, or drop --resume to start one"
             )
         try:
-            spec = cls(**json.loads(read_text(path)))
-        except (json.JSONDecodeError, Damaged, TypeError) as err:
+            spec = cls(**read_json_object(path))
+        except (Damaged, TypeError) as err:
             problem = str(err)
+        except OSError as err:
+            problem = f"it cannot be read ({err.strerror})"
         else:
             problem = "" if isinstance(spec.grid, dict) else "its grid is not a JSON object"
         if problem:

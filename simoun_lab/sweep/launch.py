@@ -19,9 +19,11 @@ from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import present
 from simoun_lab.engine.launcher import run_trials
 from simoun_lab.engine.trial import Trial as EngineTrial
 from simoun_lab.sweep.grid import SweepSpec, Trial, gpus_wanted
+from simoun_lab.sweep.report import error_line
 from simoun_lab.sweep.trainable import ERROR_FILE, STOP_FILE, SacTrial, finished
 
 
@@ -94,7 +96,7 @@ def summarize(
     resume = resume or f"simoun-sweep --resume --sweep-dir {sweep_dir}"
     for trial in outcome.get("failed", []):
         error = Path(trial.run_dir) / ERROR_FILE
-        last = error.read_text().strip().splitlines()[-1] if error.is_file() else "see Tune's log"
+        last = error_line(error) if present(error) else "see Tune's log"
         print(f"FAILED {trial.name}: {last} (traceback: {error})", file=sys.stderr)
     if written:
         print(f"report: {', '.join(map(str, written))}")

@@ -51,7 +51,7 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import STEP_LIMIT, Damaged, broken_link, read_text
+from simoun_agent.run.kept import STEP_LIMIT, Damaged, present, read_json_object, read_text
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
@@ -69,6 +69,19 @@ IQM_STEPS_PNG = "iqm_env_steps.png"
 PROFILE_PNG = "performance_profile.png"
 ERROR_FILE = "error.txt"
 """Written by a failed sweep trial into its run directory (:mod:`simoun_lab.sweep.trainable`)."""
+
+
+def error_line(path: Path) -> str:
+    """The last line of a failed trial's :data:`ERROR_FILE` (its traceback's error), or what is
+    wrong with the file: a damaged one must not hide that the trial failed."""
+    try:
+        lines = read_text(path).strip().splitlines()
+    except Damaged as err:
+        return f"failed ({path.name} is damaged: {err})"
+    except OSError as err:
+        return f"failed ({path.name} cannot be read: {err.strerror})"
+    return lines[-1] if lines else "failed"
+
 
 NOT_VARIANT = {
     "seed",
@@ -178,14 +191,11 @@ def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
 def read_json(path: Path) -> dict[str, Any]:
     """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it."""
     try:
-        data = json.loads(read_text(path))
+        return read_json_object(path)
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
-    except (OSError, json.JSONDecodeError) as err:
-        raise DamagedRun(f"{path.name} cannot be read ({err})") from None
-    if not isinstance(data, dict):
-        raise DamagedRun(f"{path.name} holds {type(data).__name__}, not a JSON object")
-    return data
+    except OSError as err:
+        raise DamagedRun(f"{path.name} cannot be read ({err.strerror})") from None
 
 
 def read_curve(path: Path) -> dict[str, np.ndarray]:
@@ -200,7 +210,7 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
     except (OSError, ValueError, TypeError, csv.Error) as err:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
-    if path.stat().st_size and not rows and "env_step" not in path.read_text():
+    if path.stat().st_size and not rows and "env_step" not in read_text(path):
         raise DamagedRun(f"{path.name} has no header line")
     if rows and (missing := [key for key in CURVE_COLUMNS if key not in rows[0]]):
         raise DamagedRun(f"{path.name} has no column {', '.join(missing)}")
@@ -238,6 +248,28 @@ MINIGRID_RUN = (
 )
 
 
+def check_summary(summary: dict[str, Any], curve: dict[str, np.ndarray]) -> None:
+    """:class:`DamagedRun` when a finished run's ``summary`` lacks a finite final return, a
+    step or a wall time, or ends at another step than the last evaluation of its ``curve``
+    (:func:`read_curve`)."""
+    final = summary.get("final_eval", {})
+    value = final.get("return_mean") if isinstance(final, dict) else None
+    if not (isinstance(value, (int, float)) and math.isfinite(value)):
+        raise DamagedRun(f"{SUMMARY_NAME} has no finite final_eval.return_mean ({value})")
+    for key in ("env_step", "wall_time_s"):
+        if not (is_real(summary.get(key)) and summary[key] >= 0):
+            raise DamagedRun(f"{SUMMARY_NAME}: {key} is {summary.get(key)!r}, not a number >= 0")
+    if not len(curve["env_step"]):
+        raise DamagedRun(f"{EVAL_CSV} holds no evaluation, but the run finished")
+    # the run's final evaluation is the last row of eval.csv: a summary that claims another
+    # step would put the run at a budget it never trained to
+    if summary["env_step"] != curve["env_step"][-1]:
+        raise DamagedRun(
+            f"{SUMMARY_NAME} says the run ended at env step {summary['env_step']:g}, but the "
+            f"last evaluation in {EVAL_CSV} is at {curve['env_step'][-1]:g}"
+        )
+
+
 def read_run(config_path: Path) -> RunRecord:
     """The run of ``config_path``'s directory, or :class:`DamagedRun`."""
     run_dir = config_path.parent
@@ -255,33 +287,11 @@ def read_run(config_path: Path) -> RunRecord:
     config = flatten(with_defaults(saved))
     curve = read_curve(run_dir / EVAL_CSV)
     summary_path = run_dir / SUMMARY_NAME
-    summary = (
-        read_json(summary_path) if summary_path.is_file() or broken_link(summary_path) else None
-    )
+    summary = read_json(summary_path) if present(summary_path) else None
     if summary is not None:
-        final = summary.get("final_eval", {})
-        value = final.get("return_mean") if isinstance(final, dict) else None
-        if not (isinstance(value, (int, float)) and math.isfinite(value)):
-            raise DamagedRun(f"{SUMMARY_NAME} has no finite final_eval.return_mean ({value})")
-        for key in ("env_step", "wall_time_s"):
-            if not (is_real(summary.get(key)) and summary[key] >= 0):
-                raise DamagedRun(
-                    f"{SUMMARY_NAME}: {key} is {summary.get(key)!r}, not a number >= 0"
-                )
-        if not len(curve["env_step"]):
-            raise DamagedRun(f"{EVAL_CSV} holds no evaluation, but the run finished")
-        # the run's final evaluation is the last row of eval.csv: a summary that claims another
-        # step would put the run at a budget it never trained to
-        if summary["env_step"] != curve["env_step"][-1]:
-            raise DamagedRun(
-                f"{SUMMARY_NAME} says the run ended at env step {summary['env_step']:g}, but the "
-                f"last evaluation in {EVAL_CSV} is at {curve['env_step'][-1]:g}"
-            )
+        check_summary(summary, curve)
     error_path = run_dir / ERROR_FILE
-    error = None
-    if error_path.is_file() and summary is None:
-        lines = error_path.read_text().strip().splitlines()
-        error = lines[-1] if lines else "failed"
+    error = error_line(error_path) if present(error_path) and summary is None else None
     written = run_dir / EVAL_CSV if (run_dir / EVAL_CSV).is_file() else config_path
     return RunRecord(run_dir, config, curve, summary, error, written.stat().st_mtime)
 
@@ -294,7 +304,7 @@ they still tell variants apart."""
 def sweep_grid(root: Path) -> dict[str, list[Any]] | None:
     """The grid of the sweep in ``root`` (its ``sweep.json``), None for runs of no sweep;
     SetupError naming the file when it is damaged."""
-    return SweepSpec.load(root).grid if (root / SWEEP_FILE).is_file() else None
+    return SweepSpec.load(root).grid if present(root / SWEEP_FILE) else None
 
 
 def variant_keys(records: list[RunRecord], root: Path) -> list[str]:

@@ -24,10 +24,12 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.config import resolve
+from simoun_agent.config import SetupError, resolve
+from simoun_agent.config.rules import is_real
 from simoun_agent.generalization import check_eval_distractions, distraction_callbacks
 from simoun_agent.run import train
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.signals import Stopped
 from simoun_lab.sweep.grid import Trial
@@ -93,8 +95,10 @@ def finished(trial: Trial) -> bool:
     if not path.is_file():
         return False
     try:
-        done = json.loads(path.read_text())["env_step"]
-    except (json.JSONDecodeError, KeyError, TypeError, UnicodeDecodeError):
+        done = read_json_object(path).get("env_step")
+    except (Damaged, OSError):
+        done = None
+    if not is_real(done):
         return True  # damaged: the report names it; training cannot tell how far the run got
     return done >= trial_budget(trial)
 
@@ -191,6 +195,23 @@ def _write_part(run_dir: Path, part: dict[str, Any], replace_last: bool = False)
 
 
 def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
-    """The parts recorded in a run directory's ``trial.json`` (none without one)."""
+    """The parts recorded in a run directory's ``trial.json`` (none without one); SetupError
+    naming the file, what is wrong and the fix when it is damaged."""
     path = Path(run_dir) / TRIAL_FILE
-    return json.loads(path.read_text())["parts"] if path.is_file() else []
+    if not present(path):
+        return []
+    try:
+        parts = read_json_object(path).get("parts")
+    except Damaged as err:
+        problem = str(err)
+    except OSError as err:
+        problem = f"it cannot be read ({err.strerror})"
+    else:
+        if isinstance(parts, list) and all(isinstance(part, dict) for part in parts):
+            return parts
+        problem = "its parts are not an array of JSON objects (one per part the run ran)"
+    raise SetupError(
+        f"{path} is damaged: {problem}. Restore it from a copy (a study's archive keeps one), or "
+        f"move it aside (mv {path} {path}.damaged): the run's CPU time and machine load are then "
+        "left out"
+    )

@@ -1,0 +1,457 @@
+"""The lab's commands on kept files damaged as a disk, a copy or an editor leaves them (empty, cut
+short, not JSON, UTF-16, NUL bytes, a directory, a named pipe or a link to nothing in place of
+the file, JSON of another kind): each names the file, what is wrong and the fix, exits with
+status 2 without a traceback, and never waits on a pipe. The files are copies of the committed
+study archives."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import re
+import shutil
+import signal
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from simoun_agent.config import SetupError
+from simoun_agent.run.kept import Damaged, csv_number, read_csv_rows, read_json_object
+from simoun_lab.cli import report as report_cli
+from simoun_lab.cli import study as study_cli
+from simoun_lab.engine.launcher import read_run_files
+from simoun_lab.minigrid_study import __main__ as minigrid_cli
+from simoun_lab.minigrid_study.runner import record_spec
+from simoun_lab.minigrid_study.spec import load_spec as load_minigrid_spec
+from simoun_lab.study.checks import finished_config
+from simoun_lab.study.choice import choose
+from simoun_lab.study.driving import REFERENCES_JSON, read_references
+from simoun_lab.study.generalization import read_modes
+from simoun_lab.study.plan import evaluation_runs
+from simoun_lab.study.report import UPDATE_COST_JSON, read_result, read_update_costs
+from simoun_lab.study.spec import load_spec
+from simoun_lab.sweep import launch
+from simoun_lab.sweep.grid import SweepSpec, Trial
+from simoun_lab.sweep.trainable import finished, read_trial_parts
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "studies"
+MINIGRID = DOCS / "minigrid"
+MINIGRID_RUNS = [f"MiniGrid-DoorKey-6x6-v0/{arm}/s0" for arm in ("ppo", "consistency", "rnd")]
+"""one seed of every arm: the runs a report compares"""
+DMC = DOCS / "dmc100k"
+DMC_SPEC = DOCS / "dmc100k.toml"
+TUNING_RUN = "tuning/drq/agent.n_step=3/cartpole-swingup/s101"
+EVALUATION_RUN = "evaluation/drq/cheetah-run/s1"
+
+
+@pytest.fixture(autouse=True)
+def no_hang() -> Iterator[None]:
+    """Fail a test that waits on a named pipe instead of hanging the suite."""
+
+    def stop(signum, frame):
+        raise TimeoutError("a read waited on a named pipe")
+
+    previous = signal.signal(signal.SIGALRM, stop)
+    signal.alarm(60)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)
+
+
+def emptied(path: Path) -> None:
+    path.write_bytes(b"")
+
+
+def cut_short(path: Path) -> None:
+    path.write_bytes(path.read_bytes()[:20])
+
+
+def utf16(path: Path) -> None:
+    path.write_text(path.read_text(), encoding="utf-16")
+
+
+def nul_byte(path: Path) -> None:
+    data = path.read_bytes()
+    path.write_bytes(data[:4] + b"\0" + data[4:])
+
+
+def a_directory(path: Path) -> None:
+    path.unlink()
+    path.mkdir()
+
+
+def named_pipe(path: Path) -> None:
+    path.unlink()
+    os.mkfifo(path)
+
+
+def link_to_nothing(path: Path) -> None:
+    path.unlink()
+    path.symlink_to(path.with_name("moved-away"))
+
+
+def an_array(path: Path) -> None:
+    path.write_text("[1, 2]")
+
+
+DAMAGES: dict[Callable[[Path], None], str] = {
+    emptied: "it is empty",
+    cut_short: "it is not JSON (",
+    utf16: "it is saved as UTF-16 text, not UTF-8",
+    nul_byte: "line 1 holds a NUL byte",
+    a_directory: "it is a directory, not a regular file",
+    named_pipe: "it is a named pipe (FIFO), not a regular file",
+    link_to_nothing: "it is a symbolic link to ",
+    an_array: "it holds an array, not a JSON object",
+}
+"""each damage of a JSON file, and what is said of it"""
+
+
+def run_main(main: Callable[[list[str]], int], *args: str) -> tuple[int, str]:
+    """A command's exit status (returned, or exited with) and what it printed."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+        try:
+            status = main(list(args))
+        except SystemExit as exit_info:
+            status = exit_info.code
+    return status, out.getvalue()
+
+
+def refused(main: Callable[[list[str]], int], *args: str) -> str:
+    """What a command says when it refuses: status 2, no traceback."""
+    status, printed = run_main(main, *args)
+    assert status == 2, printed[-3000:]
+    assert "Traceback" not in printed
+    return printed
+
+
+@pytest.mark.parametrize("damage", list(DAMAGES), ids=lambda d: d.__name__)
+def test_a_damaged_json_file_is_named_by_the_shared_reader(damage, tmp_path):
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps({"env_step": 100, "final_eval": {"return_mean": 1.0}}))
+    damage(path)
+    with pytest.raises(Damaged, match="^" + re.escape(DAMAGES[damage])):
+        read_json_object(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("", "it is empty"),
+        ("step,return_mean\n0,1\n", "its first line has no env_step column"),
+        ("env_step,return_mean\n0,1\n20\n", "line 3 has 1 fields where the header has 2"),
+        ("env_step\n" + "1" * 200_000 + "\n", "it is not a CSV file (field larger than"),
+    ],
+)
+def test_a_damaged_csv_file_is_named_by_the_shared_reader(text, problem, tmp_path):
+    path = tmp_path / "eval.csv"
+    path.write_text(text)
+    with pytest.raises(Damaged, match=re.escape(problem)):
+        read_csv_rows(path, ("env_step",))
+
+
+def test_the_shared_csv_reader_reads_rows_as_written_and_names_a_value_that_is_no_number(
+    tmp_path,
+):
+    path = tmp_path / "eval.csv"
+    path.write_text("\ufeffenv_step,return_mean\r\n0,\r\n\r\n20,1.5\r\n", newline="")
+    rows = read_csv_rows(path, ("env_step",))
+    assert rows == [{"env_step": "0", "return_mean": ""}, {"env_step": "20", "return_mean": "1.5"}]
+    assert csv_number("1.5", "return_mean", 3) == 1.5
+    with pytest.raises(Damaged, match="line 3: return_mean is 'x', not a number"):
+        csv_number("x", "return_mean", 3)
+
+
+@pytest.fixture
+def minigrid_archive(tmp_path: Path) -> Path:
+    """One seed of each arm of the committed MiniGrid study, with its spec."""
+    archive = tmp_path / "archive"
+    for name in MINIGRID_RUNS:
+        shutil.copytree(MINIGRID / name, archive / name)
+    shutil.copy(MINIGRID / "spec.json", archive / "spec.json")
+    return archive
+
+
+def test_the_minigrid_report_reads_the_copied_runs(minigrid_archive):
+    status, printed = run_main(minigrid_cli.main, "report", "--archive", str(minigrid_archive))
+    assert status == 0, printed[-3000:]
+    assert (minigrid_archive / "report" / "report.md").is_file()
+
+
+@pytest.mark.parametrize(
+    ("file", "damage", "problem"),
+    [
+        *(("summary.json", d, problem) for d, problem in DAMAGES.items() if d is not nul_byte),
+        ("summary.json", nul_byte, "line 2 holds a NUL byte"),  # written indented
+        ("summary.json", lambda p: p.write_text('{"env_steps": 1}'), "env_s is null, not a number"),
+        ("eval.csv", emptied, "it is empty"),
+        ("eval.csv", named_pipe, "it is a named pipe (FIFO), not a regular file"),
+        (
+            "eval.csv",
+            lambda p: p.write_text("env_step,wall_s\n0,1\n"),
+            "its first line has no success_rate, return_mean column",
+        ),
+        ("eval.csv", lambda p: p.write_text(p.read_text()[:40]), "it holds no row after its"),
+        ("train.csv", utf16, "it is saved as UTF-16 text, not UTF-8"),
+        ("train.csv", link_to_nothing, "it is a symbolic link to "),
+    ],
+)
+def test_a_damaged_minigrid_run_file_is_named_by_the_report(
+    file, damage, problem, minigrid_archive
+):
+    path = minigrid_archive / MINIGRID_RUNS[1] / file
+    damage(path)
+    printed = refused(minigrid_cli.main, "report", "--archive", str(minigrid_archive))
+    assert f"{path} is damaged: {problem}" in printed
+    assert f"mv {path.parent} {path.parent}.damaged" in printed and "Restore it" in printed
+
+
+def test_a_value_that_is_not_a_number_is_named_by_the_minigrid_selection(minigrid_archive):
+    path = minigrid_archive / MINIGRID_RUNS[0] / "eval.csv"
+    lines = path.read_text().splitlines()
+    lines[2] = "x" + lines[2][lines[2].index(",") :]
+    path.write_text("\n".join(lines) + "\n")
+    printed = refused(minigrid_cli.main, "select", "--archive", str(minigrid_archive))
+    assert f"{path} is damaged: line 3: env_step is 'x', not a number" in printed
+
+
+@pytest.mark.parametrize("damage", [emptied, named_pipe, an_array], ids=lambda d: d.__name__)
+def test_a_damaged_archive_spec_is_named_with_the_fix(damage, minigrid_archive):
+    path = minigrid_archive / "spec.json"
+    damage(path)
+    printed = refused(minigrid_cli.main, "report", "--archive", str(minigrid_archive))
+    assert (
+        f"{path} is damaged: {DAMAGES[damage]}" in printed and "Restore it from a copy" in printed
+    )
+    # a run given its spec on the command line checks it against the archive's before training
+    with pytest.raises(SetupError, match=re.escape(f"{path} is damaged: ")):
+        record_spec(load_minigrid_spec(MINIGRID / "spec.json"), minigrid_archive)
+
+
+def test_a_spec_in_place_of_which_a_named_pipe_stands_is_named(tmp_path):
+    spec = tmp_path / "spec.toml"
+    os.mkfifo(spec)
+    printed = refused(study_cli.main, "plan", str(spec))
+    assert f"cannot read the study spec {spec} (it is a named pipe (FIFO)" in printed
+
+
+@pytest.fixture
+def dmc_archive(tmp_path: Path) -> Path:
+    """A copy of the committed dmc100k study archive."""
+    return Path(shutil.copytree(DMC, tmp_path / "dmc100k"))
+
+
+@pytest.mark.parametrize(
+    "damage", [emptied, a_directory, named_pipe, an_array], ids=lambda d: d.__name__
+)
+def test_a_damaged_study_record_is_named_by_the_report(damage, dmc_archive):
+    path = dmc_archive / "study.json"
+    damage(path)
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{path} is damaged: {DAMAGES[damage]}" in printed
+    assert "Restore it from a copy (the study directory and its archive each keep one" in printed
+
+
+def test_a_study_record_without_its_parts_is_named(dmc_archive):
+    path = dmc_archive / "study.json"
+    record = json.loads(path.read_text())
+    del record["parts"]
+    path.write_text(json.dumps(record))
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{path} is damaged: it has no parts, which every study record holds" in printed
+
+
+@pytest.mark.parametrize(
+    ("file", "damage", "problem"),
+    [
+        ("summary.json", utf16, "summary.json is damaged: it is saved as UTF-16 text"),
+        ("summary.json", named_pipe, "summary.json is damaged: it is a named pipe (FIFO)"),
+        ("eval.csv", nul_byte, "eval.csv is damaged: line 1 holds a NUL byte"),
+        ("eval.csv", emptied, "eval.csv holds no evaluation, but the run finished"),
+    ],
+)
+def test_a_damaged_tuning_run_is_named_by_the_study_report(file, damage, problem, dmc_archive):
+    run_dir = dmc_archive / TUNING_RUN
+    damage(run_dir / file)
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"the finished run {run_dir}: {problem}" in printed
+    assert f"mv {run_dir} {run_dir}.damaged" in printed
+
+
+@pytest.fixture
+def evaluation_run(tmp_path: Path):
+    """A copy of one evaluation run of the committed dmc100k study: (study dir, its run)."""
+    shutil.copytree(DMC / EVALUATION_RUN, tmp_path / EVALUATION_RUN)
+    spec = load_spec(DMC_SPEC)
+    chosen = {recipe: choice.setting for recipe, choice in choose(spec, DMC).items()}
+    (run,) = [r for r in evaluation_runs(spec, chosen) if r.name == EVALUATION_RUN]
+    return tmp_path, run
+
+
+def test_the_evaluation_run_copy_reads_as_its_result(evaluation_run):
+    study_dir, run = evaluation_run
+    result = read_result(study_dir, run)
+    assert (
+        result.final_return
+        == json.loads((DMC / EVALUATION_RUN / "summary.json").read_text())["final_eval"][
+            "return_mean"
+        ]
+    )
+    assert result.cpu_s > 0 and result.modes is None
+
+
+@pytest.mark.parametrize(
+    ("file", "damage", "problem"),
+    [
+        ("summary.json", link_to_nothing, "summary.json is damaged: it is a symbolic link to "),
+        ("summary.json", lambda p: p.write_text("{}"), "has no finite final_eval.return_mean"),
+        ("trial.json", emptied, "trial.json is damaged: it is empty"),
+        ("trial.json", named_pipe, "trial.json is damaged: it is a named pipe (FIFO)"),
+        ("trial.json", lambda p: p.write_text('{"parts": 3}'), "trial.json is damaged: its parts"),
+    ],
+)
+def test_a_damaged_evaluation_run_is_named_when_its_result_is_read(
+    file, damage, problem, evaluation_run
+):
+    study_dir, run = evaluation_run
+    damage(study_dir / run.name / file)
+    with pytest.raises(SetupError, match=re.escape(problem)):
+        read_result(study_dir, run)
+
+
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        (b"", "it is empty"),
+        (b"mode,env_step\ntrain,100000\n", "its first line has no return_mean column"),
+        (b"mode,env_step,return_mean\ntrain,100000,high\n", "line 2: return_mean is 'high'"),
+        ("mode,env_step,return_mean\n".encode("utf-16"), "it is saved as UTF-16 text"),
+    ],
+)
+def test_a_damaged_generalization_csv_is_named_with_the_fix(text, problem, evaluation_run):
+    study_dir, run = evaluation_run
+    path = study_dir / run.name / "generalization.csv"
+    path.write_bytes(text)
+    with pytest.raises(SetupError, match=re.escape(f"is damaged: {problem}")) as refusal:
+        read_modes(study_dir / run.name, 100000)
+    assert str(path) in str(refusal.value) and "the run's final agent is then played" in str(
+        refusal.value
+    )
+
+
+def test_a_generalization_csv_reads_as_written(evaluation_run):
+    study_dir, run = evaluation_run
+    path = study_dir / run.name / "generalization.csv"
+    path.write_text("mode,env_step,return_mean\ntrain,100000,250.5\nvideo_easy,100000,12\n")
+    assert read_modes(study_dir / run.name, 100000) == {"train": 250.5, "video_easy": 12.0}
+    assert read_modes(study_dir / run.name, 50000) is None  # not the final agent's
+
+
+@pytest.mark.parametrize(
+    ("damage", "problem"),
+    [
+        (lambda p: p.write_bytes(b"{\0}"), "line 1 holds a NUL byte"),
+        (lambda p: p.write_text('{"baseline": "sac"}'), "it has no ratio, ms_per_update"),
+        (lambda p: os.mkfifo(p), "it is a named pipe (FIFO)"),
+    ],
+)
+def test_a_damaged_update_cost_file_is_named_with_the_command_that_writes_it(
+    damage, problem, tmp_path
+):
+    path = tmp_path / UPDATE_COST_JSON
+    damage(path)
+    with pytest.raises(SetupError, match=re.escape(problem)) as refusal:
+        read_update_costs(tmp_path)
+    assert f"{path} is damaged" in str(refusal.value)
+    assert "python benchmarks/recipe_update.py --selection" in str(refusal.value)
+
+
+@pytest.mark.parametrize("damage", [utf16, named_pipe, link_to_nothing], ids=lambda d: d.__name__)
+def test_a_damaged_references_file_is_named_with_its_command(damage, tmp_path):
+    path = tmp_path / REFERENCES_JSON
+    path.write_text("{}")
+    damage(path)
+    with pytest.raises(SetupError, match=re.escape(f"is damaged: {DAMAGES[damage]}")) as refusal:
+        read_references(tmp_path)
+    assert str(path) in str(refusal.value) and "write it again with" in str(refusal.value)
+
+
+@pytest.mark.parametrize("damage", [utf16, a_directory, cut_short], ids=lambda d: d.__name__)
+def test_a_damaged_config_of_a_finished_run_is_named_when_a_fixed_spec_is_checked(damage, tmp_path):
+    shutil.copytree(DMC / TUNING_RUN, tmp_path / TUNING_RUN)
+    path = tmp_path / TUNING_RUN / "config.json"
+    damage(path)
+    with pytest.raises(SetupError, match=re.escape(f"is damaged: {DAMAGES[damage]}")) as refusal:
+        finished_config(TUNING_RUN, [tmp_path])
+    assert str(path) in str(refusal.value) and "resume: the run is then trained again" in str(
+        refusal.value
+    )
+
+
+def trial_of(run_dir: Path) -> Trial:
+    return Trial("base", "dm_control/cheetah-run-v0", 1, str(run_dir), None, {})
+
+
+@pytest.mark.parametrize("damage", [utf16, emptied, an_array], ids=lambda d: d.__name__)
+def test_a_damaged_summary_leaves_a_sweep_trial_finished_for_the_report_to_name(damage, tmp_path):
+    run_dir = Path(shutil.copytree(DMC / EVALUATION_RUN, tmp_path / "run"))
+    damage(run_dir / "summary.json")
+    assert finished(trial_of(run_dir))
+    named_pipe(run_dir / "summary.json")
+    assert not finished(trial_of(run_dir))  # not read: resuming the trial names it
+
+
+def test_a_damaged_trial_record_is_named(tmp_path):
+    run_dir = Path(shutil.copytree(DMC / EVALUATION_RUN, tmp_path / "run"))
+    assert read_trial_parts(run_dir)[0]["cpu_count"] == 2
+    utf16(run_dir / "trial.json")
+    with pytest.raises(
+        SetupError, match=r"trial\.json is damaged: it is saved as UTF-16"
+    ) as refusal:
+        read_trial_parts(run_dir)
+    assert f"mv {run_dir / 'trial.json'} {run_dir / 'trial.json'}.damaged" in str(refusal.value)
+
+
+@pytest.mark.parametrize(
+    ("damage", "said"),
+    [
+        (emptied, "failed"),
+        (utf16, "failed (error.txt is damaged: it is saved as UTF-16 text, not UTF-8)"),
+        (a_directory, "failed (error.txt is damaged: it is a directory, not a regular file)"),
+    ],
+)
+def test_a_damaged_error_file_still_says_the_trial_failed(damage, said, tmp_path, capsys):
+    run_dir = Path(shutil.copytree(DMC / EVALUATION_RUN, tmp_path / "sweep" / "run"))
+    (run_dir / "summary.json").unlink()
+    error = run_dir / "error.txt"
+    error.write_text("Traceback ...\nRuntimeError: out of memory\n")
+    damage(error)
+    status = launch.summarize({"failed": [trial_of(run_dir)]}, tmp_path / "sweep", [])
+    assert status == 1
+    assert f"FAILED base/cheetah-run/s1: {said} (traceback: {error})" in capsys.readouterr().err
+    shutil.copytree(DMC / "evaluation/drq/cheetah-run/s2", tmp_path / "sweep" / "finished")
+    assert report_cli.main([str(tmp_path / "sweep"), "--out", str(tmp_path / "report")]) == 0
+    assert f"- run: {said}" in (tmp_path / "report" / "report.md").read_text()
+
+
+@pytest.mark.parametrize("damage", [a_directory, link_to_nothing], ids=lambda d: d.__name__)
+def test_a_damaged_sweep_record_is_named_not_taken_for_a_missing_one(damage, tmp_path):
+    path = tmp_path / "sweep.json"
+    path.write_text("{}")
+    damage(path)
+    with pytest.raises(SetupError, match=re.escape(f"{path} is damaged ({DAMAGES[damage]}")):
+        SweepSpec.load(tmp_path)
+
+
+@pytest.mark.parametrize("damage", [utf16, a_directory], ids=lambda d: d.__name__)
+def test_a_damaged_run_file_is_not_archived(damage, tmp_path):
+    run_dir = Path(shutil.copytree(DMC / EVALUATION_RUN, tmp_path / "run"))
+    names = ("config.json", "eval.csv", "summary.json")
+    assert list(read_run_files(run_dir, names)) == list(names)
+    damage(run_dir / "eval.csv")
+    with pytest.raises(SetupError, match=re.escape(f"{run_dir / 'eval.csv'} is damaged: ")):
+        read_run_files(run_dir, names)
