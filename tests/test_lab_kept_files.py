@@ -24,7 +24,7 @@ from simoun_lab.cli import report as report_cli
 from simoun_lab.cli import study as study_cli
 from simoun_lab.engine.launcher import read_run_files
 from simoun_lab.minigrid_study import __main__ as minigrid_cli
-from simoun_lab.minigrid_study.runner import record_spec
+from simoun_lab.minigrid_study.runner import record_spec, run_study
 from simoun_lab.minigrid_study.spec import load_spec as load_minigrid_spec
 from simoun_lab.study.checks import finished_config
 from simoun_lab.study.choice import choose
@@ -455,3 +455,44 @@ def test_a_damaged_run_file_is_not_archived(damage, tmp_path):
     damage(run_dir / "eval.csv")
     with pytest.raises(SetupError, match=re.escape(f"{run_dir / 'eval.csv'} is damaged: ")):
         read_run_files(run_dir, names)
+
+
+def zero_filled(path: Path) -> None:
+    path.write_bytes(bytes(path.stat().st_size))
+
+
+def overwritten_inside(path: Path) -> None:
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize(
+    ("damage", "problem"),
+    [
+        (emptied, "it is empty"),
+        (zero_filled, "bytes are zero"),
+        (cut_short, "it cannot be read"),
+        (overwritten_inside, "does not match its checksum"),
+        (a_directory, "it is a directory, not a regular file"),
+    ],
+    ids=lambda d: getattr(d, "__name__", ""),
+)
+def test_a_damaged_checkpoint_of_an_unfinished_minigrid_run_is_refused_before_ray_starts(
+    damage, problem, tmp_path
+):
+    import torch
+
+    spec = load_minigrid_spec(MINIGRID / "spec.json")
+    archive = tmp_path / "archive"
+    record_spec(spec, archive)
+    path = archive / spec.runs()[0].name / "checkpoint.pt"
+    path.parent.mkdir(parents=True)
+    torch.save({"policy": {"w": torch.arange(4096.0)}, "env_step": 1024}, path)
+    damage(path)
+    with pytest.raises(SetupError) as error:
+        run_study(spec, archive, tmp_path / "work")
+    said = str(error.value)
+    assert f"{path} is damaged: " in said and problem in said, said
+    assert f"mv {path} {path}.damaged" in said
+    assert not (tmp_path / "work").exists()  # nothing started

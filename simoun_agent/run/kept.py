@@ -17,6 +17,7 @@ import json
 import math
 import os
 import stat
+import zipfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -158,3 +159,20 @@ def binary_problem(path: Path) -> str:
     except OSError as err:
         return f"it cannot be read ({err.strerror})"
     return f"all its {size} bytes are zero (a disk or copy failure)"
+
+
+def checkpoint_problem(path: Path) -> str | None:
+    """What is wrong with the checkpoint at ``path`` (a ``torch.save`` file, which is a zip
+    archive), checked without torch by reading every member against its checksum; None when it
+    is whole. A link to nothing or something that is not a file is named too."""
+    problem = broken_link(path) or not_a_file(path)
+    if problem:
+        return problem
+    try:
+        with zipfile.ZipFile(path) as archive:
+            bad = archive.testzip()
+    except (zipfile.BadZipFile, EOFError, ValueError):
+        return binary_problem(path)
+    except OSError as err:
+        return f"it cannot be read ({err.strerror})"
+    return None if bad is None else f"its part {bad} does not match its checksum (overwritten)"

@@ -13,10 +13,11 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.kept import Damaged, checkpoint_problem, present, read_json_object
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.engine.trial import summary_written
+from simoun_lab.minigrid_study.checkpoint import CHECKPOINT
 from simoun_lab.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_lab.minigrid_study.training import write_json
 from simoun_lab.minigrid_study.trial import MiniGridTrial
@@ -70,6 +71,21 @@ def record_spec(spec: StudySpec, archive: Path) -> None:
     write_json(path, wanted)
 
 
+def check_checkpoints(todo: list[MiniGridTrial], archive: Path) -> None:
+    """Refuse, before Ray starts, a damaged checkpoint an unfinished run would go on from (in
+    its run directory or in the archive): its trial would fail only once it is running."""
+    for trial in todo:
+        for path in (Path(trial.run_dir, CHECKPOINT), archive / trial.name / CHECKPOINT):
+            problem = checkpoint_problem(path) if present(path) else None
+            if problem:
+                raise SetupError(
+                    f"{path} is damaged: {problem}. Restore it from a copy (git checkout -- "
+                    f"{path}, for a committed archive), or move it aside (mv {path} "
+                    f"{path}.damaged) to train run {trial.name} from the other checkpoint or "
+                    "from the start"
+                )
+
+
 def run_study(
     spec: StudySpec,
     archive: Path,
@@ -87,6 +103,7 @@ def run_study(
     done = set(finished_runs(spec, archive))
     commit, work = code_version()["commit"], str(work_dir.resolve())
     todo = [MiniGridTrial(spec, run, work, commit) for run in spec.runs() if run.name not in done]
+    check_checkpoints(todo, archive)
     print(f"{len(done)} of {len(spec.runs())} runs finished in {archive}; {len(todo)} to run")
     outcome = {"skipped": sorted(done), "finished": [], "failed": []}
     if not todo:
