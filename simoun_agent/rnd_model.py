@@ -48,7 +48,7 @@ class RNDConfig:
     """frames stored before the first gradient step"""
     background: bool = True
     """take the gradient steps in a background thread (same schedule and rewards as
-    ``CuriosityConfig.background``)"""
+    ``CuriosityConfig.background``; False for bit-reproducible runs, as there)"""
     lr: float = 1e-4
     """Adam learning rate of the predictor (the paper: 1e-4)"""
     seed: int | None = None

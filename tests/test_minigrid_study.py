@@ -357,6 +357,25 @@ def test_an_ended_run_goes_on_from_its_checkpoint(tmp_path):
     assert not (run_dir / CHECKPOINT).exists()
 
 
+@pytest.mark.parametrize("arm", ["consistency", "rnd"])
+def test_a_run_of_an_intrinsic_arm_is_the_same_bit_for_bit_when_trained_again(arm, tmp_path):
+    """The intrinsic models step on the learner's thread, so one seed gives one run."""
+    spec = spec_from_dict(
+        {**TINY, "tasks": [{**TINY["tasks"][0], "steps": 1536}], "ppo": {"n_steps": 64}}, "test"
+    )
+    (run,) = [r for r in spec.runs() if r.arm == arm]
+    for copy in ("a", "b"):
+        train_run(spec, run, tmp_path / copy)
+    first, second = (rows(tmp_path / copy / "train.csv") for copy in ("a", "b"))
+    learned = [{k: v for k, v in r.items() if not k.endswith("_s")} for r in first]
+    assert learned == [{k: v for k, v in r.items() if not k.endswith("_s")} for r in second]
+    assert float(first[-1]["intrinsic_mean"]) != 0.0  # the model trained and paid
+    assert (
+        rows(tmp_path / "a" / "eval.csv")[-1]["return_mean"]
+        == (rows(tmp_path / "b" / "eval.csv")[-1]["return_mean"])
+    )
+
+
 def test_survival_row_by_hand():
     from simoun_lab.minigrid_study.report import survival_row
 
