@@ -199,6 +199,37 @@ def test_masks_command_refuses_bad_input(runs, tmp_path, capsys):
     assert not (runs["dual_interactive"] / "analysis").exists()
 
 
+def test_analyze_refuses_numbers_out_of_range_naming_the_flag(runs, tmp_path, capsys):
+    run = str(runs["dual_interactive"])
+    cases = {
+        "--seed -1": ["bias", run, "--seed", "-1"],
+        "--seed 9223372036854775808": ["bias", run, "--seed", str(2**63)],
+        "--pairs 1": ["bias", run, "--pairs", "1"],
+        "--episodes 0": ["masks", run, "--episodes", "0"],
+        "--query -1,5": ["masks", run, "--query", "-1,5"],
+        "--steps count": ["masks", run, "--steps", "-2,4"],
+    }
+    for expected, argv in cases.items():
+        with pytest.raises(SystemExit) as exit_info:
+            main([*argv, "--out", str(tmp_path / "out")])
+        err = capsys.readouterr().err
+        assert exit_info.value.code == 2, expected
+        assert expected in err and "Traceback" not in err, (expected, err)
+    assert not (tmp_path / "out").exists()
+
+
+def test_bias_refuses_one_run_given_twice(runs, tmp_path, capsys):
+    run = runs["stacked"]
+    (tmp_path / "link").symlink_to(run)
+    for second in (run, run / "checkpoint.pt", tmp_path / "link", run / ".." / run.name):
+        with pytest.raises(SystemExit) as exit_info:
+            main(["bias", str(run), str(second), "--out", str(tmp_path / "b"), "--pairs", "8"])
+        err = capsys.readouterr().err
+        assert exit_info.value.code == 2
+        assert f"the same run ({run.resolve()}) given twice" in err and "give each run once" in err
+    assert not (tmp_path / "b").exists()
+
+
 def test_bias_command_compares_runs(runs, tmp_path):
     out = tmp_path / "bias"
     argv = ["bias", str(runs["dual_interactive"]), str(runs["stacked"]), "--pairs", "24"]

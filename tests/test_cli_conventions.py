@@ -257,6 +257,46 @@ def test_a_missing_env_module_and_bad_env_kwargs_end_in_one_line_not_a_traceback
     assert not run_dir.exists()  # refused before anything was built or written
 
 
+def test_env_kwargs_and_cameras_the_env_fails_on_are_refused_before_a_run(tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    pendulum = override(run_flags(run_dir, 20), "--env", "Pendulum-v1")
+    cases = {
+        '{"g": "x"}': "--env-kwargs: g='x' does not fit Pendulum-v1: its 'g' is a number",
+        '{"g": null}': "Pendulum-v1 was made with g=None but failed at its first reset and step",
+        '{"max_episode_steps": 0}': "--env-kwargs: max_episode_steps=0 (gymnasium.make's",
+        '{"autoreset": true}': "'autoreset' is a setting of Pendulum-v1's registration",
+    }
+    for kwargs, said in cases.items():
+        err = exit_message(capsys, train_cli.main, [*pendulum, "--env-kwargs", kwargs])
+        assert said in err and "Traceback" not in err, err
+    cameras = override(run_flags(run_dir, 20), "--env", "dm_control/cartpole-swingup-v0")
+    err = exit_message(capsys, train_cli.main, [*cameras, "--cameras", "3"])
+    assert "--cameras 3: dm_control/cartpole-swingup-v0 has only 2 cameras" in err
+    assert not run_dir.exists()  # refused before anything was written
+    limited = [*pendulum, "--env-kwargs", '{"max_episode_steps": 10}', "--no-progress"]
+    assert train_cli.main([*limited, "--no-video"]) == 0
+    assert json.loads((run_dir / "config.json").read_text())["env_kwargs"] == {
+        "max_episode_steps": 10
+    }
+
+
+def test_torch_threads_beyond_the_cores_are_warned_of_once(finished, tmp_path, capsys):
+    cores = len(os.sched_getaffinity(0))
+    threads = torch.get_num_threads()
+    warning = f"--torch-threads {cores + 1} is more than the {cores} CPU core"
+    try:
+        flags = run_flags(tmp_path / "run", 20, "--torch-threads", str(cores + 1), "--no-video")
+        assert train_cli.main([*flags, "--no-progress"]) == 0
+        assert capsys.readouterr().err.count(warning) == 1
+        argv = [str(finished), "--episodes", "1", "--no-video", "--out", str(tmp_path / "ev")]
+        assert eval_cli.main([*argv, "--torch-threads", str(cores + 1)]) == 0
+        assert capsys.readouterr().err.count(warning) == 1
+        assert eval_cli.main([*argv, "--overwrite", "--torch-threads", str(cores)]) == 0
+        assert "CPU core" not in capsys.readouterr().err
+    finally:
+        torch.set_num_threads(threads)
+
+
 def test_set_with_a_misspelled_key_suggests_by_meaning_and_takes_the_flag_spelling(
     tmp_path, capsys
 ):

@@ -119,6 +119,25 @@ def test_the_driving_references_check_every_value_before_playing(argv, said, cap
     assert list(tmp_path.iterdir()) == []
 
 
+def test_driving_references_write_over_no_file_but_their_own(capsys, tmp_path):
+    run_config = tmp_path / "config.json"
+    run_config.write_text('{"env": "highway-fast-v0"}\n')
+    (tmp_path / "dir.json").mkdir()
+    said = {
+        run_config: "it is a file this command did not write, so writing the metrics there",
+        tmp_path / "dir.json": "it is a directory, not a regular file",
+    }
+    for path, text in said.items():
+        err = refused(capsys, driving_reference.main, ["--episodes", "1", "--json", str(path)])
+        assert f"--json {path}: {text}" in err and "pass a new path" in err, err
+    assert run_config.read_text() == '{"env": "highway-fast-v0"}\n'
+    ours = tmp_path / "references.json"
+    args = driving_reference.DrivingReferenceCommand(episodes=1, json=ours)
+    metrics = {"zero": {"return_mean": 1.0}}
+    ours.write_text(driving_reference.references_json(args, driving_reference.PROG, metrics))
+    driving_reference.check_replaceable(ours)  # a file it wrote is measured anew
+
+
 @pytest.mark.parametrize(
     ("main", "argv", "flag"),
     [

@@ -135,6 +135,21 @@ def test_an_env_kwarg_the_env_refuses_is_named_before_ray_starts(tmp_path, capsy
     assert "Traceback" not in err
 
 
+def test_cameras_and_env_kwargs_a_trial_fails_on_are_named_before_ray_starts(tmp_path, capsys):
+    dmc = override(TINY, "--env", "dm_control/cartpole-swingup-v0")
+    grids = {
+        "cameras=2,3": "--cameras 3: dm_control/cartpole-swingup-v0 has only 2 cameras",
+        'env_kwargs={"render_kwargs": {"camera_id": 7}},{}': "failed at its first reset and step",
+    }
+    for grid, said in grids.items():
+        sweep_dir = tmp_path / "refused"
+        with pytest.raises(SystemExit) as exit_info:
+            cli.main([*dmc, "--grid", grid, "--sweep-dir", str(sweep_dir)])
+        assert exit_info.value.code == 2
+        err = capsys.readouterr().err
+        assert said in err and "Traceback" not in err, err
+
+
 def test_interrupted_sweep_resumes_only_the_unfinished_trials(ray_address, tmp_path):
     sweep_dir = tmp_path / "interrupted"
     # The two short trials are scheduled first (2 CPUs, 1 per trial) and finish; Ctrl-C comes

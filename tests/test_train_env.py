@@ -7,10 +7,10 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from simoun_agent.config import SetupError, resolve
-from simoun_agent.envs import POINT_REACH_ID
+from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
-from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.make_env import check_task, make_env, video_fps
 from simoun_agent.run.video import write_video
 
 
@@ -187,3 +187,76 @@ def test_csv_log_drops_rows_after_the_resumed_step_and_curve_is_drawn(tmp_path):
     assert [row["env_step"] for row in read_csv(tmp_path / "eval.csv")] == [0, 100, 150]
     plot_learning_curve(tmp_path / "eval.csv", tmp_path / "curve.png", "test")
     assert (tmp_path / "curve.png").read_bytes()[:4] == b"\x89PNG"
+
+
+class ScaledReach(PointReach):
+    """PointReach whose actions are multiplied by ``scale``, stored unchecked: a bad value shows
+    only when the env steps."""
+
+    def __init__(self, render_mode=None, scale=None):
+        super().__init__(render_mode=render_mode)
+        self.scale = 1.0 if scale is None else scale
+
+    def step(self, action):
+        return super().step(np.asarray(action) * self.scale)
+
+
+gym.register("simoun-test/ScaledReach-v0", entry_point=ScaledReach)
+
+
+def env_config(env, env_kwargs, **more):
+    return resolve(None, {"env": env, "env_kwargs": env_kwargs, "image_size": 32, **more})
+
+
+def test_gymnasium_make_keywords_in_env_kwargs_go_to_make_checked_by_value():
+    assert check_task(env_config("Pendulum-v1", {"max_episode_steps": 10})) == 10
+    assert check_task(env_config("dm_control/cartpole-swingup-v0", {"max_episode_steps": 7})) == 7
+    env = make_env(env_config("Pendulum-v1", {"max_episode_steps": 3, "disable_env_checker": True}))
+    env.reset(seed=0)
+    assert [env.step(env.action_space.sample())[3] for _ in range(3)] == [False, False, True]
+    for bad in (0, -1, 2.5, "10", True):
+        with pytest.raises(SetupError, match=r"max_episode_steps=.* must be a whole number of at"):
+            check_task(env_config("Pendulum-v1", {"max_episode_steps": bad}))
+    with pytest.raises(SetupError, match=r"disable_env_checker='yes' .* must be true or false"):
+        check_task(env_config("Pendulum-v1", {"disable_env_checker": "yes"}))
+    for setting in ("autoreset", "order_enforce", "apply_api_compatibility"):
+        with pytest.raises(SetupError) as error:
+            check_task(env_config("Pendulum-v1", {setting: True}))
+        assert f"{setting!r} is a setting of Pendulum-v1's registration" in str(error.value)
+        assert "takes no keyword" not in str(error.value)
+
+
+def test_an_env_kwarg_the_env_fails_on_is_refused_naming_it_not_raised():
+    with pytest.raises(SetupError, match=r"g='x' does not fit Pendulum-v1: its 'g' is a number"):
+        make_env(env_config("Pendulum-v1", {"g": "x"}))
+    with pytest.raises(SetupError, match=r"goal_velocity='x' does not fit MountainCarContinuous"):
+        check_task(env_config("MountainCarContinuous-v0", {"goal_velocity": "x"}))
+    time_limit = {"task_kwargs": {"time_limit": "x"}}
+    with pytest.raises(SetupError) as error:
+        make_env(env_config("dm_control/cartpole-swingup-v0", time_limit))
+    assert str(error.value).startswith('--env-kwargs {"task_kwargs": {"time_limit": "x"}}: dm_')
+    assert "environment creator" not in str(error.value)
+    # values the env stores unchecked fail at its first step: check_task takes one
+    for env, kwargs, shown in (
+        ("Pendulum-v1", {"g": None}, "g=None"),
+        ("simoun-test/ScaledReach-v0", {"scale": "x"}, "scale='x'"),
+        ("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 7}}, "camera_id"),
+    ):
+        with pytest.raises(SetupError) as error:
+            check_task(env_config(env, kwargs))
+        message = str(error.value)
+        assert shown in message and "failed at its first reset and step" in message, message
+        assert "drop --env-kwargs" in message
+    assert check_task(env_config("simoun-test/ScaledReach-v0", {"scale": 0.5})) == 20
+
+
+def test_more_cameras_than_a_dm_control_task_has_are_refused_naming_cameras():
+    config = env_config("dm_control/cartpole-swingup-v0", {}, cameras=3)
+    for make in (make_env, check_task):
+        with pytest.raises(SetupError) as error:
+            make(config)
+        assert str(error.value) == (
+            "--cameras 3: dm_control/cartpole-swingup-v0 has only 2 cameras; pass --cameras 2 "
+            "or fewer"
+        )
+    assert check_task(env_config("dm_control/cartpole-swingup-v0", {}, cameras=2)) is None

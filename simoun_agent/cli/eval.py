@@ -131,9 +131,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
     from simoun_agent.run.load import load_run
     from simoun_agent.run.make_env import video_fps
+    from simoun_agent.run.memory import threads_warning
     from simoun_agent.run.seeds import first_eval_seed
     from simoun_agent.run.video import write_video
 
+    warning = threads_warning(args.torch_threads)
+    if warning:
+        print(f"{PROG}: warning: {warning}", file=sys.stderr)
     try:
         # The machine may differ from the training one: --device applies before the checks.
         run = load_run(Path(args.checkpoint[0]), args.device, args.torch_threads)

@@ -31,7 +31,7 @@ from simoun_agent.cli.config_flags import (
     overrides_from,
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
-from simoun_agent.config import SetupError, resolve
+from simoun_agent.config import SetupError, TrainConfig, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
 
 if TYPE_CHECKING:
@@ -134,7 +134,7 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
     exits with status 2."""
     from simoun_agent.generalization import check_eval_distractions
     from simoun_agent.run import train as loop
-    from simoun_agent.run.memory import check_memory
+    from simoun_agent.run.memory import check_memory, threads_warning
 
     try:
         overrides = overrides_from(command.flags, argv)
@@ -149,12 +149,25 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
             warning = check_memory(config)  # before anything is built
             if warning:
                 print(f"simoun-train: warning: {warning}", file=sys.stderr)
-            run = loop.create_run(
-                config, overwrite=command.overwrite, check=check_eval_distractions
-            )
+            run = loop.create_run(config, overwrite=command.overwrite, check=check_new_run)
     except SetupError as err:
         fail(PROG, err)
+    warning = threads_warning(run.config.torch_threads)
+    if warning:
+        print(f"{PROG}: warning: {warning}", file=sys.stderr)
     return run
+
+
+def check_new_run(config: TrainConfig) -> None:
+    """The checks of a new run's config before its envs are built: its evaluation distractions,
+    and, when it gives ``--env-kwargs``, one env made, reset and stepped with them (an env may
+    store a value it cannot use and fail only at its first step)."""
+    from simoun_agent.generalization import check_eval_distractions
+    from simoun_agent.run.make_env import check_task
+
+    check_eval_distractions(config)
+    if config.env_kwargs:
+        check_task(config)
 
 
 if __name__ == "__main__":

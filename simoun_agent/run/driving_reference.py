@@ -39,6 +39,7 @@ from simoun_agent.config.envs import is_highway
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.driving_metrics import columns
 from simoun_agent.run.evaluate import RandomPolicy, evaluate, metrics_json
+from simoun_agent.run.kept import Damaged, broken_link, not_a_file, present, read_json_object
 from simoun_agent.run.make_env import make_env, video_fps
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.video import write_video
@@ -244,7 +245,36 @@ def check_command(args: DrivingReferenceCommand) -> TrainConfig:
         check_output("--video", args.video, "a video", VIDEO_SUFFIXES, "lane-keeping.gif")
     if args.json is not None:
         check_output("--json", args.json, "the metrics file", (".json",), "references.json")
+        check_replaceable(args.json)
     return config
+
+
+def written_here(path: Path) -> bool:
+    """Whether ``path`` holds a references file this command wrote (its ``command`` and
+    ``drivers``), which a new measurement may replace."""
+    try:
+        record = read_json_object(path)
+    except (Damaged, OSError):
+        return False
+    command = record.get("command")
+    return (
+        isinstance(command, str)
+        and command.startswith(PROG)
+        and isinstance(record.get("drivers"), dict)
+    )
+
+
+def check_replaceable(path: Path) -> None:
+    """SetupError when ``--json`` names something that is there and is not a references file
+    this command wrote: a run's config.json, a study's files or a directory are never written
+    over."""
+    if not present(path) or written_here(path):
+        return
+    what = not_a_file(path) or broken_link(path) or "it is a file this command did not write"
+    raise SetupError(
+        f"--json {path}: {what}, so writing the metrics there would destroy it; pass a new "
+        "path, e.g. --json references.json in the study directory, or move it aside"
+    )
 
 
 def references_json(args: DrivingReferenceCommand, command: str, metrics: dict) -> str:

@@ -150,16 +150,40 @@ def env_keywords(env_id: str) -> tuple[list[str], bool]:
     return sorted({*spec.kwargs, *named}), open_ended
 
 
+GYM_MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")
+"""``--env-kwargs`` keys that ``gymnasium.make`` takes itself rather than passing them on to the
+env's creator"""
+
+ENV_VALUE_ERRORS = (ValueError, TypeError, AssertionError, KeyError, IndexError, ArithmeticError)
+"""what an env's own code raises over a value it cannot use (made, reset or stepped)"""
+
+
+REGISTRATION_SETTINGS = ("order_enforce", "autoreset", "apply_api_compatibility")
+"""settings of an env's registration (``gymnasium.register``) that ``gymnasium.make`` 1.x does not
+take as keywords"""
+
+
 def check_env_kwargs(env_id: str, kwargs: dict) -> None:
-    """Refuse ``--env-kwargs`` keys that the env's creator does not take, before it is made,
-    naming the accepted ones; ``render_mode`` is refused too (simoun sets rgb_array)."""
+    """Refuse ``--env-kwargs`` keys that neither ``gymnasium.make`` nor the env's creator take,
+    before it is made, naming the accepted ones; ``render_mode`` is refused too (simoun sets
+    rgb_array), and so are values of the wrong kind for a keyword with a number or string
+    default."""
     if "render_mode" in kwargs:
         raise SetupError(
             f"--env-kwargs sets render_mode={kwargs['render_mode']!r}; simoun makes {env_id} "
             "with render_mode='rgb_array' itself (it learns from the rendered frames): drop it"
         )
+    _check_make_keywords(env_id, kwargs)
     accepted, open_ended = env_keywords(env_id)
-    unknown = [key for key in kwargs if key not in accepted]
+    own = {key: value for key, value in kwargs.items() if key not in GYM_MAKE_KEYWORDS}
+    settings = [key for key in own if key in REGISTRATION_SETTINGS and key not in accepted]
+    if settings:
+        raise SetupError(
+            f"--env-kwargs: {', '.join(map(repr, settings))} is a setting of {env_id}'s "
+            f"registration (gymnasium.register), not a keyword that gymnasium.make "
+            f"{gym.__version__} or the env takes; drop it (simoun resets each episode itself)"
+        )
+    unknown = [key for key in own if key not in accepted]
     if unknown and not open_ended:
         close = {key: difflib.get_close_matches(key, accepted, n=1) for key in unknown}
         named = ", ".join(
@@ -168,6 +192,63 @@ def check_env_kwargs(env_id: str, kwargs: dict) -> None:
         )
         listed = ", ".join(key for key in accepted if key != "render_mode") or "none"
         raise SetupError(f"--env-kwargs: {env_id} takes no keyword {named}; it accepts: {listed}")
+    _check_value_kinds(env_id, own)
+
+
+def _check_make_keywords(env_id: str, kwargs: dict) -> None:
+    """SetupError for a value of a gymnasium.make keyword that make would misread."""
+    if "max_episode_steps" in kwargs:
+        steps = kwargs["max_episode_steps"]
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+            raise SetupError(
+                f"--env-kwargs: max_episode_steps={steps!r} (gymnasium.make's episode step limit "
+                f"for {env_id}) must be a whole number of at least 1, e.g. "
+                "'{\"max_episode_steps\": 200}'; drop it for the registered limit"
+            )
+    if "disable_env_checker" in kwargs and not isinstance(kwargs["disable_env_checker"], bool):
+        raise SetupError(
+            f"--env-kwargs: disable_env_checker={kwargs['disable_env_checker']!r} (a keyword of "
+            "gymnasium.make) must be true or false"
+        )
+
+
+def _creator_defaults(env_id: str) -> dict:
+    """The default value of each keyword of ``env_id``'s creator (its registered kwargs over its
+    signature's defaults); only the registered ones when the creator cannot be read."""
+    spec = gym.spec(env_id)
+    try:
+        creator = (
+            spec.entry_point if callable(spec.entry_point) else load_env_creator(spec.entry_point)
+        )
+        parameters = inspect.signature(creator).parameters.values()
+    except (gym.error.Error, ImportError, AttributeError, TypeError, ValueError):
+        return dict(spec.kwargs)
+    defaults = {p.name: p.default for p in parameters if p.default is not p.empty}
+    return {**defaults, **spec.kwargs}
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_value_kinds(env_id: str, kwargs: dict) -> None:
+    """SetupError for a string given where the creator's default is a number, or a number where
+    it is a string: the env would take it and fail later, mid-run, on arithmetic."""
+    defaults = _creator_defaults(env_id)
+    for key, value in kwargs.items():
+        default = defaults.get(key)
+        if value is None:  # many creators take None for "their own default"
+            continue
+        if _is_number(default) and not _is_number(value):
+            kind = "a number"
+        elif isinstance(default, str) and not isinstance(value, str):
+            kind = "a string"
+        else:
+            continue
+        raise SetupError(
+            f"--env-kwargs: {key}={value!r} does not fit {env_id}: its {key!r} is {kind} "
+            f"(default {default!r}); e.g. '{json.dumps({key: default})}', or drop it"
+        )
 
 
 def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
@@ -224,16 +305,50 @@ def _make_rendering_env(config: TrainConfig) -> gym.Env:
     except TypeError as err:
         if "keyword argument" in str(err):
             raise _refused_kwargs(config.env, config.env_kwargs, err) from None
-        raise SetupError(f"gymnasium.make({config.env!r}, ...) failed: {err}") from None
+        raise _refused_by_env(config, err) from None
     except gym.error.DependencyNotInstalled as err:
         raise SetupError(f"{config.env} cannot be made: {err}") from None
-    except ValueError as err:
-        # an env that checks its own arguments refuses a bad value this way
-        if not config.env_kwargs:
-            raise SetupError(f"gymnasium.make({config.env!r}) failed: {err}") from None
+    except ENV_VALUE_ERRORS as err:
+        # an env that checks its own arguments refuses a bad value this way; without env
+        # kwargs, only a ValueError is the env's word on its arguments
+        if not (config.env_kwargs or isinstance(err, ValueError)):
+            raise
+        raise _refused_by_env(config, err) from None
+
+
+def _kwargs_text(kwargs: dict) -> str:
+    """``--env-kwargs`` as the keywords the env is called with: ``g='x', max_speed=8``."""
+    return ", ".join(f"{key}={value!r}" for key, value in kwargs.items())
+
+
+def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
+    """The SetupError for an error an env raised while it was made, naming ``--env-kwargs``
+    when the run gives any."""
+    # gymnasium re-raises a creator's TypeError with every keyword appended, simoun's own too
+    message = str(err).split(" was raised from the environment creator")[0]
+    if not config.env_kwargs:
+        return SetupError(f"gymnasium.make({config.env!r}) failed: {message}")
+    return SetupError(
+        f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({message}). "
+        "Fix or drop --env-kwargs"
+    )
+
+
+def check_first_step(env: gym.Env, config: TrainConfig) -> None:
+    """Reset ``env`` (made with ``config``'s ``--env-kwargs``), take one middle action and render:
+    an env that stores a keyword's value unchecked fails here, before a run is spent, rather
+    than at its first training step."""
+    try:
+        env.reset(seed=0)
+        space = env.action_space
+        middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
+        env.step(middle)
+        env.render()
+    except ENV_VALUE_ERRORS as err:
         raise SetupError(
-            f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({err}). "
-            "Fix or drop --env-kwargs"
+            f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} was made with "
+            f"{_kwargs_text(config.env_kwargs)} but failed at its first reset and step "
+            f"({type(err).__name__}: {err}). Fix the values or drop --env-kwargs"
         ) from None
 
 
@@ -267,14 +382,21 @@ def _check_env(env: gym.Env, env_id: str) -> None:
 
 def check_task(config: TrainConfig) -> int | None:
     """Make ``config``'s env and close it: SetupError when the agent cannot train on it (an
-    unknown id, actions that are not a bounded 1-D Box, no pixels), before a run is spent;
-    returns its episodes' step limit (None: it has none)."""
-    env = _make_base(config)
+    unknown id, actions that are not a bounded 1-D Box, no pixels, cameras it lacks, env kwargs
+    it fails on at its first step), before a run is spent; returns its episodes' step limit
+    (None: it has none)."""
+    base = env = _make_base(config)
     try:
         _check_env(env, config.env)
         limit = env.spec.max_episode_steps if env.spec is not None else None
+        if config.env_kwargs:
+            check_first_step(env, config)
+        if config.cameras > 1 and not is_highway(config.env):
+            # highway-env's viewports are drawn by viewers that outlive the wrapper: made only
+            # for the run
+            env = _multi_camera(env, config)
         # envs that truncate their own episodes (MiniGrid, PointReach) say so in max_steps
-        own = getattr(env.unwrapped, "max_steps", None)
+        own = getattr(base.unwrapped, "max_steps", None)
         return limit or (own if isinstance(own, int) and own > 0 else None)
     finally:
         env.close()
@@ -298,7 +420,7 @@ def make_env(
     env = ActionRepeat(env, config.resolved_action_repeat())
     size: int | None = config.image_size
     if config.cameras > 1 or is_highway(config.env):
-        env = MultiCamera(env, _cameras(config), size=config.image_size)
+        env = _multi_camera(env, config)
         size = None
     return SimounObservation(
         env,
@@ -307,6 +429,26 @@ def make_env(
         num_frames=config.agent.num_frames,
         motion=False,
     )
+
+
+def _multi_camera(env: gym.Env, config: TrainConfig) -> MultiCamera:
+    """``MultiCamera`` over ``env`` with ``config``'s views; a SetupError naming ``--cameras``
+    when the env lacks the cameras asked for."""
+    views = _cameras(config)
+    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
+    have = getattr(getattr(physics, "model", None), "ncam", None)
+    if isinstance(have, int) and config.cameras > have:
+        raise SetupError(
+            f"--cameras {config.cameras}: {config.env} has only {have} camera"
+            f"{'s' if have != 1 else ''}; pass --cameras {have} or fewer"
+        )
+    try:
+        return MultiCamera(env, views, size=config.image_size)
+    except ValueError as err:
+        raise SetupError(
+            f"--cameras {config.cameras}: {config.env} cannot show {config.cameras} views "
+            f"({err}); pass a smaller --cameras"
+        ) from None
 
 
 def _cameras(config: TrainConfig) -> list:

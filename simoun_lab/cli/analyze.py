@@ -23,6 +23,7 @@ from tyro.constructors import PrimitiveConstructorSpec
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.run.layout import CHECKPOINT_NAME
 
 # The analyses' modules (torch, the agent, the envs) are imported by the functions that run
 # them, once the flags are read: --help, --version and a bad flag are answered in about a second.
@@ -148,6 +149,9 @@ def masks_command(args: Masks) -> list[Path]:
     query = parse_pair(args.query) if args.query is not None else None
     run = load_run(Path(args.run), args.device)
     mask_pictures.require_masks(run.agent.encoder, run.config.agent.encoder)
+    size = tuple(run.env.observation_space["frames"].shape[-2:])
+    if query is not None:  # before the episodes are played
+        mask_pictures.query_index(query, size, (1, 1))
     episodes = [
         play_episode(run.agent, run.env, run.first_seed + e).observations
         for e in range(args.episodes)
@@ -159,9 +163,6 @@ def masks_command(args: Masks) -> list[Path]:
             f"{', '.join(map(str, lengths))} agent decisions (steps 0..length); pick steps up to "
             f"{min(lengths)}"
         )
-    size = tuple(episodes[0].shape[-2:])
-    if query is not None:
-        mask_pictures.query_index(query, size, (1, 1))
     out = Path(args.out) if args.out else run.run_dir / "analysis" / f"masks-{run.env_step}"
     prepare_output(out, ["ep*-step*.png", "ep*-step*.npz", "masks-ep0.*"], args.overwrite)
     written = []
@@ -278,6 +279,52 @@ def bias_command(args: Bias) -> list[Path]:
     return write_report(out, results, args.seed)
 
 
+MAX_SEED = 2**63
+"""--seed seeds numpy's and torch's generators: torch takes at most a 64-bit integer"""
+
+
+def check_numbers(args: Masks | Bias) -> None:
+    """SetupError naming the first numeric flag out of range, before any run is loaded."""
+    if isinstance(args, Masks):
+        if args.episodes < 1:
+            raise SetupError(f"--episodes {args.episodes}: must be at least 1; e.g. --episodes 1")
+        if args.steps is not None:
+            parse_steps(args.steps)
+        if args.query is not None:
+            row, col = parse_pair(args.query)
+            if row < 0 or col < 0:
+                raise SetupError(
+                    f"--query {args.query}: a pixel's row and column count from 0; e.g. --query 0,0"
+                )
+        return
+    if args.pairs < 2:
+        raise SetupError(f"--pairs {args.pairs}: must be at least 2; e.g. --pairs 256")
+    if not 0 <= args.seed < MAX_SEED:
+        raise SetupError(f"--seed {args.seed}: seeds lie in [0, 2**63); e.g. --seed 0")
+
+
+def run_key(path: str) -> Path:
+    """The checkpoint file ``path`` (a run directory or its checkpoint.pt) stands for, with
+    links and ``..`` resolved: two paths to one run give one key."""
+    given = Path(path)
+    return (given / CHECKPOINT_NAME if given.is_dir() else given).resolve()
+
+
+def check_distinct_runs(runs: Sequence[str]) -> None:
+    """SetupError when two of ``runs`` are one run (the same directory, the directory and its
+    checkpoint.pt, or a link to it): its rows would be counted twice."""
+    seen: dict[Path, str] = {}
+    for path in runs:
+        key = run_key(path)
+        if key in seen:
+            both = f"{path} is" if path == seen[key] else f"{seen[key]} and {path} are"
+            raise SetupError(
+                f"{both} the same run ({key.parent}) given twice: its results would be counted "
+                "twice; give each run once"
+            )
+        seen[key] = path
+
+
 PROG = "simoun-analyze"
 
 DESCRIPTION = (
@@ -291,10 +338,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-analyze``."""
     args = parse(Command, argv, PROG, DESCRIPTION)
     name = "masks" if isinstance(args, Masks) else "bias"
-    if isinstance(args, Masks) and args.episodes < 1:
-        fail(PROG, "--episodes must be at least 1")
-    if isinstance(args, Bias) and args.pairs < 2:
-        fail(PROG, "--pairs must be at least 2")
+    try:
+        check_numbers(args)
+        if isinstance(args, Bias):
+            check_distinct_runs(args.runs)
+    except SetupError as err:
+        fail(f"{PROG} {name}", err)
     try:
         written = masks_command(args) if isinstance(args, Masks) else bias_command(args)
     except SetupError as err:

@@ -368,7 +368,8 @@ def check_runnable(trials: list[Trial], envs_flag: str) -> None:
     measured: set[str] = set()
     for trial in trials:
         config = resolve(trial.preset, trial.overrides)
-        env = json.dumps([config.env, config.env_kwargs, config.env_module], sort_keys=True)
+        made_as = [config.env, config.env_kwargs, config.env_module, config.cameras]
+        env = json.dumps(made_as, sort_keys=True)
         if env not in made:
             try:
                 made[env] = check_task(config)
