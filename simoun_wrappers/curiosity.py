@@ -115,6 +115,14 @@ def _raise_to(current: Any, candidate: Any) -> Any:
     return max(float(current), float(candidate))
 
 
+def _positive_number(value: Any) -> bool:
+    """A finite Python or numpy number > 0 (not a bool, not a string)."""
+    number = isinstance(value, (int, float, np.integer, np.floating))
+    if not number or isinstance(value, (bool, np.bool_)):
+        return False
+    return math.isfinite(value) and value > 0
+
+
 @dataclass
 class RunningMax:
     """Running maxima ``r_e_max`` and ``r_i_max`` that normalise Eq. 13.
@@ -137,7 +145,7 @@ class RunningMax:
     def __post_init__(self) -> None:
         for name in ("r_e_max", "r_i_max"):
             value = getattr(self, name)
-            if not _is_tensor(value) and not (math.isfinite(float(value)) and float(value) > 0):
+            if not _is_tensor(value) and not _positive_number(value):
                 raise ValueError(
                     f"RunningMax.{name} must be a finite number > 0 (it divides or scales the "
                     f"intrinsic reward); got {value!r}. Pass e.g. {name}=1.0."
@@ -188,12 +196,7 @@ class RunningMax:
             value = state[name]
             if _is_tensor(value) and value.numel() == 1:
                 value = value.item()
-            number = isinstance(value, (int, float, np.integer, np.floating))
-            if (
-                isinstance(value, (bool, np.bool_))
-                or not number
-                or not (math.isfinite(value) and value > 0)
-            ):
+            if not _positive_number(value):
                 problems.append(f"its {name} is {value!r:.60}, not a finite number > 0")
         return problems
 

@@ -103,6 +103,12 @@ def test_running_max_on_tensors_stays_a_0d_tensor():
     assert isinstance(plain.r_i_max, torch.Tensor) and float(plain.r_i_max) == 4.0
 
 
+@pytest.mark.parametrize("value", ["x", None, 0.0, float("inf"), True])
+def test_a_maximum_that_is_no_finite_number_above_zero_is_named(value):
+    with pytest.raises(ValueError, match=r"RunningMax\.r_i_max must be a finite number > 0"):
+        RunningMax(r_i_max=value)
+
+
 def test_state_dict_round_trip_and_pickle():
     stats = RunningMax(r_e_max=1.0, r_i_max=1.0)
     stats.update(np.array([7.0]), np.array([3.0]))
