@@ -31,6 +31,12 @@ from simoun_agent.models.encoder import ENCODERS, Encoding, make_encoder, weight
 from simoun_agent.models.networks import BilinearSimilarity, RewardModel, TransitionModel
 from simoun_agent.models.sac import Critic
 from simoun_agent.replay import FrameReplay
+from simoun_agent.state_checks import (
+    count_problems,
+    module_problems,
+    optimizer_problems,
+    tensor_problems,
+)
 from simoun_wrappers._checks import check_bool, check_nonnegative_int
 from simoun_wrappers.augment import random_conv, random_shift, shift_pad
 from simoun_wrappers.curiosity import RunningMax, consistency_distance, consistency_reward
@@ -238,6 +244,11 @@ class SimounAgent:
         check_nonnegative_int(
             step, f"{owner}(step=...)", "pass the global env step, e.g. step=0, or None"
         )
+        if step >= 2**63:  # the schedules and the checkpoints hold it as an int64
+            raise ValueError(
+                f"{owner}(step=...) must be below 2**63, got {step}; pass the global env step, "
+                "e.g. step=0, or None"
+            )
         return int(step)
 
     def act(
@@ -668,8 +679,9 @@ class SimounAgent:
 
     def check_state(self, state: dict) -> None:
         """A ValueError (TypeError for no dict) that names what of ``state`` does not fit this
-        agent: a part missing, a part this agent has no network for, or a tensor of another
-        shape, with the config fields that differ; nothing is loaded."""
+        agent: a part missing, a part this agent has no network for, a network or optimizer
+        state of another shape, a counter or running maximum that is no number, with the config
+        fields that differ; nothing is loaded."""
         if not isinstance(state, Mapping):
             raise TypeError(
                 f"state must be the dict SimounAgent.state_dict() returns, got "
@@ -693,22 +705,9 @@ class SimounAgent:
         if extra:
             problems.append(f"it holds {', '.join(extra)}, which this agent has none of")
         for name, net in nets.items():
-            saved = state.get(name)
-            if saved is None:
-                continue
-            if not isinstance(saved, Mapping):
-                problems.append(f"its {name} is a {type(saved).__name__}, not a state dict")
-                continue
-            own = net.state_dict()
-            lacking = [key for key in own if key not in saved]
-            if lacking:
-                problems.append(f"its {name} lacks {', '.join(lacking)}")
-            for key, tensor in own.items():
-                shape = getattr(saved.get(key), "shape", None)
-                if shape is not None and tuple(shape) != tuple(tensor.shape):
-                    problems.append(
-                        f"{name}.{key} is {tuple(shape)} there, {tuple(tensor.shape)} here"
-                    )
+            if name in state:
+                problems += module_problems(name, net, state[name])
+        problems += self._other_state_problems(state)
         if not problems:
             return
         config = state.get("config")
@@ -728,8 +727,46 @@ class SimounAgent:
             + (f" (the state's config differs: {', '.join(differ)})" if differ else "")
             + ". The state must come from SimounAgent.state_dict() of an agent of the same "
             f"config, frame_shape {self.frame_shape} and action_dim {self.action_dim}; build "
-            "this agent with the config the state was saved with"
+            "this agent with the config the state was saved with. Nothing was loaded"
         )
+
+    def _other_state_problems(self, state: Mapping) -> list[str]:
+        """What of ``state`` besides the networks does not fit: the optimizers, the
+        temperature, the running maxima and the counters (each only where present: a missing
+        one is named by :meth:`check_state`)."""
+        optimizers = {
+            "critic_optimizer": self.critic_optimizer,
+            "actor_optimizer": self.actor_optimizer,
+        }
+        if self.log_alpha is not None:
+            optimizers["alpha_optimizer"] = self.alpha_optimizer
+        problems = []
+        for name, optimizer in optimizers.items():
+            if name in state:
+                problems += optimizer_problems(name, optimizer, state[name])
+        if self.contrastive_optimizers and "contrastive_optimizers" in state:
+            saved = state["contrastive_optimizers"]
+            if not isinstance(saved, (list, tuple)) or len(saved) != len(
+                self.contrastive_optimizers
+            ):
+                problems.append(
+                    f"its contrastive_optimizers is {saved!r:.60}, not a list of "
+                    f"{len(self.contrastive_optimizers)} optimizer states"
+                )
+            else:
+                for i, (optimizer, one) in enumerate(
+                    zip(self.contrastive_optimizers, saved, strict=True)
+                ):
+                    problems += optimizer_problems(f"contrastive_optimizers[{i}]", optimizer, one)
+        if self.log_alpha is not None and "log_alpha" in state:
+            problems += tensor_problems("log_alpha", self.log_alpha, state["log_alpha"])
+        if "running_max" in state:
+            saved = RunningMax.state_problems(state["running_max"])
+            problems += [f"its running_max: {problem}" for problem in saved]
+        for name in ("num_updates", "env_step"):
+            if name in state:
+                problems += count_problems(name, state[name])
+        return problems
 
     def load_state_dict(self, state: dict) -> None:
         """Restore what :meth:`state_dict` saved (into an agent built with the same config,

@@ -12,6 +12,7 @@ Both follow :class:`simoun_wrappers.curiosity.FeatureSource`.
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,14 +21,32 @@ import torch
 from gymnasium import spaces
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config.rules import Rule, is_int, real, setting
 from simoun_agent.config.shapes import min_image_size
 from simoun_agent.losses import contrastive_loss, transition_loss
 from simoun_agent.models.encoder import PixelEncoder, make_encoder
 from simoun_agent.models.networks import BilinearSimilarity, TransitionModel
-from simoun_agent.online_model import OnlineModel, check_online_config
+from simoun_agent.online_model import (
+    ENCODER_SIZE,
+    SEED,
+    SWITCH,
+    OnlineModel,
+    check_online_config,
+    count,
+)
 from simoun_wrappers.augment import random_conv
 
 __all__ = ["AgentFeatures", "CuriosityConfig", "CuriosityModel", "encode_actions"]
+
+BATCH = Rule(
+    "an int >= 2 (the contrastive loss takes its negatives from the batch)",
+    lambda v: is_int(v) and v >= 2,
+)
+ODD_KERNEL = Rule(
+    "an odd int >= 1 (the random convolution keeps the frame's size)",
+    lambda v: is_int(v) and v >= 1 and v % 2 == 1,
+    "e.g. CuriosityConfig(random_conv_kernel=3) (the default, as Lee et al. 2020)",
+)
 
 
 @dataclass
@@ -39,61 +58,56 @@ class CuriosityConfig:
     ``CuriosityConfig(num_filters=32, encoder_size=None)`` is the agent's own encoder size.
     """
 
-    feature_dim: int = 50
+    feature_dim: int = setting(50, count(1))
     """size of f_m and of each f_a"""
-    num_filters: int = 16
+    num_filters: int = setting(16, count(1))
     """filters of every conv layer of both paths (the agent uses 32: about 2.6x the update time
     at 42x42, measured with ``benchmarks/curiosity.py``)"""
-    encoder_size: int | None = 42
+    encoder_size: int | None = setting(42, ENCODER_SIZE)
     """frames are average-pooled by the integer factor ``min(H, W) // encoder_size`` before the
     encoder and the buffer (84x84 -> 42x42, 4x fewer pixels); no pooling when that factor is
     below 2. None encodes frames at their full size, as the agent does"""
-    interactive: bool = True
+    interactive: bool = setting(True, SWITCH)
     """use the structural interactive module (Eq. 4-6) between the paths"""
-    aux_hidden_dim: int = 256
+    aux_hidden_dim: int = setting(256, count(1))
     """hidden units of the transition model G (Eq. 2)"""
-    capacity: int = 1000
+    capacity: int = setting(1000, count(1))
     """transitions kept in the internal buffer (4 uint8 frames each: 21 MB at 42x42 RGB)"""
-    batch_size: int = 32
+    batch_size: int = setting(32, BATCH)
     """transitions per gradient step"""
-    update_every: int = 8
+    update_every: int = setting(8, count(1))
     """one gradient step every this many ``watch`` calls (env steps, or vector steps)"""
-    learning_starts: int = 256
+    learning_starts: int = setting(256, count(0))
     """transitions stored before the first gradient step"""
-    background: bool = True
+    background: bool = setting(True, SWITCH)
     """take the gradient steps in a background thread while the env steps on (torch releases
     the GIL in its kernels). The rewards are the same either way by design, but only False
     (each step inside the ``watch`` call that is due, on the caller's thread: slower, no thread)
     is bit-reproducible beside other torch work in the process"""
-    lr: float = 1e-3
+    lr: float = setting(1e-3, real(0.0, open_low=True))
     """Adam learning rate"""
-    encoder_tau: float = 0.05
+    encoder_tau: float = setting(0.05, real(0.0, 1.0, open_low=True))
     """EMA rate of the momentum encoder that encodes the L_con keys"""
-    transition_weight: float = 0.1
+    transition_weight: float = setting(0.1, real(0.0))
     """weight of L_tran (Eq. 2). Its squared error sums over the feature dimensions and is
     minimised exactly by a constant f_m; at weight 1 it outweighed the term below and the motion
     path collapsed (measured on dm_control cartpole-swingup, 48x48, random actions)"""
-    contrastive_weight: float = 1.0
+    contrastive_weight: float = setting(1.0, real(0.0))
     """weight of L_con (Eq. 3)"""
-    motion_contrastive_weight: float = 3.0
+    motion_contrastive_weight: float = setting(3.0, real(0.0))
     """weight of L_tran's InfoNCE form (G's prediction must pick its own f_m_{t+1} out of the
     batch). Not in the paper, whose motion path also gets the critic's gradient: with L_tran
     alone the motion path collapsed to a constant on PointReach, Pendulum and dm_control
     cartpole (measured). 0 (with transition_weight=1) gives exactly L_tran + L_con"""
-    random_conv_kernel: int = 3
+    random_conv_kernel: int = setting(3, ODD_KERNEL)
     """kernel of the random convolution making the contrastive positives"""
-    channels_last: bool = True
+    channels_last: bool = setting(True, SWITCH)
     """channels-last convolutions (the agent's default)"""
-    seed: int | None = None
+    seed: int | None = setting(None, SEED)
     """seeds the weights, the buffer sampling and the augmentation (None: nondeterministic)"""
 
     def __post_init__(self) -> None:
-        check_online_config(self, positive=("feature_dim", "num_filters"))
-        if self.batch_size < 2:
-            raise ValueError(
-                f"CuriosityConfig.batch_size must be >= 2: the contrastive loss needs negatives "
-                f"from the batch; got {self.batch_size}."
-            )
+        check_online_config(self)
 
 
 def action_dim(space: spaces.Space) -> int:
@@ -205,6 +219,10 @@ class CuriosityModel(OnlineModel):
 
     def _encoder_name(self) -> str:
         return "dual_interactive" if self.config.interactive else "dual"
+
+    def _slot_bytes(self) -> int:
+        """Four uint8 frames and the encoded action (float32)."""
+        return 4 * math.prod(self.encoded_shape) + 4 * action_dim(self.action_space)
 
     def _build(self) -> PixelEncoder:
         """The encoder, its momentum copy, G, the bilinear similarity, one Adam for all, and the

@@ -9,13 +9,13 @@ samples a batch and what one gradient step does.
 from __future__ import annotations
 
 import copy
-import math
+import dataclasses
 import queue
 import threading
 import time
 import weakref
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from concurrent.futures import Future
 from typing import Any, ClassVar, TypeVar
 
@@ -26,8 +26,11 @@ import torch.nn.functional as F
 from gymnasium import spaces
 from torch import nn
 
+from simoun_agent.config.rules import Rule, is_int, rules_of
 from simoun_agent.config.shapes import check_channel_first
 from simoun_agent.device import default_device
+from simoun_agent.replay import host_memory
+from simoun_agent.state_checks import count_problems, module_problems, optimizer_problems
 from simoun_wrappers.intrinsic_reward import triplet_shape
 
 Model = TypeVar("Model", bound="OnlineModel")
@@ -35,6 +38,7 @@ Model = TypeVar("Model", bound="OnlineModel")
 __all__ = [
     "OnlineModel",
     "UpdateThread",
+    "check_config_fields",
     "check_online_config",
     "default_device",
     "frozen_copy",
@@ -96,27 +100,56 @@ def run_now(work: Callable[[], Any]) -> Future:
     return future
 
 
-def check_online_config(config: Any, positive: tuple[str, ...] = ()) -> None:
-    """The checks every online model's config shares, each error naming the field and a fix:
-    ``positive`` (e.g. ``feature_dim``), ``capacity``, ``batch_size`` and ``update_every`` >= 1,
-    ``encoder_size`` None or >= 1, ``batch_size <= learning_starts <= capacity`` and ``lr`` a
-    number > 0."""
+SEED = Rule(
+    "None or an int in [0, 2**32)",
+    lambda v: v is None or (is_int(v) and 0 <= v < 2**32),
+    "e.g. seed=0, or seed=None (the default) for a nondeterministic model",
+)
+"""A config's ``seed``: it seeds numpy's and torch's generators."""
+
+ENCODER_SIZE = Rule(
+    "None or an int >= 1",
+    lambda v: v is None or (is_int(v) and v >= 1),
+    "e.g. encoder_size=42 (the default: 84x84 frames are pooled to 42x42), or None to encode "
+    "frames at full size",
+)
+"""A config's ``encoder_size``: the side frames are pooled to, or None."""
+
+
+SWITCH = Rule("True or False", lambda v: isinstance(v, (bool, np.bool_)))
+"""A config's on/off switch: a truthy stand-in such as ``"no"`` would switch it on."""
+
+
+def count(low: int) -> Rule:
+    """An int ``>= low`` (a size or a count of steps)."""
+    return Rule(f"an int >= {low}", lambda v: is_int(v) and v >= low)
+
+
+def check_config_fields(config: Any) -> None:
+    """Raise ValueError for the first field of ``config`` (a dataclass whose every field is a
+    :func:`~simoun_agent.config.rules.setting`) that breaks its rule, naming the field, the
+    value and a fix in Python's spelling: ``RNDConfig.seed=-1 must be ...; e.g. ...``."""
     name = type(config).__name__
-    for field in (*positive, "capacity", "batch_size", "update_every"):
-        if getattr(config, field) < 1:
-            raise ValueError(f"{name}.{field} must be >= 1, got {getattr(config, field)}")
-    if config.encoder_size is not None and config.encoder_size < 1:
-        raise ValueError(
-            f"{name}.encoder_size must be None (full-size frames, no pooling) or a side >= 1 in "
-            f"pixels, got {config.encoder_size}; the default 42 pools 84x84 frames to 42x42."
-        )
+    rules = rules_of(config)
+    for field in dataclasses.fields(config):
+        value = getattr(config, field.name)
+        rule = rules[field.name]
+        if not rule.ok(value):
+            fix = rule.fix or f"e.g. {name}({field.name}={field.default!r}) (the default)"
+            raise ValueError(f"{name}.{field.name}={value!r} must be {rule.need}; {fix}")
+
+
+def check_online_config(config: Any) -> None:
+    """The checks of an online model's config: every field against its rule (types, bool-only
+    switches, ranges, the seed), then ``batch_size <= learning_starts <= capacity``; each error
+    names the field, the value and a fix."""
+    check_config_fields(config)
+    name = type(config).__name__
     if not config.batch_size <= config.learning_starts <= config.capacity:
         raise ValueError(
             f"{name} needs batch_size <= learning_starts <= capacity, got "
             f"{config.batch_size}, {config.learning_starts}, {config.capacity}."
         )
-    if not (math.isfinite(config.lr) and config.lr > 0):
-        raise ValueError(f"{name}.lr must be a number > 0, got {config.lr}; e.g. lr=1e-4.")
 
 
 def frozen_copy(module: nn.Module) -> nn.Module:
@@ -152,6 +185,8 @@ class OnlineModel(ABC):
 
     config_type: ClassVar[type]
     """the config class; ``config_type()`` when a model is built without a config"""
+    _more_state: ClassVar[tuple[str, ...]] = ()
+    """keys a subclass's state holds besides those of every online model"""
     config: Any
     device: torch.device
     size: int
@@ -174,7 +209,7 @@ class OnlineModel(ABC):
             config: hyperparameters; ``config_type()`` when None.
             device: torch device; None picks cuda when available, else cpu.
         """
-        self.config = config = config if config is not None else self.config_type()
+        self.config = config = self._checked_config(config)
         self._init_frames(frame_shape, config.encoder_size)
         smallest, needs, size = self._smallest_frame()
         if min(self.encoded_shape[1:]) < smallest:
@@ -185,6 +220,7 @@ class OnlineModel(ABC):
                 f"(SimounObservation(env, size={size}) or more) or raise encoder_size."
             )
         self.action_space = action_space
+        self._check_memory()
         self.device = default_device(device)
         with torch.random.fork_rng(devices=[]):
             if config.seed is not None:
@@ -193,6 +229,21 @@ class OnlineModel(ABC):
         self.size = 0
         self._head = 0
         self._init_schedule(trained)
+
+    @classmethod
+    def _checked_config(cls, config: Any) -> Any:
+        """``config``, or ``config_type()`` for None; a TypeError naming the argument for
+        anything else (a dict of its fields, say)."""
+        if config is None:
+            return cls.config_type()
+        if not isinstance(config, cls.config_type):
+            kind = cls.config_type.__name__
+            raise TypeError(
+                f"{cls.__name__}'s config must be of type {kind}, got {type(config).__name__} "
+                f"{config!r:.60}; e.g. {cls.__name__}.for_env(env, config={kind}(lr=1e-4)), or "
+                f"{kind}(**values) for a dict of its fields"
+            )
+        return config
 
     @classmethod
     def for_env(
@@ -225,6 +276,27 @@ class OnlineModel(ABC):
     def _smallest_frame(self) -> tuple[int, str, int]:
         """The smallest side the networks take after pooling, what needs it (for the error) and
         a ``SimounObservation`` size to suggest."""
+
+    def _check_memory(self) -> None:
+        """Refuse a buffer larger than this machine's memory, naming the bytes and the fix
+        (numpy's MemoryError names neither the config field nor a capacity that fits)."""
+        per_slot = self._slot_bytes()
+        need = self.config.capacity * per_slot
+        have = host_memory()
+        if have is None or need <= have:
+            return
+        kind = type(self.config).__name__
+        raise ValueError(
+            f"{kind}.capacity={self.config.capacity} makes {type(self).__name__}'s buffer "
+            f"{need:,} bytes ({need / 1e9:,.1f} GB) for frames of {self.encoded_shape}, more "
+            f"than this machine's {have / 1e9:,.1f} GB of memory; lower capacity (about "
+            f"{int(have / 2 / per_slot):,} take half of it), e.g. {kind}(capacity=1000) (the "
+            "default)"
+        )
+
+    @abstractmethod
+    def _slot_bytes(self) -> int:
+        """Bytes the buffer holds per stored transition."""
 
     @abstractmethod
     def _build(self) -> nn.Module:
@@ -502,8 +574,10 @@ class OnlineModel(ABC):
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
         """Restore what :meth:`state_dict` returned (the buffer refills from new transitions);
-        clears a failure."""
+        clears a failure. A state that does not fit this model (:meth:`check_state`) is refused
+        before anything is loaded."""
         self.wait()
+        self.check_state(state)
         self._load_modules_state(state)
         self.published = frozen_copy(self._trained())
         if "published" in state:  # states saved before the published weights were kept
@@ -518,3 +592,77 @@ class OnlineModel(ABC):
         self.updates = int(state["updates"])
         self.rng.bit_generator.state = state["rng"]
         self.generator.set_state(state["generator"])
+
+    def check_state(self, state: Any) -> None:
+        """A TypeError for a ``state`` that is no dict, a ValueError naming every part of it
+        that does not fit this model (a part missing, a network or optimizer state of another
+        shape, a counter or RNG state that is no such thing); nothing is loaded."""
+        name = type(self).__name__
+        fix = (
+            f"the state must come from state_dict() of a {name} built for frames of "
+            f"{self.frame_shape} with the same config, e.g. "
+            "model.load_state_dict(other.state_dict())"
+        )
+        if not isinstance(state, Mapping):
+            raise TypeError(
+                f"{name}.load_state_dict got a {type(state).__name__}, not a dict; {fix}"
+            )
+        problems = self._state_problems(state)
+        if problems:
+            more = len(problems) - 4
+            shown = "; ".join(problems[:4]) + (f"; {more} more" if more > 0 else "")
+            raise ValueError(
+                f"{name}.load_state_dict cannot load this state: {shown}; {fix}. "
+                "Nothing was loaded."
+            )
+
+    def _state_problems(self, state: Mapping) -> list[str]:
+        """What of ``state`` does not fit: the parts of :meth:`_stateful`, the published
+        weights, the step in flight, the counters and the RNG states."""
+        parts = self._stateful()
+        required = [*parts, "watch_calls", "updates", "rng", "generator", *self._more_state]
+        missing = [key for key in required if key not in state]
+        problems = [f"it lacks {', '.join(missing)}"] if missing else []
+        for key, part in parts.items():
+            if key not in state:
+                continue
+            if isinstance(part, torch.optim.Optimizer):
+                problems += optimizer_problems(key, part, state[key])
+            else:
+                problems += module_problems(key, part, state[key])
+        if "published" in state:
+            problems += module_problems("published", self._trained(), state["published"])
+        metrics = state.get("pending_metrics")
+        if metrics is not None and not isinstance(metrics, Mapping):
+            problems.append(f"its pending_metrics is {metrics!r:.60}, not None or a dict")
+        for key in ("watch_calls", "updates"):
+            if key in state:
+                problems += count_problems(key, state[key])
+        if "rng" in state and not self._fits_rng(state["rng"]):
+            kind = type(self.rng.bit_generator).__name__
+            problems.append(f"its rng is no state of numpy's {kind} generator")
+        if "generator" in state and not self._fits_generator(state["generator"]):
+            problems.append(f"its generator is no state of a torch {self.device.type} generator")
+        return problems
+
+    def _fits_rng(self, saved: Any) -> bool:
+        """Whether ``saved`` is a state of this model's numpy bit generator (set on a scratch
+        one)."""
+        scratch = type(self.rng.bit_generator)()
+        try:
+            scratch.state = saved
+        except (TypeError, ValueError, KeyError):
+            return False
+        return True
+
+    def _fits_generator(self, saved: Any) -> bool:
+        """Whether ``saved`` is a state of this model's torch generator (set on a scratch
+        one)."""
+        if not isinstance(saved, torch.Tensor):
+            return False
+        scratch = torch.Generator(self.device)
+        try:
+            scratch.set_state(saved)
+        except (TypeError, ValueError, RuntimeError):
+            return False
+        return True

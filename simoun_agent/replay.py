@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import inspect
 import json
+import math
 import os
 import zipfile
 from collections.abc import Callable
@@ -79,7 +80,11 @@ class FrameReplay:
                 )
         if not is_int(num_frames) or num_frames < 1:
             raise ValueError(f"num_frames must be an int >= 1, got {num_frames!r}; use 3")
-        shape = tuple(frame_shape) if isinstance(frame_shape, (tuple, list)) else ()
+        # a tuple of numpy ints or a 1-D array is what env.observation_space shapes give
+        sequence = isinstance(frame_shape, (tuple, list)) or (
+            isinstance(frame_shape, np.ndarray) and frame_shape.ndim == 1
+        )
+        shape = tuple(frame_shape) if sequence else ()
         if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
             raise ValueError(
                 f"frame_shape must be (C, H, W) positive ints, got {frame_shape!r}; pass "
@@ -94,7 +99,9 @@ class FrameReplay:
         # episodes of 50 steps put one reset frame in every 51 frames: (capacity + 48) // 50
         # slots for them leave capacity transitions with whole windows, beside the num_frames
         # oldest frames whose windows lost their first frames
-        self._allocate(self.capacity + (self.capacity + 48) // 50 + self.num_frames)
+        slots = self.capacity + (self.capacity + 48) // 50 + self.num_frames
+        self._check_memory(slots)
+        self._allocate(slots)
         self.written = 0
         """frames written since creation; absolute index of the next frame"""
         self.transitions = 0
@@ -103,6 +110,25 @@ class FrameReplay:
         self.episode_step: int | None = None
         """step of the open episode, None between an episode's end and the next start_episode"""
         self.rng = np.random.default_rng(seed)
+
+    def _slot_bytes(self) -> int:
+        """Bytes of one ring slot: the frame, the action, the reward, two flags and the step."""
+        return math.prod(self.frame_shape) + 4 * self.action_dim + 4 + 3
+
+    def _check_memory(self, slots: int) -> None:
+        """Refuse a ring larger than this machine's memory, with the bytes it needs and the
+        capacity that fits (numpy's MemoryError names neither the argument nor the fix)."""
+        need = slots * self._slot_bytes()
+        have = host_memory()
+        if have is None or need <= have:
+            return
+        fits = int(have / 2 / self._slot_bytes())
+        raise ValueError(
+            f"FrameReplay(capacity={self.capacity}) needs {need:,} bytes ({need / 1e9:,.1f} GB) "
+            f"for frames of {self.frame_shape}, more than this machine's {have / 1e9:,.1f} GB of "
+            f"memory; lower capacity (about {fits:,} transitions take half of it) or the frame "
+            "size"
+        )
 
     def _allocate(self, slots: int) -> None:
         """Empty arrays for a ring of ``slots`` frames."""
@@ -336,7 +362,7 @@ class FrameReplay:
         if hasattr(path, "write"):
             np.savez(path, **arrays)
         else:
-            with open(path, "wb") as f:
+            with open(_writable(path), "wb") as f:
                 np.savez(f, **arrays)
 
     @_ClassOrInstanceMethod
@@ -394,6 +420,43 @@ class FrameReplay:
         return into
 
 
+def host_memory() -> int | None:
+    """This machine's memory in bytes (None where the system does not say)."""
+    if hasattr(os, "sysconf") and "SC_PHYS_PAGES" in os.sysconf_names:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    return None
+
+
+def _check_path_type(path: object, method: str) -> None:
+    """A TypeError naming the argument of ``FrameReplay.<method>(path)`` (``"save"`` or
+    ``"load"``) for a path that is neither a file path nor a binary file object."""
+    stream = "write" if method == "save" else "read"
+    if not isinstance(path, (str, os.PathLike)) and not hasattr(path, stream):
+        raise TypeError(
+            f"FrameReplay.{method}(path) takes a file path (str or os.PathLike) or a binary file "
+            f"object, got {type(path).__name__} {path!r:.60}; e.g. "
+            f"replay.{method}('replay.npz')"
+        )
+
+
+def _writable(path: str | os.PathLike) -> str | os.PathLike:
+    """``path`` if a file can be written there, else an error naming the path and the fix:
+    a directory, or a folder that does not exist."""
+    _check_path_type(path, "save")
+    if os.path.isdir(path):
+        raise ValueError(
+            f"FrameReplay.save(path): {os.fspath(path)} is a directory; pass a file path in it, "
+            f"e.g. replay.save({os.path.join(os.fspath(path), 'replay.npz')!r})"
+        )
+    folder = os.path.dirname(os.fspath(path)) or "."
+    if not os.path.isdir(folder):
+        raise FileNotFoundError(
+            f"FrameReplay.save(path): the folder {folder} of {os.fspath(path)} does not exist; "
+            "create it first (os.makedirs) or pass a path in an existing folder"
+        )
+    return path
+
+
 def _name(path: str | os.PathLike | IO[bytes]) -> str:
     return str(getattr(path, "name", path))
 
@@ -414,6 +477,7 @@ def _damaged(path: str | os.PathLike | IO[bytes], problem: str) -> ValueError:
 def _open_replay(path: str | os.PathLike | IO[bytes]) -> np.lib.npyio.NpzFile:
     """``path`` opened as an ``.npz`` without pickled data, or an error that names the file as
     missing, damaged, or not a replay (numpy's own advice, ``allow_pickle``, would load code)."""
+    _check_path_type(path, "load")
     if not hasattr(path, "read") and not os.path.isfile(path):
         raise FileNotFoundError(
             f"replay file {_name(path)} does not exist (or is not a file); pass the path "

@@ -12,6 +12,7 @@ of the watched frames and clipped to [-5, 5], as in the paper.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,9 +21,20 @@ import torch
 from gymnasium.wrappers.utils import RunningMeanStd
 from torch import nn
 
-from simoun_agent.online_model import OnlineModel, check_online_config
+from simoun_agent.config.rules import is_real, real, setting
+from simoun_agent.online_model import (
+    ENCODER_SIZE,
+    SEED,
+    SWITCH,
+    OnlineModel,
+    check_online_config,
+    count,
+)
 
 __all__ = ["RNDConfig", "RNDModel", "rnd_network"]
+
+STATISTICS = ("observation_mean", "observation_var", "observation_count")
+"""The keys of the running frame statistics in a state."""
 
 SMALLEST_SIDE = 36
 """the three convolutions (8/4, 4/2, 3/1) need frames of at least 36x36"""
@@ -32,30 +44,30 @@ SMALLEST_SIDE = 36
 class RNDConfig:
     """Hyperparameters of :class:`RNDModel` (network and learning rate as in Burda et al.)."""
 
-    feature_dim: int = 512
+    feature_dim: int = setting(512, count(1))
     """output size of the target and the predictor (the paper: 512)"""
-    encoder_size: int | None = 42
+    encoder_size: int | None = setting(42, ENCODER_SIZE)
     """frames are average-pooled by the integer factor ``min(H, W) // encoder_size`` first
     (84x84 -> 42x42; MiniGrid's 56x56 views are kept as they are); None never pools"""
-    capacity: int = 1000
+    capacity: int = setting(1000, count(1))
     """frames kept in the buffer the predictor is trained on"""
-    batch_size: int = 64
+    batch_size: int = setting(64, count(1))
     """frames per gradient step"""
-    update_every: int = 8
+    update_every: int = setting(8, count(1))
     """one gradient step every this many ``watch`` calls (env steps, or vector steps: with 8
     sub-envs each watched frame is trained on about once)"""
-    learning_starts: int = 256
+    learning_starts: int = setting(256, count(0))
     """frames stored before the first gradient step"""
-    background: bool = True
+    background: bool = setting(True, SWITCH)
     """take the gradient steps in a background thread (same schedule and rewards as
     ``CuriosityConfig.background``; False for bit-reproducible runs, as there)"""
-    lr: float = 1e-4
+    lr: float = setting(1e-4, real(0.0, open_low=True))
     """Adam learning rate of the predictor (the paper: 1e-4)"""
-    seed: int | None = None
+    seed: int | None = setting(None, SEED)
     """seeds both networks and the buffer sampling (None: nondeterministic)"""
 
     def __post_init__(self) -> None:
-        check_online_config(self, positive=("feature_dim",))
+        check_online_config(self)
 
 
 def rnd_network(
@@ -118,9 +130,13 @@ class RNDModel(OnlineModel):
     """
 
     config_type = RNDConfig
+    _more_state = STATISTICS
 
     def _smallest_frame(self) -> tuple[int, str, int]:
         return SMALLEST_SIDE, "RND's convolutions", 42
+
+    def _slot_bytes(self) -> int:
+        return math.prod(self.encoded_shape)
 
     def _build(self) -> nn.Module:
         """The fixed target, the predictor and its Adam, the buffer and the running statistics
@@ -181,6 +197,34 @@ class RNDModel(OnlineModel):
             "observation_var": self.observations.var.copy(),
             "observation_count": self.observations.count,
         }
+
+    def _state_problems(self, state: Mapping) -> list[str]:
+        """Those of every online model, and the running statistics of the frames: arrays of the
+        pooled frame's shape, a variance >= 0 and a count >= 0."""
+        problems = super()._state_problems(state)
+        for key in ("observation_mean", "observation_var"):
+            if key in state:
+                problems += self._statistics_problems(key, state[key])
+        count = state.get("observation_count", 0)
+        if not (is_real(count) and math.isfinite(count) and count >= 0):
+            problems.append(f"its observation_count is {count!r:.60}, not a number >= 0")
+        return problems
+
+    def _statistics_problems(self, key: str, saved: Any) -> list[str]:
+        """A running mean or variance: finite numbers of the pooled frame's shape (the
+        variance >= 0)."""
+        try:
+            values = np.asarray(saved, dtype=np.float64)
+        except (TypeError, ValueError):
+            return [f"its {key} is a {type(saved).__name__}, not an array of numbers"]
+        if values.shape != self.encoded_shape:
+            return [f"{key} is {values.shape} there, {self.encoded_shape} here"]
+        if not np.all(np.isfinite(values)) or (key == "observation_var" and np.any(values < 0)):
+            return [
+                f"its {key} holds values that are not finite"
+                + (" or below 0" if key == "observation_var" else "")
+            ]
+        return []
 
     def _load_modules_state(self, state: dict[str, Any]) -> None:
         super()._load_modules_state(state)

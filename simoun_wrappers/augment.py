@@ -77,6 +77,7 @@ def random_conv(
             f"random_conv expects a (B, C, H, W) or (B, T, C, H, W) batch, got shape "
             f"{tuple(batch.shape)}; add a leading batch axis with batch[None] for one sample."
         )
+    check_no_empty_axis(batch.shape)
     if not is_int(kernel_size) or kernel_size < 1 or kernel_size % 2 == 0:
         raise ValueError(
             f"kernel_size must be a positive odd int so the output keeps its size, got "
@@ -137,6 +138,22 @@ def described(value: Any) -> str:
     if isinstance(value, np.ndarray):
         return f"numpy.ndarray of {value.dtype}"
     return type(value).__name__
+
+
+def check_no_empty_axis(shape: tuple[int, ...]) -> None:
+    """Refuse a batch with no channels, frames, rows or columns (a batch of no samples is
+    fine): a convolution of nothing is a slicing mistake upstream, not an image."""
+    axes = ("B", "C", "H", "W") if len(shape) == 4 else ("B", "T", "C", "H", "W")
+    meaning = {"T": "frames", "C": "channels", "H": "rows", "W": "columns"}
+    empty = [axis for axis, size in zip(axes[1:], shape[1:], strict=True) if size == 0]
+    if empty:
+        named = ", ".join(f"{axis} ({meaning[axis]})" for axis in empty)
+        raise ValueError(
+            f"random_conv got a batch of shape {tuple(shape)} whose {named} "
+            f"{'axis is' if len(empty) == 1 else 'axes are'} empty; "
+            f"pass images with at least one channel and pixel, e.g. shape "
+            f"({', '.join(axes)}) = {(2, 3, 84, 84) if len(shape) == 4 else (2, 3, 3, 84, 84)}"
+        )
 
 
 def check_kernel_fits(kernel_size: int, height: int, width: int) -> None:

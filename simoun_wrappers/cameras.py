@@ -14,7 +14,7 @@ from gymnasium import spaces
 from simoun_wrappers.augment import RandomConvolution
 from simoun_wrappers.distractors._dm_control import check_open, dm_control_physics
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
-from simoun_wrappers.observation import check_image, parse_size
+from simoun_wrappers.observation import check_image, parse_size, plain_size
 
 Camera = int | str | Mapping[str, Any] | Callable[[gym.Env], np.ndarray]
 """A dm_control camera id or name, a highway-env viewport dict, or a callable env -> image."""
@@ -139,6 +139,7 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         # read once, here: a generator cannot be recorded (deep-copied) or pickled with the
         # wrapper, and would be empty when read again
         cameras = tuple(cameras)
+        size = plain_size(size)
         self._hw = parse_size(size)
         self._dm_control = any(isinstance(c, (int, np.integer, str)) for c in cameras)
         """whether a view renders the physics of a dm_control task, which close() frees"""

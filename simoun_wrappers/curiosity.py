@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
@@ -114,6 +115,14 @@ def _raise_to(current: Any, candidate: Any) -> Any:
     return max(float(current), float(candidate))
 
 
+def _positive_number(value: Any) -> bool:
+    """A finite Python or numpy number > 0 (not a bool, not a string)."""
+    number = isinstance(value, (int, float, np.integer, np.floating))
+    if not number or isinstance(value, (bool, np.bool_)):
+        return False
+    return math.isfinite(value) and value > 0
+
+
 @dataclass
 class RunningMax:
     """Running maxima ``r_e_max`` and ``r_i_max`` that normalise Eq. 13.
@@ -136,7 +145,7 @@ class RunningMax:
     def __post_init__(self) -> None:
         for name in ("r_e_max", "r_i_max"):
             value = getattr(self, name)
-            if not _is_tensor(value) and not (math.isfinite(float(value)) and float(value) > 0):
+            if not _is_tensor(value) and not _positive_number(value):
                 raise ValueError(
                     f"RunningMax.{name} must be a finite number > 0 (it divides or scales the "
                     f"intrinsic reward); got {value!r}. Pass e.g. {name}=1.0."
@@ -173,11 +182,34 @@ class RunningMax:
         """Both maxima as python floats (one host sync each when they live on a device)."""
         return {"r_e_max": float(self.r_e_max), "r_i_max": float(self.r_i_max)}
 
+    @staticmethod
+    def state_problems(state: Any) -> list[str]:
+        """What keeps ``state`` from loading: no dict, or a maximum missing or not a finite
+        number > 0 (a one-element tensor counts as a number)."""
+        if not isinstance(state, Mapping):
+            return [f"it is a {type(state).__name__}, not a dict of r_e_max and r_i_max"]
+        problems = []
+        for name in ("r_e_max", "r_i_max"):
+            if name not in state:
+                problems.append(f"it lacks {name}")
+                continue
+            value = state[name]
+            if _is_tensor(value) and value.numel() == 1:
+                value = value.item()
+            if not _positive_number(value):
+                problems.append(f"its {name} is {value!r:.60}, not a finite number > 0")
+        return problems
+
     def load_state_dict(self, state: dict[str, float]) -> None:
-        """Restore the maxima, keeping the current storage (float or tensor, device, dtype)."""
-        missing = {"r_e_max", "r_i_max"} - set(state)
-        if missing:
-            raise KeyError(f"RunningMax state is missing {sorted(missing)}; got keys {list(state)}")
+        """Restore the maxima, keeping the current storage (float or tensor, device, dtype); a
+        state without both as finite numbers > 0 is refused and nothing is loaded."""
+        problems = self.state_problems(state)
+        if problems:
+            raise ValueError(
+                f"RunningMax.load_state_dict cannot load this state: {'; '.join(problems)}; pass "
+                "what RunningMax.state_dict() returned, e.g. {'r_e_max': 1.0, 'r_i_max': 1.0}. "
+                "Nothing was loaded."
+            )
         for name in ("r_e_max", "r_i_max"):
             current = getattr(self, name)
             if _is_tensor(current):

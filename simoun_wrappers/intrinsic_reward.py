@@ -12,6 +12,7 @@ transition to a source that learns online, ``info``, state and ``close``.
 
 from __future__ import annotations
 
+import inspect
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
@@ -286,8 +287,12 @@ class IntrinsicMechanism(ABC):
         if arguments:
             name, source = next(iter(arguments.items()))
             recorded[name] = SharedSource(SharedSource.unwrap(source))
+        recorded.update(scale=scale, normalization=normalization, **weighting, **paper)
+        # only what the class's constructor takes, so that gym.make(env.spec) re-makes it (the
+        # constant bonus fixes its normalization, warm-up and progress)
+        taken = inspect.signature(type(self).__init__).parameters
         gym.utils.RecordConstructorArgs.__init__(
-            self, **recorded, scale=scale, normalization=normalization, **weighting, **paper
+            self, **{key: value for key, value in recorded.items() if key in taken}
         )
         self.signal = self.signal_type(**arguments)
         self.normalization = make_normalization(normalization, **paper)

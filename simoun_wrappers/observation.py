@@ -44,10 +44,20 @@ MAX_FRAME_BYTES = 2**28
 frame a pixel agent learns from."""
 
 
+def plain_size(size: Any) -> Any:
+    """A numpy array of integers given as ``size`` as the Python int (0-d) or tuple (1-D) it
+    holds, as a shape read off a space may be; anything else as it is (``parse_size`` checks
+    it). Recorded for ``env.spec`` this way, the size stays JSON."""
+    if isinstance(size, np.ndarray) and size.dtype.kind in "iu" and size.ndim <= 1:
+        return size.item() if size.ndim == 0 else tuple(size.tolist())
+    return size
+
+
 def parse_size(size: int | tuple[int, int] | None) -> tuple[int, int] | None:
     """``size`` as ``(H, W)``; an int means a square; None stays None (keep the image's size)."""
     if size is None:
         return None
+    size = plain_size(size)
     if is_int(size):
         pair = (size, size)
     else:
@@ -423,6 +433,7 @@ class SimounObservation(ChainWrapper):
         """
         check_single_env(env, "SimounObservation")
         # parsed before it is recorded: recording deep-copies it, which a generator refuses
+        size = plain_size(size)
         hw = parse_size(size)
         gym.utils.RecordConstructorArgs.__init__(
             self,

@@ -108,6 +108,23 @@ def _policy_kind(policy: str | type) -> str:
     return ""
 
 
+def check_policy_class(policy: type) -> None:
+    """Refuse a class that is no policy: SB3's policies are torch modules, so an algorithm class
+    (``stable_baselines3.PPO``) or any other class given where the policy belongs is named, with
+    the policy names to pass instead."""
+    ancestors = {f"{kind.__module__}.{kind.__qualname__}" for kind in policy.__mro__}
+    if "torch.nn.modules.module.Module" in ancestors:
+        return
+    names = ", ".join(map(repr, SB3_POLICIES))
+    algorithm = any(kind.__name__ == "BaseAlgorithm" for kind in policy.__mro__)
+    what = "an SB3 algorithm, not a policy" if algorithm else "no policy class (no torch module)"
+    example = f" for {policy.__name__}('CnnPolicy', env)" if algorithm else ""
+    raise TypeError(
+        f"policy {policy.__name__} is {what}; pass the policy's name ({names}) or a policy "
+        f"class, e.g. check_sb3_policy(env, 'CnnPolicy'){example}"
+    )
+
+
 def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type:
     """Return ``policy`` if SB3 would see ``env``'s frames as images, else raise ValueError.
 
@@ -146,6 +163,8 @@ def check_sb3_policy(env: gym.Env | gym.Space, policy: str | type) -> str | type
         )
     if not isinstance(policy, (str, type)):
         raise TypeError(f"policy must be a policy name (str) or class, got {type(policy).__name__}")
+    if isinstance(policy, type):
+        check_policy_class(policy)
     if isinstance(env, spaces.Space):
         space = env
     elif isinstance(getattr(env, "single_observation_space", None), spaces.Space):

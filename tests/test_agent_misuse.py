@@ -108,6 +108,12 @@ SMALL = AgentConfig(batch_size=8, num_filters=4, feature_dim=8, hidden_dim=16, a
         (lambda: FrameReplay(100, (3, SIZE, SIZE), 0), ValueError, "action_dim must be an int"),
         (lambda: FrameReplay(100, None, 1), ValueError, "frame_shape must be (C, H, W)"),
         (lambda: FrameReplay(100, (3, SIZE, SIZE), 1, seed=-1), ValueError, "seed must be None"),
+        (lambda: FrameReplay(100, np.zeros((3, 1)), 1), ValueError, "frame_shape must be (C, H"),
+        (
+            lambda: FrameReplay(10**12, (3, SIZE, SIZE), 1),
+            ValueError,
+            "FrameReplay(capacity=1000000000000) needs 3,144,660,000,009,249 bytes",
+        ),
     ],
 )
 def test_agent_and_replay_arguments_are_named(build, error, said):
@@ -245,6 +251,20 @@ def test_a_step_that_is_not_an_int_of_zero_or_more_is_named(step):
     assert agent.env_step == 10 and type(agent.env_step) is int
 
 
+def test_a_step_beyond_an_int64_is_named():
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    replay = point_reach_replay(steps=10)
+    for name, call in (
+        ("update", lambda: agent.update(replay, 2**70)),
+        ("act", lambda: agent.act(np.zeros((3, 3, SIZE, SIZE), np.uint8), step=2**63)),
+    ):
+        with pytest.raises(ValueError, match=rf"{name}\(step=\.\.\.\) must be below 2\*\*63, got"):
+            call()
+    assert agent.num_updates == 0
+    agent.update(replay, 2**63 - 1)
+    assert agent.env_step == 2**63 - 1
+
+
 @pytest.mark.parametrize("frames", [np.zeros((3, 3, SIZE, SIZE), np.uint8).tolist(), None, 7])
 def test_an_observation_that_is_no_array_is_named_with_the_array_it_must_be(frames):
     agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
@@ -280,3 +300,86 @@ def test_a_state_of_another_agent_or_none_is_named_before_anything_loads():
                        r"\(16, 18\) here; .*; \d+ more\. The state must"):  # fmt: skip
         agent.load_state_dict(other_actions)
     agent.load_state_dict(SimounAgent((3, SIZE, SIZE), 2, SMALL, "cpu").state_dict())
+
+
+def test_a_shape_read_off_a_space_is_taken_as_the_frame_shape():
+    for shape in (np.array([3, SIZE, SIZE]), tuple(np.array([3, SIZE, SIZE]))):
+        replay = FrameReplay(100, shape, np.int64(1), seed=np.int64(3))
+        assert replay.frame_shape == (3, SIZE, SIZE) and type(replay.frame_shape[0]) is int
+
+
+def test_a_capacity_beyond_the_memory_names_the_bytes_and_a_capacity_that_fits():
+    with pytest.raises(ValueError) as raised:
+        FrameReplay(10**12, (3, SIZE, SIZE), 1)
+    message = str(raised.value)
+    assert "more than this machine's" in message and "GB of memory; lower capacity" in message
+    fits = int(message.split("(about ")[1].split(" transitions")[0].replace(",", ""))
+    assert FrameReplay(fits // 1000, (3, SIZE, SIZE), 1).capacity == fits // 1000
+
+
+def test_saving_a_replay_to_no_path_a_directory_or_a_missing_folder_is_named(tmp_path):
+    replay = point_reach_replay(steps=5)
+    with pytest.raises(TypeError, match=r"FrameReplay\.save\(path\) takes a file path .* got "
+                       r"NoneType None; e\.g\. replay\.save\('replay\.npz'\)"):  # fmt: skip
+        replay.save(None)
+    with pytest.raises(ValueError, match=rf"{tmp_path} is a directory; pass a file path in it, "
+                       rf"e\.g\. replay\.save\('{tmp_path}/replay\.npz'\)"):  # fmt: skip
+        replay.save(tmp_path)
+    with pytest.raises(FileNotFoundError, match=r"the folder .*nope of .* does not exist"):
+        replay.save(tmp_path / "nope" / "replay.npz")
+    with pytest.raises(TypeError, match=r"FrameReplay\.load\(path\) takes a file path"):
+        FrameReplay.load(None)
+    assert list(tmp_path.iterdir()) == []
+    replay.save(tmp_path / "replay.npz")
+    assert len(FrameReplay.load(tmp_path / "replay.npz")) == len(replay)
+
+
+def spoilt_states(state: dict) -> list[tuple[str, object, str]]:
+    """An agent's state with one part spoilt: (key, value, what the refusal must say)."""
+    critic = state["critic"]
+    first = next(iter(state["critic_optimizer"]["state"]))
+    slots = state["critic_optimizer"]["state"][first]
+    return [
+        ("num_updates", "x", "its num_updates is 'x', not an int >= 0"),
+        ("env_step", -1, "its env_step is -1, not an int >= 0"),
+        ("critic", {k: v.numpy() for k, v in critic.items()}, "critic.q1.0.weight is a numpy"),
+        ("critic", {**critic, "extra": torch.zeros(1)}, "its critic holds extra, which this"),
+        ("critic_optimizer", {}, "its critic_optimizer lacks state, param_groups"),
+        (
+            "critic_optimizer",
+            {**state["critic_optimizer"], "state": {first: {**slots, "exp_avg": torch.zeros(2)}}},
+            f"its critic_optimizer state of parameter {first!r}: exp_avg is (2,) there",
+        ),
+        (
+            "actor_optimizer",
+            {**state["actor_optimizer"], "param_groups": [{"params": []}]},
+            "its actor_optimizer parameter group 0 holds 0 parameters",
+        ),
+        (
+            "running_max",
+            None,
+            "its running_max: it is a NoneType, not a dict of r_e_max and r_i_max",
+        ),
+        ("running_max", {"r_e_max": 1.0}, "its running_max: it lacks r_i_max"),
+        ("running_max", {"r_e_max": 1.0, "r_i_max": 0}, "its running_max: its r_i_max is 0, not a"),
+        ("log_alpha", 0.1, "its log_alpha is a float, not a torch tensor"),
+    ]
+
+
+def test_a_state_with_a_spoilt_part_is_refused_whole_naming_it_and_nothing_loads():
+    agent = SimounAgent((3, SIZE, SIZE), action_dim=2, config=SMALL, device="cpu")
+    before = {k: v.clone() for k, v in agent.critic.state_dict().items()}
+    trained = SimounAgent((3, SIZE, SIZE), 2, SMALL, "cpu")
+    trained.update(point_reach_replay(steps=20), 20)  # fills the optimizers' states
+    state = trained.state_dict()
+    state["num_updates"] = 7
+    for key, value, said in spoilt_states(state):
+        with pytest.raises(ValueError) as raised:
+            agent.load_state_dict({**state, key: value})
+        assert said in str(raised.value), (key, str(raised.value))
+        assert str(raised.value).endswith("Nothing was loaded")
+        assert agent.num_updates == 0
+        for name, tensor in agent.critic.state_dict().items():
+            assert torch.equal(tensor, before[name]), name
+    agent.load_state_dict(state)
+    assert agent.num_updates == 7

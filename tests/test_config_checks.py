@@ -4,11 +4,13 @@ and the fix. One bad value per field, and every field has a row."""
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 import torch
 
 from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import config_fields
+from simoun_agent.config.resolve import to_dict
 from simoun_agent.config.rules import Rule, check_fields, integer, rules_of, setting
 
 BAD = {
@@ -116,6 +118,13 @@ def test_bad_value_names_the_flag(key):
         ),
         ({"replay_capacity": 100, "agent.batch_size": 512}, ["--replay-capacity 100", "512"]),
         ({"agent.log_std_min": 3.0}, ["--agent.log-std-min 3", "--agent.log-std-max 2"]),
+        (
+            {"total_env_steps": "100"},
+            ["--total-env-steps '100' (TrainConfig.total_env_steps)", "(below 2**63), not a str"],
+        ),
+        ({"agent.lr": "1e-3"}, ["--agent.lr '1e-3'", "must be a number > 0, not a str"]),
+        ({"image_size": np.array([64, 64])}, ["--image-size [64 64]", "not a numpy.ndarray"]),
+        ({"agent.recipe": 3}, ["unknown recipe --agent.recipe 3; choose one of simoun"]),
     ],
 )
 def test_messages_give_the_value_and_the_fix(overrides, words):
@@ -150,6 +159,17 @@ def test_a_field_without_a_rule_is_refused_when_the_config_is_built():
 
     with pytest.raises(TypeError, match="Partial fields without a rule: bare"):
         Partial()
+
+
+def test_numpy_numbers_are_taken_as_the_python_numbers_they_hold():
+    config = resolve(
+        "cpu", {"image_size": np.int64(64), "seed": np.array(3), "agent.lr": np.float32(0.5)}
+    )
+    assert (config.image_size, config.seed, config.agent.lr) == (64, 3, 0.5)
+    assert [type(v) for v in (config.image_size, config.seed, config.agent.lr)] == [int, int, float]
+    assert to_dict(config)["seed"] == 3  # config.json can hold them
+    with pytest.raises(SetupError, match=r"unknown preset \['cpu'\]"):
+        resolve(["cpu"], {})
 
 
 def test_agent_config_in_python_names_the_field_too():

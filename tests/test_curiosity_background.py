@@ -239,5 +239,5 @@ def test_frames_are_average_pooled_to_about_encoder_size():
     assert CuriosityModel.for_env(cartpole(), pooled_config, device="cpu").pool == 1
     with pytest.raises(ValueError, match=r"encoded at \(3, 16, 16\).*encoder_size=16"):
         CuriosityModel.for_env(cartpole(), dataclasses.replace(TINY, encoder_size=16))
-    with pytest.raises(ValueError, match="encoder_size must be None"):
+    with pytest.raises(ValueError, match=r"encoder_size=0 must be None or an int >= 1"):
         dataclasses.replace(TINY, encoder_size=0)

@@ -103,6 +103,12 @@ def test_running_max_on_tensors_stays_a_0d_tensor():
     assert isinstance(plain.r_i_max, torch.Tensor) and float(plain.r_i_max) == 4.0
 
 
+@pytest.mark.parametrize("value", ["x", None, 0.0, float("inf"), True])
+def test_a_maximum_that_is_no_finite_number_above_zero_is_named(value):
+    with pytest.raises(ValueError, match=r"RunningMax\.r_i_max must be a finite number > 0"):
+        RunningMax(r_i_max=value)
+
+
 def test_state_dict_round_trip_and_pickle():
     stats = RunningMax(r_e_max=1.0, r_i_max=1.0)
     stats.update(np.array([7.0]), np.array([3.0]))
@@ -112,8 +118,18 @@ def test_state_dict_round_trip_and_pickle():
     on_device.load_state_dict(stats.state_dict())
     assert isinstance(on_device.r_e_max, torch.Tensor)
     assert on_device.state_dict() == {"r_e_max": 7.0, "r_i_max": 3.0}
-    with pytest.raises(KeyError, match="missing"):
-        RunningMax().load_state_dict({"r_e_max": 1.0})
+    for state, said in [
+        ({"r_e_max": 1.0}, "it lacks r_i_max"),
+        ({"r_e_max": 1.0, "r_i_max": None}, "its r_i_max is None, not a finite number > 0"),
+        ({"r_e_max": float("nan"), "r_i_max": 1.0}, "its r_e_max is nan"),
+        ({"r_e_max": 1.0, "r_i_max": -2}, "its r_i_max is -2"),
+        (None, "it is a NoneType, not a dict"),
+    ]:
+        with pytest.raises(ValueError, match=rf"cannot load this state: {said}.*Nothing was"):
+            on_device.load_state_dict(state)
+        assert on_device.state_dict() == {"r_e_max": 7.0, "r_i_max": 3.0}
+    on_device.load_state_dict({"r_e_max": torch.tensor(2.0), "r_i_max": np.float32(4.0)})
+    assert on_device.state_dict() == {"r_e_max": 2.0, "r_i_max": 4.0}
 
 
 def test_the_wrapper_scores_a_plain_function_source_by_eq13_and_refuses_a_non_source():

@@ -67,6 +67,21 @@ def test_random_conv_errors():
         random_conv(torch.zeros(2, 3, 8, 8), kernel_size=4)
 
 
+@pytest.mark.parametrize(
+    ("shape", "named"),
+    [
+        ((2, 0, 8, 8), r"C \(channels\) axis is empty"),
+        ((2, 3, 0, 8), r"H \(rows\) axis is empty"),
+        ((2, 0, 3, 8, 8), r"T \(frames\) axis is empty"),
+        ((2, 3, 0, 0), r"H \(rows\), W \(columns\) axes are empty"),
+    ],
+)
+def test_a_batch_with_an_empty_axis_is_named_and_an_empty_batch_is_returned(shape, named):
+    with pytest.raises(ValueError, match=rf"random_conv got a batch of shape .*{named}"):
+        random_conv(torch.zeros(shape))
+    assert random_conv(torch.zeros(0, 3, 8, 8)).shape == (0, 3, 8, 8)
+
+
 def _randconv_cartpole() -> RandomConvolution:
     return RandomConvolution(gym.make("CartPole-v1", render_mode="rgb_array"))
 

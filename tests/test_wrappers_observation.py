@@ -156,6 +156,19 @@ def test_error_motion_with_one_frame_names_the_fix():
     assert env.observation_space["frames"].shape == (1, 3, 16, 16)
 
 
+def test_a_size_given_as_a_numpy_array_is_taken_and_recorded_as_python_ints():
+    env = SimounObservation(
+        gym.make("CartPole-v1", render_mode="rgb_array"), size=np.array([16, 24])
+    )
+    assert env.observation_space["frames"].shape == (3, 3, 16, 24)
+    assert env.spec.additional_wrappers[-1].kwargs["size"] == (16, 24)
+    env.spec.to_json()
+    square = SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=np.array(16))
+    assert square.observation_space["frames"].shape == (3, 3, 16, 16)
+    with pytest.raises(ValueError, match=r"size must be a positive int or an \(H, W\) pair"):
+        SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=np.ones((2, 2)))
+
+
 def test_error_bad_size_and_source():
     with pytest.raises(ValueError, match=r"size must be.*size=84"):
         SimounObservation(gym.make("CartPole-v1", render_mode="rgb_array"), size=(0, 4))

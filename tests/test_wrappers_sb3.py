@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import stable_baselines3 as sb3
 import torch
+from stable_baselines3.common.policies import ActorCriticCnnPolicy, ActorCriticPolicy
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_wrappers import SimounObservation, check_sb3_policy
@@ -69,7 +70,7 @@ def test_a_space_sb3_takes_in_no_policy_is_refused_for_every_policy():
     blackjack = gym.make("Blackjack-v1")  # a Tuple of Discretes
     with pytest.raises(NotImplementedError, match="Tuple"):  # what SB3 alone does with it
         sb3.PPO("MlpPolicy", blackjack, device="cpu")
-    for policy in ("MlpPolicy", "CnnPolicy", "MultiInputPolicy", sb3.PPO):
+    for policy in ("MlpPolicy", "CnnPolicy", "MultiInputPolicy", ActorCriticPolicy):
         with pytest.raises(ValueError, match=r"takes this observation space: it is a Tuple "
                            r"space.*gymnasium\.wrappers\.FlattenObservation"):  # fmt: skip
             check_sb3_policy(blackjack, policy)
@@ -115,3 +116,14 @@ def test_a_policy_that_does_not_fit_the_space_is_named_with_the_one_that_does(
     if fitting:
         assert check_sb3_policy(env, fitting) == fitting
         sb3.PPO(fitting, env, n_steps=16, batch_size=16, device="cpu")
+
+
+@pytest.mark.parametrize("given", [sb3.PPO, sb3.SAC, dict])
+def test_a_class_that_is_no_policy_is_named_with_the_policy_names(given):
+    space = gym.spaces.Box(0, 255, (84, 84, 3), np.uint8)
+    algorithm = given is not dict
+    said = "an SB3 algorithm, not a policy" if algorithm else r"no policy class \(no torch module\)"
+    with pytest.raises(TypeError, match=rf"policy {given.__name__} is {said}; pass the policy's "
+                       r"name \('CnnPolicy', 'MlpPolicy', 'MultiInputPolicy'\)"):  # fmt: skip
+        check_sb3_policy(space, given)
+    assert check_sb3_policy(space, ActorCriticCnnPolicy) is ActorCriticCnnPolicy

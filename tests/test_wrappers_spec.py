@@ -1,16 +1,24 @@
 """Every wrapper records its constructor arguments: gym.make(env.spec) rebuilds the same chain."""
 
+import inspect
+
 import gymnasium as gym
 import numpy as np
 import pytest
 import shimmy
 
+import simoun_wrappers
 from simoun_wrappers import (
     ActionRepeat,
+    ColorShift,
+    ConsistencyCuriosityReward,
+    ConstantBonusReward,
     FrameTriplet,
+    MovingBackground,
     MultiCamera,
     RandomConvolution,
     ResidualMotion,
+    RNDReward,
     SimounObservation,
 )
 
@@ -27,6 +35,19 @@ def _cartpole() -> gym.Env:
     return gym.make("CartPole-v1", render_mode="rgb_array")
 
 
+def _novelty(triplets: np.ndarray) -> np.ndarray:
+    return triplets[:, -1].mean(axis=(1, 2, 3)).astype(np.float32)
+
+
+def _features(triplets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    f_a = triplets.reshape(*triplets.shape[:2], -1)[..., :8].astype(np.float32)
+    return f_a[:, 2] - f_a[:, 1], f_a
+
+
+def _pixels() -> gym.Env:
+    return SimounObservation(_cartpole(), size=16)
+
+
 CHAINS = {
     "FrameTriplet": lambda: FrameTriplet(gym.make("CartPole-v1"), num_frames=4),
     "ResidualMotion": lambda: ResidualMotion(FrameTriplet(_channel_first(_cartpole()), 2)),
@@ -38,7 +59,38 @@ CHAINS = {
     "SimounObservation": lambda: SimounObservation(
         _cartpole(), size=(12, 20), grayscale=True, num_frames=4, fold_frames=True
     ),
+    "ConstantBonusReward": lambda: ConstantBonusReward(_pixels(), 0.1, decay=0.01),
+    "RNDReward": lambda: RNDReward(_pixels(), _novelty, scale=0.3, warmup=0, progress=0.5),
+    "ConsistencyCuriosityReward": lambda: ConsistencyCuriosityReward(
+        _pixels(), _features, normalization="reward_std", warmup=1
+    ),
+    "ColorShift": lambda: ColorShift(
+        gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array"), seed=0
+    ),
+    "MovingBackground": lambda: MovingBackground(
+        gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array"), seed=0
+    ),
 }
+"""one chain per wrapper class of simoun_wrappers that takes a single env"""
+
+
+def test_every_single_env_wrapper_has_a_chain():
+    wrappers = {
+        name
+        for name in simoun_wrappers.__all__
+        if isinstance(getattr(simoun_wrappers, name), type)
+        and issubclass(getattr(simoun_wrappers, name), gym.utils.RecordConstructorArgs)
+        and "Vector" not in name
+    }
+    assert wrappers == set(CHAINS)
+
+
+@pytest.mark.parametrize("name", list(CHAINS))
+def test_the_recorded_arguments_are_the_constructors_own(name):
+    env = CHAINS[name]()
+    recorded = env.spec.additional_wrappers[-1].kwargs
+    taken = inspect.signature(type(env).__init__).parameters
+    assert set(recorded) <= set(taken) - {"self", "env"}, set(recorded) - set(taken)
 
 
 @pytest.mark.parametrize("name", list(CHAINS))
@@ -51,10 +103,22 @@ def test_spec_rebuilds_an_equal_env(name):
     actions = [env.action_space.sample() for _ in range(3)]
     for a, b in [(env.reset(seed=2)[0], rebuilt.reset(seed=2)[0])] + [
         (env.step(action)[0], rebuilt.step(action)[0]) for action in actions
-    ]:
+    ]:  # the observations; the rewards of the intrinsic-reward wrappers are checked below
         if isinstance(a, dict):
             assert a.keys() == b.keys()
             for key in a:
                 np.testing.assert_array_equal(a[key], b[key])
         else:
             np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", ["ConstantBonusReward", "RNDReward", "ConsistencyCuriosityReward"])
+def test_a_rebuilt_intrinsic_reward_wrapper_pays_the_same_rewards(name):
+    env = CHAINS[name]()
+    rebuilt = gym.make(env.spec)
+    env.reset(seed=0)
+    rebuilt.reset(seed=0)
+    for action in (0, 1, 1):
+        ours, theirs = env.step(action), rebuilt.step(action)
+        assert ours[1] == theirs[1]
+        assert ours[4]["reward_intrinsic"] == theirs[4]["reward_intrinsic"]

@@ -71,7 +71,7 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
 def preset_values(name: str) -> dict[str, Any]:
     """The flat overrides of the preset ``name`` with ``"preset": name``; SetupError for an
     unknown preset or a preset entry with an unknown key."""
-    if name not in PRESETS:
+    if not isinstance(name, str) or name not in PRESETS:
         hint = difflib.get_close_matches(str(name), PRESETS, n=1)
         raise SetupError(
             f"unknown preset {name!r}"
@@ -87,8 +87,8 @@ def recipe_values(name: str, task: str | None = None) -> dict[str, Any]:
     """The flat overrides (``{"agent.encoder": "stacked", ...}``) of the recipe ``name`` on the
     DMC ``task`` (its ``per_task`` values there; None: any other env); SetupError for an unknown
     recipe or a recipe entry with an unknown key."""
-    if name not in RECIPES:
-        hint = difflib.get_close_matches(name, RECIPES, n=1)
+    if not isinstance(name, str) or name not in RECIPES:
+        hint = difflib.get_close_matches(str(name), RECIPES, n=1)
         raise SetupError(
             f"unknown recipe --agent.recipe {name!r}"
             + (f" (did you mean {hint[0]!r}?)" if hint else "")

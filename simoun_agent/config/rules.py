@@ -189,7 +189,8 @@ def check_fields(config: Any, prefix: str) -> None:
     cls = type(config).__name__
     rules = rules_of(config)
     for f in dataclasses.fields(config):
-        value = getattr(config, f.name)
+        value = plain_scalar(getattr(config, f.name))
+        setattr(config, f.name, value)
         if dataclasses.is_dataclass(value):
             continue
         rule = rules[f.name]
@@ -198,9 +199,29 @@ def check_fields(config: Any, prefix: str) -> None:
             default = f.default if f.default is not dataclasses.MISSING else f.default_factory()
             fix = rule.fix or f"e.g. {flag} {show(default)} (the default)"
             close = rule.suggest(value) if rule.suggest else ""
+            given, kind = wrong_kind(value, str(f.type))
             raise ValueError(
-                f"{flag} {show(value)} ({cls}.{f.name}) must be {rule.need}{close}; {fix}"
+                f"{flag} {given} ({cls}.{f.name}) must be {rule.need}{close}{kind}; {fix}"
             )
+
+
+def plain_scalar(value: Any) -> Any:
+    """A numpy scalar or 0-d array as the Python number it holds (what a config means by it,
+    and what ``config.json`` can hold); anything else as it is."""
+    if type(value).__module__ == "numpy" and getattr(value, "ndim", None) == 0:
+        return value.item()
+    return value
+
+
+def wrong_kind(value: Any, annotation: str) -> tuple[str, str]:
+    """``value`` as an error message shows it and, for a value of a kind its field never takes
+    (a string where a number belongs, an array), ``", not a str"``: ``--seed '3'`` must not
+    read as if the number 3 was given."""
+    if isinstance(value, str) and "str" not in annotation:
+        return repr(value), ", not a str"
+    if getattr(value, "ndim", 0):
+        return show(value), f", not a {type(value).__module__}.{type(value).__name__}"
+    return show(value), ""
 
 
 def fail(config: Any, prefix: str, name: str, problem: str) -> ValueError:
