@@ -4,6 +4,7 @@ and --resume, and the bad inputs it refuses."""
 import csv
 import json
 import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -17,10 +18,19 @@ from broken_envs import NAN_REACH_ID
 from flag_lists import override
 
 from benchmarks.sweep import tiny_flags
+from simoun_agent.config import resolve
+from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
+from simoun_lab.cli import report as report_cli
 from simoun_lab.cli import sweep as cli
-from simoun_lab.sweep.grid import SWEEP_FILE, parse_seeds, split_values
+from simoun_lab.sweep.grid import (
+    SWEEP_FILE,
+    SweepSpec,
+    check_trial_dirs,
+    parse_seeds,
+    split_values,
+)
 
 TINY = override(
     tiny_flags(total_env_steps=60),
@@ -393,3 +403,189 @@ def test_seeds_and_grid_values_parse():
     assert parse_seeds("0-2,5") == [0, 1, 2, 5]
     assert parse_seeds("3") == [3]
     assert split_values('1e-3, {"a": [1, 2]},"x,y"') == ["1e-3", '{"a": [1, 2]}', '"x,y"']
+
+
+BASE = {
+    "env": "simoun/PointReach-v0",
+    "image_size": 24,
+    "total_env_steps": 40,
+    "warmup_agent_steps": 20,
+    "replay_capacity": 1000,
+    "eval_every": 20,
+    "eval_episodes": 1,
+    "checkpoint_every": 20,
+    "video": False,
+    "device": "cpu",
+    "agent.batch_size": 8,
+    "agent.num_filters": 8,
+    "agent.feature_dim": 16,
+    "agent.hidden_dim": 32,
+    "agent.aux_hidden_dim": 32,
+}
+"""TINY as a sweep's base config, shorter still (20 updates)."""
+
+TRIAL = "base/simoun-PointReach-v0/s{}"
+
+
+@pytest.fixture(scope="module")
+def trained_sweep(tmp_path_factory):
+    """A finished sweep of seeds 1 and 2, its trials trained here without Ray as the sweep
+    trains them: what simoun-sweep leaves."""
+    sweep_dir = tmp_path_factory.mktemp("sweeps") / "trained"
+    sweep_dir.mkdir()
+    spec = SweepSpec.create(None, BASE, [], "1-2", None)
+    spec.save(sweep_dir)
+    for trial in spec.trials(sweep_dir):
+        run = train.create_run(resolve(trial.preset, trial.overrides))
+        train.train(run)
+        run.env.close()
+        run.eval_env.close()
+        train.release(run)
+    return sweep_dir
+
+
+def copy_sweep(sweep_dir: Path, tmp_path: Path) -> Path:
+    return Path(shutil.copytree(sweep_dir, tmp_path / "sw"))
+
+
+@pytest.mark.parametrize(
+    ("flags", "said"),
+    [
+        (["--seeds", "0-3"], "(--seeds: saved [1, 2], given [0, 1, 2, 3])"),
+        (["--grid", "agent.lr=1e-3,3e-4"], '--grid: saved {}, given {"agent.lr": [0.001, 0.0003]}'),
+        (["--cpus-per-trial", "2"], "(--cpus-per-trial: saved 1, given 2)"),
+        (["--eval-every", "40", "--seeds", "1-2"], "(--eval-every: saved 20, given 40)"),
+        (
+            ["--cpus-per-trial", "2", "--agent.lr", "0.01", "--preset", "cpu"],
+            '(--preset: saved null, given "cpu"; --agent.lr: saved 0.001, given 0.01; '
+            "--cpus-per-trial: saved 1, given 2)",
+        ),
+    ],
+)  # fmt: skip
+def test_a_resume_refusal_names_only_the_flags_given_that_differ(
+    trained_sweep, tmp_path, capsys, flags, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir), *flags], capsys)
+    assert f"the sweep in {sweep_dir} was started with another grid" in err
+    assert said in err
+    assert "--envs" not in err and "base config" not in err
+
+
+def test_a_resume_with_flags_equal_to_the_saved_ones_goes_on(trained_sweep, tmp_path, capsys):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    argv = ["--resume", "--sweep-dir", str(sweep_dir), "--seeds", "1-2", "--eval-every", "20"]
+    assert cli.main([*argv, "--env", "simoun/PointReach-v0", "--cpus-per-trial", "1"]) == 0
+    assert "0 trials to run, 2 already finished" in capsys.readouterr().out
+
+
+SWEEP_JSON_DAMAGES = [
+    (lambda d: d.update(seeds="1"), 'seeds is "1", not a list of seeds'),
+    (lambda d: d.update(seeds=[1, 1]), "seeds is [1, 1], not a list of seeds"),
+    (lambda d: d.update(seeds=[True]), "seeds is [true], not a list of seeds"),
+    (lambda d: d.update(envs=[]), "envs is [], not a list of Gymnasium ids"),
+    (lambda d: d.update(envs="simoun/PointReach-v0"), 'envs is "simoun/PointReach-v0", not a list'),
+    (lambda d: d.update(grid={"agent.lr": 0.001}), "grid: agent.lr is 0.001, not a non-empty list"),
+    (lambda d: d.update(grid={"agent.lr": []}), "grid: agent.lr is [], not a non-empty list"),
+    (lambda d: d.update(grid={"agent.lr": ["x"]}), 'grid: agent.lr is "x", which must be a number'),
+    (lambda d: d.update(grid={"seed": [1, 2]}), "grid varies seed, which the sweep sets"),
+    (lambda d: d.update(grid=[]), "grid is [], not a JSON object"),
+    (lambda d: d.update(preset="cpux"), "preset is \"cpux\", which is no preset (did you mean"),
+    (lambda d: d["base"].update(nope=1), "base: 'nope' is no config key"),
+    (lambda d: d["base"].update(eval_every=0), "base: eval_every is 0, which must be an int >= 1"),
+    (lambda d: d["base"].update(torch_threads=0), "base sets torch_threads, which the sweep sets"),
+    (lambda d: d.update(base=None), "base is null, not a JSON object of config keys"),
+    (lambda d: d.update(cpus_per_trial=0), "cpus_per_trial is 0, not an integer >= 1"),
+    (lambda d: d.update(cpus_per_trial="2"), 'cpus_per_trial is "2", not an integer >= 1'),
+    (lambda d: d.pop("envs"), "it has no envs, which every sweep records"),
+    (lambda d: d.update(nope=1), "it holds the key 'nope', which no sweep writes"),
+    (lambda d: d.update(preset="cartpole-swingup"), "preset 'cartpole-swingup' is meant for "
+     "dm_control/cartpole-swingup-v0, but envs lists 'simoun/PointReach-v0'"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("command", ["report", "resume"])
+@pytest.mark.parametrize(("edit", "said"), SWEEP_JSON_DAMAGES)
+def test_a_sweep_json_edited_out_of_what_a_sweep_accepts_is_named(
+    trained_sweep, tmp_path, capsys, command, edit, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    path = sweep_dir / SWEEP_FILE
+    saved = json.loads(path.read_text())
+    edit(saved)
+    path.write_text(json.dumps(saved))
+    main = report_cli.main if command == "report" else cli.main
+    argv = [str(sweep_dir)] if command == "report" else ["--resume", "--sweep-dir", str(sweep_dir)]
+    err = error_of_main(main, argv, capsys)
+    assert f"{path} is damaged ({said}" in err
+    assert "restore it from a copy" in err and "start a new sweep in a new --sweep-dir" in err
+    assert "--seed " not in err and "--torch-threads" not in err and "Traceback" not in err
+
+
+def error_of_main(main, argv: list[str], capsys) -> str:
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    return capsys.readouterr().err
+
+
+def another_env(run_dir: Path) -> None:
+    config = json.loads((run_dir / "config.json").read_text())
+    (run_dir / "config.json").write_text(json.dumps({**config, "env": "Pendulum-v1"}))
+
+
+def another_seed(run_dir: Path) -> None:
+    config = json.loads((run_dir / "config.json").read_text())
+    (run_dir / "config.json").write_text(json.dumps({**config, "seed": 2}))
+
+
+def config_removed(run_dir: Path) -> None:
+    (run_dir / "config.json").unlink()
+
+
+TRIAL_DAMAGES = [
+    (another_env, "config.json records env Pendulum-v1, but the sweep's trial "
+     f"{TRIAL.format(1)} has simoun/PointReach-v0: it is another run's config"),
+    (another_seed, f"config.json records seed 2, but the sweep's trial {TRIAL.format(1)} has 1"),
+    (config_removed, "config.json is missing, though the run's other files are there"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("damage", "said"), TRIAL_DAMAGES)
+def test_a_trial_run_that_is_not_the_trials_own_is_left_out_of_the_report(
+    trained_sweep, tmp_path, damage, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    damage(sweep_dir / TRIAL.format(1))
+    assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
+    (row,) = list(csv.DictReader((tmp_path / "out" / "report.csv").open()))
+    assert (row["env"], row["n"]) == ("simoun-PointReach-v0", "1")
+    table = (tmp_path / "out" / "report.md").read_text()
+    assert "## Damaged runs (not counted)" in table and f"- {TRIAL.format(1)}: {said}" in table
+
+
+@pytest.mark.parametrize(("damage", "said"), TRIAL_DAMAGES)
+def test_a_trial_run_that_is_not_the_trials_own_is_refused_on_resume(
+    trained_sweep, tmp_path, capsys, damage, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    damage(run_dir)
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(1)}: {run_dir / said}" in err
+    assert f"move the run directory aside (mv {run_dir} {run_dir}.aside)" in err
+    assert "already finished" not in capsys.readouterr().out
+
+
+def test_an_emptied_trial_is_listed_by_the_report_and_trained_anew_on_resume(
+    trained_sweep, tmp_path
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    shutil.rmtree(run_dir)
+    run_dir.mkdir()
+    assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
+    table = (tmp_path / "out" / "report.md").read_text()
+    assert f"- {TRIAL.format(1)}: its directory is empty (the trial has not started" in table
+    spec = SweepSpec.load(sweep_dir)
+    check_trial_dirs(spec, sweep_dir)  # nothing to refuse: the trial starts over

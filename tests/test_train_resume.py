@@ -187,3 +187,39 @@ def test_a_kept_file_that_is_a_directory_is_named_and_nothing_changes(finished_r
     with pytest.raises(SetupError, match=rf"{name} is not a file.*; move it aside"):
         train.resume_run(run_dir, {"total_env_steps": 60})
     assert {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()} == before
+
+
+def into_file(path):
+    shutil.rmtree(path)
+    path.write_text("not a directory\n")
+
+
+def into_directory(path):
+    path.unlink(missing_ok=True)
+    path.mkdir()
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "said"),
+    [
+        ("tb", into_file, "is a file where the run writes its TensorBoard logs (a directory)"),
+        ("learning_curve.png", into_directory, "it is a directory, not a regular file"),
+        ("video.mp4", into_directory, "it is a directory, not a regular file"),
+        (".lock", into_directory, "it is a directory, not a regular file"),
+    ],
+)
+def test_a_path_the_run_writes_of_the_wrong_kind_is_named_before_training(
+    finished_run, tmp_path, capsys, name, damage, said
+):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    damage(run_dir / name)
+    before = {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()}
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(["--resume", str(run_dir), "--total-env-steps", "60"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{run_dir / name} " in err and said in err
+    assert f"move it aside (mv {run_dir / name} {run_dir / name}.aside)" in err
+    assert "cannot write to the run directory" not in err and "Traceback" not in err
+    assert {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()} == before

@@ -20,8 +20,19 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import broken_link
-from simoun_agent.run.layout import CHECKPOINT_NAME, LOCK_NAME, TENSORBOARD_DIR, TRAINER_FILES
+from simoun_agent.run.kept import broken_link, not_a_file
+from simoun_agent.run.layout import (
+    CHECKPOINT_NAME,
+    CONFIG_NAME,
+    CURVE_PNG,
+    EVAL_CSV,
+    LOCK_NAME,
+    SUMMARY_NAME,
+    TENSORBOARD_DIR,
+    TRAIN_CSV,
+    TRAINER_FILES,
+    VIDEO_NAME,
+)
 
 _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""
@@ -97,12 +108,54 @@ def make_output_dir(path: Path, flag: str = "--out") -> bool:
     return created
 
 
+WRITTEN_FILES = (
+    CONFIG_NAME,
+    EVAL_CSV,
+    TRAIN_CSV,
+    CURVE_PNG,
+    VIDEO_NAME,
+    CHECKPOINT_NAME,
+    SUMMARY_NAME,
+    LOCK_NAME,
+)
+"""The files a trainer writes in its run directory (with the directory ``tb/``)."""
+
+READ_BACK = (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, CHECKPOINT_NAME, SUMMARY_NAME)
+"""Those of :data:`WRITTEN_FILES` a resumed run reads back: lost, they come from a copy."""
+
+
+def wrong_kind(run_dir: Path) -> str | None:
+    """What is wrong with the first path a trainer writes in ``run_dir`` that is the wrong kind
+    of thing (a directory or a named pipe where a file goes, a file where ``tb/`` goes), with
+    the fix; None when each is missing or of its kind. A run that met it would fail after
+    training, when it writes the path, or take it for a directory it cannot write to."""
+    tensorboard = run_dir / TENSORBOARD_DIR
+    if tensorboard.exists() and not tensorboard.is_dir():
+        return (
+            f"{tensorboard} is a file where the run writes its TensorBoard logs (a directory); "
+            f"move it aside (mv {tensorboard} {tensorboard}.aside) and run again"
+        )
+    for name in WRITTEN_FILES:
+        path = run_dir / name
+        problem = not_a_file(path)
+        if problem:
+            fix = "restore the file from a copy" if name in READ_BACK else "the run writes it anew"
+            return (
+                f"{path} is not a file the run can write ({problem}); move it aside (mv {path} "
+                f"{path}.aside), {fix}, and run again"
+            )
+    return None
+
+
 def lock_run_dir(run_dir: Path) -> IO[str]:
     """Take the run directory's lock, or raise SetupError naming the PID that holds it.
 
     Keep the returned file open as long as the run uses the directory; closing it releases the
     lock.
     """
+    problem = wrong_kind(run_dir)
+    if problem:
+        raise SetupError(problem)
     path = (run_dir / LOCK_NAME).resolve()
     earlier = _held.pop(path, None)
     if earlier is not None:

@@ -13,6 +13,7 @@ the report (:mod:`simoun_lab.sweep.report`) is written when the sweep ends. The 
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -30,11 +31,19 @@ from simoun_agent.cli.config_flags import (
     overrides_from,
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
-from simoun_agent.config import RECIPES, SetupError, resolve
+from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
+from simoun_agent.config.resolve import flatten
+from simoun_agent.config.rules import flag_name
 from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
-from simoun_lab.sweep.grid import SWEEP_FILE, SweepSpec, check_runnable, gpus_wanted
+from simoun_lab.sweep.grid import (
+    SWEEP_FILE,
+    SweepSpec,
+    check_runnable,
+    check_trial_dirs,
+    gpus_wanted,
+)
 
 PROG = "simoun-sweep"
 
@@ -124,7 +133,7 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
             args.envs,
             saved.cpus_per_trial if args.cpus_per_trial is None else args.cpus_per_trial,
         )
-        differences = spec.describe_differences(wanted)
+        differences = resume_differences(args, base, spec, wanted)
         if differences:
             raise SetupError(
                 f"the sweep in {sweep_dir} was started with another grid, so --resume cannot "
@@ -133,6 +142,58 @@ def sweep_spec(args: SweepCommand, base: dict[str, Any], sweep_dir: Path) -> Swe
                 "--sweep-dir"
             )
     return wanted
+
+
+def resume_differences(
+    args: SweepCommand, base: dict[str, Any], given: SweepSpec, saved: SweepSpec
+) -> list[str]:
+    """What the flags given with ``--resume`` (read into ``given``, ``base`` the config keys
+    they set) change in the ``saved`` sweep, one line per flag and only for the flags given, in
+    the order of the command line's help: the preset, the grid, the seeds, the envs, each base
+    config flag, the CPUs."""
+    lines = []
+    seeds_flag = "--seeds" if args.seeds is not None else "--seed" if "seed" in base else None
+    envs_flag = "--envs" if args.envs is not None else "--env" if "env" in base else None
+    for flag, name in (
+        ("--preset" if args.flags.preset is not None else None, "preset"),
+        ("--grid" if args.grid else None, "grid"),
+        (seeds_flag, "seeds"),
+        (envs_flag, "envs"),
+    ):
+        mine, theirs = getattr(given, name), getattr(saved, name)
+        if flag and mine != theirs:
+            lines.append(f"{flag}: saved {json.dumps(theirs)}, given {json.dumps(mine)}")
+    lines += base_differences(base, saved)
+    if args.cpus_per_trial not in (None, saved.cpus_per_trial):
+        lines.append(f"--cpus-per-trial: saved {saved.cpus_per_trial}, given {args.cpus_per_trial}")
+    return lines
+
+
+def base_differences(base: dict[str, Any], saved: SweepSpec) -> list[str]:
+    """Each base config flag of ``base`` whose value differs from the ``saved`` sweep's (its base
+    config's, or its preset's or the default when the base leaves the key out); the seed, env and
+    ``--total-env-steps`` are compared elsewhere."""
+    effective = flatten(to_dict(resolve(saved.preset, saved.base)))
+    lines = []
+    for key, value in base.items():
+        if key in ("seed", "env", "total_env_steps"):
+            continue
+        name = key.rpartition(".")[2]
+        flag = flag_name(key.removesuffix(name), name)
+        mine = plain(value)
+        if key in saved.grid:
+            theirs = f"{json.dumps(saved.grid[key])} (its --grid)"
+        elif plain(effective.get(key)) != mine:
+            theirs = json.dumps(plain(effective.get(key)))
+        else:
+            continue
+        lines.append(f"{flag}: saved {theirs}, given {json.dumps(mine)}")
+    return lines
+
+
+def plain(value: Any) -> Any:
+    """A config value in its JSON form (tuples as lists), to compare a flag with a saved one."""
+    return json.loads(json.dumps(value))
 
 
 @quiet_pipe
@@ -152,6 +213,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        check_trial_dirs(spec, sweep_dir)
         check_output_dir(sweep_dir, "--sweep-dir")
         gpus_wanted(args.gpus_per_trial)
         ray = load_ray()

@@ -29,9 +29,12 @@ from typing import Any
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
+from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.layout import CONFIG_NAME
+from simoun_lab.sweep.saved import saved_problem
 
 SWEEP_FILE = "sweep.json"
 """The sweep's grid and base config, written once in the sweep directory."""
@@ -266,15 +269,16 @@ class SweepSpec:
                 )
         return trials
 
-    def check_trials(self) -> None:
+    def check_trials(self, source: str = "--grid / --envs") -> None:
         """Resolve every trial's config now (unknown recipe, a value its key refuses, a preset
-        meant for another env...), before anything runs; two trials may not share a directory."""
+        meant for another env...), before anything runs; two trials may not share a directory.
+        ``source`` is where the grid came from, for the messages."""
         seen: dict[str, Trial] = {}
         for trial in self.trials("."):
             try:
                 resolve(trial.preset, trial.overrides)
             except SetupError as err:
-                raise SetupError(f"trial {trial.name} (from --grid / --envs): {err}") from None
+                raise SetupError(f"trial {trial.name} (from {source}): {err}") from None
             if trial.run_dir in seen:
                 first = seen[trial.run_dir]
                 fix = "make their --grid values differ in letters or digits"
@@ -288,23 +292,6 @@ class SweepSpec:
                     f"{trial.run_dir}; {fix}"
                 )
             seen[trial.run_dir] = trial
-
-    def describe_differences(self, other: SweepSpec) -> list[str]:
-        """What differs from ``other`` (the saved sweep), one line per flag."""
-        flags = {
-            "grid": "--grid",
-            "seeds": "--seeds",
-            "envs": "--envs",
-            "preset": "--preset",
-            "base": "the base config flags",
-            "cpus_per_trial": "--cpus-per-trial",
-        }
-        mine, saved = asdict(self), asdict(other)
-        return [
-            f"{flag}: saved {json.dumps(saved[name])}, given {json.dumps(mine[name])}"
-            for name, flag in flags.items()
-            if mine[name] != saved[name]
-        ]
 
     def total_env_steps(self) -> int:
         """The env-step budget of every trial (the base flags', else the preset's)."""
@@ -340,19 +327,67 @@ class SweepSpec:
                 "a sweep that simoun-sweep started, or drop --resume to start one"
             )
         try:
-            spec = cls(**read_json_object(path))
-        except (Damaged, TypeError) as err:
+            data = read_json_object(path)
+        except Damaged as err:
             problem = str(err)
         except OSError as err:
             problem = f"it cannot be read ({err.strerror})"
         else:
-            problem = "" if isinstance(spec.grid, dict) else "its grid is not a JSON object"
+            problem = saved_problem(data) or ""
+        if not problem:
+            spec = cls(**data)
+            try:
+                spec.check_trials(SWEEP_FILE)
+            except SetupError as err:
+                problem = str(err)
         if problem:
             raise SetupError(
                 f"{path} is damaged ({problem}); restore it from a copy (it records the sweep's "
                 "base, grid, seeds and envs), or start a new sweep in a new --sweep-dir"
             )
         return spec
+
+
+def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
+    """What is wrong with a started trial's run directory: its config.json missing while other
+    files are there, damaged, or recording another env, seed or ``grid`` value than the trial's
+    (a run copied in from elsewhere, a config.json replaced); None for a trial not started (no
+    directory, or an empty one) and for one whose config.json is its own. The answer starts
+    with the name config.json."""
+    run_dir = Path(trial.run_dir)
+    if not run_dir.is_dir() or not any(run_dir.iterdir()):
+        return None
+    path = run_dir / CONFIG_NAME
+    if not present(path):
+        return f"{CONFIG_NAME} is missing, though the run's other files are there"
+    try:
+        saved = flatten(read_json_object(path))
+    except Damaged as err:
+        return f"{CONFIG_NAME} is damaged: {err}"
+    except OSError as err:
+        return f"{CONFIG_NAME} cannot be read ({err.strerror})"
+    for key in ("env", "seed", *grid):
+        recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
+        if key in saved and recorded != wanted:
+            return (
+                f"{CONFIG_NAME} records {key} {show(recorded)}, but the sweep's trial "
+                f"{trial.name} has {show(wanted)}: it is another run's config"
+            )
+    return None
+
+
+def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
+    """SetupError naming the first trial whose run directory is not its own
+    (:func:`trial_problem`), before the sweep counts it as finished or goes on from it."""
+    for trial in spec.trials(sweep_dir):
+        problem = trial_problem(trial, spec.grid)
+        if problem:
+            run_dir = trial.run_dir
+            raise SetupError(
+                f"trial {trial.name}: {Path(run_dir, CONFIG_NAME)} {problem.partition(' ')[2]}; "
+                f"restore {CONFIG_NAME} from a copy, or move the run directory aside (mv "
+                f"{run_dir} {run_dir}.aside) so that the trial trains anew"
+            )
 
 
 def check_runnable(trials: list[Trial], envs_flag: str) -> None:

@@ -56,7 +56,7 @@ from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
 from simoun_lab import stats
-from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE, SweepSpec
+from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE, SweepSpec, trial_problem
 from simoun_lab.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
@@ -305,6 +305,34 @@ def sweep_grid(root: Path) -> dict[str, list[Any]] | None:
     """The grid of the sweep in ``root`` (its ``sweep.json``), None for runs of no sweep;
     SetupError naming the file when it is damaged."""
     return SweepSpec.load(root).grid if present(root / SWEEP_FILE) else None
+
+
+def sweep_trials_only(root: Path, records: list[RunRecord], damaged: list[str]) -> list[RunRecord]:
+    """``records`` less the trials of the sweep in ``root`` whose run directory is not the
+    trial's own (:func:`~simoun_lab.sweep.grid.trial_problem`: config.json missing, or another
+    env, seed or grid value), each named in ``damaged``: such a run would be counted as finished
+    or reported under another env. Runs of no sweep, and runs outside its trials' directories,
+    are kept as they are."""
+    if not present(root / SWEEP_FILE):
+        return records
+    spec = SweepSpec.load(root)
+    named = {line.partition(": ")[0] for line in damaged}
+    refused: set[Path] = set()
+    for trial in spec.trials(root):
+        run_dir = Path(trial.run_dir)
+        label = run_dir.relative_to(root).as_posix()
+        if label in named:
+            continue  # its config.json is damaged: find_runs named it
+        problem = trial_problem(trial, spec.grid)
+        if run_dir.is_dir() and not any(run_dir.iterdir()):
+            problem = (
+                "its directory is empty (the trial has not started, or its files were removed; "
+                "simoun-sweep --resume trains it)"
+            )
+        if problem:
+            damaged.append(f"{label}: {problem}")
+            refused.add(run_dir)
+    return [record for record in records if record.run_dir not in refused]
 
 
 def variant_keys(records: list[RunRecord], root: Path) -> list[str]:
@@ -584,7 +612,7 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
             "--sweep-dir) or the parent of run directories"
         )
     damaged: list[str] = []
-    records = find_runs(root, damaged)
+    records = sweep_trials_only(root, find_runs(root, damaged), damaged)
     if not records:
         if damaged and all(line.endswith(MINIGRID_RUN) for line in damaged):
             raise SetupError(
