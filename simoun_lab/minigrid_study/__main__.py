@@ -74,9 +74,9 @@ def check_archive_spec(spec: StudySpec, path: Path, saved: Path) -> None:
     changed = sorted(changed_keys(archived, spec.to_json()))
     if changed:
         raise SetupError(
-            f"--spec {path} is not the spec the archive's runs were trained with ({saved}; keys "
-            f"{', '.join(changed)} differ); leave --spec out to use the archive's, or pass the "
-            "--archive of the study that spec ran"
+            f"--spec {path} is another spec than the one the archive's runs were trained with "
+            f"({saved}; keys {', '.join(changed)} differ); leave --spec out to use the "
+            "archive's, or pass the --archive of the study that spec ran"
         )
 
 
