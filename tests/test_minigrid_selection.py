@@ -90,7 +90,12 @@ def test_the_rule_picks_the_highest_mean_area_once_every_setting_has_finished(tm
     )
     for v1_arm, arm in names.items():
         for seed in (0, 1):
-            shutil.copytree(V1 / TASK / v1_arm / f"s{seed}", tmp_path / TASK / arm / f"s{seed}")
+            run_dir = tmp_path / TASK / arm / f"s{seed}"
+            shutil.copytree(V1 / TASK / v1_arm / f"s{seed}", run_dir)
+            # recorded as the run of this spec it stands in for, which the selection checks
+            config = json.loads((run_dir / "config.json").read_text())
+            config.update(run=f"{TASK}/{arm}/s{seed}", spec=spec.to_json())
+            (run_dir / "config.json").write_text(json.dumps(config))
     hand = {
         arm: np.mean(
             [

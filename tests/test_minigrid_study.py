@@ -417,3 +417,135 @@ def test_the_report_compares_the_arms_on_the_seeds_all_of_them_finished(tmp_path
         if x.startswith(f"| {task} | ppo | 90-100 % |")
     )
     assert line.endswith(f"| {visited:.0f} |") and 100 < visited < 400
+
+
+V1_ARCHIVE = Path("docs/studies/minigrid")
+V1_RUNS = [f"MiniGrid-DoorKey-6x6-v0/{arm}/s0" for arm in ("ppo", "consistency", "rnd")]
+
+
+@pytest.fixture
+def v1_copy(tmp_path: Path) -> Path:
+    """One seed of each arm of the committed MiniGrid study, with its spec."""
+    archive = tmp_path / "archive"
+    for name in V1_RUNS:
+        shutil.copytree(V1_ARCHIVE / name, archive / name)
+    shutil.copy(V1_ARCHIVE / "spec.json", archive / "spec.json")
+    return archive
+
+
+def edit_csv(path: Path, edit) -> None:
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(edit(lines)) + "\n")
+
+
+def edit_json(path: Path, edit) -> None:
+    data = json.loads(path.read_text())
+    edit(data)
+    path.write_text(json.dumps(data))
+
+
+def with_success(lines: list[str], rate: str) -> list[str]:
+    """eval.csv's lines with the last row's success_rate (its third column) set to ``rate``."""
+    last = lines[-1].split(",")
+    return [*lines[:-1], ",".join([*last[:2], rate, *last[3:]])]
+
+
+@pytest.mark.parametrize("command", ["report", "select"])
+@pytest.mark.parametrize(
+    ("file", "damage", "said"),
+    [
+        (
+            "eval.csv",
+            lambda p: edit_csv(p, lambda lines: [lines[0], *reversed(lines[1:])]),
+            "line 3: env_step 400000 is negative or does not come after the line before (rows "
+            "out of order or repeated)",
+        ),
+        (
+            "eval.csv",
+            lambda p: edit_csv(p, lambda lines: with_success(lines, "2.0")),
+            ": success_rate is 2, not a rate in [0, 1]",
+        ),
+        (
+            "eval.csv",
+            lambda p: edit_csv(p, lambda lines: with_success(lines, "nan")),
+            ": success_rate is nan, not a finite number",
+        ),
+        (
+            "summary.json",
+            lambda p: edit_json(p, lambda d: d.update(final_success_rate=float("nan"))),
+            "final_success_rate is NaN, not a rate in [0, 1]",
+        ),
+        ("config.json", lambda p: p.write_text("{"), "it is not JSON"),
+        ("config.json", lambda p: p.unlink(), "it is missing, but its run finished"),
+        (
+            "config.json",
+            lambda p: edit_json(p, lambda d: d["spec"]["ppo"].update(gamma=0.5)),
+            "its run was trained with another spec than the archive's (ppo differ: ppo.gamma "
+            "0.5 where the spec has 0.99)",
+        ),
+        (
+            "config.json",
+            lambda p: edit_json(p, lambda d: d.update(run="MiniGrid-DoorKey-6x6-v0/ppo/s1")),
+            "its run is \"MiniGrid-DoorKey-6x6-v0/ppo/s1\", not 'MiniGrid-DoorKey-6x6-v0/rnd/s0'",
+        ),
+    ],
+)
+def test_a_damaged_file_of_a_finished_run_is_named_not_counted(
+    command, file, damage, said, v1_copy
+):
+    path = v1_copy / V1_RUNS[2] / file
+    damage(path)
+    status, printed = study(command, "--archive", str(v1_copy))
+    assert status == 2 and "Traceback" not in printed, printed[-2000:]
+    assert f"{path} is damaged: " in printed and said in printed
+    assert not (v1_copy / "report").exists() and not (v1_copy / "selection.md").exists()
+
+
+def test_a_finished_run_without_its_train_csv_is_named_by_the_report(v1_copy):
+    path = v1_copy / V1_RUNS[1] / "train.csv"
+    path.unlink()
+    status, printed = study("report", "--archive", str(v1_copy))
+    assert status == 2 and f"{path} is damaged: it is missing, but its run finished" in printed
+
+
+def test_select_with_another_spec_than_the_archives_writes_nothing(v1_copy, tmp_path):
+    status, _ = study("select", "--archive", str(v1_copy))
+    assert status == 0
+    kept = {name: (v1_copy / name).read_bytes() for name in ("selection.md", "selection.json")}
+    other = Path("docs/studies/minigrid-v2/tuning/spec.json")
+    status, printed = study("select", "--archive", str(v1_copy), "--spec", str(other))
+    assert status == 2 and "Traceback" not in printed
+    assert (
+        f"--spec {other} is another spec than the one the archive's runs were trained with"
+        in printed
+    )
+    assert "leave --spec out to use the archive's" in printed
+    assert kept == {name: (v1_copy / name).read_bytes() for name in kept}
+    # an archive with no finished run of its spec keeps its selection too
+    for name in V1_RUNS:
+        (v1_copy / name / "summary.json").unlink()
+    status, printed = study("select", "--archive", str(v1_copy))
+    assert status == 2 and "holds no finished run of its spec: nothing to select from" in printed
+    assert kept == {name: (v1_copy / name).read_bytes() for name in kept}
+
+
+def test_a_report_directory_that_is_a_file_is_named(v1_copy):
+    (v1_copy / "report").write_text("notes\n")
+    status, printed = study("report", "--archive", str(v1_copy))
+    assert status == 2 and "Traceback" not in printed
+    assert f"{v1_copy / 'report'} is where the report is written, but it is a file" in printed
+
+
+def test_a_sac_study_archive_is_told_apart_from_a_minigrid_one(tmp_path, capsys):
+    from simoun_lab.cli import study as study_cli
+
+    archive = tmp_path / "dmc100k"
+    archive.mkdir()
+    shutil.copy("docs/studies/dmc100k/study.json", archive / "study.json")
+    status, printed = study("report", "--archive", str(archive))
+    assert status == 2 and f"--archive {archive} holds runs of a SAC study" in printed
+    with pytest.raises(SystemExit) as exit_info:
+        study_cli.main(["report", str(V1_ARCHIVE / "spec.json"), "--study-dir", str(archive)])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2 and "Traceback" not in err
+    assert f"--study-dir {archive} holds runs of a SAC study ({archive / 'study.json'})" in err

@@ -361,6 +361,12 @@ BAD_SPECS = [
      "'drq' is not one of the study's recipes (simoun, sac)"),
     ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["sac"]',
      "'sac' is one of the study's recipes, tuned and compared on its own"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsac = ["simoun_no_aux"]',
+     "'simoun_no_aux' is an ablation of 'simoun', not of 'sac'; list it under simoun = "),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["drq"]',
+     "'drq' is no ablation (a method of its own)"),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["color_easy", "color_easy"]',
+     "'color_easy' is listed twice; list each mode once"),
     ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["colour_easy"]',
      "unknown distraction 'colour_easy' in modes; did you mean 'color_easy'?"),
     ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["train"]',
@@ -686,3 +692,93 @@ def test_a_task_given_as_module_id_reaches_every_run_with_its_module(tmp_path):
         config = resolve(trial.preset, trial.overrides)
         assert (config.env, config.env_module) == (NAN_REACH_ID, "broken_envs")
         assert "/simoun-test-NanReach-v0/" in trial.run_dir
+
+
+DMC = Path("docs/studies/dmc100k")
+DMC_TUNING_RUN = "tuning/simoun/agent.n_step=1/cartpole-swingup/s101"
+DMC_EVALUATION_RUN = "evaluation/simoun/cartpole-swingup/s1"
+
+
+@pytest.fixture
+def dmc_archive(tmp_path: Path) -> Path:
+    """A copy of the committed dmc100k study archive."""
+    return Path(shutil.copytree(DMC, tmp_path / "dmc100k"))
+
+
+def report_refused(archive: Path, capsys, spec: str = "docs/studies/dmc100k.toml") -> str:
+    """What ``simoun-study report`` says refusing ``archive``: status 2, no traceback."""
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["report", spec, "--study-dir", str(archive)])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2 and "Traceback" not in err
+    return err
+
+
+def edit_json(path: Path, edit) -> None:
+    data = json.loads(path.read_text())
+    edit(data)
+    path.write_text(json.dumps(data))
+
+
+@pytest.mark.parametrize(
+    ("run", "damage", "said"),
+    [
+        (DMC_EVALUATION_RUN, lambda p: p.unlink(), "config.json is missing, but the run finished"),
+        (DMC_EVALUATION_RUN, lambda p: p.write_text("{"), "config.json is damaged: it is not JSON"),
+        (
+            DMC_TUNING_RUN,
+            lambda p: edit_json(p, lambda d: d["agent"].update(recipe="drq")),
+            "config.json records another run than this one: agent.recipe is drq where the "
+            "spec gives simoun",
+        ),
+        (
+            DMC_EVALUATION_RUN,
+            lambda p: edit_json(p, lambda d: d.update(seed=7)),
+            "config.json records another run than this one: seed is 7 where the spec gives 1",
+        ),
+    ],
+)
+def test_a_finished_run_whose_config_is_damaged_or_another_runs_is_named_by_the_report(
+    run, damage, said, dmc_archive, capsys
+):
+    damage(dmc_archive / run / "config.json")
+    err = report_refused(dmc_archive, capsys)
+    assert f"the finished run {dmc_archive / run}: {said}" in err
+    assert f"mv {dmc_archive / run} {dmc_archive / run}.damaged" in err
+
+
+def test_a_report_directory_that_is_a_file_is_named(dmc_archive, capsys):
+    shutil.rmtree(dmc_archive / "report")
+    (dmc_archive / "report").write_text("notes\n")
+    err = report_refused(dmc_archive, capsys)
+    assert f"{dmc_archive / 'report'} is where the report is written, but it is a file" in err
+    assert f"mv {dmc_archive / 'report'} {dmc_archive / 'report'}.old" in err
+
+
+@pytest.mark.parametrize(
+    ("edit", "said"),
+    [
+        (lambda d: d["parts"][0].pop("commit"), "its part 1 has no commit, which every part"),
+        (lambda d: d["spec"].pop("tuning"), "its spec has no tuning"),
+        (lambda d: d["spec"].update(budget=3), "its spec has an unknown key 'budget'"),
+        (lambda d: d["spec"].update(evaluation=[]), "its spec's evaluation is not a phase"),
+    ],
+)
+def test_a_study_record_with_a_part_or_spec_key_missing_is_named(edit, said, dmc_archive, capsys):
+    edit_json(dmc_archive / "study.json", edit)
+    err = report_refused(dmc_archive, capsys)
+    assert f"{dmc_archive / 'study.json'} is damaged: {said}" in err
+
+
+def test_a_study_record_saved_before_specs_named_a_selection_rule_reads_as_auc():
+    record = json.loads((DMC / "study.json").read_text())
+    del record["spec"]["selection"]
+    spec = spec_from("docs/studies/dmc100k.toml")
+    assert spec.selection == "auc"
+    check_same_spec(record, spec, "not the same", "fix it")  # raises when they differ
+
+
+def test_a_minigrid_archive_given_a_sac_spec_is_told_its_kind(tmp_path, capsys):
+    archive = Path(shutil.copytree("docs/studies/minigrid-v2/tuning", tmp_path / "mgt"))
+    err = report_refused(archive, capsys)
+    assert f"{archive} holds runs of a MiniGrid PPO study ({archive / 'spec.json'})" in err

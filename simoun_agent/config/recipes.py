@@ -48,6 +48,9 @@ class Recipe:
     per_task: dict[str, dict[str, Any]] = field(default_factory=dict)
     """DMC task (``cartpole-swingup``) -> AgentConfig values that replace ``values`` on that task,
     as the published code configures each task"""
+    ablation_of: str | None = None
+    """the method this recipe is an ablation of (the method with a part removed or replaced),
+    which a study's ``[diagnostics]`` lists it under; None for a method"""
 
     def values_for(self, task: str | None) -> dict[str, Any]:
         """The recipe's values on ``task`` (a DMC task name, or None for any other env)."""
@@ -95,6 +98,7 @@ def _encoder_ablation(encoder: str, what: str) -> Recipe:
     return Recipe(
         f"Fig. 6 ablation: {what}, with Simoun's L_tran + L_con + L_re and no curiosity",
         {"encoder": encoder, **SIMOUN_LOSSES, "curiosity": False},
+        ablation_of="simoun",
     )
 
 
@@ -132,6 +136,7 @@ def _simoun_without(part: str) -> Recipe:
         f"({', '.join(f'{key}={value}' for key, value in SIMOUN_PARTS[part].items())})",
         {**SIMOUN, **SIMOUN_PARTS[part]},
         SIMOUN_DEVIATIONS,
+        ablation_of="simoun",
     )
 
 

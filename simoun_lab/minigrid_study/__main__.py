@@ -40,14 +40,19 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     from simoun_agent.run.kept import present
     from simoun_lab.minigrid_study.runner import SPEC_FILE, load_saved_spec
     from simoun_lab.minigrid_study.spec import StudySpec, load_spec
+    from simoun_lab.minigrid_study.study_command import refuse_sac_study
 
     if not archive.is_dir():
         where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
         in_clone = " (run it from the root of a clone of simoun)" if archive == ARCHIVE else ""
         start = "; to start a new study, create the directory first" if new else ""
         raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
+    refuse_sac_study(archive, "--archive")
     if spec is not None:
-        return load_spec(spec)
+        given = load_spec(spec)
+        if present(archive / SPEC_FILE):
+            check_archive_spec(given, spec, archive / SPEC_FILE)
+        return given
     if present(archive / SPEC_FILE):
         return load_saved_spec(archive / SPEC_FILE)
     if new and (archive == ARCHIVE or not any(archive.iterdir())):
@@ -56,6 +61,23 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
         f"--archive {archive} holds no {SPEC_FILE}, so it is not a study's archive; pass the "
         "archive a run wrote, or --spec FILE for the spec its runs were trained with"
     )
+
+
+def check_archive_spec(spec: StudySpec, path: Path, saved: Path) -> None:
+    """Refuse the spec ``spec`` (read from ``--spec path``) when the archive's runs were
+    trained with another (``saved``): its report or selection would mix the two designs."""
+    from simoun_lab.engine.launcher import changed_keys
+    from simoun_lab.minigrid_study.runner import read_saved_spec
+    from simoun_lab.minigrid_study.spec import spec_from_dict
+
+    archived = spec_from_dict(read_saved_spec(saved), str(saved)).to_json()
+    changed = sorted(changed_keys(archived, spec.to_json()))
+    if changed:
+        raise SetupError(
+            f"--spec {path} is another spec than the one the archive's runs were trained with "
+            f"({saved}; keys {', '.join(changed)} differ); leave --spec out to use the "
+            "archive's, or pass the --archive of the study that spec ran"
+        )
 
 
 @dataclass

@@ -12,6 +12,7 @@ stopped part way compares the arms on the same seeds; the runs left out are coun
 from __future__ import annotations
 
 import json
+import math
 import warnings
 from pathlib import Path
 from typing import Any
@@ -33,7 +34,9 @@ from simoun_agent.run.kept import (
 )
 from simoun_lab import stats
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
-from simoun_lab.minigrid_study.spec import Run, StudySpec
+from simoun_lab.minigrid_study.spec import Run, StudySpec, spec_from_dict
+from simoun_lab.minigrid_study.training import CONFIG
+from simoun_lab.study.report import report_dir
 
 __all__ = ["REPORT", "write_report"]
 
@@ -75,12 +78,49 @@ def read_rows(path: Path, columns: tuple[str, ...] = ("env_step",)) -> list[dict
     except Damaged as err:
         raise damaged(path, str(err)) from None
     except OSError as err:
-        raise damaged(path, f"it cannot be read ({err.strerror})") from None
+        raise damaged(path, unreadable(err)) from None
+
+
+def unreadable(err: OSError) -> str:
+    """What is wrong with a finished run's file that could not be opened."""
+    if isinstance(err, FileNotFoundError):
+        return "it is missing, but its run finished (summary.json is there)"
+    return f"it cannot be read ({err.strerror})"
+
+
+def read_eval(path: Path) -> list[dict[str, float]]:
+    """A finished run's ``eval.csv`` (:func:`read_rows`); SetupError naming the file and line
+    when a value the report and the selection read is not finite, a step is negative or does
+    not come after the one before (rows out of order or repeated), or a success rate lies
+    outside [0, 1]."""
+    rows = read_rows(path, EVAL_COLUMNS)
+    for line, row in enumerate(rows, start=2):
+        problem = eval_row_problem(row, rows[line - 3] if line > 2 else None)
+        if problem:
+            raise damaged(path, f"line {line}: {problem}")
+    return rows
+
+
+def eval_row_problem(row: dict[str, float], before: dict[str, float] | None) -> str | None:
+    """What is wrong with one row of ``eval.csv`` (``before``: the row above it), else None."""
+    for key in EVAL_COLUMNS:
+        if not math.isfinite(row[key]):
+            return f"{key} is {row[key]}, not a finite number"
+    step = row["env_step"]
+    if step < 0 or (before is not None and step <= before["env_step"]):
+        return (
+            f"env_step {step:g} is negative or does not come after the line before (rows out "
+            "of order or repeated)"
+        )
+    if not 0 <= row["success_rate"] <= 1:
+        return f"success_rate is {row['success_rate']:g}, not a rate in [0, 1]"
+    return None
 
 
 def read_summary(path: Path) -> dict[str, Any]:
-    """A finished run's ``summary.json``; SetupError naming the file when it is damaged or
-    lacks one of :data:`SUMMARY_KEYS` as a number > 0."""
+    """A finished run's ``summary.json``; SetupError naming the file when it is damaged, lacks
+    one of :data:`SUMMARY_KEYS` as a number > 0, or its final success rate is no rate in
+    [0, 1] or its final return no finite number."""
     try:
         summary = read_json_object(path)
     except Damaged as err:
@@ -91,6 +131,59 @@ def read_summary(path: Path) -> dict[str, Any]:
         value = summary.get(key)
         if not (is_real(value) and value > 0):
             raise damaged(path, f"{key} is {json.dumps(value)}, not a number > 0")
+    rate, final = summary.get("final_success_rate"), summary.get("final_return_mean")
+    if not (is_real(rate) and 0 <= rate <= 1):
+        raise damaged(path, f"final_success_rate is {json.dumps(rate)}, not a rate in [0, 1]")
+    if not is_real(final):
+        raise damaged(path, f"final_return_mean is {json.dumps(final)}, not a finite number")
+    return summary
+
+
+def check_config(path: Path, spec: StudySpec, run: Run) -> None:
+    """SetupError naming a finished run's ``config.json`` when it is damaged, or records
+    another run or a run of another spec: its results would be counted as this run's."""
+    try:
+        config = read_json_object(path)
+    except Damaged as err:
+        raise damaged(path, str(err)) from None
+    except OSError as err:
+        raise damaged(path, unreadable(err)) from None
+    if config.get("run") != run.name:
+        raise damaged(path, f"its run is {json.dumps(config.get('run'))}, not {run.name!r}")
+    saved = config.get("spec")
+    if not isinstance(saved, dict):
+        raise damaged(path, f"its spec is {json.dumps(saved)}, not the object of a study spec")
+    try:
+        trained = spec_from_dict(saved, str(path)).to_json()
+    except SetupError as err:
+        raise damaged(path, f"its spec cannot be read ({err})") from None
+    wanted = spec.to_json()
+    changed = sorted(key for key in {**trained, **wanted} if trained.get(key) != wanted.get(key))
+    if changed:
+        raise damaged(
+            path,
+            f"its run was trained with another spec than the archive's ({', '.join(changed)} "
+            f"differ: {describe_change(trained, wanted, changed[0])})",
+        )
+
+
+def describe_change(trained: dict[str, Any], wanted: dict[str, Any], key: str) -> str:
+    """``key`` of two specs' JSON forms, the nested keys that differ named where there are."""
+    old, new = trained.get(key), wanted.get(key)
+    if isinstance(old, dict) and isinstance(new, dict):
+        inner = [k for k in {**old, **new} if old.get(k) != new.get(k)]
+        return ", ".join(
+            f"{key}.{k} {json.dumps(old.get(k))} where the spec has {json.dumps(new.get(k))}"
+            for k in inner
+        )
+    return f"{key} {json.dumps(old)} where the spec has {json.dumps(new)}"
+
+
+def read_finished(spec: StudySpec, archive: Path, run: Run) -> dict[str, Any]:
+    """A finished run's checked ``summary.json``, its ``config.json`` checked against ``spec``
+    (SetupError naming a damaged file)."""
+    summary = read_summary(archive / run.name / SUMMARY)
+    check_config(archive / run.name / CONFIG, spec, run)
     return summary
 
 
@@ -108,10 +201,9 @@ class Records:
             for r in self.finished
             if all((r.task.env_id, r.seed, arm) in done for arm in spec.arms)
         ]
-        self.summary = {r.name: read_summary(archive / r.name / SUMMARY) for r in self.used}
-        self.eval = {
-            r.name: read_rows(archive / r.name / EVAL_CSV, EVAL_COLUMNS) for r in self.used
-        }
+        summaries = {r.name: read_finished(spec, archive, r) for r in self.finished}
+        self.summary = {r.name: summaries[r.name] for r in self.used}
+        self.eval = {r.name: read_eval(archive / r.name / EVAL_CSV) for r in self.used}
         self.train = {
             r.name: read_rows(archive / r.name / TRAIN_CSV, TRAIN_COLUMNS) for r in self.used
         }
@@ -381,8 +473,7 @@ def plot_training(records: Records, out: Path) -> list[str]:
 def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
     records = Records(spec, archive)
-    out = archive / "report"
-    out.mkdir(parents=True, exist_ok=True)
+    out = report_dir(archive / "report")
     total = len(spec.runs())
     lines = [
         "# MiniGrid PPO study: does an intrinsic reward help PPO from pixels?",

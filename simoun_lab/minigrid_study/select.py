@@ -19,11 +19,13 @@ from typing import Any
 import numpy as np
 
 from simoun_agent import table
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.kept import present
 from simoun_lab.minigrid_study.arms import parse_arm
-from simoun_lab.minigrid_study.report import EVAL_COLUMNS, read_rows
+from simoun_lab.minigrid_study.report import damaged, read_eval, read_finished
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY
-from simoun_lab.minigrid_study.spec import StudySpec
+from simoun_lab.minigrid_study.spec import Run, StudySpec
 
 __all__ = ["SELECTION", "run_auc", "select", "write_selection"]
 
@@ -40,6 +42,19 @@ def run_auc(rows: list[dict[str, float]], steps: int) -> float:
     return float(np.trapezoid(y, x) / steps)
 
 
+def finished_auc(spec: StudySpec, archive: Path, run: Run) -> float:
+    """The area of a finished run, its files checked as the report checks them (SetupError
+    naming a damaged one)."""
+    read_finished(spec, archive, run)
+    path = archive / run.name / EVAL_CSV
+    rows = read_eval(path)
+    if len(rows) < 2:
+        raise damaged(
+            path, f"it holds {len(rows)} evaluation; the area under a success curve needs 2 or more"
+        )
+    return run_auc(rows, run.task.steps)
+
+
 def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
     """Per arm: its area on each finished run and their mean; per entry: the selected setting
     (None while a setting of that entry is still missing runs)."""
@@ -47,9 +62,9 @@ def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
     for arm in spec.arms:
         runs = [r for r in spec.runs() if r.arm == arm]
         areas = {
-            r.name: run_auc(read_rows(archive / r.name / EVAL_CSV, EVAL_COLUMNS), r.task.steps)
+            r.name: finished_auc(spec, archive, r)
             for r in runs
-            if (archive / r.name / SUMMARY).is_file()
+            if present(archive / r.name / SUMMARY)  # a damaged summary is named, not skipped
         }
         arms[arm] = {
             "areas": areas,
@@ -77,6 +92,12 @@ def write_selection(spec: StudySpec, archive: Path) -> Path:
     """Write ``selection.json`` and ``selection.md`` into ``archive``; return the Markdown's
     path."""
     result = select(spec, archive)
+    if not any(record["areas"] for record in result["arms"].values()):
+        raise SetupError(
+            f"--archive {archive} holds no finished run of its spec: nothing to select from yet "
+            f"(its {SELECTION}.md and {SELECTION}.json are left as they are); train the runs "
+            f"with: python -m simoun_lab.minigrid_study run --archive {archive}"
+        )
     lines = [
         "# Tuning: the selected setting of each arm",
         "",

@@ -18,7 +18,7 @@ import tomllib
 from simoun_agent.config import SetupError
 from simoun_agent.run.kept import Damaged, present, read_text
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
-from simoun_lab.study.runner import StudyOptions
+from simoun_lab.study.runner import PPO_SPEC_FILE, STUDY_FILE, StudyOptions
 
 __all__ = ["is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
 
@@ -99,12 +99,26 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
     return 1 if outcome["failed"] else 0
 
 
+def refuse_sac_study(study_dir: Path, flag: str = "--study-dir") -> None:
+    """Refuse a SAC study's directory (its ``study.json`` and no MiniGrid ``spec.json``): its
+    runs are of another kind of study, which a MiniGrid spec cannot report."""
+    record = study_dir / STUDY_FILE
+    if present(record) and not present(study_dir / PPO_SPEC_FILE):
+        raise SetupError(
+            f"{flag} {study_dir} holds runs of a SAC study ({record}), not of a MiniGrid "
+            f"PPO study; report it with the TOML spec it was run with (simoun-study report "
+            f"SPEC.toml --study-dir {study_dir}; {record} names it), or pass the archive of a "
+            "MiniGrid study"
+        )
+
+
 def report(spec: StudySpec, study_dir: Path) -> Path:
     """The MiniGrid report of the archive ``study_dir``, written into it."""
     from simoun_lab.minigrid_study.report import write_report
 
     runner = _runner()
     saved = study_dir / runner.SPEC_FILE
+    refuse_sac_study(study_dir)
     if present(saved) and runner.load_saved_spec(saved) != spec:
         raise SetupError(
             f"--study-dir {study_dir} holds runs of another spec ({saved}); pass the spec it "

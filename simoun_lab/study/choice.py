@@ -10,10 +10,12 @@ from typing import Any
 
 import numpy as np
 
-from simoun_agent.config import SetupError
+from simoun_agent.config import SetupError, resolve, to_dict
+from simoun_agent.config.resolve import flatten
+from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import present
-from simoun_agent.run.layout import SUMMARY_NAME
+from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_lab.study.plan import StudyRun, tuning_runs
 from simoun_lab.study.selection import SELECTION_RULES, TIE_RULE, best_setting
@@ -59,11 +61,42 @@ def read_finished(run_dir: Path) -> tuple[dict[str, Any], dict[str, np.ndarray],
         problem = f"{EVAL_CSV} holds a value that is not a number ({err})"
     else:
         return summary, curve, rows
-    raise SetupError(
+    raise damaged_run(run_dir, problem)
+
+
+def damaged_run(run_dir: Path, problem: str) -> SetupError:
+    """The error for a finished run whose files say ``problem``: the two fixes."""
+    return SetupError(
         f"the finished run {run_dir}: {problem}. Restore the run's files from a copy (the study "
         f"directory and its archive each keep one), or move the run aside in both (mv {run_dir} "
         f"{run_dir}.damaged) and resume the study: the run is then trained again"
     )
+
+
+def check_config(spec: StudySpec, study_dir: Path, run: StudyRun) -> None:
+    """SetupError when the finished ``run``'s ``config.json`` is missing or damaged (then
+    ``simoun-report`` of its phase would leave the run out) or records another run than the
+    spec gives it (another recipe, task, seed, setting or budget: its result would be counted
+    as this run's)."""
+    run_dir = Path(study_dir, run.name)
+    path = run_dir / CONFIG_NAME
+    if not present(path):
+        raise damaged_run(run_dir, f"{CONFIG_NAME} is missing, but the run finished")
+    try:
+        saved = sweep_report.read_run(path).config
+    except sweep_report.DamagedRun as err:
+        raise damaged_run(run_dir, str(err)) from None
+    overrides = spec.overrides(run.recipe, run.task, run.setting or {}, run.seed, run.env_steps)
+    overrides.pop("progress")
+    wanted = flatten(to_dict(resolve(spec.preset, overrides)))
+    keys = ["preset", *overrides] if spec.preset else list(overrides)
+    differ = [key for key in keys if show(saved.get(key)) != show(wanted.get(key))]
+    if differ:
+        values = "; ".join(
+            f"{key} is {show(saved.get(key))} where the spec gives {show(wanted.get(key))}"
+            for key in differ
+        )
+        raise damaged_run(run_dir, f"{CONFIG_NAME} records another run than this one: {values}")
 
 
 def run_score(spec: StudySpec, study_dir: Path, run: StudyRun) -> float:
@@ -74,6 +107,7 @@ def run_score(spec: StudySpec, study_dir: Path, run: StudyRun) -> float:
             f"the tuning run {run.name} has not finished, so no setting can be selected yet; "
             "resume the study to finish it"
         )
+    check_config(spec, study_dir, run)
     _, curve, _ = read_finished(run_dir)
     return SELECTION_RULES[spec.selection].score(run.task, curve["env_step"], curve["return_mean"])
 

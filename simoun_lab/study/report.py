@@ -47,10 +47,10 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.kept import Damaged, broken_link, present, read_json_object
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_lab import stats
-from simoun_lab.study.choice import SELECTION_FILE, Choice, read_finished
+from simoun_lab.study.choice import SELECTION_FILE, Choice, check_config, read_finished
 from simoun_lab.study.driving import (
     MEASURES,
     REFERENCE_COMMAND,
@@ -981,12 +981,14 @@ def write_study_report(
     Counts the finished evaluation runs (the missing ones are listed). ``rewritten_by``: the
     commit of the code writing the report again after the study (``simoun-study report``),
     named under the protocol."""
-    out = study_dir / REPORT_DIR
-    out.mkdir(parents=True, exist_ok=True)
+    out = report_dir(study_dir / REPORT_DIR)
+    runs = phase_runs(spec, EVALUATION, choices)
+    for run in runs:  # before simoun-report of the phase, which would leave a damaged one out
+        if present(Path(study_dir, run.name, SUMMARY_NAME)):
+            check_config(spec, study_dir, run)
     for phase in (TUNING, EVALUATION):
         if any(run.finished(study_dir) for run in phase_runs(spec, phase, choices)):
             sweep_report.write_report(study_dir / phase, out / phase)
-    runs = phase_runs(spec, EVALUATION, choices)
     results = [result for run in runs if (result := read_result(study_dir, run)) is not None]
     tuned = [r for run in tuning_runs(spec) if (r := read_result(study_dir, run)) is not None]
     missing = [run.name for run in runs if not run.finished(study_dir)]
@@ -1014,6 +1016,21 @@ def write_study_report(
     atomic_write(out / REPORT_MD, lambda tmp: tmp.write_text(text))
     _write_csv(out / SCORES_CSV, score_rows(tuned + results))
     return sorted(p for p in out.rglob("*") if p.is_file())
+
+
+def report_dir(out: Path) -> Path:
+    """The report's directory ``out``, made; SetupError naming it when something else stands
+    there (a file, a link to nothing), which a report cannot be written into."""
+    problem = broken_link(out)
+    if problem is None and present(out) and not out.is_dir():
+        problem = "it is a file, not a directory"
+    if problem:
+        raise SetupError(
+            f"{out} is where the report is written, but {problem}; move it aside (mv {out} "
+            f"{out}.old) and run the command again"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    return out
 
 
 def phase_runs(spec: StudySpec, phase: str, choices: dict[str, Choice]) -> list[StudyRun]:

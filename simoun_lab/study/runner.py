@@ -43,6 +43,10 @@ STUDY_FILE = "study.json"
 """The study record, in the study directory and the archive: the spec (its file, text and
 parsed form) and each part's code version."""
 
+PPO_SPEC_FILE = "spec.json"
+"""What a MiniGrid PPO study's archive holds in place of ``study.json``
+(:data:`simoun_lab.minigrid_study.runner.SPEC_FILE`, not imported: it brings SB3 along)."""
+
 
 def spec_from(path: str) -> StudySpec:
     spec = load_spec(path)
@@ -58,6 +62,14 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
         if where is not None and present(where / STUDY_FILE):
             return read_record(where / STUDY_FILE)
     places = " or ".join(str(p) for p in (study_dir, archive) if p is not None)
+    for where in (study_dir, archive):
+        if where is not None and present(where / PPO_SPEC_FILE):
+            raise SetupError(
+                f"{where} holds runs of a MiniGrid PPO study ({where / PPO_SPEC_FILE}), not of "
+                f"the SAC study of this spec; give that study its own spec (simoun-study "
+                f"report {where / PPO_SPEC_FILE} --study-dir {where}), or pass the directory "
+                "of a SAC study"
+            )
     missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
     if not resuming:
         raise SetupError(
@@ -72,6 +84,9 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
 
 RECORD_KEYS = ("spec_file", "spec_text", "spec", "parts")
 """Keys every study record holds (:func:`open_study`)."""
+
+PART_KEYS = ("commit", "dirty", "version")
+"""Keys every part of a study record holds: the code it ran (:func:`code_version`)."""
 
 
 def read_record(path: Path) -> dict[str, Any]:
@@ -104,6 +119,14 @@ def record_problem(record: dict[str, Any]) -> str | None:
     parts = record["parts"]
     if not (isinstance(parts, list) and parts and all(isinstance(p, dict) for p in parts)):
         return "its parts are not an array of JSON objects, one per part the study ran"
+    for number, part in enumerate(parts, start=1):
+        missing = [key for key in PART_KEYS if key not in part]
+        if missing:
+            return f"its part {number} has no {', '.join(missing)}, which every part records"
+    try:
+        StudySpec.from_json(record["spec"])
+    except ValueError as err:
+        return str(err)
     return None
 
 

@@ -53,7 +53,7 @@ import difflib
 import itertools
 import json
 from collections.abc import Iterator
-from dataclasses import asdict, dataclass, field
+from dataclasses import MISSING, asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -133,6 +133,9 @@ STUDY_SETS = {
 """Config keys the study sets itself, and where to say them instead."""
 
 REQUIRED = ("recipes", "grid", "tuning", "evaluation")
+
+DEFAULT_SELECTION = "auc"
+"""The selection rule of a spec that names none, and of a study saved before specs named one."""
 
 
 @dataclass(frozen=True)
@@ -227,8 +230,26 @@ class StudySpec:
     @classmethod
     def from_json(cls, data: dict[str, Any]) -> StudySpec:
         """The spec saved in ``study.json``; keys added since it was saved take their defaults,
-        so an older study reads as the spec it was (no diagnostics, no generalization)."""
-        phases = {name: Phase(**data[name]) for name in PHASES}
+        so an older study reads as the spec it was (no diagnostics, no generalization);
+        ValueError saying what is wrong when a key every spec holds is missing, a key is
+        unknown or a phase is not the object of one."""
+        data = {"selection": DEFAULT_SELECTION, **data}
+        known = {f.name for f in fields(cls)}
+        needed = [
+            f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING
+        ]
+        problems = [f"no {key}" for key in needed if key not in data]
+        problems += [f"an unknown key {key!r}" for key in data if key not in known]
+        if problems:
+            raise ValueError(f"its spec has {', '.join(problems)}")
+        phases = {}
+        for name in PHASES:
+            try:
+                phases[name] = Phase(**data[name])
+            except TypeError:
+                raise ValueError(
+                    f"its spec's {name} is not a phase ({', '.join(f.name for f in fields(Phase))})"
+                ) from None
         return cls(**{**data, **phases})
 
 
@@ -310,7 +331,7 @@ class _Reader:
         if not isinstance(description, str):
             raise self.fail(("description",), "give a string")
         recipes = self.recipes(data["recipes"])
-        selection = data.get("selection", "auc")
+        selection = data.get("selection", DEFAULT_SELECTION)
         if selection not in SELECTION_RULES:
             raise self.fail(
                 ("selection",),
@@ -705,11 +726,30 @@ class _Reader:
                         "own; a diagnostic runs at another recipe's setting, so list it in one "
                         "place",
                     )
+                self.ablation_of(ablation, method, where)
                 if ablation in seen:
                     raise self.fail(where, f"{ablation!r} is listed twice; list each once")
                 seen.add(ablation)
             out[method] = list(ablations)
         return out
+
+    def ablation_of(self, recipe: str, method: str, where: tuple[str, ...]) -> None:
+        """Refuse a diagnostic ``recipe`` that is no ablation of ``method``: the report compares
+        each with its method as the method with a part removed."""
+        of = RECIPES[recipe].ablation_of
+        if of == method:
+            return
+        if of is None:
+            raise self.fail(
+                where,
+                f"{recipe!r} is no ablation (a method of its own); list the ablations of "
+                f"{method!r} here, or compare {recipe!r} as one of the recipes",
+            )
+        raise self.fail(
+            where,
+            f"{recipe!r} is an ablation of {of!r}, not of {method!r}; list it under "
+            f'{of} = ["{recipe}"], with {of!r} among the recipes',
+        )
 
     def generalization(self, value: Any, evaluation: Phase) -> tuple[list[str], int]:
         """The distraction modes (checked, each a dm_control evaluation task's) and episodes."""
@@ -723,6 +763,11 @@ class _Reader:
         modes = table["modes"]
         if not isinstance(modes, list) or not all(isinstance(m, str) for m in modes):
             raise self.fail((*where, "modes"), f"give a list ({SCHEMA[where]['modes']})")
+        repeated = sorted({mode for mode in modes if modes.count(mode) > 1})
+        if repeated:
+            raise self.fail(
+                (*where, "modes"), f"{repeated[0]!r} is listed twice; list each mode once"
+            )
         try:
             modes = parse_distractions(modes, "modes")
         except SetupError as err:
