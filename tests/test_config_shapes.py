@@ -91,5 +91,9 @@ def test_the_closed_form_of_the_paper_encoders():
 def test_a_train_config_is_refused_just_below_the_smallest_size(cameras):
     agent = {"agent.reduce_kernel": 5, "agent.reduce_stride": 2, "cameras": cameras}
     assert resolve(None, {**agent, "image_size": 23}).image_size == 23
-    with pytest.raises(SetupError, match=r"--image-size 22: too small .* --image-size 23 or more"):
+    with pytest.raises(
+        SetupError,
+        match=r"--image-size 22 \(TrainConfig.image_size\): too small .* --image-size 23 "
+        r"\(TrainConfig.image_size=23\) or more",
+    ):
         resolve(None, {**agent, "image_size": 22})
