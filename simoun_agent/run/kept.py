@@ -98,9 +98,12 @@ def json_kind(value: Any) -> str:
 
 def read_json_object(path: Path) -> dict[str, Any]:
     """The JSON object in ``path``; :class:`Damaged` for what :func:`read_text` refuses, an
-    empty file, text that is not JSON (cut short, say) or JSON that is not an object. OSError
-    for a file that cannot be read."""
-    text = read_text(path)
+    empty file, text that is not JSON (cut short, say), JSON that is not an object, or a file
+    that cannot be read (its callers name every such file the same way)."""
+    try:
+        text = read_text(path)
+    except OSError as err:
+        raise Damaged(f"it cannot be read ({err.strerror})") from None
     if not text.strip():
         raise Damaged("it is empty")
     try:

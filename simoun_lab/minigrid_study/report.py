@@ -125,8 +125,6 @@ def read_summary(path: Path) -> dict[str, Any]:
         summary = read_json_object(path)
     except Damaged as err:
         raise damaged(path, str(err)) from None
-    except OSError as err:
-        raise damaged(path, f"it cannot be read ({err.strerror})") from None
     for key in SUMMARY_KEYS:
         value = summary.get(key)
         if not (is_real(value) and value > 0):
@@ -142,12 +140,12 @@ def read_summary(path: Path) -> dict[str, Any]:
 def check_config(path: Path, spec: StudySpec, run: Run) -> None:
     """SetupError naming a finished run's ``config.json`` when it is damaged, or records
     another run or a run of another spec: its results would be counted as this run's."""
+    if not present(path):
+        raise damaged(path, unreadable(FileNotFoundError()))
     try:
         config = read_json_object(path)
     except Damaged as err:
         raise damaged(path, str(err)) from None
-    except OSError as err:
-        raise damaged(path, unreadable(err)) from None
     if config.get("run") != run.name:
         raise damaged(path, f"its run is {json.dumps(config.get('run'))}, not {run.name!r}")
     saved = config.get("spec")

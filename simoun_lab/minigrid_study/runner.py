@@ -41,8 +41,6 @@ def read_saved_spec(path: Path) -> dict[str, Any]:
         return read_json_object(path)
     except Damaged as err:
         problem = str(err)
-    except OSError as err:
-        problem = f"it cannot be read ({err.strerror})"
     raise SetupError(
         f"{path} is damaged: {problem}. Restore it from a copy (git checkout -- {path}, for a "
         "committed archive): it records the spec the archive's runs were trained with"

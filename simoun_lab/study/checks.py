@@ -122,8 +122,6 @@ def read_config(path: Path) -> dict[str, Any]:
         return read_json_object(path)
     except Damaged as err:
         problem = str(err)
-    except OSError as err:
-        problem = f"it cannot be read ({err.strerror})"
     run_dir = path.parent
     raise SetupError(
         f"{path} is damaged: {problem}. Restore it from a copy (the study directory and its "

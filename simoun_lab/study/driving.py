@@ -58,8 +58,6 @@ def read_references(study_dir: Path) -> dict[str, Any] | None:
         references = read_json_object(path)
     except Damaged as err:
         raise SetupError(f"{path} is damaged: {err}; {fix}") from None
-    except OSError as err:
-        raise SetupError(f"{path} cannot be read ({err.strerror}); {fix}") from None
     if missing := [key for key in REFERENCE_KEYS if key not in references]:
         raise SetupError(f"{path} lacks {', '.join(missing)}; {fix}")
     if not isinstance(references["drivers"], dict):

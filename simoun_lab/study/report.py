@@ -718,8 +718,6 @@ def read_update_costs(study_dir: Path) -> dict[str, Any] | None:
         costs = read_json_object(path)
     except Damaged as err:
         problem = str(err)
-    except OSError as err:
-        problem = f"it cannot be read ({err.strerror})"
     else:
         missing = [key for key in UPDATE_COST_KEYS if key not in costs]
         tables = [key for key in ("ratio", "ms_per_update") if not isinstance(costs.get(key), dict)]

@@ -96,8 +96,6 @@ def read_record(path: Path) -> dict[str, Any]:
         record = read_json_object(path)
     except Damaged as err:
         problem = str(err)
-    except OSError as err:
-        problem = f"it cannot be read ({err.strerror})"
     else:
         problem = record_problem(record)
         if problem is None:

@@ -330,8 +330,6 @@ class SweepSpec:
             data = read_json_object(path)
         except Damaged as err:
             problem = str(err)
-        except OSError as err:
-            problem = f"it cannot be read ({err.strerror})"
         else:
             problem = saved_problem(data) or ""
         if not problem:
@@ -364,8 +362,6 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
         saved = flatten(read_json_object(path))
     except Damaged as err:
         return f"{CONFIG_NAME} is damaged: {err}"
-    except OSError as err:
-        return f"{CONFIG_NAME} cannot be read ({err.strerror})"
     for key in ("env", "seed", *grid):
         recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
         if key in saved and recorded != wanted:

@@ -194,8 +194,6 @@ def read_json(path: Path) -> dict[str, Any]:
         return read_json_object(path)
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
-    except OSError as err:
-        raise DamagedRun(f"{path.name} cannot be read ({err.strerror})") from None
 
 
 def read_curve(path: Path) -> dict[str, np.ndarray]:

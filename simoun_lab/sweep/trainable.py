@@ -204,8 +204,6 @@ def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
         parts = read_json_object(path).get("parts")
     except Damaged as err:
         problem = str(err)
-    except OSError as err:
-        problem = f"it cannot be read ({err.strerror})"
     else:
         if isinstance(parts, list) and all(isinstance(part, dict) for part in parts):
             return parts
