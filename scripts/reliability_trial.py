@@ -7,6 +7,7 @@ Python API and the files users keep, each classified by what the user is told.
     python scripts/reliability_trial.py --markdown out.md
     python scripts/reliability_trial.py --set third --only 0,5,12   # three of one trial's cases
     python scripts/reliability_trial.py --set fifth --timeout 90    # the fifth trial
+    python scripts/reliability_trial.py --set sixth --timeout 90    # the sixth trial
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
 it needs one) and is stopped after 20 s (``--timeout``; spec cases that import Ray want about 90 s
@@ -3395,6 +3396,28 @@ CASES = (
 )  # fmt: skip
 
 
+SIXTH_MODULES = (
+    "reliability_sixth_agent",
+    "reliability_sixth_lab",
+    "reliability_sixth_files",
+    "reliability_sixth_api",
+)
+"""The sixth trial's cases, one module of this directory per area, each with a list ``CASES``
+made with this module's helpers (imported when the trial is selected: they import this module)."""
+
+
+def sixth_cases() -> list[dict]:
+    """Every case of :data:`SIXTH_MODULES`, marked as the sixth trial's."""
+    import importlib
+
+    cases = []
+    for name in SIXTH_MODULES:
+        for case in importlib.import_module(name).CASES:
+            case["set"] = "sixth"
+            cases.append(case)
+    return cases
+
+
 def tiny_run(where: Path) -> Path:
     """A tiny finished simoun-train run (40 env steps, PointReach 32x32)."""
     from simoun_agent.cli import train
@@ -3527,7 +3550,7 @@ def main() -> int:
     )
     parser.add_argument(
         "--set",
-        choices=("first", "second", "third", "fourth", "fifth"),
+        choices=("first", "second", "third", "fourth", "fifth", "sixth"),
         help="only that trial's cases (default: all)",
     )
     parser.add_argument(
@@ -3542,9 +3565,10 @@ def main() -> int:
     args = parser.parse_args()
     for name in COMMANDS.values():  # imported once, before the children fork
         __import__(name)
+    every = CASES + (sixth_cases() if args.set in (None, "sixth") else [])
     cases = [
         case
-        for case in CASES
+        for case in every
         if (args.area is None or case["area"] in args.area)
         and (args.command is None or case.get("command", "api") in args.command)
         and (args.set is None or case.get("set", "first") == args.set)
