@@ -38,6 +38,12 @@ PPO_CHECK = lab_copy("minigrid-v2/ppo-check", "ppoc")
 SPEC_COPY = put("my-dmc100k.toml", SPEC)  # the archive's spec kept under another name
 
 
+def without(argv: list[str], flag: str) -> list[str]:
+    """``argv`` without ``flag`` and its value."""
+    at = argv.index(flag)
+    return argv[:at] + argv[at + 2 :]
+
+
 def made_dir(name: str):
     """Work: an empty directory ``name`` in the case's directory."""
     return lambda here: (here / name).mkdir()
@@ -60,8 +66,9 @@ def tuning_json(change) -> str:
 # command lines: (command, argv, what the refusal names[, valid[, works]])
 FLAGS = [
     # simoun-sweep: refused before Ray starts, or (the guard) read as work started
-    ("sweep", sweep_tiny("--envs", "Pendulum-v1,Pendulum-v1"), ("Pendulum-v1", "--envs")),
-    ("sweep", sweep_tiny("--envs", "Pendulum-v1,"), "--envs"),
+    ("sweep", [*without(sweep_tiny(), "--env"), "--envs", "Pendulum-v1,Pendulum-v1"],
+     ("Pendulum-v1", "--envs")),
+    ("sweep", [*without(sweep_tiny(), "--env"), "--envs", "Pendulum-v1,"], "--envs"),
     ("sweep", sweep_tiny("--seeds", "0,2,5"), "", True),
     ("sweep", sweep_tiny("--seeds", "0..4"), "--seeds"),
     ("sweep", sweep_tiny("--seeds", "0 1 2"), "--seeds"),
@@ -73,7 +80,7 @@ FLAGS = [
     ("sweep", sweep_tiny("--cpus-per-trial", "1.5"), "--cpus-per-trial"),
     ("sweep", sweep_tiny("--gpus-per-trial", "0"), "", True),
     ("sweep", sweep_tiny("--num-cpus", "-1"), "--num-cpus"),
-    ("sweep", sweep_tiny("--grid", "image_size=32,48"), "", True),
+    ("sweep", [*without(sweep_tiny(), "--image-size"), "--grid", "image_size=32,48"], "", True),
     ("sweep", sweep_tiny("--grid", "agent.lr=1e-3"), "agent.lr", True),
     ("sweep", sweep_tiny("--grid", "agent.recipe=drqv2", "--grid", "agent.n_step=1,3"),
      "n_step", True),
