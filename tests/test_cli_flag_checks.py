@@ -79,6 +79,24 @@ def test_a_subcommand_option_given_twice_is_refused(main, argv, said, capsys):
     assert said in err and "give it once" in err
 
 
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (minigrid_cli.main, ["Run", "--archive", "mg"],
+         f"unknown subcommand 'Run' (did you mean run?); {MINIGRID} takes one of run, report, "
+         f"select, probe first, e.g. `{MINIGRID} run --help`"),
+        (study_cli.main, ["Plan", "s.toml"], "unknown subcommand 'Plan' (did you mean plan?)"),
+        (analyze_cli.main, ["mask", "RUN"], "unknown subcommand 'mask' (did you mean masks?)"),
+        (study_cli.main, ["--study-dir", "a", "run", "s.toml"],
+         "--study-dir comes before the subcommand; simoun-study takes its subcommand first (put "
+         "run before --study-dir)"),
+        (minigrid_cli.main, ["--archive", "mg"], "(name one of run, report, select, probe)"),
+    ],
+)  # fmt: skip
+def test_a_word_that_is_no_subcommand_is_named_with_the_close_ones(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
 def test_the_same_subcommand_option_twice_with_one_value_is_kept(capsys):
     # refused for the missing spec, not for the option given twice alike
     err = refused(capsys, study_cli.main, ["plan", "s.toml", "--probe-updates", "1",

@@ -221,6 +221,34 @@ def bool_argv(argv: Sequence[str], flags: Iterable[str]) -> list[str]:
     return out
 
 
+def refuse_unknown_subcommand(argv: Sequence[str], command: Any, prog: str) -> None:
+    """Raise ValueError when ``argv`` does not start with one of ``command``'s subcommands: a
+    word that is none of them (``Run`` for ``run``, ``plot`` for ``report``), named with the
+    close ones, or flags before the subcommand. tyro would answer with a box listing every word
+    as a misplaced option."""
+    named = subcommands(command)
+    words = [arg for arg in argv if arg not in ("--help", "-h")]
+    if not named or not words or words[0] in named:
+        return
+    first = words[0]
+    example = f"`{prog} {next(iter(named))} --help`"
+    if first.startswith("-"):
+        later = next((arg for arg in words if arg in named), None)
+        where = f"put {later} before {first}" if later else f"name one of {', '.join(named)}"
+        raise ValueError(
+            f"{first} comes before the subcommand; {prog} takes its subcommand first ({where}), "
+            f"e.g. {example}"
+        )
+    lowered = {name.lower(): name for name in named}
+    close = lowered.get(first.lower())
+    options = [close] if close else close_keys(first, dict.fromkeys(named, ""))
+    hint = f" (did you mean {' or '.join(options)}?)" if options else ""
+    raise ValueError(
+        f"unknown subcommand {first!r}{hint}; {prog} takes one of {', '.join(named)} first, "
+        f"e.g. {example}"
+    )
+
+
 def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str) -> None:
     """Raise ValueError for a ``--flag`` of ``argv`` that is not one of ``flags`` (the command's,
     :func:`~simoun_agent.cli.command_flags.command_flags`), naming the flags it most likely
@@ -565,6 +593,7 @@ def parse(
         sys.exit(0)
     try:
         argv = bool_argv(argv, switches)
+        refuse_unknown_subcommand(argv, cls, prog)
         flags = command_flags(cls, argv)
         refuse_unknown(argv, flags, cls, prog)
         refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
