@@ -163,13 +163,16 @@ EVAL, RESUME, REPORT, MASKS = (FILE_COMMANDS[c] for c in ("eval", "train", "repo
 RUN_COMMANDS = {"eval": EVAL, "train": RESUME, "report": REPORT, "analyze": MASKS}
 
 
-def on_run(commands: str, what: str, works, names, ok: bool = False) -> list[dict]:
+def on_run(
+    commands: str, what: str, works, names, ok: bool = False, valid_for: str = ""
+) -> list[dict]:
     """One case per command of ``commands`` (space-separated keys of :data:`RUN_COMMANDS`) on
-    the run changed by ``works``."""
+    the run changed by ``works``; valid (``ok``) for all, or for those of ``valid_for``."""
     return [
-        fifth("files", command, RUN_COMMANDS[command], names, ok, works=works, what=what)
+        fifth("files", command, RUN_COMMANDS[command], names, ok or command in valid_for.split(),
+              works=works, what=what)
         for command in commands.split()
-    ]
+    ]  # fmt: skip
 
 
 def run_file(name: str, how):
@@ -230,16 +233,18 @@ RUN_CSV = [
     *on_run("train report", "eval.csv saved by pandas with its index column",
             (run_file("eval.csv", PANDAS_INDEX),), "eval.csv", True),
 ]  # fmt: skip
-# JSON files of valid syntax with a wrong type or size deep inside, and valid variants
+# JSON files of valid syntax with a wrong type or size deep inside, and valid variants; a damaged
+# config.json is a file simoun-eval does not need (it rebuilds the run from the checkpoint's own)
 RUN_JSON = [
     *on_run("eval train", "config.json with agent.lr as a string",
             (run_file("config.json", edit_json(lambda d: d["agent"].update(lr="0.001"))),),
-            "lr"),
+            "lr", valid_for="eval"),
     *on_run("eval", "config.json with agent a list",
-            (run_file("config.json", edit_json(lambda d: d.update(agent=[]))),), "agent"),
+            (run_file("config.json", edit_json(lambda d: d.update(agent=[]))),), "agent",
+            True),
     *on_run("eval", "config.json with env_kwargs a list",
             (run_file("config.json", edit_json(lambda d: d.update(env_kwargs=[]))),),
-            "env_kwargs"),
+            "env_kwargs", True),
     *on_run("train", "config.json with eval_distraction a string",
             (run_file("config.json", edit_json(
                 lambda d: d.update(eval_distraction="color_easy"))),),
@@ -248,17 +253,18 @@ RUN_JSON = [
             (run_file("config.json", edit_json(lambda d: d["agent"].update(batch_size=8.0))),),
             "batch_size", True),
     *on_run("eval train", "config.json with a 31-digit seed",
-            (run_file("config.json", edit_json(lambda d: d.update(seed=HUGE))),), "seed"),
+            (run_file("config.json", edit_json(lambda d: d.update(seed=HUGE))),), "seed",
+            valid_for="eval"),
     *on_run("eval train", "config.json with CRLF line endings",
             (run_file("config.json", CRLF),), "config.json", True),
     *on_run("eval train", "config.json appended to itself",
-            (run_file("config.json", TWICE),), "config.json"),
+            (run_file("config.json", TWICE),), "config.json", valid_for="eval"),
     *on_run("train", "config.json with agent.lr a list",
             (run_file("config.json", edit_json(lambda d: d["agent"].update(lr=[0.001]))),),
             "lr"),
     *on_run("eval", "config.json with image_size 32.5",
             (run_file("config.json", edit_json(lambda d: d.update(image_size=32.5))),),
-            "image_size"),
+            "image_size", True),
     *on_run("train", "config.json with total_env_steps 1e30",
             (run_file("config.json", edit_json(lambda d: d.update(total_env_steps=1e30))),),
             "total_env_steps"),
@@ -338,8 +344,7 @@ STUDY_CASES = [
 ]  # fmt: skip
 MG_REPORT = ["report", "--archive", "mg"]
 MGT_SELECT = ["select", "--archive", "mgt"]
-MGT_RESUME = ["run", "mgt/spec.json", "--study-dir", "s", "--archive", "mgt", "--resume",
-              "--allow-other-commit"]  # fmt: skip
+MGT_RESUME = ["run", "mgt/spec.json", "--study-dir", "s", "--archive", "mgt", "--resume"]
 MGT_PPO_S100 = "mgt/MiniGrid-DoorKey-6x6-v0/rnd,normalization=paper,scale=0.5/s100"
 # the MiniGrid archives: (command, argv, what, works, names[, valid])
 MINIGRID_CASES = [
