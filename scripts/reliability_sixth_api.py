@@ -248,7 +248,8 @@ SIXTH_CODES = [
      "{})); d['agent']['recipe'] = 'drqq'; from_dict(d)", "drqq"),
     # copies of a wrapper whose model trains in a thread
     (CUR + f"m = CuriosityModel.for_env({M64}); e = w.ConsistencyCuriosityReward({M64}, m); "
-     f"{STEP}; c = pickle.loads(pickle.dumps(e)); c.step(c.action_space.sample())",
+     f"{STEP}; c = pickle.loads(pickle.dumps(e)); c.reset(seed=1); "
+     "c.step(c.action_space.sample())",
      ("pickle", "CuriosityModel", "thread"), True),
 ]  # fmt: skip
 
