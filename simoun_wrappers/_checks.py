@@ -58,9 +58,9 @@ def plain(value: Any) -> Any:
         return value.item()
     if isinstance(value, np.ndarray):
         return value.tolist()
-    if isinstance(value, (list, tuple)):
+    if type(value) in (list, tuple):  # not a named tuple, whose fields are its arguments
         return type(value)(plain(item) for item in value)
-    if isinstance(value, dict):
+    if type(value) is dict:
         return {key: plain(item) for key, item in value.items()}
     return value
 

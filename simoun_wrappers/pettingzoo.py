@@ -115,9 +115,9 @@ class SimounParallelObservation(BaseParallelWrapper):
         return True
 
     def _check_agent(self, agent: Any, call: str) -> None:
-        """A KeyError naming the env's agents for an ``agent`` that is none of them."""
+        """A ValueError naming the env's agents for an ``agent`` that is none of them."""
         if agent not in self.env.possible_agents:
-            raise KeyError(
+            raise ValueError(
                 f"SimounParallelObservation.{call}({agent!r}): no such agent; this env's agents "
                 f"are {list(self.env.possible_agents)} (env.possible_agents)."
             )

@@ -193,7 +193,7 @@ def test_wrapping_twice_is_refused():
 def test_agent_names_actions_and_seeds_are_checked_naming_the_agents():
     env = SimounParallelObservation(JoiningAgents(), size=8)
     for call in (env.observation_space, env.action_space):
-        with pytest.raises(KeyError, match=r"'nope'\): no such agent.*\['a0', 'a1'\]"):
+        with pytest.raises(ValueError, match=r"'nope'\): no such agent.*\['a0', 'a1'\]"):
             call("nope")
     with pytest.raises(ValueError, match=r"reset\(seed=...\) takes None or an int"):
         env.reset(seed=True)
