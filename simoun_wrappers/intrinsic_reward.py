@@ -23,7 +23,14 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
-from simoun_wrappers._checks import is_int, is_real
+from simoun_wrappers._checks import (
+    check_action,
+    check_reset_seed,
+    check_vector_reset_seed,
+    is_int,
+    is_real,
+    plain,
+)
 from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
@@ -90,6 +97,38 @@ class TripletReader:
 def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
     """A function taking a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``."""
     return TripletReader(space)
+
+
+def _observation_space(env: gym.Env | VectorEnv) -> spaces.Space:
+    return env.single_observation_space if isinstance(env, VectorEnv) else env.observation_space
+
+
+def env_triplet_reader(env: gym.Env | VectorEnv, owner: str) -> TripletReader:
+    """The :class:`TripletReader` of ``env``'s (for a vector env, each sub-env's) observations.
+    When they are no triplets but wrappers over an env of triplets changed them (Gymnasium's
+    ``NormalizeObservation``, ``FlattenObservation``), the TypeError names those wrappers and
+    the order that works: ``owner`` reads the triplets, the wrappers go outside it."""
+    try:
+        return TripletReader(_observation_space(env))
+    except (TypeError, ValueError):
+        over: list[str] = []
+        inner = env
+        while isinstance(inner, (gym.Wrapper, VectorWrapper)):
+            over.append(type(inner).__name__)
+            inner = inner.env
+            try:
+                triplet_shape(_observation_space(inner))
+            except (TypeError, ValueError):
+                continue
+            outside = ", ".join(over)
+            raise TypeError(
+                f"{owner} reads Simoun frame triplets, but {outside} over "
+                f"{type(inner).__name__} changed them to {_observation_space(env)}. Put "
+                f"{outside} outside {owner}: e.g. {over[0]}({owner}({type(inner).__name__}(env, "
+                f"...), ...)) gives the reward the triplets and the learner the changed "
+                "observations."
+            ) from None
+        raise
 
 
 LARGEST = np.finfo(np.float64).max
@@ -292,7 +331,7 @@ class IntrinsicMechanism(ABC):
         # constant bonus fixes its normalization, warm-up and progress)
         taken = inspect.signature(type(self).__init__).parameters
         gym.utils.RecordConstructorArgs.__init__(
-            self, **{key: value for key, value in recorded.items() if key in taken}
+            self, **{key: plain(value) for key, value in recorded.items() if key in taken}
         )
         self.signal = self.signal_type(**arguments)
         self.normalization = make_normalization(normalization, **paper)
@@ -395,12 +434,13 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
 
     def _attach(self, env: gym.Env) -> None:
         gym.Wrapper.__init__(self, env)
-        self._read = triplet_reader(env.observation_space)
+        self._read = env_triplet_reader(env, type(self).__name__)
         self._last_triplet: np.ndarray | None = None
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, type(self).__name__)
         obs, info = self.env.reset(seed=seed, options=options)
         self._last_triplet = self._read(obs)
         return obs, info
@@ -408,6 +448,7 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
         if self._last_triplet is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
+        check_action(action, self.action_space, type(self).__name__)
         obs, extrinsic, terminated, truncated, info = self.env.step(action)
         extrinsic = float(extrinsic)
         batch = np.array([extrinsic], dtype=np.float64)
@@ -447,7 +488,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
 
     def _attach(self, env: VectorEnv) -> None:
         VectorWrapper.__init__(self, env)
-        self._read = triplet_reader(env.single_observation_space)
+        self._read = env_triplet_reader(env, type(self).__name__)
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
         self._prev_dones = np.zeros(self.num_envs, dtype=bool)
         self._last_triplets: np.ndarray | None = None
@@ -457,6 +498,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     ) -> tuple[Any, dict[str, Any]]:
         # read before the reset: Gymnasium's vector envs pop "reset_mask" from the options
         mask = None if options is None else options.get("reset_mask")
+        seed = check_vector_reset_seed(seed, type(self).__name__, self.num_envs)
         obs, info = self.env.reset(seed=seed, options=options)
         # a masked reset returns the other sub-envs' observations unchanged
         self._last_triplets = self._read(obs)
@@ -467,6 +509,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
         if self._last_triplets is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
+        check_action(actions, self.action_space, type(self).__name__, vector=self.num_envs)
         obs, extrinsic, terminated, truncated, info = self.env.step(actions)
         triplets = self._read(obs)
         # The triplet that ends a SAME_STEP episode is in final_obs; obs already holds the reset.

@@ -281,3 +281,56 @@ def test_load_state_dict_refuses_a_state_that_does_not_fit_and_loads_nothing():
         env.load_state_dict(before)
         assert env.state_dict() == before
         env.close()
+
+
+def test_the_vector_wrappers_check_the_actions_and_seeds_of_their_sub_envs():
+    envs = RNDVectorReward(vector(AutoresetMode.SAME_STEP), Recorder(), warmup=0)
+    with pytest.raises(
+        ValueError, match=r"seed=\[...\]\) takes one seed per sub-env, 2 here, got 3"
+    ):
+        envs.reset(seed=[0, 1, 2])
+    with pytest.raises(ValueError, match=r"RNDVectorReward.reset\(seed=...\) takes None or an int"):
+        envs.reset(seed=[0, True])
+    envs.reset(seed=[np.int64(0), None])
+    for wrong, said in [
+        (np.zeros(1, np.int64), r"of shape \(1,\), not \(2,\)"),
+        (np.array([0.5, 0.5]), "ndarray of dtype float64, not ints"),
+    ]:
+        with pytest.raises(ValueError, match=rf"MultiDiscrete\(\[2 2\]\): {said}.*one per sub-env"):
+            envs.step(wrong)
+    envs.step([0, 1])
+    pendulums = ConstantBonusVectorReward(SyncVectorEnv([pendulum, pendulum]), scale=0.1)
+    pendulums.reset(seed=0)
+    with pytest.raises(ValueError, match=r"of shape \(2,\), not \(2, 1\)"):
+        pendulums.step(np.zeros(2))
+    pendulums.step(np.zeros((2, 1)))
+
+
+def test_a_single_reward_wrapper_checks_the_action_and_the_seed():
+    env = ConstantBonusReward(cartpole(), scale=0.1)
+    with pytest.raises(ValueError, match=r"ConstantBonusReward.reset\(seed=...\)"):
+        env.reset(seed=True)
+    env.reset(seed=np.int64(0))
+    with pytest.raises(ValueError, match=r"Discrete\(2\): float of dtype float64, not ints"):
+        env.step(0.5)
+
+
+@pytest.mark.parametrize(
+    ("between", "fold_frames"),
+    [(gym.wrappers.FlattenObservation, False), (gym.wrappers.NormalizeObservation, True)],
+)
+def test_a_gymnasium_wrapper_between_is_named_with_the_order_that_works(between, fold_frames):
+    def pixels() -> gym.Env:
+        pendulum = gym.make("Pendulum-v1", render_mode="rgb_array")
+        return SimounObservation(pendulum, size=16, fold_frames=fold_frames)
+
+    name = between.__name__
+    with pytest.raises(
+        TypeError,
+        match=rf"but {name} over SimounObservation changed them.*Put {name} outside "
+        rf"ConstantBonusReward: e.g. {name}\(ConstantBonusReward\(SimounObservation",
+    ):
+        ConstantBonusReward(between(pixels()), scale=0.1)
+    right = between(ConstantBonusReward(pixels(), scale=0.1))
+    right.reset(seed=0)
+    right.step(right.action_space.sample())
