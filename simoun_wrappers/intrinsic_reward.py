@@ -586,9 +586,10 @@ def check_constant_normalization(normalization: Any, owner: str) -> None:
     raise ValueError(
         f"{owner} takes no normalization, got normalization={normalization!r}: its raw value is "
         "the constant 1, whose running std is 0 ('reward_std' and 'standardize' would pay 0 at "
-        "every step), so the bonus is scale itself. Drop normalization (the bonus b a step is "
-        f"{owner}(env, scale=b)); to pay a normalized novelty use RNDReward or "
-        "ConsistencyCuriosityReward with that normalization."
+        "every step), and 'paper' or 'return_std' would scale it by the env's rewards or by "
+        "time, so it would no longer be the control it is; the bonus is scale itself. Drop "
+        f"normalization (a bonus of b a step is {owner}(env, scale=b)); to pay a normalized "
+        "novelty use RNDReward or ConsistencyCuriosityReward with that normalization."
     )
 
 
