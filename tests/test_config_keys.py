@@ -62,3 +62,19 @@ def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
     refused = r"unknown preset 'gpu' \(did you mean 'cpu'\?\); choose one of .*cpu"
     with pytest.raises(SetupError, match=refused):
         resolve("gpu", {})
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        ("agent-lr", "agent.lr"),
+        ("agent_lr", "agent.lr"),
+        ("Agent.LR", "agent.lr"),
+        ("agent-batch-size", "agent.batch_size"),
+        ("agent.batch.size", "agent.batch_size"),
+    ],
+)
+def test_a_key_with_another_separator_is_answered_with_the_key_itself(typed, meant):
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {typed: 1e-3})
+    assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)

@@ -126,7 +126,12 @@ def build(
 ) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
     """The training env's runner (in this process or a background one), the evaluation env,
     the agent and an empty replay; each random stream seeded from its child of the run's
-    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first."""
+    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first, after
+    the config's own rules (checked again: it may have been changed since it was built)."""
+    try:
+        check_train_config(config)
+    except ValueError as err:
+        raise SetupError(str(err)) from None
     seed = config.seed
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
