@@ -91,6 +91,9 @@ def check_config_file(payload: dict) -> None:
             "restore the file from a copy (simoun-train writes UTF-8 JSON), or move it aside "
             f"(mv {path} {path}.damaged) to read the checkpoint on its own"
         ) from None
-    # both sides read the same way, so keys a version added later compare as equal
-    as_saved = to_dict(from_dict(saved, str(path)))
-    check_config({"config": to_dict(from_dict(payload["config"]))}, as_saved, run_dir, saved=path)
+    # Both sides read the same way, so keys a version added later compare as equal; the device
+    # is this machine's choice (load_run's ``device``), so a GPU run's reads on a CPU machine.
+    machine = {"device": "cpu"}
+    as_saved = to_dict(from_dict({**saved, **machine}, str(path)))
+    checkpoint = to_dict(from_dict({**payload["config"], **machine}))
+    check_config({"config": checkpoint}, as_saved, run_dir, saved=path)

@@ -127,12 +127,12 @@ def read_summary(path: Path, spec: StudySpec, run: Run) -> dict[str, Any]:
         summary = read_json_object(path)
     except Damaged as err:
         raise damaged(path, str(err)) from None
-    if summary.get("run") != run.name:  # a copy of another run's would count its results twice
-        raise damaged(path, f"its run is {json.dumps(summary.get('run'))}, not {run.name!r}")
     for key in SUMMARY_KEYS:
         value = summary.get(key)
         if not (is_real(value) and value > 0):
             raise damaged(path, f"{key} is {json.dumps(value)}, not a number > 0")
+    if summary.get("run") != run.name:  # a copy of another run's would count its results twice
+        raise damaged(path, f"its run is {json.dumps(summary.get('run'))}, not {run.name!r}")
     rollout = spec.ppo.n_envs * spec.ppo.n_steps  # PPO stops after the rollout that passes it
     steps, budget = summary["env_steps"], run.task.steps
     if not budget <= steps < budget + rollout:
