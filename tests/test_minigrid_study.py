@@ -21,6 +21,7 @@ import ray  # noqa: F401  (the lab extra: a missing install fails instead of ski
 import torch
 from gymnasium.vector import AutoresetMode
 
+from simoun_agent.config import SetupError
 from simoun_lab.minigrid_study.__main__ import main
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT, restore
 from simoun_lab.minigrid_study.envs import STATE_KEY, SB3VecEnv, minigrid_pixels
@@ -549,3 +550,27 @@ def test_a_sac_study_archive_is_told_apart_from_a_minigrid_one(tmp_path, capsys)
     err = capsys.readouterr().err
     assert exit_info.value.code == 2 and "Traceback" not in err
     assert f"--study-dir {archive} holds runs of a SAC study ({archive / 'study.json'})" in err
+
+
+@pytest.mark.parametrize(
+    ("edit", "said"),
+    [
+        (('"device": "cpu"', '"device": "cpu",'), "a comma after the last item, line 47: JSON "
+         "allows none there; remove it"),
+        (("101\n", "101,\n"), "a comma after the last item, line 8: JSON allows none "
+         "there; remove it"),
+        (('"evaluations": 20,', '"evaluations": 20, // twenty'), "a comment, line 44: JSON has "
+         "no comments; remove it"),
+        (('"evaluations": 20,', '"evaluations": 20'), "Expecting ',' delimiter, line 45 column 3"),
+    ],
+)  # fmt: skip
+def test_a_hand_edited_json_spec_is_told_where_and_why_it_is_not_json(edit, said, tmp_path):
+    text = Path("docs/studies/minigrid-v2/tuning/spec.json").read_text()
+    path = tmp_path / "spec.json"
+    path.write_text(text.replace(*edit))
+    with pytest.raises(SetupError) as refused:
+        load_spec(path)
+    assert str(refused.value) == f"--spec {path} is not valid JSON: {said}"
+    with pytest.raises(SetupError) as refused:
+        load_ppo_spec(str(path))
+    assert str(refused.value).startswith(f"the study spec {path} is not valid JSON: {said}")

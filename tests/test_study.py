@@ -168,6 +168,19 @@ def restamp(record_path: Path) -> None:
     record_path.write_text(json.dumps(record))
 
 
+def test_a_renamed_copy_of_the_spec_is_told_that_a_study_is_named_for_its_spec_file(
+    study, tmp_path, capsys
+):
+    spec_path, _, archive = study
+    renamed = tmp_path / f"my-{spec_path.name}"
+    shutil.copy(spec_path, renamed)
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["report", str(renamed), "--study-dir", str(archive)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and "a study is named for its spec file" in err
+    assert f"pass the spec under the name {spec_path.name}" in err
+
+
 def test_resume_from_the_archive_reruns_only_the_missing_run(study, tmp_path, capsys):
     spec_path, study_dir, archive = study
     # the study directory is gone (another machine); the archive lost one evaluation run

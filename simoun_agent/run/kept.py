@@ -28,6 +28,22 @@ STEP_LIMIT = 2**63
 _UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")
 
 
+def json_problem(text: str, err: json.JSONDecodeError) -> str:
+    """Where and why ``text`` is not JSON (``err``, json's error on it), in the words of a
+    person who edited the file: the two slips of hand-edited JSON are named, since json's own
+    message hides them (a comma after the last item, which it reports on the line after, and a
+    comment), else json's message with its line and column."""
+    before, rest = text[: err.pos].rstrip(), text[err.pos :]
+    if before.endswith(",") and rest.lstrip()[:1] in ("}", "]"):
+        return (
+            f"a comma after the last item, line {before.count(chr(10)) + 1}: JSON allows none "
+            "there; remove it"
+        )
+    if rest.startswith(("//", "/*", "#")):
+        return f"a comment, line {err.lineno}: JSON has no comments; remove it"
+    return f"{err.msg}, line {err.lineno} column {err.colno}"
+
+
 class Damaged(ValueError):
     """A kept file that cannot be what the run wrote; ``str()`` says what is wrong with it."""
 
@@ -109,7 +125,7 @@ def read_json_object(path: Path) -> dict[str, Any]:
     try:
         value = json.loads(text)
     except json.JSONDecodeError as err:
-        raise Damaged(f"it is not JSON ({err})") from None
+        raise Damaged(f"it is not JSON ({json_problem(text, err)})") from None
     if not isinstance(value, dict):
         raise Damaged(f"it holds {json_kind(value)}, not a JSON object")
     return value

@@ -19,7 +19,7 @@ import gymnasium as gym
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
-from simoun_agent.run.kept import Damaged, json_kind, read_text
+from simoun_agent.run.kept import Damaged, json_kind, json_problem, read_text
 from simoun_lab.minigrid_study.arms import ARMS, arm_settings
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
@@ -236,24 +236,27 @@ def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
     return build(StudySpec, values, where)
 
 
-def load_spec(path: Path) -> StudySpec:
-    """The spec in the JSON file ``path``."""
+def load_spec(path: Path, label: str = "--spec") -> StudySpec:
+    """The spec in the JSON file ``path``; errors name it as ``label`` (the flag or argument it
+    was given by)."""
     try:
-        values = json_value(read_text(Path(path)))
+        text = read_text(Path(path))
+        values = json_value(text)
     except FileNotFoundError:
-        raise SetupError(f"--spec {path}: no such file") from None
+        raise SetupError(f"{label} {path}: no such file") from None
     except Damaged as err:
         raise SetupError(
-            f"--spec {path} cannot be read ({err}); pass a JSON spec saved as UTF-8 text"
+            f"{label} {path} cannot be read ({err}); pass a JSON spec saved as UTF-8 text"
         ) from None
     except json.JSONDecodeError as err:
-        raise SetupError(f"--spec {path}: not valid JSON ({err})") from None
+        raise SetupError(f"{label} {path} is not valid JSON: {json_problem(text, err)}") from None
     except ValueError as err:  # a key given twice
-        raise SetupError(f"--spec {path}: {err}") from None
+        raise SetupError(f"{label} {path}: {err}") from None
     if not isinstance(values, dict):
         raise SetupError(
-            f"--spec {path} holds {json_kind(values)}, not the object of a study spec "
+            f"{label} {path} holds {json_kind(values)}, not the object of a study spec "
             '({"tasks": [...], "arms": [...], ...}); write one as docs/studies/minigrid-v2/'
-            "tuning/spec.json does, or leave --spec out to use the archive's"
+            "tuning/spec.json does"
+            + (", or leave --spec out to use the archive's" if label == "--spec" else "")
         )
     return spec_from_dict(values, str(path))

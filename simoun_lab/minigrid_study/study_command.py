@@ -43,7 +43,7 @@ def is_ppo_spec(path: str) -> bool:
 def load_ppo_spec(path: str) -> StudySpec:
     """The MiniGrid PPO spec at ``path``, JSON or TOML; SetupError naming the file and key."""
     if Path(path).suffix.lower() == ".json":
-        return load_spec(Path(path))
+        return load_spec(Path(path), label="the study spec")
     return spec_from_dict(_toml(Path(path)) or {}, path)
 
 

@@ -173,6 +173,13 @@ def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: 
     existed has that key's default (read through :meth:`StudySpec.from_json`)."""
     saved, wanted = StudySpec.from_json(record["spec"]).to_json(), spec.to_json()
     changed = changed_keys(saved, wanted)
+    if changed == ["name"]:
+        raise SetupError(
+            f"{problem}: a study is named for its spec file, and the saved {STUDY_FILE} names "
+            f"study {saved['name']!r} where this spec file names {wanted['name']!r} (the specs "
+            f"are otherwise the same); pass the spec under the name {saved['name']}"
+            f"{Path(record['spec_file']).suffix or '.toml'} (a copy or a rename of this file)"
+        )
     if changed:
         raise SetupError(
             f"{problem} ({', '.join(changed)} differ from the saved {STUDY_FILE}); {fix}"
