@@ -8,6 +8,7 @@ Python API and the files users keep, each classified by what the user is told.
     python scripts/reliability_trial.py --set third --only 0,5,12   # three of one trial's cases
     python scripts/reliability_trial.py --set fifth --timeout 90    # the fifth trial
     python scripts/reliability_trial.py --set sixth --timeout 90    # the sixth trial
+    python scripts/reliability_trial.py --set seventh --timeout 90  # the seventh trial
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
 it needs one) and is stopped after 20 s (``--timeout``; spec cases that import Ray want about 90 s
@@ -3396,24 +3397,21 @@ CASES = (
 )  # fmt: skip
 
 
-SIXTH_MODULES = (
-    "reliability_sixth_agent",
-    "reliability_sixth_lab",
-    "reliability_sixth_files",
-    "reliability_sixth_api",
-)
-"""The sixth trial's cases, one module of this directory per area, each with a list ``CASES``
-made with this module's helpers (imported when the trial is selected: they import this module)."""
+AREAS = ("agent", "lab", "files", "api")
+"""the areas of a trial kept as modules: ``reliability_<trial>_<area>.py`` in this directory"""
+MODULE_TRIALS = ("sixth", "seventh")
+"""the trials whose cases live in those modules, each with a list ``CASES`` made with this
+module's helpers (imported when the trial is selected: they import this module)"""
 
 
-def sixth_cases() -> list[dict]:
-    """Every case of :data:`SIXTH_MODULES`, marked as the sixth trial's."""
+def module_cases(trial: str) -> list[dict]:
+    """Every case of ``trial``'s modules, marked as that trial's."""
     import importlib
 
     cases = []
-    for name in SIXTH_MODULES:
-        for case in importlib.import_module(name).CASES:
-            case["set"] = "sixth"
+    for area in AREAS:
+        for case in importlib.import_module(f"reliability_{trial}_{area}").CASES:
+            case["set"] = trial
             cases.append(case)
     return cases
 
@@ -3550,7 +3548,7 @@ def main() -> int:
     )
     parser.add_argument(
         "--set",
-        choices=("first", "second", "third", "fourth", "fifth", "sixth"),
+        choices=("first", "second", "third", "fourth", "fifth", *MODULE_TRIALS),
         help="only that trial's cases (default: all)",
     )
     parser.add_argument(
@@ -3565,7 +3563,12 @@ def main() -> int:
     args = parser.parse_args()
     for name in COMMANDS.values():  # imported once, before the children fork
         __import__(name)
-    every = CASES + (sixth_cases() if args.set in (None, "sixth") else [])
+    every = CASES + [
+        case
+        for trial in MODULE_TRIALS
+        if args.set in (None, trial)
+        for case in module_cases(trial)
+    ]
     cases = [
         case
         for case in every
