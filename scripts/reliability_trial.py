@@ -3564,10 +3564,7 @@ def main() -> int:
     for name in COMMANDS.values():  # imported once, before the children fork
         __import__(name)
     every = CASES + [
-        case
-        for trial in MODULE_TRIALS
-        if args.set in (None, trial)
-        for case in module_cases(trial)
+        case for trial in MODULE_TRIALS if args.set in (None, trial) for case in module_cases(trial)
     ]
     cases = [
         case
