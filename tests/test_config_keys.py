@@ -13,6 +13,8 @@ from simoun_agent.config import (
     resolve,
     to_dict,
 )
+from simoun_agent.config.key_match import close_keys
+from simoun_agent.config.keys import config_fields
 
 
 def test_a_misspelled_top_level_key_in_a_preset_is_refused_with_the_close_match(monkeypatch):
@@ -62,3 +64,10 @@ def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
     refused = r"unknown preset 'gpu' \(did you mean 'cpu'\?\); choose one of .*cpu"
     with pytest.raises(SetupError, match=refused):
         resolve("gpu", {})
+
+
+def test_close_keys_read_words_through_their_synonyms():
+    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
+    assert close_keys("frame_size", docs) == ["image_size"]
+    assert close_keys("resolution", docs) == ["image_size"]
+    assert close_keys("frame_skip", docs) == ["action_repeat"]

@@ -172,9 +172,9 @@ def unmakeable(env_id: str, err: Exception) -> SetupError:
     missing = getattr(err, "name", None) if isinstance(err, ModuleNotFoundError) else None
     if missing:
         top = missing.split(".")[0]
-        reason = f"it needs the module {missing!r}, which is not installed: pip install {top},"
+        reason = f"it needs the module {missing!r}, which is not installed (pip install {top})"
     newer = _newest_version(env_id)
-    fix = f"use --env {newer} instead, or pick another --env" if newer else "or pick another --env"
+    fix = f"use --env {newer} instead, or pick another --env" if newer else "pick another --env"
     return SetupError(f"--env {env_id} cannot be made: {reason}; {fix}")
 
 
