@@ -133,7 +133,8 @@ def test_an_action_repeat_longer_than_the_run_is_refused_before_training(tmp_pat
         train_cli.main([*argv, "--run-dir", str(tmp_path / "run")])
     assert stop.value.code == 2
     err = capsys.readouterr().err
-    assert "--action-repeat 1000 is longer than the whole run (--total-env-steps 40)" in err
+    assert "--action-repeat 1000 (TrainConfig.action_repeat) is longer than the whole run" in err
+    assert "(--total-env-steps 40, TrainConfig.total_env_steps)" in err
     assert "set --action-repeat 40 or less" in err
     assert "warning" not in err
     assert not (tmp_path / "run" / "config.json").exists()

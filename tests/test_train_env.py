@@ -306,8 +306,9 @@ def test_episode_limits_and_action_repeats_that_leave_one_decision_are_refused()
     with pytest.raises(SetupError) as error:
         check_task(env_config("dm_control/cartpole-swingup-v0", {}, action_repeat=1000))
     assert str(error.value).startswith(
-        "--action-repeat 1000: an episode of dm_control/cartpole-swingup-v0 ends after 1000 env "
-        "steps, so it would hold 1 agent decision"
+        "--action-repeat 1000 (TrainConfig.action_repeat): an episode of "
+        "dm_control/cartpole-swingup-v0 ends after 1000 env steps, so it would hold 1 agent "
+        "decision"
     )
     assert str(error.value).endswith("set --action-repeat 500 or less (the paper uses 2 to 8)")
 

@@ -529,13 +529,14 @@ def check_decisions(config: TrainConfig, limit: int | None) -> None:
     repeat = config.resolved_action_repeat()
     if limit is None or limit // repeat >= MIN_EPISODE_DECISIONS:
         return
-    given = "" if config.action_repeat is not None else " (the paper's value for this task)"
+    given = "" if config.action_repeat is not None else ", the paper's value for this task"
     decisions = max(1, math.ceil(limit / repeat))
     raise SetupError(
-        f"--action-repeat {repeat}{given}: an episode of {config.env} ends after {limit} env "
-        f"steps, so it would hold {decisions} agent decision{'s' if decisions != 1 else ''} and "
-        f"the agent could not learn from what its actions lead to; set --action-repeat "
-        f"{limit // MIN_EPISODE_DECISIONS} or less (the paper uses 2 to 8)"
+        f"--action-repeat {repeat} (TrainConfig.action_repeat{given}): an episode of "
+        f"{config.env} ends after {limit} env steps, so it would hold {decisions} agent "
+        f"decision{'s' if decisions != 1 else ''} and the agent could not learn from what its "
+        f"actions lead to; set --action-repeat {limit // MIN_EPISODE_DECISIONS} or less (the "
+        "paper uses 2 to 8)"
     )
 
 

@@ -188,12 +188,13 @@ def check_budget(config: TrainConfig) -> None:
     repeat = config.resolved_action_repeat()
     if repeat <= config.total_env_steps:
         return
-    given = "" if config.action_repeat is not None else " (the paper's value for this task)"
+    given = "" if config.action_repeat is not None else ", the paper's value for this task"
     raise SetupError(
-        f"--action-repeat {repeat}{given} is longer than the whole run (--total-env-steps "
-        f"{config.total_env_steps}): each agent decision takes {repeat} env steps, so the run "
-        f"would take one decision and overrun its budget; set --action-repeat "
-        f"{config.total_env_steps} or less, or --total-env-steps many times {repeat}"
+        f"--action-repeat {repeat} (TrainConfig.action_repeat{given}) is longer than the whole "
+        f"run (--total-env-steps {config.total_env_steps}, TrainConfig.total_env_steps): each "
+        f"agent decision takes {repeat} env steps, so the run would take one decision and "
+        f"overrun its budget; set --action-repeat {config.total_env_steps} or less, or "
+        f"--total-env-steps many times {repeat}"
     )
 
 
