@@ -289,6 +289,10 @@ def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
         check_task(env_config("highway-fast-v0", highway))
     assert "highway-fast-v0 cannot use config.lanes_count=0 (making it failed: " in str(error.value)
     assert str(error.value).endswith("Fix or drop that key")
+    # a misspelled action type: only dropping the dict that holds it makes the env work
+    typo = {"config": {"action": {"type": "ContinousAction"}}}
+    with pytest.raises(SetupError, match=r'cannot use config.action=\{"type": "ContinousAction"\}'):
+        check_task(env_config("highway-fast-v0", typo))
     with pytest.raises(SetupError, match=r'cannot use task_kwargs.random="x"'):
         check_task(env_config("dm_control/cartpole-swingup-v0", {"task_kwargs": {"random": "x"}}))
 

@@ -432,14 +432,14 @@ def faulty_key(config: TrainConfig) -> str | None:
 
 
 def _leaves(kwargs: dict, prefix: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
-    """The key path of every value of ``kwargs`` that is not a non-empty dict."""
+    """The key path of every value of ``kwargs``, a nested dict's too, deepest first: a value
+    is tried before the dict that holds it (``config.action.type``, then ``config.action``)."""
     paths: list[tuple[str, ...]] = []
     for key, value in kwargs.items():
         if isinstance(value, dict) and value:
             paths += _leaves(value, (*prefix, key))
-        else:
-            paths.append((*prefix, key))
-    return paths
+        paths.append((*prefix, key))
+    return sorted(paths, key=len, reverse=True)
 
 
 def _without(kwargs: dict, path: tuple[str, ...]) -> dict:
