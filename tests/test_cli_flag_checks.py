@@ -62,6 +62,8 @@ def refused(capsys, main, argv) -> str:
          "simoun-eval uses the run's own; it is chosen when the run is trained (simoun-train "
          "--action-repeat ...)"),
         (eval_cli.main, ["RUN", "--env", "Pendulum-v1"], "--env is not a flag of simoun-eval"),
+        (eval_cli.main, ["RUN", "--agent.no-curiosity"], "agent.curiosity is a setting of the "
+         "run"),
     ],
 )  # fmt: skip
 def test_every_command_names_the_flag_an_unknown_one_meant(main, argv, said, capsys):

@@ -257,9 +257,13 @@ def refuse_unknown_subcommand(argv: Sequence[str], command: Any, prog: str) -> N
 
 
 def run_setting(name: str) -> str | None:
-    """The run config key whose flag ``name`` is (``--action-repeat``: action_repeat), else
-    None."""
-    return next((key for key in config_fields() if "--" + key.replace("_", "-") == name), None)
+    """The run config key whose flag ``name`` is (``--action-repeat``: action_repeat; a
+    switch's negation too, ``--agent.no-curiosity``), else None."""
+    for key, (kind, _, _) in config_fields().items():
+        flag = "--" + key.replace("_", "-")
+        if name == flag or (kind is bool and name in (negated(flag), "--no-" + flag[2:])):
+            return key
+    return None
 
 
 def refuse_unknown(
@@ -285,10 +289,11 @@ def refuse_unknown(
         if spelled := ascii_flag(arg):
             raise lookalike_error(arg, spelled)
         if reads_runs and (key := run_setting(name)):
+            value = "" if config_fields()[key][0] is bool else " ..."
             raise ValueError(
                 f"{name} is not a flag of {prog}{sub}: {key} is a setting of the run, saved in "
                 f"its config.json, and {prog} uses the run's own; it is chosen when the run is "
-                f"trained (simoun-train {name} ...). `{prog}{sub} --help` lists every flag"
+                f"trained (simoun-train {name}{value}). `{prog}{sub} --help` lists every flag"
             )
         matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
         hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
