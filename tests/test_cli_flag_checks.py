@@ -9,6 +9,7 @@ import os
 from pathlib import Path
 
 import pytest
+import torch
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
@@ -51,6 +52,18 @@ def refused(capsys, main, argv) -> str:
         (minigrid_cli.main, ["probe", "--settings.stesp", "3"], "--settings.steps"),
         (driving_reference.main, ["--episdoes", "2"], "(did you mean --episodes?)"),
         (train_cli.main, ["--xyzzy"], "unknown flag --xyzzy; `simoun-train --help`"),
+        (train_cli.main, ["--frame-size", "64"], "unknown flag --frame-size (did you mean "
+         "--image-size?)"),
+        (train_cli.main, ["--resolution", "64"], "unknown flag --resolution (did you mean "
+         "--image-size?)"),
+        (train_cli.main, ["--frame-skip", "4"], "(did you mean --action-repeat?)"),
+        (eval_cli.main, ["RUN", "--action-repeat", "2"], "--action-repeat is not a flag of "
+         "simoun-eval: action_repeat is a setting of the run, saved in its config.json, and "
+         "simoun-eval uses the run's own; it is chosen when the run is trained (simoun-train "
+         "--action-repeat ...)"),
+        (eval_cli.main, ["RUN", "--env", "Pendulum-v1"], "--env is not a flag of simoun-eval"),
+        (eval_cli.main, ["RUN", "--agent.no-curiosity"], "agent.curiosity is a setting of the "
+         "run"),
     ],
 )  # fmt: skip
 def test_every_command_names_the_flag_an_unknown_one_meant(main, argv, said, capsys):
@@ -503,3 +516,12 @@ def test_an_env_given_twice_in_envs_is_named_as_such(envs, said, tmp_path, capsy
     err = refused(capsys, sweep_cli.main, argv)
     assert said in err and "--grid" not in err
     assert not (tmp_path / "s").exists()
+
+
+def test_simoun_eval_names_its_device_flag_for_a_device_the_machine_lacks(capsys, tmp_path):
+    said = refused(capsys, eval_cli.main, [str(tmp_path), "--device", "gpu"])
+    assert "simoun-eval: error: --device gpu: device type 'gpu' is not supported" in said
+    if not torch.cuda.is_available():
+        said = refused(capsys, eval_cli.main, [str(tmp_path), "--device", "cuda"])
+        assert said.startswith("simoun-eval: error: --device cuda: this torch")
+        assert "saved config" not in said

@@ -70,3 +70,46 @@ def test_an_unknown_preset_is_refused_before_parsing(capsys):
 def test_an_unknown_set_key_is_refused_with_the_close_match():
     with pytest.raises(SetupError, match=r"unknown config key gamma \(did you mean agent.discount"):
         overrides(["--set", "gamma=0.9"])
+
+
+@pytest.mark.parametrize("spelling", ["none", "None", "null"])
+def test_preset_none_is_no_preset(spelling, capsys):
+    argv = ["--preset", spelling, "--help"]
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(argv)
+    assert exit_info.value.code == 0
+    assert train_cli.parse_command(["--preset", spelling]).flags.preset is None
+    assert overrides(["--preset", spelling, "--seed", "2"]) == {"seed": 2}
+
+
+def test_set_preset_is_refused_pointing_at_the_preset_flag():
+    with pytest.raises(
+        SetupError,
+        match=r"--set preset=cpu would only label the run: .* give "
+        r"--preset cpu instead",
+    ):
+        overrides(["--set", "preset=cpu"])
+    assert overrides(["--preset", "cpu", "--set", "preset=cpu"]) == {}
+
+
+def test_set_with_spaces_around_the_equals_sign_says_so():
+    with pytest.raises(SetupError) as error:
+        overrides(["--set", "agent.lr = 3e-4"])
+    assert str(error.value) == (
+        "--set 'agent.lr = 3e-4': KEY=VALUE takes no spaces around '='; write --set agent.lr=3e-4"
+    )
+
+
+def test_set_into_env_kwargs_gives_the_json_object_to_pass():
+    with pytest.raises(SetupError, match=r"""give --env-kwargs '\{"size": 32\}'$"""):
+        overrides(["--set", "env_kwargs.size=32"])
+    with pytest.raises(SetupError, match=r"""--env-kwargs '\{"mode": "fast"\}'$"""):
+        overrides(["--set", "env_kwargs.mode=fast"])
+
+
+def test_env_kwargs_are_merged_into_a_presets_own():
+    config = resolve("highway-cpu", {"env_kwargs": {"config": {"lanes_count": 2}}})
+    assert config.env_kwargs["config"]["lanes_count"] == 2
+    assert config.env_kwargs["config"]["action"] == {"type": "ContinuousAction"}
+    assert config.env_kwargs["config"]["offroad_terminal"] is True
+    assert resolve(None, {"env_kwargs": {"a": 1}}).env_kwargs == {"a": 1}

@@ -190,6 +190,10 @@ def test_agent_config_in_python_names_the_field_too():
         ),
         (lambda: AgentConfig(num_frames=2), ["AgentConfig.num_frames=3"]),
         (
+            lambda: AgentConfig(encoder="flare", curiosity=False, num_frames=1),
+            ["AgentConfig.num_frames=3", "AgentConfig.encoder='single'"],
+        ),
+        (
             lambda: AgentConfig(encoder="single", curiosity=True, num_frames=1),
             ["AgentConfig.curiosity=False"],
         ),
@@ -235,3 +239,9 @@ def test_agent_constructor_names_the_problem(frame_shape, action_dim, words):
 
     with pytest.raises(ValueError, match=words):
         SimounAgent(frame_shape, action_dim, AgentConfig(batch_size=8, num_filters=4))
+
+
+def test_the_flare_recipe_refuses_one_frame_and_takes_two():
+    with pytest.raises(SetupError, match=r"--agent.num-frames 1 .*'flare' learns from the latent"):
+        resolve(None, {"agent.recipe": "flare", "agent.num_frames": 1})
+    assert resolve(None, {"agent.recipe": "flare", "agent.num_frames": 2}).agent.num_frames == 2

@@ -13,6 +13,8 @@ from simoun_agent.config import (
     resolve,
     to_dict,
 )
+from simoun_agent.config.key_match import close_keys
+from simoun_agent.config.keys import config_fields
 
 
 def test_a_misspelled_top_level_key_in_a_preset_is_refused_with_the_close_match(monkeypatch):
@@ -78,3 +80,10 @@ def test_a_key_with_another_separator_is_answered_with_the_key_itself(typed, mea
     with pytest.raises(SetupError) as error:
         resolve("cpu", {typed: 1e-3})
     assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)
+
+
+def test_close_keys_read_words_through_their_synonyms():
+    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
+    assert close_keys("frame_size", docs) == ["image_size"]
+    assert close_keys("resolution", docs) == ["image_size"]
+    assert close_keys("frame_skip", docs) == ["action_repeat"]

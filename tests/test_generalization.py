@@ -144,6 +144,11 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
     [
         (["--eval-distraction", "video_hrd"], "did you mean 'video_hard'?"),
         (["--eval-distraction", "train"], "is the run's own evaluation"),
+        (
+            ["--eval-distraction", "none"],
+            "for no distraction, leave --eval-distraction out (the run's own evaluation always "
+            "runs); choose from color_easy, color_hard, video_easy, video_hard (",
+        ),
         (["--env", "simoun/PointReach-v0", "--eval-distraction", "video_hard"], "dm_control"),
     ],
 )

@@ -141,7 +141,8 @@ def test_an_env_kwarg_the_env_refuses_is_named_before_ray_starts(tmp_path, capsy
         cli.main(argv)
     assert exit_info.value.code == 2
     err = capsys.readouterr().err
-    assert "simoun/PointReach-v0 refused them (step_size must be a finite number > 0" in err
+    said = "simoun/PointReach-v0 cannot use step_size=NaN (making it failed: step_size must be a"
+    assert said in err
     assert "Traceback" not in err
 
 

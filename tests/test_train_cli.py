@@ -125,3 +125,27 @@ def test_setup_script_announces_every_step_before_it_runs():
     assert steps == list(range(1, total + 1)) and len(commands) == total
     assert all(script[i - 1].startswith("step ") for i in commands)
     assert subprocess.run(["bash", "-n", str(path)], timeout=120).returncode == 0
+
+
+def test_an_action_repeat_longer_than_the_run_is_refused_before_training(tmp_path, capsys):
+    argv = [*TINY_FLAGS, "--action-repeat", "1000", "--total-env-steps", "40"]
+    with pytest.raises(SystemExit) as stop:
+        train_cli.main([*argv, "--run-dir", str(tmp_path / "run")])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "--action-repeat 1000 (TrainConfig.action_repeat) is longer than the whole run" in err
+    assert "(--total-env-steps 40, TrainConfig.total_env_steps)" in err
+    assert "set --action-repeat 40 or less" in err
+    assert "warning" not in err
+    assert not (tmp_path / "run" / "config.json").exists()
+
+
+def test_a_warmup_that_takes_the_whole_run_is_warned_of(tmp_path, capsys):
+    tiny = [flag for flag in TINY_FLAGS if flag not in ("--warmup-agent-steps", "20")]
+    argv = [*tiny, "--warmup-agent-steps", "40", "--total-env-steps", "40", "--no-video"]
+    assert train_cli.main([*argv, "--run-dir", str(tmp_path / "run")]) == 0
+    err = capsys.readouterr().err
+    assert (
+        "simoun-train: warning: --warmup-agent-steps 40 takes all the run's 40 agent decisions "
+        "(--total-env-steps 40 at action repeat 1): it ends before its first update"
+    ) in err

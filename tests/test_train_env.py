@@ -1,5 +1,7 @@
 """Environment construction, video, logs and driving measures of simoun-train."""
 
+import importlib.util
+
 import gymnasium as gym
 import imageio.v2 as imageio
 import numpy as np
@@ -10,7 +12,7 @@ from simoun_agent.config import SetupError, resolve
 from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
-from simoun_agent.run.make_env import check_task, make_env, video_fps
+from simoun_agent.run.make_env import check_task, episode_limit, make_env, video_fps
 from simoun_agent.run.video import write_video
 
 
@@ -210,7 +212,10 @@ def env_config(env, env_kwargs, **more):
 
 def test_gymnasium_make_keywords_in_env_kwargs_go_to_make_checked_by_value():
     assert check_task(env_config("Pendulum-v1", {"max_episode_steps": 10})) == 10
-    assert check_task(env_config("dm_control/cartpole-swingup-v0", {"max_episode_steps": 7})) == 7
+    dmc_limit = env_config(
+        "dm_control/cartpole-swingup-v0", {"max_episode_steps": 7}, action_repeat=1
+    )
+    assert check_task(dmc_limit) == 7
     env = make_env(env_config("Pendulum-v1", {"max_episode_steps": 3, "disable_env_checker": True}))
     env.reset(seed=0)
     assert [env.step(env.action_space.sample())[3] for _ in range(3)] == [False, False, True]
@@ -259,4 +264,68 @@ def test_more_cameras_than_a_dm_control_task_has_are_refused_naming_cameras():
             "--cameras 3: dm_control/cartpole-swingup-v0 has only 2 cameras; pass --cameras 2 "
             "or fewer"
         )
-    assert check_task(env_config("dm_control/cartpole-swingup-v0", {}, cameras=2)) is None
+    assert check_task(env_config("dm_control/cartpole-swingup-v0", {}, cameras=2)) == 1000
+
+
+def test_an_env_id_that_cannot_be_made_is_refused_naming_it_and_the_fix():
+    # gymnasium keeps the MuJoCo v2 ids only to raise an ImportError saying where they went
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("InvertedPendulum-v2", {}))
+    message = str(error.value)
+    assert message.startswith("--env InvertedPendulum-v2 cannot be made: The mujoco v2 and v3")
+    assert message.endswith("use --env InvertedPendulum-v5 instead, or pick another --env")
+    if importlib.util.find_spec("jax") is None:  # the phys2d envs import jax
+        with pytest.raises(SetupError) as error:
+            make_env(env_config("phys2d/Pendulum-v0", {}))
+        assert str(error.value) == (
+            "--env phys2d/Pendulum-v0 cannot be made: it needs the module 'jax', which is not "
+            "installed (pip install jax); pick another --env"
+        )
+
+
+def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
+    highway = {"config": {"action": {"type": "ContinuousAction"}, "lanes_count": 0}}
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("highway-fast-v0", highway))
+    assert "highway-fast-v0 cannot use config.lanes_count=0 (making it failed: " in str(error.value)
+    assert str(error.value).endswith("Fix or drop that key")
+    # a misspelled action type: only dropping the dict that holds it makes the env work
+    typo = {"config": {"action": {"type": "ContinousAction"}}}
+    with pytest.raises(SetupError, match=r'cannot use config.action=\{"type": "ContinousAction"\}'):
+        check_task(env_config("highway-fast-v0", typo))
+    with pytest.raises(SetupError, match=r'cannot use task_kwargs.random="x"'):
+        check_task(env_config("dm_control/cartpole-swingup-v0", {"task_kwargs": {"random": "x"}}))
+
+
+def test_episode_limits_and_action_repeats_that_leave_one_decision_are_refused():
+    for env, kwargs, limit in (
+        ("Pendulum-v1", {"max_episode_steps": 30}, 30),
+        ("dm_control/cartpole-swingup-v0", {}, 1000),  # dm_control's own time limit
+        ("simoun/PointReach-v0", {}, 20),  # the env's own max_steps
+    ):
+        made = make_env(env_config(env, kwargs))
+        assert episode_limit(made) == limit
+        made.close()
+    assert check_task(env_config("Pendulum-v1", {}, action_repeat=100)) == 200
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("dm_control/cartpole-swingup-v0", {}, action_repeat=1000))
+    assert str(error.value).startswith(
+        "--action-repeat 1000 (TrainConfig.action_repeat): an episode of "
+        "dm_control/cartpole-swingup-v0 ends after 1000 env steps, so it would hold 1 agent "
+        "decision"
+    )
+    assert str(error.value).endswith("set --action-repeat 500 or less (the paper uses 2 to 8)")
+
+
+gym.register("simoun-test/NeedsMissing-v0", entry_point="simoun_test_absent.envs:Env")
+
+
+def test_an_env_whose_package_is_missing_is_refused_with_the_install():
+    for make in (check_task, make_env):
+        with pytest.raises(SetupError) as error:
+            make(env_config("simoun-test/NeedsMissing-v0", {}))
+        assert str(error.value) == (
+            "--env simoun-test/NeedsMissing-v0 cannot be made: it needs the module "
+            "'simoun_test_absent', which is not installed (pip install simoun_test_absent); "
+            "pick another --env"
+        )

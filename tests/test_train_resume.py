@@ -89,8 +89,29 @@ def test_finished_run_directory_is_complete(finished_run):
 
 
 def test_resume_with_another_config_is_refused(finished_run):
-    with pytest.raises(SetupError, match=r"only total_env_steps.*agent\.lr"):
+    with pytest.raises(SetupError, match=r"only total_env_steps.*agent\.lr was given another"):
         train.resume_run(finished_run, {"agent.lr": 3e-4})
+
+
+def test_resume_with_the_saved_values_of_fixed_keys_is_accepted(finished_run, tmp_path):
+    run_dir = tmp_path / "copy"
+    shutil.copytree(finished_run, run_dir)
+    saved = json.loads((run_dir / "config.json").read_text())
+    same = {
+        "total_env_steps": 60,
+        "seed": saved["seed"],
+        "env_kwargs": saved["env_kwargs"],
+        "action_repeat": saved["action_repeat"],
+        "agent.lr": saved["agent"]["lr"],
+        "run_dir": f"{run_dir}/",  # the directory resumed, spelled another way
+    }
+    run = train.resume_run(run_dir, same)
+    try:
+        assert run.config.seed == saved["seed"]
+    finally:
+        run.env.close()
+        run.eval_env.close()
+        train.release(run)
 
 
 def test_checkpoint_from_another_config_is_refused(finished_run, tmp_path):

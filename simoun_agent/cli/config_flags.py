@@ -25,6 +25,7 @@ from simoun_agent.cli.flags import empty_value, negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import (
     FALSE_WORDS,
+    NONE_WORDS,
     TRUE_WORDS,
     check_keys,
     config_fields,
@@ -75,7 +76,9 @@ def preset_in(argv: Sequence[str]) -> str | None:
             raise SetupError(empty_value("--preset", name))
     if len(set(names)) > 1:
         raise SetupError(f"--preset is given twice ({' and '.join(names)}); give it once")
-    return names[0] if names else None
+    if not names or names[0].lower() in NONE_WORDS:  # --preset none: the paper defaults
+        return None
+    return names[0]
 
 
 @functools.cache
@@ -124,9 +127,39 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
         key = key.replace("-", "_")  # the flag's spelling: --set agent.batch-size=64
         if not sep or not key:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
-        check_keys([key])  # an unknown key fails here, with its close matches
+        if key == "preset" and value == flags.preset:
+            continue  # the label --preset gives anyway
+        check_set_key(key, value, pair)
         given[key] = parse_value(key, value, fields[key][0])
     return given
+
+
+def check_set_key(key: str, value: str, pair: str) -> None:
+    """SetupError for the key of ``--set KEY=VALUE`` that is no config key, with the fix for
+    the common ways of getting it wrong: spaces around ``=``, ``preset`` (a label that
+    ``--preset`` sets with the preset's values), a key inside ``env_kwargs``; else the close
+    matches of :func:`~simoun_agent.config.keys.check_keys`."""
+    if key != key.strip() or value != value.lstrip():
+        raise SetupError(
+            f"--set {pair!r}: KEY=VALUE takes no spaces around '='; write "
+            f"--set {key.strip()}={value.strip()}"
+        )
+    if key == "preset":
+        raise SetupError(
+            f"--set preset={value} would only label the run: a preset's values are applied by "
+            f"--preset; give --preset {value} instead"
+        )
+    section, dot, inner = key.partition(".")
+    if dot and section == "env_kwargs":
+        try:
+            typed = json.loads(value)
+        except json.JSONDecodeError:
+            typed = value
+        raise SetupError(
+            f"--set {pair}: env_kwargs takes a whole JSON object, not a key inside it; give "
+            f"--env-kwargs '{json.dumps({inner: typed})}'"
+        )
+    check_keys([key])  # an unknown key fails here, with its close matches
 
 
 def check_given_once(argv: Sequence[str], pairs: Sequence[str]) -> None:

@@ -25,6 +25,7 @@ from tqdm import tqdm
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
 from simoun_agent.run.rundir import make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
@@ -103,13 +104,17 @@ class EvalCommand:
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
-    args = parse(EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"))
+    args = parse(
+        EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"), reads_runs=True
+    )
     if not args.checkpoint:  # tyro accepts no value for a variable number of them
         fail(PROG, "give the run to evaluate: a run directory or its checkpoint.pt")
     if args.episodes < 1:
         fail(PROG, "--episodes must be at least 1")
     if args.seed is not None and not 0 <= args.seed < 2**32:
         fail(PROG, f"--seed {args.seed}: seeds lie in [0, 2**32); e.g. --seed 0")
+    if args.device is not None and (problem := device_problem(args.device)):
+        fail(PROG, f"--device {args.device}: {problem}")
     if args.torch_threads is not None and args.torch_threads < 1:
         fail(PROG, f"--torch-threads {args.torch_threads}: must be at least 1; e.g. 1")
     if args.distraction is not None and args.torch_threads is not None:

@@ -66,7 +66,14 @@ from simoun_agent.cli.command_flags import (
 )
 from simoun_agent.config import TrainConfig
 from simoun_agent.config.key_match import close_keys
-from simoun_agent.config.keys import FALSE_WORDS, NONE_WORDS, TRUE_WORDS, field_docs, json_value
+from simoun_agent.config.keys import (
+    FALSE_WORDS,
+    NONE_WORDS,
+    TRUE_WORDS,
+    config_fields,
+    field_docs,
+    json_value,
+)
 
 T = TypeVar("T")
 
@@ -249,11 +256,24 @@ def refuse_unknown_subcommand(argv: Sequence[str], command: Any, prog: str) -> N
     )
 
 
-def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str) -> None:
+def run_setting(name: str) -> str | None:
+    """The run config key whose flag ``name`` is (``--action-repeat``: action_repeat; a
+    switch's negation too, ``--agent.no-curiosity``), else None."""
+    for key, (kind, _, _) in config_fields().items():
+        flag = "--" + key.replace("_", "-")
+        if name == flag or (kind is bool and name in (negated(flag), "--no-" + flag[2:])):
+            return key
+    return None
+
+
+def refuse_unknown(
+    argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str, reads_runs: bool = False
+) -> None:
     """Raise ValueError for a ``--flag`` of ``argv`` that is not one of ``flags`` (the command's,
     :func:`~simoun_agent.cli.command_flags.command_flags`), naming the flags it most likely
     meant, found by meaning as well as spelling (``--learning-rate``: ``--agent.lr``;
-    ``--num-episodes``: ``--episodes``). Nothing is checked before a subcommand is named: tyro
+    ``--num-episodes``: ``--episodes``); for a command that ``reads_runs``, a flag of the run
+    config is told to be the run's own. Nothing is checked before a subcommand is named: tyro
     asks for one."""
     if not flags:
         return
@@ -268,6 +288,13 @@ def refuse_unknown(argv: Sequence[str], flags: dict[str, Flag], command: Any, pr
             continue
         if spelled := ascii_flag(arg):
             raise lookalike_error(arg, spelled)
+        if reads_runs and (key := run_setting(name)):
+            value = "" if config_fields()[key][0] is bool else " ..."
+            raise ValueError(
+                f"{name} is not a flag of {prog}{sub}: {key} is a setting of the run, saved in "
+                f"its config.json, and {prog} uses the run's own; it is chosen when the run is "
+                f"trained (simoun-train {name}{value}). `{prog}{sub} --help` lists every flag"
+            )
         matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
         hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
@@ -581,9 +608,11 @@ def parse(
     description: str,
     default: T | None = None,
     switches: Iterable[str] = (),
+    reads_runs: bool = False,
 ) -> T:
     """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
-    ``switches`` are the boolean flags that also take the older ``--flag false``. Exits 0
+    ``switches`` are the boolean flags that also take the older ``--flag false``; a command that
+    ``reads_runs`` tells a run config flag it does not take to be the run's own. Exits 0
     after ``--version`` or ``--help``, 2 with one line for input the checks above refuse, or
     tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -595,7 +624,7 @@ def parse(
         argv = bool_argv(argv, switches)
         refuse_unknown_subcommand(argv, cls, prog)
         flags = command_flags(cls, argv)
-        refuse_unknown(argv, flags, cls, prog)
+        refuse_unknown(argv, flags, cls, prog, reads_runs)
         refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
         refuse_switch_values(argv, flags, switches)
         refuse_stray_arguments(argv, flags, cls, prog)

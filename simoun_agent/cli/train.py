@@ -146,9 +146,9 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
             run = loop.resume_run(Path(command.resume), overrides, check=check_eval_distractions)
         else:
             config = resolve(command.flags.preset, overrides)
-            warning = check_memory(config)  # before anything is built
-            if warning:
-                print(f"simoun-train: warning: {warning}", file=sys.stderr)
+            for warning in (check_memory(config), loop.budget_warning(config)):
+                if warning:  # before anything is built
+                    print(f"simoun-train: warning: {warning}", file=sys.stderr)
             run = loop.create_run(config, overwrite=command.overwrite, check=check_new_run)
     except SetupError as err:
         fail(PROG, err)

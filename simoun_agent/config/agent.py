@@ -270,6 +270,16 @@ def check_agent_config(config: Any) -> None:
             f"the dual-path encoder {config.encoder!r} needs 3 frames (o_t-2, o_t-1, o_t); "
             f"set {knob(config, AGENT, 'num_frames', 3)}",
         )
+    if config.num_frames < 2 and ENCODER_SHAPES[config.encoder].latent_flow:
+        raise fail(
+            config,
+            AGENT,
+            "num_frames",
+            f"the encoder {config.encoder!r} learns from the latent flow between successive "
+            "frames, which one frame does not have; set "
+            f"{knob(config, AGENT, 'num_frames', 3)}, or "
+            f"{knob(config, AGENT, 'encoder', 'single')} for one frame",
+        )
     if config.curiosity and not motion_path:
         raise fail(
             config,

@@ -51,6 +51,23 @@ def same_word(typed: str, known: str) -> bool:
     return difflib.SequenceMatcher(None, typed, known).ratio() >= 0.8
 
 
+SYNONYMS = {
+    "frame": ("image",),
+    "frames": ("image",),
+    "img": ("image",),
+    "resolution": ("image", "size"),
+    "res": ("image", "size"),
+    "pixels": ("image", "size"),
+    "width": ("image", "size"),
+    "height": ("image", "size"),
+}
+"""Words a user types for a key's word that neither its name nor its docstring uses:
+``--frame-size`` and ``--resolution`` mean ``--image-size``."""
+
+SYNONYM_DISCOUNT = 1.0
+"""A key matched only through :data:`SYNONYMS` scores this much below the same match typed."""
+
+
 def score(typed: str, key: str, doc: str) -> float:
     """How well ``key`` (with field docstring ``doc``) fits the unknown ``typed`` key; 0 for
     no relation at all."""
@@ -79,10 +96,23 @@ def score(typed: str, key: str, doc: str) -> float:
     return total - (0.5 if typed_section and typed_section != section else 0.0)
 
 
+def meaning_score(typed: str, key: str, doc: str) -> float:
+    """:func:`score`, or that of ``typed`` with its words read through :data:`SYNONYMS` (less
+    :data:`SYNONYM_DISCOUNT`) when that is higher."""
+    best = score(typed, key, doc)
+    section, dot, name = typed.rpartition(".")
+    said = words(name)
+    meant = [word for typed_word in said for word in SYNONYMS.get(typed_word, (typed_word,))]
+    if meant != said:
+        as_meant = score(f"{section}{dot}{'_'.join(dict.fromkeys(meant))}", key, doc)
+        best = max(best, as_meant - SYNONYM_DISCOUNT)
+    return best
+
+
 def close_keys(typed: str, docs: dict[str, str], n: int = 3) -> list[str]:
     """Up to ``n`` keys of ``docs`` (key -> field docstring) that ``typed`` most likely meant,
     best first; empty when none is related."""
-    scores = {key: score(typed, key, doc) for key, doc in docs.items()}
+    scores = {key: meaning_score(typed, key, doc) for key, doc in docs.items()}
     ranked = sorted((key for key in scores if scores[key] > 0), key=lambda k: -scores[k])
     if not ranked:
         return []

@@ -3,7 +3,10 @@
 The dataclass defaults (the paper's DrQ-style setup), then a named preset
 (:mod:`simoun_agent.config.presets`), then a named agent recipe (``--agent.recipe drq``,
 :mod:`simoun_agent.config.recipes`, with its values for the run's DMC task), then the user's
-overrides (``--agent.batch-size 64`` or ``--set agent.batch_size=64``). Every layer's keys
+overrides (``--agent.batch-size 64`` or ``--set agent.batch_size=64``). A layer's value replaces
+the one below it, but for ``env_kwargs``, whose keys are merged into the layer's below (key by
+key, nested dicts too): ``--preset highway-cpu --env-kwargs '{"config": {"lanes_count": 2}}'``
+keeps the preset's continuous actions and episode settings. Every layer's keys
 pass :func:`~simoun_agent.config.keys.check_keys`, so a misspelled key is refused with its
 close match wherever it comes from. The resolved config is saved as ``config.json`` in the run
 directory and checked again when the run is resumed.
@@ -64,8 +67,29 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
     if recipe is not None:
         env_id = split_env_id(overrides.get("env", values.get("env", TrainConfig.env)))[1]
         values.update(recipe_values(recipe, dmc_task(env_id)))
+    if isinstance(values.get("env_kwargs"), dict) and isinstance(overrides.get("env_kwargs"), dict):
+        overrides = {
+            **overrides,
+            "env_kwargs": merged(values["env_kwargs"], overrides["env_kwargs"]),
+        }
     values.update(overrides)
     return from_flat(values)
+
+
+def merged(base: dict, extra: dict) -> dict:
+    """``base`` with ``extra``'s keys set over it, dicts merged key by key at every depth.
+
+    Example:
+        >>> merged({"config": {"lanes_count": 4, "duration": 40}}, {"config": {"lanes_count": 2}})
+        {'config': {'lanes_count': 2, 'duration': 40}}
+    """
+    out = dict(base)
+    for key, value in extra.items():
+        below = out.get(key)
+        out[key] = (
+            merged(below, value) if isinstance(below, dict) and isinstance(value, dict) else value
+        )
+    return out
 
 
 def preset_values(name: str) -> dict[str, Any]:

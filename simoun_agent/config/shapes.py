@@ -62,13 +62,16 @@ class EncoderShape:
     conv_state: bool = False
     """one conv path on a stack of frames, whose flattened maps can be the state that the actor
     and the critic put their own trunks on (``AgentConfig.separate_trunks``, DrQ-v2)"""
+    latent_flow: bool = False
+    """reads the differences between successive frames' latents (Flare's latent flow), which
+    needs two frames or more"""
 
 
 ENCODER_SHAPES: dict[str, EncoderShape] = {
     "single": EncoderShape(motion_path=False, conv_state=True),
     "stacked": EncoderShape(motion_path=False, conv_state=True),
     "stacked_wide": EncoderShape(motion_path=False, conv_state=True),
-    "flare": EncoderShape(motion_path=False),
+    "flare": EncoderShape(motion_path=False, latent_flow=True),
     "dual": EncoderShape(motion_path=True),
     "dual_interactive": EncoderShape(motion_path=True, interactive=True),
 }

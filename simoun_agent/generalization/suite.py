@@ -33,23 +33,38 @@ DISTRACTION_SEED = 0
 backgrounds of each episode, so two runs evaluated on the same seeds see the same ones."""
 
 
-def parse_distractions(text: str | Sequence[str], flag: str = "--distraction") -> list[str]:
-    """Mode names from ``"color_easy,video_hard"`` (or a list), checked, duplicates dropped.
+NO_DISTRACTION_WORDS = ("none", "null", "off", "no", "clean")
+"""What a user types for "no distraction", answered with how a command gives it."""
+
+
+def parse_distractions(
+    text: str | Sequence[str],
+    flag: str = "--distraction",
+    modes: Sequence[str] = tuple(DISTRACTIONS),
+    undistracted: str = "--distraction train",
+) -> list[str]:
+    """Mode names from ``"color_easy,video_hard"`` (or a list), checked against ``modes`` (the
+    ones ``flag`` takes), duplicates dropped; ``undistracted`` says how ``flag``'s command is
+    given no distraction.
 
     Raises SetupError for an unknown name, suggesting the closest one.
     """
     parts = text.split(",") if isinstance(text, str) else list(text)
     names = [part.strip() for part in parts if part.strip()]
     if not names:
-        raise SetupError(f"{flag} is empty; pass modes from {', '.join(DISTRACTIONS)}")
+        raise SetupError(f"{flag} is empty; pass modes from {', '.join(modes)}")
     for name in names:
-        if name not in DISTRACTIONS:
-            close = difflib.get_close_matches(name, list(DISTRACTIONS), n=1, cutoff=0.5)
+        if name in modes:
+            continue
+        if name.lower() in NO_DISTRACTION_WORDS:
+            hint = f"for no distraction, {undistracted}; "
+        else:
+            close = difflib.get_close_matches(name, list(modes), n=1, cutoff=0.5)
             hint = f"did you mean {close[0]!r}? " if close else ""
-            raise SetupError(
-                f"unknown distraction {name!r} in {flag}; {hint}choose from "
-                f"{', '.join(DISTRACTIONS)} (comma-separated, e.g. {flag} color_easy,video_hard)"
-            )
+        raise SetupError(
+            f"unknown distraction {name!r} in {flag}; {hint}choose from "
+            f"{', '.join(modes)} (comma-separated, e.g. {flag} color_easy,video_hard)"
+        )
     return list(dict.fromkeys(names))
 
 
@@ -114,11 +129,17 @@ def check_eval_distractions(config: TrainConfig) -> list[str]:
     ``train`` is refused: it is the run's own evaluation, which always runs.
     """
     flag = "--eval-distraction"
-    names = parse_distractions(config.eval_distraction, flag) if config.eval_distraction else []
-    if "train" in names:
+    if "train" in config.eval_distraction:
         raise SetupError(
             f"{flag} train is the run's own evaluation, which always runs; name distraction "
             f"modes only, e.g. {flag} video_hard"
         )
+    modes = [name for name, entry in DISTRACTIONS.items() if entry is not None]
+    undistracted = f"leave {flag} out (the run's own evaluation always runs)"
+    names = (
+        parse_distractions(config.eval_distraction, flag, modes, undistracted)
+        if config.eval_distraction
+        else []
+    )
     check_supported(config, names)
     return names

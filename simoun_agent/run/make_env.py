@@ -9,17 +9,20 @@ agent computes the motion channels itself, so the wrapper's are switched off).
 from __future__ import annotations
 
 import difflib
+import functools
 import importlib
 import importlib.util
 import inspect
 import json
+import math
 import os
 from collections.abc import Callable
+from dataclasses import replace
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
-from gymnasium.envs.registration import load_env_creator
+from gymnasium.envs.registration import find_highest_version, load_env_creator, parse_env_id
 from gymnasium.wrappers import RescaleAction
 
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
@@ -85,6 +88,11 @@ def import_env_module(module: str) -> None:
             f"pip install {top.replace('_', '-')} (or the package that provides {module}), or "
             "drop the module from --env"
         ) from None
+    except ImportError as err:  # a module of the package that the package itself cannot import
+        raise SetupError(
+            f"importing --env-module {module!r} failed ({err}); fix or reinstall the package "
+            "that provides it, or drop the module from --env"
+        ) from None
 
 
 def ensure_registered(env_id: str, module: str | None = None) -> None:
@@ -135,8 +143,8 @@ def env_keywords(env_id: str) -> tuple[list[str], bool]:
         creator = (
             spec.entry_point if callable(spec.entry_point) else load_env_creator(spec.entry_point)
         )
-    except gym.error.DependencyNotInstalled as err:
-        raise SetupError(f"{env_id} cannot be made: {err}") from None
+    except MAKE_ERRORS as err:
+        raise unmakeable(env_id, err) from None
     try:
         parameters = inspect.signature(creator).parameters.values()
     except (TypeError, ValueError):  # a builtin or C extension: nothing to read
@@ -148,6 +156,39 @@ def env_keywords(env_id: str) -> tuple[list[str], bool]:
     ]
     open_ended = any(p.kind is p.VAR_KEYWORD for p in parameters)
     return sorted({*spec.kwargs, *named}), open_ended
+
+
+MAKE_ERRORS = (ImportError, gym.error.Error)
+"""what loading or calling an env's creator raises when the env cannot be made here at all: a
+package it imports is missing (``phys2d/Pendulum-v0`` needs jax), an id that gymnasium keeps
+only to say where it went (the MuJoCo v2 and v3 ids), a deprecated version"""
+
+
+def unmakeable(env_id: str, err: Exception) -> SetupError:
+    """The SetupError for ``env_id`` that cannot be made (:data:`MAKE_ERRORS`): the env's own
+    reason, what to install when a module is missing, and the newest registered version of
+    the same env when there is one."""
+    reason = str(err).strip().rstrip(".") or type(err).__name__
+    missing = getattr(err, "name", None) if isinstance(err, ModuleNotFoundError) else None
+    if missing:
+        top = missing.split(".")[0]
+        reason = f"it needs the module {missing!r}, which is not installed (pip install {top})"
+    newer = _newest_version(env_id)
+    fix = f"use --env {newer} instead, or pick another --env" if newer else "pick another --env"
+    return SetupError(f"--env {env_id} cannot be made: {reason}; {fix}")
+
+
+def _newest_version(env_id: str) -> str | None:
+    """The newest registered version of ``env_id``'s env when it is not ``env_id`` itself
+    (``InvertedPendulum-v5`` for ``InvertedPendulum-v2``), else None."""
+    try:
+        namespace, name, version = parse_env_id(env_id)
+        newest = find_highest_version(namespace, name)
+    except gym.error.Error:
+        return None
+    if newest is None or newest == version:
+        return None
+    return f"{namespace + '/' if namespace else ''}{name}-v{newest}"
 
 
 GYM_MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")
@@ -285,15 +326,22 @@ def _make_base(config: TrainConfig) -> gym.Env:
         ) from None
 
 
-def _make_rendering_env(config: TrainConfig) -> gym.Env:
-    ensure_registered(config.env, config.env_module)
-    check_env_kwargs(config.env, config.env_kwargs)
+def _make_kwargs(config: TrainConfig) -> dict:
+    """The keywords ``gym.make`` is given for ``config``: its ``--env-kwargs`` with dm_control's
+    render size and highway-env's dropped observation."""
     kwargs = dict(config.env_kwargs)
     if config.env.startswith("dm_control/"):
         render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
         kwargs.setdefault("render_kwargs", render)
     if is_highway(config.env):
         kwargs["config"] = {"observation": HIGHWAY_DROPPED_OBSERVATION, **kwargs.get("config", {})}
+    return kwargs
+
+
+def _make_rendering_env(config: TrainConfig) -> gym.Env:
+    ensure_registered(config.env, config.env_module)
+    check_env_kwargs(config.env, config.env_kwargs)
+    kwargs = _make_kwargs(config)
     try:
         try:
             return gym.make(config.env, render_mode="rgb_array", **kwargs)
@@ -306,8 +354,8 @@ def _make_rendering_env(config: TrainConfig) -> gym.Env:
         if "keyword argument" in str(err):
             raise _refused_kwargs(config.env, config.env_kwargs, err) from None
         raise _refused_by_env(config, err) from None
-    except gym.error.DependencyNotInstalled as err:
-        raise SetupError(f"{config.env} cannot be made: {err}") from None
+    except MAKE_ERRORS as err:
+        raise unmakeable(config.env, err) from None
     except ENV_VALUE_ERRORS as err:
         # an env that checks its own arguments refuses a bad value this way; without env
         # kwargs, only a ValueError is the env's word on its arguments
@@ -323,15 +371,30 @@ def _kwargs_text(kwargs: dict) -> str:
 
 def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
     """The SetupError for an error an env raised while it was made, naming ``--env-kwargs``
-    when the run gives any."""
+    (and the key at fault, when one is) when the run gives any."""
     # gymnasium re-raises a creator's TypeError with every keyword appended, simoun's own too
     message = str(err).split(" was raised from the environment creator")[0]
     if not config.env_kwargs:
         return SetupError(f"gymnasium.make({config.env!r}) failed: {message}")
+    culprit = faulty_key(config)
+    if culprit:
+        return SetupError(
+            f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} cannot use {culprit} "
+            f"(making it failed: {message}). Fix or drop that key"
+        )
     return SetupError(
         f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({message}). "
         "Fix or drop --env-kwargs"
     )
+
+
+def _first_step(env: gym.Env) -> None:
+    """Reset ``env``, take one middle action and render."""
+    env.reset(seed=0)
+    space = env.action_space
+    middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
+    env.step(middle)
+    env.render()
 
 
 def check_first_step(env: gym.Env, config: TrainConfig) -> None:
@@ -339,17 +402,70 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
     an env that stores a keyword's value unchecked fails here, before a run is spent, rather
     than at its first training step."""
     try:
-        env.reset(seed=0)
-        space = env.action_space
-        middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
-        env.step(middle)
-        env.render()
+        _first_step(env)
     except ENV_VALUE_ERRORS as err:
+        culprit = faulty_key(config)
+        at_fault = f"; {culprit} is the value it cannot use" if culprit else ""
         raise SetupError(
             f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} was made with "
             f"{_kwargs_text(config.env_kwargs)} but failed at its first reset and step "
-            f"({type(err).__name__}: {err}). Fix the values or drop --env-kwargs"
+            f"({type(err).__name__}: {err}){at_fault}. Fix the values or drop --env-kwargs"
         ) from None
+
+
+MAX_PROBED_KEYS = 12
+"""``--env-kwargs`` values tried one by one for the one at fault (each try makes the env)."""
+
+
+def faulty_key(config: TrainConfig) -> str | None:
+    """``config.lanes_count=0``: the one ``--env-kwargs`` value (a nested dict's too) without
+    which ``config``'s env is made, reset and stepped, when the env's own error does not say
+    which it cannot use; None when no single value is at fault."""
+    paths = _leaves(config.env_kwargs)
+    if len(paths) > MAX_PROBED_KEYS:
+        return None
+    for path in paths:
+        if _works(config, _without(config.env_kwargs, path)):
+            value = functools.reduce(lambda d, k: d[k], path, config.env_kwargs)
+            return f"{'.'.join(path)}={json.dumps(value)}"
+    return None
+
+
+def _leaves(kwargs: dict, prefix: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
+    """The key path of every value of ``kwargs``, a nested dict's too, deepest first: a value
+    is tried before the dict that holds it (``config.action.type``, then ``config.action``)."""
+    paths: list[tuple[str, ...]] = []
+    for key, value in kwargs.items():
+        if isinstance(value, dict) and value:
+            paths += _leaves(value, (*prefix, key))
+        paths.append((*prefix, key))
+    return sorted(paths, key=len, reverse=True)
+
+
+def _without(kwargs: dict, path: tuple[str, ...]) -> dict:
+    """``kwargs`` without the value at ``path`` (copied where it changes)."""
+    head, *rest = path
+    if not rest:
+        return {key: value for key, value in kwargs.items() if key != head}
+    return {**kwargs, head: _without(kwargs[head], tuple(rest))}
+
+
+def _works(config: TrainConfig, kwargs: dict) -> bool:
+    """Whether ``config``'s env, made with ``kwargs`` for its ``--env-kwargs``, is made, reset
+    and stepped."""
+    try:
+        env = gym.make(
+            config.env, render_mode="rgb_array", **_make_kwargs(replace(config, env_kwargs=kwargs))
+        )
+    except (*ENV_VALUE_ERRORS, *MAKE_ERRORS):
+        return False
+    try:
+        _first_step(env)
+    except ENV_VALUE_ERRORS:
+        return False
+    finally:
+        env.close()
+    return True
 
 
 def _check_env(env: gym.Env, env_id: str) -> None:
@@ -388,18 +504,56 @@ def check_task(config: TrainConfig) -> int | None:
     base = env = _make_base(config)
     try:
         _check_env(env, config.env)
-        limit = env.spec.max_episode_steps if env.spec is not None else None
         if config.env_kwargs:
             check_first_step(env, config)
         if config.cameras > 1 and not is_highway(config.env):
             # highway-env's viewports are drawn by viewers that outlive the wrapper: made only
             # for the run
             env = _multi_camera(env, config)
-        # envs that truncate their own episodes (MiniGrid, PointReach) say so in max_steps
-        own = getattr(base.unwrapped, "max_steps", None)
-        return limit or (own if isinstance(own, int) and own > 0 else None)
+        limit = episode_limit(base)
+        check_decisions(config, limit)
+        return limit
     finally:
         env.close()
+
+
+MIN_EPISODE_DECISIONS = 2
+"""Agent decisions an episode must hold at least: with one, every action is the episode's
+last, and nothing the agent sees follows from what it did."""
+
+
+def check_decisions(config: TrainConfig, limit: int | None) -> None:
+    """SetupError when ``config``'s action repeat leaves fewer than
+    :data:`MIN_EPISODE_DECISIONS` agent decisions in an episode of ``limit`` env steps (None:
+    episodes without a limit, nothing to check)."""
+    repeat = config.resolved_action_repeat()
+    if limit is None or limit // repeat >= MIN_EPISODE_DECISIONS:
+        return
+    given = "" if config.action_repeat is not None else ", the paper's value for this task"
+    decisions = max(1, math.ceil(limit / repeat))
+    raise SetupError(
+        f"--action-repeat {repeat} (TrainConfig.action_repeat{given}): an episode of "
+        f"{config.env} ends after {limit} env steps, so it would hold {decisions} agent "
+        f"decision{'s' if decisions != 1 else ''} and the agent could not learn from what its "
+        f"actions lead to; set --action-repeat {limit // MIN_EPISODE_DECISIONS} or less (the "
+        "paper uses 2 to 8)"
+    )
+
+
+def episode_limit(env: gym.Env) -> int | None:
+    """The env steps after which ``env``'s episodes end at the latest: its registered limit
+    (an ``--env-kwargs`` max_episode_steps included), a dm_control task's time limit, or the
+    ``max_steps`` of an env that truncates its own episodes (MiniGrid, PointReach); None when
+    it has none."""
+    spec = env.spec
+    if spec is not None and spec.max_episode_steps:
+        return spec.max_episode_steps
+    base = env.unwrapped
+    dm_limit = getattr(getattr(base, "_env", None), "_step_limit", None)
+    if isinstance(dm_limit, (int, float)) and math.isfinite(dm_limit) and dm_limit > 0:
+        return int(dm_limit)
+    own = getattr(base, "max_steps", None)
+    return own if isinstance(own, int) and own > 0 else None
 
 
 def make_env(

@@ -77,7 +77,7 @@ from simoun_agent.run.layout import (
     VIDEO_NAME,
 )
 from simoun_agent.run.logger import RunLogger, damaged_log, read_log
-from simoun_agent.run.make_env import make_env, video_fps
+from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import make_output_dir, take_run_dir
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
@@ -170,7 +170,14 @@ def create_run(
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
         take_run_dir(run_dir, overwrite=overwrite).close()
+    check_budget(config)
     env, eval_env, agent, replay = build(config, check)
+    try:
+        check_decisions(config, episode_limit(eval_env))
+    except SetupError:
+        env.close()
+        eval_env.close()
+        raise
     make_output_dir(run_dir, "--run-dir")
     lock = take_run_dir(run_dir, overwrite=overwrite)
     remove_leftovers(run_dir)
@@ -178,6 +185,38 @@ def create_run(
     write_config(run_dir, config)
     rng = np.random.default_rng(stream(config.seed, Stream.WARMUP_ACTIONS))
     return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters(), lock)
+
+
+def check_budget(config: TrainConfig) -> None:
+    """SetupError when one agent decision (``action_repeat`` env steps) is longer than the
+    whole run: the run would take that one decision, overrun ``total_env_steps`` and learn
+    nothing."""
+    repeat = config.resolved_action_repeat()
+    if repeat <= config.total_env_steps:
+        return
+    given = "" if config.action_repeat is not None else ", the paper's value for this task"
+    raise SetupError(
+        f"--action-repeat {repeat} (TrainConfig.action_repeat{given}) is longer than the whole "
+        f"run (--total-env-steps {config.total_env_steps}, TrainConfig.total_env_steps): each "
+        f"agent decision takes {repeat} env steps, so the run would take one decision and "
+        f"overrun its budget; set --action-repeat {config.total_env_steps} or less, or "
+        f"--total-env-steps many times {repeat}"
+    )
+
+
+def budget_warning(config: TrainConfig) -> str | None:
+    """A warning when the warm-up takes every agent decision of the run, so that it ends
+    before its first update; else None."""
+    decisions = config.total_env_steps // config.resolved_action_repeat()
+    if decisions == 0 or config.warmup_agent_steps < decisions:  # none: check_budget refuses
+        return None
+    return (
+        f"--warmup-agent-steps {config.warmup_agent_steps} takes all the run's {decisions} "
+        f"agent decisions (--total-env-steps {config.total_env_steps} at action repeat "
+        f"{config.resolved_action_repeat()}): it ends before its first update and the agent "
+        f"learns nothing; lower --warmup-agent-steps below {decisions}, or raise "
+        "--total-env-steps"
+    )
 
 
 def write_config(run_dir: Path, config: TrainConfig) -> None:
@@ -199,6 +238,24 @@ def damaged_config(path: Path, problem: str) -> SetupError:
     return SetupError(
         f"{path} is damaged: {problem}. Nothing in the run was changed. Restore the file from a "
         "copy (simoun-train writes UTF-8 JSON), or start a new run"
+    )
+
+
+def changes(saved: Any, key: str, value: Any, run_dir: Path) -> bool:
+    """Whether the override ``key``: ``value`` of a resumed run changes a fixed key of its
+    ``saved`` config (``config.json`` as read); a key given its saved value changes nothing,
+    and ``run_dir`` is the same directory however it is spelled."""
+    if key in RESUMABLE_FIELDS:
+        return False
+    kept = saved
+    for part in key.split("."):
+        if not isinstance(kept, dict) or part not in kept:
+            return True
+        kept = kept[part]
+    if key == "run_dir" and isinstance(value, str) and isinstance(kept, str):
+        return Path(value).resolve() != run_dir.resolve()
+    return json.dumps(value, sort_keys=True, default=str) != json.dumps(
+        kept, sort_keys=True, default=str
     )
 
 
@@ -230,11 +287,12 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         saved = json.loads(read_text(config_path))
     except (Damaged, json.JSONDecodeError) as err:
         raise damaged_config(config_path, str(err)) from None
-    fixed = {k: v for k, v in overrides.items() if k not in RESUMABLE_FIELDS}
+    fixed = [key for key, value in overrides.items() if changes(saved, key, value, run_dir)]
     if fixed:
         raise SetupError(
             f"a resumed run keeps its config; only {', '.join(RESUMABLE_FIELDS)} may change, "
-            f"but {', '.join(fixed)} was given. Start a new run to change it."
+            f"but {', '.join(fixed)} was given another value than the run's. Drop it, or start a "
+            "new run to change it."
         )
     config = from_dict(saved, str(config_path))
     as_saved = to_dict(config)
