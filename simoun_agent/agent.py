@@ -14,6 +14,7 @@ import numpy as np
 import torch
 
 from simoun_agent.config import AgentConfig
+from simoun_agent.config.agent import check_agent_config
 from simoun_agent.config.shapes import check_agent_inputs
 from simoun_agent.device import default_device
 from simoun_agent.losses import (
@@ -63,6 +64,15 @@ def unchanged(frames: torch.Tensor) -> torch.Tensor:
     return frames
 
 
+def check_config_in_use(config: AgentConfig) -> None:
+    """Check ``config`` again where it is used: a dataclass takes any value assigned after it
+    was built (``config.lr = -1``), which would otherwise fail inside torch naming no field."""
+    try:
+        check_agent_config(config)
+    except ValueError as err:
+        raise ValueError(f"SimounAgent cannot use this config: {err}") from None
+
+
 class SimounAgent:
     """SAC on the dual-path (or ablation) encoder with Simoun's auxiliary losses and curiosity.
 
@@ -94,6 +104,7 @@ class SimounAgent:
                 "simoun_agent.config.resolve(preset, overrides).agent for a preset"
             )
         self.config = config = config or AgentConfig()
+        check_config_in_use(config)
         check_agent_inputs(frame_shape, action_dim, config)
         self.frame_shape = tuple(int(s) for s in frame_shape)
         self.action_dim = int(action_dim)
@@ -767,6 +778,25 @@ class SimounAgent:
             if name in state:
                 problems += count_problems(name, state[name])
         return problems
+
+    def to(self, device: str | torch.device) -> SimounAgent:
+        """Refused with a TypeError that says how to move an agent: its device is chosen when
+        it is built (its optimizers, generators and running maxima live there too), so
+        ``SimounAgent(..., device=device)`` and :meth:`load_state_dict` move it whole."""
+        raise TypeError(
+            f"SimounAgent.to({device!r}): an agent's device is chosen when it is built, not "
+            f"moved like a torch module (this one is on {self.device}). Build it there, "
+            f"SimounAgent(frame_shape, action_dim, config, device={str(device)!r}), and load "
+            "the trained weights into it: moved.load_state_dict(agent.state_dict())."
+        )
+
+    def cpu(self) -> SimounAgent:
+        """Refused as :meth:`to` is."""
+        return self.to("cpu")
+
+    def cuda(self) -> SimounAgent:
+        """Refused as :meth:`to` is."""
+        return self.to("cuda")
 
     def load_state_dict(self, state: dict) -> None:
         """Restore what :meth:`state_dict` saved (into an agent built with the same config,

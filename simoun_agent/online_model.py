@@ -233,7 +233,9 @@ class OnlineModel(ABC):
     @classmethod
     def _checked_config(cls, config: Any) -> Any:
         """``config``, or ``config_type()`` for None; a TypeError naming the argument for
-        anything else (a dict of its fields, say)."""
+        anything else (a dict of its fields, say). A config is checked again here: a dataclass
+        takes any value assigned after it was built (``config.lr = -1``), which would otherwise
+        fail inside torch naming no field."""
         if config is None:
             return cls.config_type()
         if not isinstance(config, cls.config_type):
@@ -243,6 +245,10 @@ class OnlineModel(ABC):
                 f"{config!r:.60}; e.g. {cls.__name__}.for_env(env, config={kind}(lr=1e-4)), or "
                 f"{kind}(**values) for a dict of its fields"
             )
+        try:
+            check_online_config(config)
+        except ValueError as err:
+            raise ValueError(f"{cls.__name__} cannot use this config: {err}") from None
         return config
 
     @classmethod

@@ -1,8 +1,10 @@
 """Argument checks shared by the wrappers."""
 
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 
 def is_int(value: Any) -> bool:
@@ -19,13 +21,138 @@ def is_real(value: Any) -> bool:
     )
 
 
-def check_reset_seed(seed: Any, owner: str) -> None:
-    """A clear error for a ``reset(seed=...)`` that is neither None nor an int >= 0, raised before
-    ``owner`` seeds its own random generator with it (numpy's error names no argument)."""
-    if seed is not None and not (is_int(seed) and seed >= 0):
+def check_reset_seed(seed: Any, owner: str) -> int | None:
+    """``seed`` of ``owner.reset(seed=...)`` as a Python int, or None; a ValueError for anything
+    else, raised before ``owner`` or the env it wraps seeds a random generator with it (numpy's
+    and Gymnasium's errors name no argument, and Gymnasium takes ``True`` for 1). A numpy int is
+    taken as the int it holds: Gymnasium's own seeding refuses it."""
+    if seed is None:
+        return None
+    if not (is_int(seed) and seed >= 0):
         raise ValueError(
             f"{owner}.reset(seed=...) takes None or an int >= 0, got {seed!r}; e.g. "
             f"env.reset(seed=0), or env.reset() to continue the random stream."
+        )
+    return int(seed)
+
+
+def check_vector_reset_seed(seed: Any, owner: str, num_envs: int) -> int | list[int | None] | None:
+    """``seed`` of a vector env's ``owner.reset(seed=...)``: None, an int (sub-env ``i`` gets
+    ``seed + i``) or one int or None per sub-env, as Python values; a ValueError naming the
+    sub-envs for anything else."""
+    if not isinstance(seed, (list, tuple)):
+        return check_reset_seed(seed, owner)
+    if len(seed) != num_envs:
+        raise ValueError(
+            f"{owner}.reset(seed=[...]) takes one seed per sub-env, {num_envs} here, got "
+            f"{len(seed)}: {list(seed)!r}; e.g. envs.reset(seed=0) (sub-env i gets seed 0 + i)."
+        )
+    return [check_reset_seed(one, owner) for one in seed]
+
+
+def plain(value: Any) -> Any:
+    """``value`` with numpy scalars and arrays made Python values (recursively through lists,
+    tuples and dicts): what a wrapper records of its constructor arguments for ``env.spec``,
+    whose ``to_json()`` takes only plain values."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if type(value) in (list, tuple):  # not a named tuple, whose fields are its arguments
+        return type(value)(plain(item) for item in value)
+    if type(value) is dict:
+        return {key: plain(item) for key, item in value.items()}
+    return value
+
+
+def _box_problem(action: Any, space: spaces.Box) -> str | None:
+    """Why ``action`` is not an action of ``space``, or None when it is. As ``Box.contains``,
+    with two exceptions the envs themselves make: a float array is taken for a Box of another
+    float type (``np.array([0.5])`` for Pendulum's float32 Box), and a value out of the bounds
+    is left to the env, which clips it (Pendulum, MuJoCo; ``gymnasium.wrappers.ClipAction`` for
+    the others). NaN is refused: no env can clip it, and it would silently spoil the state."""
+    try:
+        array = np.asarray(action)
+    except (TypeError, ValueError):
+        return f"{type(action).__name__}, not an array"
+    if array.dtype.kind not in "biuf":
+        return f"{type(action).__name__} of dtype {array.dtype}, not real numbers"
+    if not np.can_cast(array.dtype, space.dtype, casting="same_kind"):
+        return f"of dtype {array.dtype}, which does not cast to {space.dtype}"
+    if array.shape != space.shape:
+        return f"of shape {array.shape}, not {space.shape}"
+    if np.isnan(array).any():
+        return "it holds NaN"
+    return None
+
+
+def _valid_actions(space: spaces.Space, vector: int | None) -> str:
+    """What the actions of ``space`` are, with an example; ``vector`` is the number of sub-envs
+    of a vector env's batched space, else None."""
+    each = f", one per sub-env ({vector} sub-envs)" if vector else ""
+    if isinstance(space, spaces.Discrete):
+        last = int(space.start) + int(space.n) - 1
+        return f"an int in {int(space.start)}..{last}, e.g. {int(space.start)}"
+    if isinstance(space, spaces.MultiDiscrete):
+        low, high = space.start, space.start + space.nvec - 1
+        if np.all(low == low.flat[0]) and np.all(high == high.flat[0]):
+            low, high = low.flat[0], high.flat[0]
+        return (
+            f"an int array of shape {space.shape} with values in {low.tolist()}..{high.tolist()}"
+            f"{each}, e.g. np.array({space.start.tolist()})"
+        )
+    if isinstance(space, spaces.Box):
+        low, high = np.min(space.low), np.max(space.high)
+        example = np.zeros(space.shape).clip(space.low, space.high).tolist()
+        return (
+            f"an array of shape {space.shape} ({space.dtype}) with values in [{low}, {high}]"
+            f"{each}, e.g. np.array({example}, np.{space.dtype})"
+        )
+    return f"a value of {space}{each}, e.g. env.action_space.sample()"
+
+
+def _problem(action: Any, space: spaces.Space) -> str | None:
+    """Why ``action`` is not in ``space`` (None when it is): ``space.contains`` for every
+    space, with Box's float types taken as :func:`_box_problem` says, also inside Tuple and
+    Dict spaces."""
+    if isinstance(space, spaces.Box):
+        return _box_problem(action, space)
+    if isinstance(space, spaces.Tuple):
+        if not isinstance(action, Sequence) or len(action) != len(space.spaces):
+            return f"not a tuple of {len(space.spaces)} actions"
+        return next(filter(None, map(_problem, action, space.spaces)), None)
+    if isinstance(space, spaces.Dict):
+        if not isinstance(action, Mapping) or set(action) != set(space.spaces):
+            return f"not a dict with the keys {list(space.spaces)}"
+        return next(filter(None, (_problem(action[k], s) for k, s in space.spaces.items())), None)
+    if space.contains(action):
+        return None
+    if isinstance(space, (spaces.Discrete, spaces.MultiDiscrete)):
+        array = np.asarray(action)
+        if not np.issubdtype(array.dtype, np.integer):
+            return f"{type(action).__name__} of dtype {array.dtype}, not ints"
+        if array.shape != space.shape:
+            return f"of shape {array.shape}, not {space.shape}"
+        return "out of its range"
+    return "not one of its values"
+
+
+def check_action(action: Any, space: spaces.Space, owner: str, vector: int | None = None) -> None:
+    """A ValueError unless ``action`` is in ``space``, the action space ``owner`` exposes (the
+    batched one for a vector env of ``vector`` sub-envs), raised before the env gets it: an
+    env's own error names neither the space nor what is valid, and some envs take a wrong
+    action silently.
+
+    Gymnasium's ``space.contains`` decides, so a 0-d value is no action of a ``Box`` of shape
+    ``(1,)`` (pass ``np.array([a])``) and a float no action of a ``Discrete``; a ``Box`` takes
+    a float array of another float type and leaves its bounds to the env (see
+    :func:`_box_problem`).
+    """
+    problem = _problem(action, space)
+    if problem is not None:
+        raise ValueError(
+            f"{owner}.step got the action {action!r:.80}, which is not in its action space "
+            f"{space}: {problem}. Pass {_valid_actions(space, vector)}."
         )
 
 

@@ -8,7 +8,7 @@ from typing import Any, SupportsFloat
 
 import gymnasium as gym
 
-from simoun_wrappers._checks import check_positive_int
+from simoun_wrappers._checks import check_action, check_positive_int, check_reset_seed, plain
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 
 
@@ -38,7 +38,7 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
             repeat: inner steps per agent step, a positive int (1 changes nothing).
         """
         check_single_env(env, "ActionRepeat")
-        gym.utils.RecordConstructorArgs.__init__(self, repeat=repeat)
+        gym.utils.RecordConstructorArgs.__init__(self, repeat=plain(repeat))
         gym.Wrapper.__init__(self, env)
         check_positive_int(
             repeat,
@@ -54,7 +54,14 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
         )
         self.repeat = int(repeat)
 
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, "ActionRepeat")
+        return self.env.reset(seed=seed, options=options)
+
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, "ActionRepeat")
         total, finite = 0.0, True
         for _ in range(self.repeat):
             obs, reward, terminated, truncated, info = self.env.step(action)

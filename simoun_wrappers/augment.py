@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
-from simoun_wrappers._checks import check_reset_seed, is_int
+from simoun_wrappers._checks import check_reset_seed, is_int, plain
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
@@ -247,7 +247,9 @@ class RandomConvolution(ChainWrapper):
             source: ``"auto"``, ``"observation"`` or ``"render"``, as in ``SimounObservation``.
         """
         check_single_env(env, "RandomConvolution")
-        gym.utils.RecordConstructorArgs.__init__(self, kernel_size=kernel_size, source=source)
+        gym.utils.RecordConstructorArgs.__init__(
+            self, kernel_size=plain(kernel_size), source=source
+        )
         import torch
 
         if not is_int(kernel_size) or kernel_size < 1 or kernel_size % 2 == 0:
@@ -277,7 +279,7 @@ class RandomConvolution(ChainWrapper):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        check_reset_seed(seed, "RandomConvolution")
+        seed = check_reset_seed(seed, "RandomConvolution")
         if seed is not None:
             self._rng = np.random.default_rng(seed)
         self._kernel_seed = int(self._rng.integers(2**62))

@@ -11,6 +11,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from simoun_wrappers._checks import check_action, check_reset_seed, plain
 from simoun_wrappers.augment import RandomConvolution
 from simoun_wrappers.distractors._dm_control import check_open, dm_control_physics
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
@@ -143,7 +144,7 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         self._hw = parse_size(size)
         self._dm_control = any(isinstance(c, (int, np.integer, str)) for c in cameras)
         """whether a view renders the physics of a dm_control task, which close() frees"""
-        gym.utils.RecordConstructorArgs.__init__(self, cameras=cameras, size=size)
+        gym.utils.RecordConstructorArgs.__init__(self, cameras=plain(cameras), size=size)
         gym.ObservationWrapper.__init__(self, env)
         refuse_over_frame_stack(
             env,
@@ -217,10 +218,12 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        seed = check_reset_seed(seed, "MultiCamera")
         self._check_open()
         return super().reset(seed=seed, options=options)
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, "MultiCamera")
         self._check_open()
         return super().step(action)
 

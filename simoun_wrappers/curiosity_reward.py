@@ -9,6 +9,8 @@ trained Simoun agent's encoder). The wrappers are ``simoun_wrappers.intrinsic_re
 
 from __future__ import annotations
 
+from typing import Any
+
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import VectorEnv
@@ -51,7 +53,7 @@ class ConsistencySignal(IntrinsicSignal):
         return self.source
 
     def raw(self, triplets: np.ndarray) -> np.ndarray:
-        f_m, f_a = self.source(triplets)
+        f_m, f_a = self._features(triplets)
         f_m = np.asarray(f_m, dtype=np.float32)
         f_a = np.asarray(f_a, dtype=np.float32)
         if not (np.all(np.isfinite(f_m)) and np.all(np.isfinite(f_a))):
@@ -66,6 +68,43 @@ class ConsistencySignal(IntrinsicSignal):
             )
         return consistency_distance(f_m, f_a).astype(np.float64)
 
+    def _features(self, triplets: np.ndarray) -> tuple[Any, Any]:
+        """The source's ``(f_m, f_a)``, or a clear error naming the source and what it must
+        return (Python's own is "too many values to unpack")."""
+        returned = self.source(triplets)
+        if isinstance(returned, (tuple, list)) and len(returned) == 2:
+            return returned[0], returned[1]
+        if isinstance(returned, (tuple, list)):
+            got = f"a {type(returned).__name__} of {len(returned)}"
+        else:
+            shape = getattr(returned, "shape", None)
+            got = f"a {type(returned).__name__}" + (f" of shape {tuple(shape)}" if shape else "")
+        hint = (
+            " A NoveltySource such as RNDModel (one error per triplet) goes with RNDReward, not "
+            "ConsistencyCuriosityReward."
+            if not isinstance(returned, (tuple, list))
+            else ""
+        )
+        raise ValueError(
+            f"The feature source {source_name(self.source)} returned {got} for "
+            f"{len(triplets)} triplets; a FeatureSource (features=) must return the tuple "
+            f"(f_m, f_a): motion features ({len(triplets)}, D) and appearance features "
+            f"({len(triplets)}, 3, D).{hint}"
+        )
+
+
+def source_name(source: object) -> str:
+    """How an error names a source: a function by its name, an object by its class."""
+    qualname = getattr(source, "__qualname__", None)
+    return f"function {qualname}" if isinstance(qualname, str) else type(source).__name__
+
+
+def is_paper(normalization: str | Normalization) -> bool:
+    """Whether ``normalization`` is Eq. 13's, by name or as an instance."""
+    if isinstance(normalization, Normalization):
+        return isinstance(normalization, PaperMaxima)
+    return isinstance(normalization, str) and normalization == PaperMaxima.name
+
 
 class ConsistencyArguments:
     """The consistency wrappers' constructor: ``features``, Eq. 13's constants, and the
@@ -79,8 +118,8 @@ class ConsistencyArguments:
         features: FeatureSource,
         scale: float = 0.2,
         decay: float | None = None,
-        r_e_max_init: float = 1.0,
-        r_i_max_init: float = 1.0,
+        r_e_max_init: float | None = None,
+        r_i_max_init: float | None = None,
         normalization: str | Normalization = "paper",
         warmup: int = 0,
         progress: float | None = None,
@@ -95,20 +134,25 @@ class ConsistencyArguments:
             features: the :class:`FeatureSource` giving ``f_m`` and ``f_a``.
             scale: the weight of the normalized reward (C of Eq. 13).
             decay: lambda of Eq. 13's ``exp(-lambda * t)``, per environment step; None: the
-                paper's 2e-5 with ``normalization="paper"`` (Eq. 13 as written), else 0 (the
-                literature's normalizations have no schedule).
-            r_e_max_init: initial running maximum of ``|r_e|`` (> 0; ``"paper"`` only).
-            r_i_max_init: initial running maximum of ``d`` (> 0; ``"paper"`` only). Both
+                paper's 2e-5 with Eq. 13's normalization, given by name (``"paper"``) or as an
+                instance (``PaperMaxima(...)``), else 0 (the literature's normalizations have no
+                schedule).
+            r_e_max_init: initial running maximum of ``|r_e|`` (> 0) of ``normalization=
+                "paper"``; None: 1.0. Refused with any other normalization, an instance
+                included (``PaperMaxima(r_e_max_init=...)`` takes it there).
+            r_i_max_init: initial running maximum of ``d`` (> 0), as ``r_e_max_init``. Both
                 defaults match ``simoun_agent.AgentConfig``; a tiny ``r_i_max_init`` lets the
                 first distances set the scale instead.
             normalization: a name of ``simoun_wrappers.intrinsic_normalization.NORMALIZATIONS``
-                or a ``Normalization``. ``"paper"`` (Eq. 13 as written) is always positive: a
-                bonus for staying alive to an on-policy learner (see docs/intrinsic-rewards.md).
+                or a ``Normalization``; an instance means what its name means (a
+                ``PaperMaxima()`` is ``"paper"``). ``"paper"`` (Eq. 13 as written) is always
+                positive: a bonus for staying alive to an on-policy learner (see
+                docs/intrinsic-rewards.md).
             warmup: transitions that get reward 0 while the statistics settle.
             progress: None, or NovelD's alpha: pay ``max(d(s') - alpha * d(s), 0)``.
         """
         if decay is None:
-            decay = PAPER_DECAY if normalization == PaperMaxima.name else 0.0
+            decay = PAPER_DECAY if is_paper(normalization) else 0.0
         super().__init__(
             env,
             scale,

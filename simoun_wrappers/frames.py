@@ -12,7 +12,7 @@ from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
 from gymnasium.wrappers import FrameStackObservation
 
-from simoun_wrappers._checks import check_positive_int
+from simoun_wrappers._checks import check_action, check_positive_int, check_reset_seed, plain
 
 MAX_STACK_BYTES = 2**30
 """The largest stack ``FrameTriplet`` or ``FrameStack`` builds (1 GiB: over 12,000 RGB frames of
@@ -91,7 +91,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
             num_frames: how many consecutive observations to stack (``k``).
         """
         check_single_env(env, "FrameTriplet")
-        gym.utils.RecordConstructorArgs.__init__(self, num_frames=num_frames)
+        gym.utils.RecordConstructorArgs.__init__(self, num_frames=plain(num_frames))
         gym.Wrapper.__init__(self, env)
         check_positive_int(num_frames, "num_frames", "use 3 for a triplet.")
         space = env.observation_space
@@ -111,6 +111,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        seed = check_reset_seed(seed, type(self).__name__)
         obs, info = self.env.reset(seed=seed, options=options)
         self._has_reset = True
         return self._ring.reset(obs), info
@@ -122,6 +123,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 "Cannot call env.step() before calling env.reset(): FrameTriplet fills its "
                 "frame stack in reset(); call env.reset(seed=...) first."
             )
+        check_action(action, self.action_space, type(self).__name__)
         obs, reward, terminated, truncated, info = self.env.step(action)
         return self._ring.push(obs), reward, terminated, truncated, info
 

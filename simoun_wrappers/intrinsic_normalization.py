@@ -116,6 +116,9 @@ class Normalization(ABC):
     bounds: ClassVar[dict[str, str]] = {}
     """statistics with a sign: key -> ``">= 0"`` or ``"> 0"``"""
 
+    per_env: ClassVar[tuple[str, ...]] = ()
+    """statistics that are lists of one value per sub-env (empty before the first step)"""
+
     def state_problems(self, state: Any) -> list[str]:
         """What keeps ``state`` from being loaded here, empty when it fits: not a dict, the
         statistics of another normalization (named), keys missing or unknown, or a value of the
@@ -165,6 +168,18 @@ class Normalization(ABC):
                 )
         return problems
 
+    def sub_env_problems(self, state: dict[str, Any], num_envs: int) -> list[str]:
+        """What keeps ``state``, which :meth:`state_problems` passed, from a wrapper of
+        ``num_envs`` sub-envs (1 for a single env): a :attr:`per_env` list of another length,
+        whose sub-envs would take each other's statistics or start from nothing."""
+        return [
+            f"its {key} holds {len(state[key])} values, one per sub-env, but this wrapper has "
+            f"{num_envs} sub-env{'s' if num_envs != 1 else ''} (num_envs={num_envs}); a state "
+            "loads only into a wrapper with as many sub-envs as the one that saved it"
+            for key in self.per_env
+            if len(state[key]) not in (0, num_envs)
+        ]
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
 
@@ -199,6 +214,7 @@ class PaperMaxima(Normalization):
     bounds: ClassVar[dict[str, str]] = {"r_e_max": "> 0", "r_i_max": "> 0"}
 
     def __init__(self, r_e_max_init: float = 1.0, r_i_max_init: float = 1.0) -> None:
+        self.initial = {"r_e_max_init": r_e_max_init, "r_i_max_init": r_i_max_init}
         for name, value in (("r_e_max_init", r_e_max_init), ("r_i_max_init", r_i_max_init)):
             if not (is_real(value) and math.isfinite(value) and value > 0):
                 raise ValueError(
@@ -218,6 +234,9 @@ class PaperMaxima(Normalization):
 
     def restore(self, state: dict[str, Any]) -> None:
         self.maxima.load_state_dict(state)
+
+    def __repr__(self) -> str:
+        return f"PaperMaxima({', '.join(f'{k}={v!r}' for k, v in self.initial.items())})"
 
 
 class RewardStd(Normalization):
@@ -277,9 +296,11 @@ class ReturnStd(Normalization):
 
     name = "return_std"
     bounds: ClassVar[dict[str, str]] = {"var": ">= 0", "count": ">= 0"}
+    per_env = ("returns",)
 
     def __init__(self, gamma: float = 0.99) -> None:
-        if not (isinstance(gamma, (int, float)) and 0 <= gamma < 1):
+        # the wrappers' number rule: numpy scalars are numbers, a bool is a mistake, NaN is out
+        if not (is_real(gamma) and 0 <= gamma < 1):
             raise ValueError(
                 f"gamma must be a number in [0, 1) (the intrinsic return's discount), got "
                 f"{gamma!r}; RND uses gamma=0.99."
@@ -362,11 +383,16 @@ NORMALIZATIONS: dict[str, type[Normalization]] = {
 """normalization name -> class"""
 
 
-def make_normalization(normalization: str | Normalization, **paper: float) -> Normalization:
+def make_normalization(normalization: str | Normalization, **paper: float | None) -> Normalization:
     """``normalization`` itself when it is a :class:`Normalization`, else the registered class of
-    that name, built with its defaults (``paper``: ``r_e_max_init`` / ``r_i_max_init``, used by
-    ``"paper"`` only)."""
+    that name, built with its defaults. ``paper``: ``r_e_max_init`` / ``r_i_max_init`` of
+    ``"paper"``, None where not given. Given with another name they are refused (it has no
+    running maxima), and so they are with an instance, which keeps the values it was built with:
+    ``PaperMaxima(r_e_max_init=5.0)`` is how an instance takes them."""
+    given = {key: value for key, value in paper.items() if value is not None}
     if isinstance(normalization, Normalization):
+        if given:
+            raise unused_maxima(given, normalization)
         return normalization
     if normalization not in NORMALIZATIONS:
         from difflib import get_close_matches
@@ -378,5 +404,24 @@ def make_normalization(normalization: str | Normalization, **paper: float) -> No
             "or pass a Normalization instance (e.g. ReturnStd(gamma=0.999))."
         )
     if normalization == PaperMaxima.name:
-        return PaperMaxima(**paper)
+        return PaperMaxima(**given)
+    if given:
+        raise unused_maxima(given, normalization)
     return NORMALIZATIONS[normalization]()
+
+
+def unused_maxima(given: dict[str, float], normalization: str | Normalization) -> ValueError:
+    """The error for initial maxima (``given``) that ``normalization`` would not use: an
+    argument must never be dropped without a word."""
+    named = ", ".join(f"{key}={value!r}" for key, value in given.items())
+    keys = " and ".join(given)
+    if isinstance(normalization, PaperMaxima):
+        return ValueError(
+            f"{named} cannot change normalization={normalization!r}: an instance keeps the "
+            f"initial maxima it was built with. Build it with them, normalization="
+            f"PaperMaxima({named}), or pass normalization='paper', {named}."
+        )
+    return ValueError(
+        f"{named} is used by normalization='paper' only, and normalization={normalization!r} "
+        f"has no running maxima; drop {keys}, or use normalization='paper' (Eq. 13)."
+    )

@@ -4,8 +4,9 @@
 :class:`IntrinsicSignal`: Simoun's consistency distance (``simoun_wrappers.curiosity_reward``),
 random network distillation's error (``simoun_wrappers.rnd``) and a constant bonus
 (:class:`ConstantSignal`) are one signal class each over the same two wrappers
-(:class:`IntrinsicReward`, :class:`IntrinsicVectorReward`), and every signal takes every
-normalization of ``simoun_wrappers.intrinsic_normalization``. The wrappers handle the rest:
+(:class:`IntrinsicReward`, :class:`IntrinsicVectorReward`), and every signal with a spread takes
+every normalization of ``simoun_wrappers.intrinsic_normalization`` (the constant bonus takes
+none: a constant has no spread to divide by). The wrappers handle the rest:
 reading the Simoun frame triplets, skipping the autoreset steps of a vector env, handing each
 transition to a source that learns online, ``info``, state and ``close``.
 """
@@ -23,10 +24,18 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
-from simoun_wrappers._checks import is_int, is_real
+from simoun_wrappers._checks import (
+    check_action,
+    check_reset_seed,
+    check_vector_reset_seed,
+    is_int,
+    is_real,
+    plain,
+)
 from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
+    Raw,
     make_normalization,
     normalization_name,
 )
@@ -90,6 +99,38 @@ class TripletReader:
 def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
     """A function taking a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``."""
     return TripletReader(space)
+
+
+def _observation_space(env: gym.Env | VectorEnv) -> spaces.Space:
+    return env.single_observation_space if isinstance(env, VectorEnv) else env.observation_space
+
+
+def env_triplet_reader(env: gym.Env | VectorEnv, owner: str) -> TripletReader:
+    """The :class:`TripletReader` of ``env``'s (for a vector env, each sub-env's) observations.
+    When they are no triplets but wrappers over an env of triplets changed them (Gymnasium's
+    ``NormalizeObservation``, ``FlattenObservation``), the TypeError names those wrappers and
+    the order that works: ``owner`` reads the triplets, the wrappers go outside it."""
+    try:
+        return TripletReader(_observation_space(env))
+    except (TypeError, ValueError):
+        over: list[str] = []
+        inner = env
+        while isinstance(inner, (gym.Wrapper, VectorWrapper)):
+            over.append(type(inner).__name__)
+            inner = inner.env
+            try:
+                triplet_shape(_observation_space(inner))
+            except (TypeError, ValueError):
+                continue
+            outside = ", ".join(over)
+            raise TypeError(
+                f"{owner} reads Simoun frame triplets, but {outside} over "
+                f"{type(inner).__name__} changed them to {_observation_space(env)}. Put "
+                f"{outside} outside {owner}: e.g. {over[0]}({owner}({type(inner).__name__}(env, "
+                f"...), ...)) gives the reward the triplets and the learner the changed "
+                "observations."
+            ) from None
+        raise
 
 
 LARGEST = np.finfo(np.float64).max
@@ -292,7 +333,7 @@ class IntrinsicMechanism(ABC):
         # constant bonus fixes its normalization, warm-up and progress)
         taken = inspect.signature(type(self).__init__).parameters
         gym.utils.RecordConstructorArgs.__init__(
-            self, **{key: value for key, value in recorded.items() if key in taken}
+            self, **{key: plain(value) for key, value in recorded.items() if key in taken}
         )
         self.signal = self.signal_type(**arguments)
         self.normalization = make_normalization(normalization, **paper)
@@ -314,10 +355,41 @@ class IntrinsicMechanism(ABC):
             both = self._raw(np.concatenate([previous, reached]))
             raw = np.maximum(both[len(reached) :] - self.progress * both[: len(reached)], 0.0)
         position = self.scored + np.arange(len(raw))
-        normalized = self.normalization(raw, extrinsic, envs, position >= self.warmup // 2)
+        normalized = self._normalize(raw, extrinsic, envs, position >= self.warmup // 2)
         weight = self.scale * math.exp(-self.decay * self.scored)
         self.scored += len(raw)
         return np.where(position >= self.warmup, weight * normalized, 0.0)
+
+    def _normalize(
+        self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
+    ) -> np.ndarray:
+        """The normalization's rewards for ``raw``, checked as the raw values are: one finite
+        float per row (a user's own ``Normalization`` may return anything)."""
+        returned = self.normalization(raw, extrinsic, envs, counted)
+        try:
+            values = np.asarray(returned, dtype=np.float64)
+        except (TypeError, ValueError):
+            values = None
+        if values is None or values.shape != raw.shape:
+            got = (
+                f"shape {values.shape}"
+                if values is not None and values.ndim
+                else f"{returned!r:.40} ({type(returned).__name__})"
+            )
+            raise ValueError(
+                f"normalization {self.normalization!r} returned {got} for a batch of "
+                f"{len(raw)} raw values; its __call__ must return one reward per row, a float "
+                f"array of shape ({len(raw)},)."
+            )
+        if not np.all(np.isfinite(values)):
+            row = int(np.flatnonzero(~np.isfinite(values))[0])
+            raise ValueError(
+                f"normalization {self.normalization!r} gave the non-finite reward {values[row]} "
+                f"for the raw value {raw[row]} at transition {self.scored + row} of this "
+                "wrapper; a Normalization must turn finite values into finite rewards (check its "
+                "statistics, e.g. a division by a spread of 0)."
+            )
+        return values
 
     def _raw(self, triplets: np.ndarray) -> np.ndarray:
         raw = np.asarray(self.signal.raw(triplets), dtype=np.float64)
@@ -354,7 +426,10 @@ class IntrinsicMechanism(ABC):
         if not (is_real(scored) and math.isfinite(scored) and scored >= 0 and scored % 1 == 0):
             problems.append(f"its scored is {scored!r}, not an int >= 0")
         if "normalization" in state:
-            problems += self.normalization.state_problems(state["normalization"])
+            statistics = state["normalization"]
+            unfit = self.normalization.state_problems(statistics)
+            num_envs = self.num_envs if self.vector else 1
+            problems += unfit or self.normalization.sub_env_problems(statistics, num_envs)
         if problems:
             raise ValueError(
                 f"{name}.load_state_dict cannot load this state: {'; '.join(problems)}; {fix}. "
@@ -395,12 +470,13 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
 
     def _attach(self, env: gym.Env) -> None:
         gym.Wrapper.__init__(self, env)
-        self._read = triplet_reader(env.observation_space)
+        self._read = env_triplet_reader(env, type(self).__name__)
         self._last_triplet: np.ndarray | None = None
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, type(self).__name__)
         obs, info = self.env.reset(seed=seed, options=options)
         self._last_triplet = self._read(obs)
         return obs, info
@@ -408,6 +484,7 @@ class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstruct
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
         if self._last_triplet is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
+        check_action(action, self.action_space, type(self).__name__)
         obs, extrinsic, terminated, truncated, info = self.env.step(action)
         extrinsic = float(extrinsic)
         batch = np.array([extrinsic], dtype=np.float64)
@@ -447,7 +524,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
 
     def _attach(self, env: VectorEnv) -> None:
         VectorWrapper.__init__(self, env)
-        self._read = triplet_reader(env.single_observation_space)
+        self._read = env_triplet_reader(env, type(self).__name__)
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
         self._prev_dones = np.zeros(self.num_envs, dtype=bool)
         self._last_triplets: np.ndarray | None = None
@@ -457,6 +534,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     ) -> tuple[Any, dict[str, Any]]:
         # read before the reset: Gymnasium's vector envs pop "reset_mask" from the options
         mask = None if options is None else options.get("reset_mask")
+        seed = check_vector_reset_seed(seed, type(self).__name__, self.num_envs)
         obs, info = self.env.reset(seed=seed, options=options)
         # a masked reset returns the other sub-envs' observations unchanged
         self._last_triplets = self._read(obs)
@@ -467,6 +545,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
         if self._last_triplets is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
+        check_action(actions, self.action_space, type(self).__name__, vector=self.num_envs)
         obs, extrinsic, terminated, truncated, info = self.env.step(actions)
         triplets = self._read(obs)
         # The triplet that ends a SAME_STEP episode is in final_obs; obs already holds the reset.
@@ -515,7 +594,13 @@ class ConstantBonusArguments:
 
     signal_type = ConstantSignal
 
-    def __init__(self, env: gym.Env | VectorEnv, scale: float, decay: float = 0.0) -> None:
+    def __init__(
+        self,
+        env: gym.Env | VectorEnv,
+        scale: float,
+        decay: float = 0.0,
+        normalization: str | Normalization = "none",
+    ) -> None:
         """Wrap ``env``, whose observations are Simoun triplets (read but not used).
 
         Args:
@@ -523,10 +608,32 @@ class ConstantBonusArguments:
                 :class:`ConstantBonusVectorReward`.
             scale: the bonus paid at every step.
             decay: lambda of a weight ``exp(-lambda * t)``, per environment step.
+            normalization: ``"none"`` only (or ``Raw()``): the bonus is ``scale`` itself. A
+                constant has no spread to divide by (``"reward_std"`` and ``"standardize"``
+                would pay 0 at every step) and no novelty to scale; any other is refused.
         """
+        check_constant_normalization(normalization, type(self).__name__)
         super().__init__(
             env, scale, "none", {"decay": decay, "warmup": 0, "progress": None}, {}, {}
         )
+
+
+def check_constant_normalization(normalization: Any, owner: str) -> None:
+    """A ValueError for a constant bonus given a normalization other than ``"none"``: the
+    running statistics of a constant would turn it into 0 or into a bonus that depends on the
+    env's rewards, which is no longer the control it is meant to be."""
+    if isinstance(normalization, Raw) or (
+        isinstance(normalization, str) and normalization == Raw.name
+    ):
+        return
+    raise ValueError(
+        f"{owner} takes no normalization, got normalization={normalization!r}: its raw value is "
+        "the constant 1, whose running std is 0 ('reward_std' and 'standardize' would pay 0 at "
+        "every step), and 'paper' or 'return_std' would scale it by the env's rewards or by "
+        "time, so it would no longer be the control it is; the bonus is scale itself. Drop "
+        f"normalization (a bonus of b a step is {owner}(env, scale=b)); to pay a normalized "
+        "novelty use RNDReward or ConsistencyCuriosityReward with that normalization."
+    )
 
 
 class ConstantBonusReward(ConstantBonusArguments, IntrinsicReward):

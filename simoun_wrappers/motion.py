@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, SupportsFloat
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from simoun_wrappers._checks import check_action, check_reset_seed
 from simoun_wrappers.frames import check_single_env
 
 
@@ -94,6 +95,16 @@ class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
                 f"stack more frames (FrameTriplet(env, num_frames=3)) or drop the motion channels."
             )
         self.observation_space = spaces.Dict({"frames": space, "motion": motion_space(space)})
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
+        seed = check_reset_seed(seed, "ResidualMotion")
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[dict[str, Any], SupportsFloat, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, "ResidualMotion")
+        return super().step(action)
 
     def observation(self, observation: np.ndarray) -> dict[str, Any]:
         return {"frames": observation, "motion": residual_motion(observation)}

@@ -13,7 +13,14 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec, WrapperSpec
 from gymnasium.wrappers import AddRenderObservation, TransformObservation
 
-from simoun_wrappers._checks import check_bool, check_positive_int, is_int
+from simoun_wrappers._checks import (
+    check_action,
+    check_bool,
+    check_positive_int,
+    check_reset_seed,
+    is_int,
+    plain,
+)
 from simoun_wrappers.frames import check_single_env, frame_stack_in
 
 # LUMA, frame_shape and to_frame (the per-frame step) are importable from this module too.
@@ -45,11 +52,16 @@ frame a pixel agent learns from."""
 
 
 def plain_size(size: Any) -> Any:
-    """A numpy array of integers given as ``size`` as the Python int (0-d) or tuple (1-D) it
-    holds, as a shape read off a space may be; anything else as it is (``parse_size`` checks
+    """A numpy int, an array of integers or a pair of numpy ints given as ``size`` as the Python
+    int (0-d) or tuple (1-D, pair) it holds, as a shape read off a space may be; anything else as
+    it is (``parse_size`` checks
     it). Recorded for ``env.spec`` this way, the size stays JSON."""
     if isinstance(size, np.ndarray) and size.dtype.kind in "iu" and size.ndim <= 1:
         return size.item() if size.ndim == 0 else tuple(size.tolist())
+    if isinstance(size, np.integer):
+        return int(size)
+    if isinstance(size, (tuple, list)) and all(is_int(v) for v in size):
+        return tuple(int(v) for v in size)
     return size
 
 
@@ -220,6 +232,15 @@ def pixel_env(
         return chain, False
 
     if env.render_mode != "rgb_array":
+        changer = render_mode_changer(env)
+        if changer is not None:
+            name = type(changer).__name__
+            raise ValueError(
+                f"{owner} needs pixels: the env has no image observations (observation space "
+                f"{env.observation_space}), and {name} turned the render mode 'rgb_array' into "
+                f"{changer.render_mode!r}, which gives no single frame to take. Put {owner} under "
+                f"{name}, {name}({owner}(env, ...)), or leave {name} out."
+            )
         raise ValueError(
             f"{owner} needs pixels: the env has neither image observations "
             f"(observation space {env.observation_space}) nor render_mode='rgb_array' "
@@ -251,6 +272,17 @@ def pixel_env(
     if _rgba(pixels.observation_space):
         pixels = _drop_alpha(pixels)
     return pixels, True
+
+
+def render_mode_changer(env: gym.Env) -> gym.Wrapper | None:
+    """The wrapper in ``env`` that turned the ``"rgb_array"`` render mode of the env under it into
+    another (gymnasium's ``RenderCollection`` makes it ``"rgb_array_list"``), or None."""
+    inner = env
+    while isinstance(inner, gym.Wrapper):
+        if inner.render_mode != "rgb_array" and inner.env.render_mode == "rgb_array":
+            return inner
+        inner = inner.env
+    return None
 
 
 def check_render(frame: Any, owner: str, shape: tuple[int, ...] | None = None) -> np.ndarray:
@@ -330,6 +362,16 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def __init__(self, chain: gym.Env, source_env: gym.Env) -> None:
         gym.Wrapper.__init__(self, chain)
         self._source_env = source_env
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, type(self).__name__)
+        return self.env.reset(seed=seed, options=options)
+
+    def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, type(self).__name__)
+        return self.env.step(action)
 
     def __reduce__(self) -> tuple:
         """Pickled as its arguments around the pickled source env, since gymnasium's wrappers in
@@ -438,10 +480,10 @@ class SimounObservation(ChainWrapper):
         gym.utils.RecordConstructorArgs.__init__(
             self,
             size=size,
-            grayscale=grayscale,
-            num_frames=num_frames,
-            motion=motion,
-            fold_frames=fold_frames,
+            grayscale=plain(grayscale),
+            num_frames=plain(num_frames),
+            motion=plain(motion),
+            fold_frames=plain(fold_frames),
             source=source,
         )
         check_stack_options(num_frames, motion, fold_frames, source, grayscale)

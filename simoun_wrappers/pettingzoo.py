@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.error import ResetNeeded
 from pettingzoo.utils.env import AECEnv, ParallelEnv
 from pettingzoo.utils.wrappers import BaseParallelWrapper
 
+from simoun_wrappers._checks import check_action, check_reset_seed
 from simoun_wrappers.observation import check_stack_options, image_layout, parse_size
 from simoun_wrappers.stack import FrameStack
 
@@ -88,6 +91,7 @@ class SimounParallelObservation(BaseParallelWrapper):
         # same object; _live names the agents whose stack holds frames of this episode.
         self._stacks: dict[Any, FrameStack] = {}
         self._live: set[Any] = set()
+        self._has_reset = False
 
     def _pick_source(self, source: str) -> bool:
         agent = self.env.possible_agents[0]
@@ -110,8 +114,23 @@ class SimounParallelObservation(BaseParallelWrapper):
             )
         return True
 
+    def _check_agent(self, agent: Any, call: str) -> None:
+        """A ValueError naming the env's agents for an ``agent`` that is none of them."""
+        if agent not in self.env.possible_agents:
+            raise ValueError(
+                f"SimounParallelObservation.{call}({agent!r}): no such agent; this env's agents "
+                f"are {list(self.env.possible_agents)} (env.possible_agents)."
+            )
+
     def _stack_of(self, agent: Any, image: np.ndarray | None = None) -> FrameStack:
         if agent not in self._stacks:
+            if self._from_render and self._size is None and image is None and not self._has_reset:
+                # the frame size is the first render's, and PettingZoo envs render after reset()
+                raise ResetNeeded(
+                    "SimounParallelObservation(size=None) takes its frame size from the env's "
+                    "first render, which PettingZoo allows only after reset(); call "
+                    "env.reset(seed=...) before observation_space(agent), or pass size=(H, W)."
+                )
             if self._from_render and self._size is not None:
                 # rgb_array renders are (H, W, 3) and get resized: no render needed, which lets
                 # observation_space() answer before reset() (PettingZoo envs cannot render yet).
@@ -125,7 +144,12 @@ class SimounParallelObservation(BaseParallelWrapper):
         return self._stacks[agent]
 
     def observation_space(self, agent: Any) -> spaces.Space:
+        self._check_agent(agent, "observation_space")
         return self._stack_of(agent).observation_space
+
+    def action_space(self, agent: Any) -> spaces.Space:
+        self._check_agent(agent, "action_space")
+        return self.env.action_space(agent)
 
     def _images(self, obs: dict[Any, Any]) -> dict[Any, np.ndarray]:
         if not self._from_render:
@@ -136,11 +160,41 @@ class SimounParallelObservation(BaseParallelWrapper):
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[Any, Any], dict[Any, dict[str, Any]]]:
+        seed = check_reset_seed(seed, "SimounParallelObservation")
         obs, infos = self.env.reset(seed=seed, options=options)
+        self._has_reset = True
         self._live = set()
         return self._stack(self._images(obs)), infos
 
+    def _check_actions(self, actions: Any) -> None:
+        """A clear error for ``actions`` that is no dict, names an agent that is none of the
+        env's, lacks the action of an agent that acts (one live since its last reset or
+        appearance), or holds an action outside that agent's action space."""
+        owner = "SimounParallelObservation"
+        if not isinstance(actions, Mapping):
+            raise TypeError(
+                f"{owner}.step takes a dict of one action per agent, got "
+                f"{type(actions).__name__}; e.g. {{agent: env.action_space(agent).sample() for "
+                f"agent in env.agents}}."
+            )
+        unknown = [agent for agent in actions if agent not in self.env.possible_agents]
+        if unknown:
+            raise ValueError(
+                f"{owner}.step got actions for {unknown}, which are no agents of this env; its "
+                f"agents are {list(self.env.possible_agents)} (env.possible_agents)."
+            )
+        missing = [a for a in self.env.agents if a in self._live and a not in actions]
+        if missing:
+            raise ValueError(
+                f"{owner}.step got no action for {missing}: every live agent acts at each step "
+                f"(env.agents: {list(self.env.agents)}); e.g. {{agent: "
+                f"env.action_space(agent).sample() for agent in env.agents}}."
+            )
+        for agent, action in actions.items():
+            check_action(action, self.env.action_space(agent), f"{owner}[{agent!r}]")
+
     def step(self, actions: dict[Any, Any]) -> tuple[dict[Any, Any], ...]:
+        self._check_actions(actions)
         obs, rewards, terminations, truncations, infos = self.env.step(actions)
         stacked = self._stack(self._images(obs))
         for agent in set(terminations) | set(truncations):

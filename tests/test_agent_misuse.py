@@ -383,3 +383,68 @@ def test_a_state_with_a_spoilt_part_is_refused_whole_naming_it_and_nothing_loads
             assert torch.equal(tensor, before[name]), name
     agent.load_state_dict(state)
     assert agent.num_updates == 7
+
+
+def small_agent_config() -> AgentConfig:
+    return AgentConfig(batch_size=8, num_filters=4, feature_dim=8, hidden_dim=16, aux_hidden_dim=16)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "said"),
+    [
+        ("lr", -1, "--agent.lr -1 (AgentConfig.lr) must be a number > 0"),
+        ("discount", 1.5, "(AgentConfig.discount) must be a number >= 0 and <= 1"),
+        ("batch_size", 2.5, "(AgentConfig.batch_size) must be an int >= 1"),
+        ("encoder", "single", "(AgentConfig.curiosity): curiosity (Eq. 13) compares"),
+    ],
+)
+def test_an_agent_config_changed_after_it_was_built_is_checked_again_by_the_agent(
+    field, value, said
+):
+    config = small_agent_config()
+    setattr(config, field, value)
+    with pytest.raises(ValueError) as error:
+        SimounAgent((3, SIZE, SIZE), 1, config, device="cpu")
+    assert str(error.value).startswith("SimounAgent cannot use this config: ")
+    assert said in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("model", "field", "value", "said"),
+    [
+        (CuriosityModel, "lr", -1.0, "CuriosityConfig.lr=-1.0 must be a number > 0"),
+        (CuriosityModel, "batch_size", 1, "CuriosityConfig.batch_size=1 must be an int >= 2"),
+        (RNDModel, "seed", -1, "RNDConfig.seed=-1 must be None or an int in [0, 2**32)"),
+        (RNDModel, "learning_starts", 10**6, "needs batch_size <= learning_starts <= capacity"),
+    ],
+)
+def test_an_online_model_config_changed_after_it_was_built_is_checked_again(
+    model, field, value, said
+):
+    config = model.config_type()
+    setattr(config, field, value)
+    env = SimounObservation(gym.make("simoun/PointReach-v0", size=48), size=None)
+    with pytest.raises(ValueError) as error:
+        model.for_env(env, config, device="cpu")
+    assert str(error.value).startswith(f"{model.__name__} cannot use this config: ")
+    assert said in str(error.value)
+
+
+@pytest.mark.parametrize("move", [lambda a: a.to("cpu"), lambda a: a.cpu(), lambda a: a.cuda()])
+def test_moving_an_agent_like_a_torch_module_says_how_to_move_it(move):
+    agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
+    with pytest.raises(TypeError) as error:
+        move(agent)
+    said = str(error.value)
+    assert "device is chosen when it is built" in said and "this one is on cpu" in said
+    assert "load_state_dict(agent.state_dict())" in said
+
+
+def test_an_agent_moves_by_a_new_agent_and_its_state_as_the_error_says():
+    agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
+    moved = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device=torch.device("cpu"))
+    moved.load_state_dict(agent.state_dict())
+    frames = np.zeros((3, 3, SIZE, SIZE), np.uint8)
+    np.testing.assert_array_equal(
+        agent.act(frames, deterministic=True), moved.act(frames, deterministic=True)
+    )

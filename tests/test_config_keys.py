@@ -71,3 +71,19 @@ def test_close_keys_read_words_through_their_synonyms():
     assert close_keys("frame_size", docs) == ["image_size"]
     assert close_keys("resolution", docs) == ["image_size"]
     assert close_keys("frame_skip", docs) == ["action_repeat"]
+
+
+@pytest.mark.parametrize(
+    ("typed", "meant"),
+    [
+        ("agent-lr", "agent.lr"),
+        ("agent_lr", "agent.lr"),
+        ("Agent.LR", "agent.lr"),
+        ("agent-batch-size", "agent.batch_size"),
+        ("agent.batch.size", "agent.batch_size"),
+    ],
+)
+def test_a_key_with_another_separator_is_answered_with_the_key_itself(typed, meant):
+    with pytest.raises(SetupError) as error:
+        resolve("cpu", {typed: 1e-3})
+    assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)

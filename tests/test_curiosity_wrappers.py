@@ -297,3 +297,28 @@ def test_single_env_wrapper_given_a_vector_env_points_to_the_vector_wrapper():
     with pytest.raises(TypeError, match=r"use ConsistencyCuriosityVectorReward\(envs"):
         ConsistencyCuriosityReward(envs, ProjectionFeatures(3 * SIZE * SIZE))
     envs.close()
+
+
+def mean_error(triplets):
+    """A novelty source: one error per triplet, not (f_m, f_a)."""
+    return triplets[:, -1].reshape(len(triplets), -1).mean(axis=1) / 255.0
+
+
+@pytest.mark.parametrize(
+    ("source", "said"),
+    [
+        (lambda t: (t, t, t), r"function <lambda> returned a tuple of 3 for 1 triplets"),
+        (lambda t: None, r"function <lambda> returned a NoneType for 1 triplets"),
+        (mean_error, r"returned a ndarray of shape \(1,\) .*goes with RNDReward"),
+    ],
+)
+def test_a_feature_source_that_returns_no_pair_is_named_with_what_it_must_return(source, said):
+    env = ConsistencyCuriosityReward(cartpole(), source)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=said) as error:
+        env.step(0)
+    assert "must return the tuple (f_m, f_a)" in str(error.value)
+    envs = ConsistencyCuriosityVectorReward(make_vec(2), source)
+    envs.reset(seed=0)
+    with pytest.raises(ValueError, match="must return the tuple"):
+        envs.step(np.array([0, 1]))

@@ -12,11 +12,12 @@ from test_train_resume import TINY
 from simoun_agent import FrameReplay
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
-from simoun_agent.config import resolve, to_dict
+from simoun_agent.config import SetupError, resolve, to_dict
 from simoun_agent.run import train
 from simoun_agent.run.logger import CsvLog, read_csv, read_log
 from simoun_lab.cli import analyze as analyze_cli
 from simoun_lab.cli import report as report_cli
+from simoun_lab.sweep.report import DamagedRun, read_curve
 
 
 @pytest.mark.parametrize("text", ["[]", "null", "3", '"config"'])
@@ -251,3 +252,53 @@ def test_a_damaged_config_or_log_is_named_on_resume_and_by_the_report(
     else:
         assert f"{run_dir / file} is damaged: " in err and problem in err
         assert "Restore the file from a copy" in err
+
+
+@pytest.mark.parametrize("command", ["simoun-eval", "simoun-analyze"])
+def test_a_config_json_of_another_run_beside_the_checkpoint_is_named(
+    trained_run, command, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    config = json.loads((run_dir / "config.json").read_text())
+    (run_dir / "config.json").write_text(json.dumps({**config, "seed": config["seed"] + 1}))
+    err = refusal(command, run_dir, capsys)
+    assert f"{run_dir / 'config.json'} does not hold the config of the checkpoint in " in err
+    assert f"(seed: {config['seed']} in the checkpoint, {config['seed'] + 1} now)" in err
+
+
+def test_a_replay_of_another_seed_or_step_is_named_on_resume(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (path,) = run_dir.glob("replay-*.npz")
+    replay = FrameReplay.load(path)
+    replay.rng.random()  # the same transitions drawn from by another random stream
+    replay.save(path)
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{path} (the replay of the checkpoint) is not the one saved with " in err
+    assert "its random state is another run's" in err and "copied or linked from another" in err
+
+
+@pytest.mark.parametrize("log", ["eval.csv", "train.csv"])
+def test_a_log_older_than_the_checkpoint_is_named_on_resume(trained_run, log, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    lines = (run_dir / log).read_text().splitlines(keepends=True)
+    last = lines[-1].split(",")[lines[0].split(",").index("env_step")]
+    (run_dir / log).write_text("".join(lines[:2]))
+    first = lines[1].split(",")[lines[0].split(",").index("env_step")]
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{run_dir / log} ends at env step {first}, but the checkpoint (env step 60) " in err
+    assert f"had logged rows up to env step {last}" in err
+    assert f"Restore the newer {log} from a copy" in err and f"mv {run_dir / log}" in err
+
+
+def test_steps_written_as_whole_floats_read_as_steps_by_resume_and_report(tmp_path):
+    path = tmp_path / "eval.csv"
+    path.write_text("env_step,return_mean\n0.0,1.0\n20.0,2.0\n")
+    assert read_log(path)[1] == [
+        {"env_step": "0", "return_mean": "1.0"},
+        {"env_step": "20", "return_mean": "2.0"},
+    ]
+    path.write_text("env_step,return_mean,wall_time_s\n0,1.0,1.0\n20.5,2.0,2.0\n")
+    with pytest.raises(SetupError, match=r"line 3's env_step '20.5' is not a step count"):
+        read_log(path)
+    with pytest.raises(DamagedRun, match=r"line 3: env_step 20.5 is not a step count"):
+        read_curve(path)

@@ -539,10 +539,13 @@ def test_a_spec_that_is_not_utf8_is_named_by_every_spec_reader(encode, said, tmp
     assert f"cannot read the study spec {toml} ({said}" in err and "saved as UTF-8 text" in err
     spec = tmp_path / "spec16.json"
     spec.write_bytes(encode(json.dumps(MINIGRID_SPEC, indent=1)))
-    for argv in (["select", "--spec", str(spec), "--archive", "."], ["plan", str(spec)]):
+    for argv, label in (
+        (["select", "--spec", str(spec), "--archive", "."], "--spec"),
+        (["plan", str(spec)], "the study spec"),
+    ):
         main = minigrid_cli.main if argv[0] == "select" else study_cli.main
         err = refused(capsys, main, argv)
-        assert f"--spec {spec} cannot be read ({said}" in err and "saved as UTF-8 text" in err
+        assert f"{label} {spec} cannot be read ({said}" in err and "saved as UTF-8 text" in err
     sweep = tmp_path / "sweep"
     sweep.mkdir()
     (sweep / "sweep.json").write_bytes(encode('{\n"base": {},\n"grid": {}\n}'))
@@ -556,6 +559,6 @@ def test_a_minigrid_spec_that_gives_a_key_twice_is_refused_naming_it(tmp_path, c
     spec = tmp_path / "spec.json"
     text = json.dumps(MINIGRID_SPEC, indent=1)
     spec.write_text(text.replace('"arms": [', '"arms": ["rnd"],\n "arms": [', 1))
-    said = f"--spec {spec}: the key 'arms' is given twice; give each key once"
-    assert said in refused(capsys, minigrid_cli.main, ["select", "--spec", str(spec)])
-    assert said in refused(capsys, study_cli.main, ["plan", str(spec)])
+    said = f"{spec}: the key 'arms' is given twice; give each key once"
+    assert f"--spec {said}" in refused(capsys, minigrid_cli.main, ["select", "--spec", str(spec)])
+    assert f"the study spec {said}" in refused(capsys, study_cli.main, ["plan", str(spec)])

@@ -281,3 +281,62 @@ def test_a_normalization_loads_its_own_state():
     copy = ReturnStd(gamma=0.5)
     copy.load_state_dict(source.state_dict())
     assert copy.state_dict() == source.state_dict()
+
+
+@pytest.mark.parametrize("gamma", [np.float32(0.99), np.float64(0.5), np.int64(0), 0])
+def test_return_std_takes_numpy_scalars_as_numbers(gamma):
+    assert ReturnStd(gamma=gamma).gamma == float(gamma)
+
+
+@pytest.mark.parametrize("gamma", [False, True, np.bool_(False), "0.99", float("nan"), np.inf])
+def test_return_std_refuses_a_bool_a_string_and_a_non_finite_gamma(gamma):
+    with pytest.raises(ValueError, match=r"gamma must be a number in \[0, 1\)"):
+        ReturnStd(gamma=gamma)
+
+
+def test_an_instance_of_the_paper_form_means_what_its_name_means():
+    by_name = ConsistencyCuriosityReward(cartpole(), Features(), normalization="paper")
+    by_instance = ConsistencyCuriosityReward(cartpole(), Features(), normalization=PaperMaxima())
+    assert by_instance.decay == by_name.decay == 2e-5
+    other = ConsistencyCuriosityReward(cartpole(), Features(), normalization=ReturnStd())
+    assert other.decay == 0.0
+
+
+def test_initial_maxima_are_applied_by_the_paper_name_and_refused_where_unused():
+    env = ConsistencyCuriosityReward(cartpole(), Features(), r_e_max_init=5.0)
+    assert env.state_dict()["normalization"] == {"r_e_max": 5.0, "r_i_max": 1.0}
+    with pytest.raises(ValueError) as error:
+        ConsistencyCuriosityReward(
+            cartpole(), Features(), normalization=PaperMaxima(), r_e_max_init=5.0
+        )
+    said = str(error.value)
+    assert "r_e_max_init=5.0" in said and "PaperMaxima(r_e_max_init=1.0" in said
+    assert "normalization=PaperMaxima(r_e_max_init=5.0)" in said
+    with pytest.raises(ValueError, match=r"r_i_max_init=0\.5 is used by normalization='paper'"):
+        ConsistencyCuriosityReward(
+            cartpole(), Features(), normalization="reward_std", r_i_max_init=0.5
+        )
+
+
+def return_std_envs(num_envs: int) -> RNDVectorReward:
+    envs = SyncVectorEnv([cartpole] * num_envs, autoreset_mode=AutoresetMode.NEXT_STEP)
+    return RNDVectorReward(envs, Brightness(), warmup=0, normalization="return_std")
+
+
+def test_a_return_std_state_loads_only_into_as_many_sub_envs():
+    two = return_std_envs(2)
+    two.reset(seed=0)
+    two.step(np.array([0, 1]))
+    three = return_std_envs(3)
+    before = three.state_dict()
+    with pytest.raises(ValueError) as error:
+        three.load_state_dict(two.state_dict())
+    said = str(error.value)
+    assert "returns holds 2 values, one per sub-env" in said and "num_envs=3" in said
+    assert three.state_dict() == before
+    single = RNDReward(cartpole(), Brightness(), warmup=0, normalization="return_std")
+    with pytest.raises(ValueError, match="this wrapper has 1 sub-env "):
+        single.load_state_dict(two.state_dict())
+    again = return_std_envs(2)
+    again.load_state_dict(two.state_dict())  # as many sub-envs, or a state before any step
+    again.load_state_dict(return_std_envs(2).state_dict())

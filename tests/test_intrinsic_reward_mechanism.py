@@ -10,6 +10,7 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 from simoun_wrappers import SimounObservation
 from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+from simoun_wrappers.intrinsic_normalization import Normalization, Raw, ReturnStd
 from simoun_wrappers.intrinsic_reward import (
     ConstantBonusReward,
     ConstantBonusVectorReward,
@@ -281,3 +282,135 @@ def test_load_state_dict_refuses_a_state_that_does_not_fit_and_loads_nothing():
         env.load_state_dict(before)
         assert env.state_dict() == before
         env.close()
+
+
+def test_the_vector_wrappers_check_the_actions_and_seeds_of_their_sub_envs():
+    envs = RNDVectorReward(vector(AutoresetMode.SAME_STEP), Recorder(), warmup=0)
+    with pytest.raises(
+        ValueError, match=r"seed=\[...\]\) takes one seed per sub-env, 2 here, got 3"
+    ):
+        envs.reset(seed=[0, 1, 2])
+    with pytest.raises(ValueError, match=r"RNDVectorReward.reset\(seed=...\) takes None or an int"):
+        envs.reset(seed=[0, True])
+    envs.reset(seed=[np.int64(0), None])
+    for wrong, said in [
+        (np.zeros(1, np.int64), r"of shape \(1,\), not \(2,\)"),
+        (np.array([0.5, 0.5]), "ndarray of dtype float64, not ints"),
+    ]:
+        with pytest.raises(ValueError, match=rf"MultiDiscrete\(\[2 2\]\): {said}.*one per sub-env"):
+            envs.step(wrong)
+    envs.step([0, 1])
+    pendulums = ConstantBonusVectorReward(SyncVectorEnv([pendulum, pendulum]), scale=0.1)
+    pendulums.reset(seed=0)
+    with pytest.raises(ValueError, match=r"of shape \(2,\), not \(2, 1\)"):
+        pendulums.step(np.zeros(2))
+    pendulums.step(np.zeros((2, 1)))
+
+
+def test_a_single_reward_wrapper_checks_the_action_and_the_seed():
+    env = ConstantBonusReward(cartpole(), scale=0.1)
+    with pytest.raises(ValueError, match=r"ConstantBonusReward.reset\(seed=...\)"):
+        env.reset(seed=True)
+    env.reset(seed=np.int64(0))
+    with pytest.raises(ValueError, match=r"Discrete\(2\): float of dtype float64, not ints"):
+        env.step(0.5)
+
+
+@pytest.mark.parametrize(
+    ("between", "fold_frames"),
+    [(gym.wrappers.FlattenObservation, False), (gym.wrappers.NormalizeObservation, True)],
+)
+def test_a_gymnasium_wrapper_between_is_named_with_the_order_that_works(between, fold_frames):
+    def pixels() -> gym.Env:
+        pendulum = gym.make("Pendulum-v1", render_mode="rgb_array")
+        return SimounObservation(pendulum, size=16, fold_frames=fold_frames)
+
+    name = between.__name__
+    with pytest.raises(
+        TypeError,
+        match=rf"but {name} over SimounObservation changed them.*Put {name} outside "
+        rf"ConstantBonusReward: e.g. {name}\(ConstantBonusReward\(SimounObservation",
+    ):
+        ConstantBonusReward(between(pixels()), scale=0.1)
+    right = between(ConstantBonusReward(pixels(), scale=0.1))
+    right.reset(seed=0)
+    right.step(right.action_space.sample())
+
+
+class Returning(Normalization):
+    """A user's own normalization that returns what it is told to (the raw batch's length
+    given)."""
+
+    name = "returning"
+
+    def __init__(self, make):
+        self.make = make
+
+    def __call__(self, raw, extrinsic, envs, counted):
+        return self.make(len(raw))
+
+    def state_dict(self):
+        return {}
+
+    def restore(self, state):
+        return None
+
+
+def features(triplets):
+    """f_m the newest frame's mean, f_a zeros."""
+    newest = triplets[:, -1].reshape(len(triplets), -1).mean(axis=1, keepdims=True)
+    return newest.astype(np.float32), np.zeros((len(triplets), 3, 1), np.float32)
+
+
+WRAPPERS = {
+    "rnd": lambda norm: RNDReward(cartpole(), Recorder(), warmup=0, normalization=norm),
+    "consistency": lambda norm: ConsistencyCuriosityReward(
+        cartpole(), features, normalization=norm
+    ),
+    "rnd vector": lambda norm: RNDVectorReward(
+        vector(AutoresetMode.NEXT_STEP), Recorder(), warmup=0, normalization=norm
+    ),
+}
+
+
+def first_step(env):
+    env.reset(seed=0)
+    return env.step(np.zeros(env.num_envs, np.int64) if hasattr(env, "num_envs") else 0)
+
+
+@pytest.mark.parametrize("wrapper", WRAPPERS)
+@pytest.mark.parametrize(
+    ("make", "said"),
+    [
+        (lambda n: np.ones(n + 1), r"returned shape \(\d,\) for a batch of \d raw values"),
+        (lambda n: None, r"returned None \(NoneType\)"),
+        (lambda n: np.full(n, np.nan), "gave the non-finite reward nan .* at transition 0"),
+        (lambda n: np.full(n, -np.inf), "gave the non-finite reward -inf"),
+    ],
+)
+def test_a_normalization_s_output_is_checked_in_every_wrapper(wrapper, make, said):
+    env = WRAPPERS[wrapper](Returning(make))
+    with pytest.raises(ValueError, match=said) as error:
+        first_step(env)
+    assert "Returning()" in str(error.value)
+
+
+@pytest.mark.parametrize("normalization", ["standardize", "reward_std", "paper", ReturnStd()])
+def test_the_constant_bonus_refuses_a_normalization_and_says_why(normalization):
+    for wrapper, env in ((ConstantBonusReward, cartpole()), (ConstantBonusVectorReward, None)):
+        env = env if env is not None else vector(AutoresetMode.NEXT_STEP)
+        with pytest.raises(ValueError) as error:
+            wrapper(env, 0.1, normalization=normalization)
+        said = str(error.value)
+        assert f"{wrapper.__name__} takes no normalization" in said and "running std is 0" in said
+        assert f"{wrapper.__name__}(env, scale=b)" in said and "RNDReward" in said
+
+
+def test_the_constant_bonus_takes_none_by_name_or_instance_and_re_makes_from_its_spec():
+    for normalization in ("none", Raw()):
+        env = ConstantBonusReward(cartpole(), 0.1, normalization=normalization)
+        env.reset(seed=0)
+        assert env.step(0)[4]["reward_intrinsic"] == pytest.approx(0.1)
+    again = gym.make(ConstantBonusReward(cartpole(), 0.1).spec)
+    again.reset(seed=0)
+    assert again.step(0)[4]["reward_intrinsic"] == pytest.approx(0.1)

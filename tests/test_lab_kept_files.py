@@ -30,8 +30,10 @@ from simoun_lab.study.checks import finished_config
 from simoun_lab.study.choice import choose
 from simoun_lab.study.driving import REFERENCES_JSON, read_references
 from simoun_lab.study.generalization import read_modes
+from simoun_lab.study.options import StudyOptions
 from simoun_lab.study.plan import evaluation_runs
 from simoun_lab.study.report import UPDATE_COST_JSON, read_result, read_update_costs
+from simoun_lab.study.runner import open_study
 from simoun_lab.study.spec import load_spec
 from simoun_lab.sweep import launch
 from simoun_lab.sweep.grid import SweepSpec, Trial
@@ -312,6 +314,16 @@ def test_the_evaluation_run_copy_reads_as_its_result(evaluation_run):
         ("trial.json", emptied, "trial.json is damaged: it is empty"),
         ("trial.json", named_pipe, "trial.json is damaged: it is a named pipe (FIFO)"),
         ("trial.json", lambda p: p.write_text('{"parts": 3}'), "trial.json is damaged: its parts"),
+        (
+            "trial.json",
+            lambda p: p.write_text('{"parts": [{"cpu_count": 2, "loadavg": "high"}]}'),
+            'trial.json is damaged: part 1\'s loadavg is "high", where an array of the 1, 5 and',
+        ),
+        (
+            "trial.json",
+            lambda p: p.write_text('{"parts": [{"cpu_count": 0, "loadavg": [1, 1, 1]}]}'),
+            "trial.json is damaged: part 1's cpu_count is 0, where a whole number of CPUs",
+        ),
     ],
 )
 def test_a_damaged_evaluation_run_is_named_when_its_result_is_read(
@@ -496,3 +508,83 @@ def test_a_damaged_checkpoint_of_an_unfinished_minigrid_run_is_refused_before_ra
     assert f"{path} is damaged: " in said and problem in said, said
     assert f"mv {path} {path}.damaged" in said
     assert not (tmp_path / "work").exists()  # nothing started
+
+
+def test_a_minigrid_run_directory_replaced_by_a_file_is_named_by_report_and_select(
+    minigrid_archive,
+):
+    path = minigrid_archive / MINIGRID_RUNS[0]
+    shutil.rmtree(path)
+    path.write_text("not a directory\n")
+    for command in ("report", "select"):
+        printed = refused(minigrid_cli.main, command, "--archive", str(minigrid_archive))
+        said = f"{path} (the directory of run {MINIGRID_RUNS[0]}) is damaged: it is a file"
+        assert said in printed
+        assert f"mv {path} {path}.damaged" in printed
+
+
+def edit_json(path: Path, **changes: object) -> None:
+    path.write_text(json.dumps({**json.loads(path.read_text()), **changes}))
+
+
+@pytest.mark.parametrize(
+    ("changes", "problem"),
+    [
+        ({"run": MINIGRID_RUNS[1]}, f'its run is "{MINIGRID_RUNS[1]}", not {MINIGRID_RUNS[0]!r}'),
+        ({"env_steps": 10**30}, "env_steps is 1000000000000000000000000000000, but a run of "),
+        (
+            {"env_steps": 399_999},
+            "env_steps is 399999, but a run of 400000 env steps takes from 400000 to 401023",
+        ),
+    ],
+)
+def test_a_minigrid_summary_of_another_run_or_budget_is_named(changes, problem, minigrid_archive):
+    path = minigrid_archive / MINIGRID_RUNS[0] / "summary.json"
+    edit_json(path, **changes)
+    printed = refused(minigrid_cli.main, "report", "--archive", str(minigrid_archive))
+    assert f"{path} is damaged: {problem}" in printed
+
+
+def test_a_minigrid_spec_of_another_study_is_named_not_taken_for_nothing_to_report(
+    minigrid_archive,
+):
+    path = minigrid_archive / "spec.json"
+    shutil.copy(DOCS / "minigrid-v2/tuning/spec.json", path)
+    printed = refused(minigrid_cli.main, "report", "--archive", str(minigrid_archive))
+    assert f"{minigrid_archive} holds no finished run of the spec in {path}, but 3 " in printed
+    assert "is another study's" in printed and "nothing to report" not in printed
+
+
+def test_a_resumed_minigrid_study_checks_its_finished_runs_before_ray(minigrid_archive, tmp_path):
+    config = minigrid_archive / MINIGRID_RUNS[0] / "config.json"
+    shutil.copy(minigrid_archive / MINIGRID_RUNS[1] / "config.json", config)
+    spec = load_minigrid_spec(minigrid_archive / "spec.json")
+    with pytest.raises(SetupError, match=re.escape(f"{config} is damaged: its run is ")):
+        run_study(spec, minigrid_archive, tmp_path / "work", address="no-such-cluster:1")
+
+
+def test_a_study_run_directory_replaced_by_a_file_is_named_by_the_report(dmc_archive):
+    path = dmc_archive / EVALUATION_RUN
+    shutil.rmtree(path)
+    path.write_text("not a directory\n")
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{path} (the directory of run {EVALUATION_RUN}) is damaged: it is a file" in printed
+
+
+def test_a_study_record_with_recipes_a_string_is_named_as_damaged(dmc_archive):
+    path = dmc_archive / "study.json"
+    record = json.loads(path.read_text())
+    record["spec"]["recipes"] = "simoun"
+    path.write_text(json.dumps(record))
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f'{path} is damaged: its spec\'s recipes is "simoun", where an array belongs' in printed
+
+
+def test_a_resumed_study_with_the_record_of_another_study_names_it(dmc_archive, tmp_path):
+    path = dmc_archive / "study.json"
+    shutil.copy(DOCS / "dmc100k-drqv2-easy" / "study.json", path)
+    options = StudyOptions(
+        study_dir=tmp_path / "s", archive=dmc_archive, resume=True, allow_other_commit=True
+    )
+    with pytest.raises(SetupError, match=re.escape(f"{path} is the record of another study")):
+        open_study(load_spec(DMC_SPEC), str(DMC_SPEC), options)

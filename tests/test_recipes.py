@@ -470,3 +470,28 @@ def test_state_dict_resumes_drq_and_drqv2_bit_exactly(name):
         )
     assert all(np.array_equal(a, b) for a, b in zip(runs[0][0], runs[1][0], strict=True))
     assert all(torch.equal(a, b) for a, b in zip(runs[0][1], runs[1][1], strict=True))
+
+
+def test_an_agent_config_naming_a_recipe_carries_the_recipe_s_values():
+    config = AgentConfig(recipe="drqv2")
+    for key, value in RECIPES["drqv2"].values.items():
+        assert getattr(config, key) == value, key
+    agent = SimounAgent((3, 32, 32), 1, dataclasses.replace(config, batch_size=8), device="cpu")
+    assert isinstance(agent.actor, DeterministicActor)
+    assert AgentConfig("drq").critic_augmentations == 2  # the recipe given by position
+
+
+def test_fields_given_beside_a_recipe_override_it_as_on_the_command_line():
+    config = AgentConfig(recipe="drqv2", lr=3e-4, actor="gaussian")
+    assert (config.lr, config.actor, config.n_step) == (3e-4, "gaussian", 3)
+    overrides = {"agent.recipe": "drqv2", "agent.lr": 3e-4}
+    anywhere = resolve(None, {**overrides, "env": "Pendulum-v1"}).agent
+    assert AgentConfig(recipe="drqv2", lr=3e-4) == anywhere
+    # a DMC task's own values come with resolve: DrQ-v2's easy schedule on cartpole-swingup
+    assert resolve(None, overrides).agent.exploration_steps == 200_000
+
+
+def test_a_saved_config_lacking_a_key_takes_the_default_not_the_recipe_s_value():
+    saved = to_dict(resolve("cpu", {"agent.recipe": "drqv2"}))
+    del saved["agent"]["update_every_steps"]  # as if saved before the key existed
+    assert from_dict(json.loads(json.dumps(saved))).agent.update_every_steps == 1

@@ -192,3 +192,21 @@ def test_cpu_preset_fits_any_env_and_is_small():
     config = resolve("cpu", {"env": "simoun/PointReach-v0"})
     assert config.agent.batch_size < 512 and config.total_env_steps <= 100_000
     assert set(PRESETS) >= {"cpu", "highway", *PAPER_ACTION_REPEAT}
+
+
+@pytest.mark.parametrize(
+    ("change", "said"),
+    [
+        (lambda c: setattr(c, "seed", -1), "--seed -1 (TrainConfig.seed) must be"),
+        (lambda c: setattr(c.agent, "lr", 0), "--agent.lr 0 (AgentConfig.lr) must be"),
+    ],
+)
+def test_a_config_changed_after_it_was_resolved_is_checked_again_before_a_run_is_built(
+    change, said
+):
+    from simoun_agent.run.train import build
+
+    config = resolve("cpu", {"env": "Pendulum-v1"})
+    change(config)
+    with pytest.raises(SetupError, match=said.replace("(", r"\(").replace(")", r"\)")):
+        build(config)

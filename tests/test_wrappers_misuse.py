@@ -17,6 +17,7 @@ import shimmy
 import torch
 from gymnasium.error import ResetNeeded
 from gymnasium.wrappers import TransformReward
+from test_wrappers_spec import CHAINS
 
 from simoun_wrappers import (
     ActionRepeat,
@@ -396,3 +397,55 @@ def test_a_closed_dm_control_task_is_named_as_closed_at_reset_step_and_render(wr
         assert f"{owner} cannot reset, step or render" in message
         assert "the env was closed (close() freed its dm_control physics)" in message
         assert "gym.make('dm_control/cartpole-swingup-v0', render_mode='rgb_array')" in message
+
+
+@pytest.mark.parametrize("name", list(CHAINS))
+def test_every_wrapper_refuses_an_action_outside_its_action_space_naming_it(name):
+    env = CHAINS[name]()
+    env.reset(seed=0)
+    space = env.action_space
+    wrong = np.zeros(3, np.float32) if isinstance(space, gym.spaces.Box) else 2.5
+    owner = type(env).__name__  # the outermost wrapper of the chain
+    with pytest.raises(ValueError, match=rf"{owner}.step got the action .* action space .*Pass"):
+        env.step(wrong)
+    with pytest.raises(ValueError, match=rf"{owner}.step got the action None"):
+        env.step(None)
+    env.step(space.sample())
+
+
+def test_the_action_check_follows_gymnasiums_space_contains():
+    env = FrameTriplet(gym.make("Pendulum-v1"))
+    env.reset(seed=0)
+    # a float64 array is taken for the float32 Box, and one out of the bounds is left to
+    # Pendulum, which clips it, as the env itself takes them
+    env.step(np.array([0.5]))
+    env.step([0.5])
+    env.step(np.array([3.0]))
+    for wrong, said in [
+        (np.float64(0.5), r"of shape \(\), not \(1,\)"),  # 0-d: no member of Box(1,)
+        (np.array([np.nan]), "it holds NaN"),
+        (np.array([1], np.complex64), "ndarray of dtype complex64, not real numbers"),
+    ]:
+        with pytest.raises(ValueError, match=said):
+            env.step(wrong)
+    grid = ActionRepeat(gym.make("MiniGrid-Empty-5x5-v0"), 2)
+    grid.reset(seed=0)
+    grid.step(np.int64(2))
+    with pytest.raises(ValueError, match=r"Discrete\(7\): out of its range. Pass an int in 0..6"):
+        grid.step(7)
+    with pytest.raises(ValueError, match=r"float of dtype float64, not ints"):
+        grid.step(2.0)
+
+
+@pytest.mark.parametrize("name", list(CHAINS))
+def test_every_wrapper_checks_its_reset_seed_and_takes_numpy_ints(name):
+    env = CHAINS[name]()
+    owner = type(env).__name__
+    for seed in (True, -1, float("nan"), "0"):
+        with pytest.raises(ValueError, match=rf"{owner}.reset\(seed=...\) takes None or an int"):
+            env.reset(seed=seed)
+    first, _ = env.reset(seed=np.int64(3))
+    again, _ = env.reset(seed=3)
+    pairs = [(first[k], again[k]) for k in first] if isinstance(first, dict) else [(first, again)]
+    for a, b in pairs:
+        np.testing.assert_array_equal(a, b)

@@ -200,3 +200,19 @@ def test_frames_equal_gymnasiums_own_chain_channel_first(grayscale):
         if terminated or truncated:
             obs, _ = ours.reset(seed=1)
             expected, _ = ref.reset(seed=1)
+
+
+def test_a_wrapper_that_changed_the_render_mode_is_named_with_the_order_that_works():
+    collected = gym.wrappers.RenderCollection(gym.make("Pendulum-v1", render_mode="rgb_array"))
+    with pytest.raises(
+        ValueError,
+        match=r"RenderCollection turned the render mode 'rgb_array' into 'rgb_array_list'.*"
+        r"RenderCollection\(SimounObservation\(env, ...\)\)",
+    ):
+        SimounObservation(collected, size=16)
+    right = gym.wrappers.RenderCollection(
+        SimounObservation(gym.make("Pendulum-v1", render_mode="rgb_array"), size=16)
+    )
+    right.reset(seed=0)
+    right.step(right.action_space.sample())
+    assert len(right.render()) == 2

@@ -188,3 +188,36 @@ def test_wrapping_twice_is_refused():
         TypeError, match=r"stacks frames itself.*Apply SimounParallelObservation once"
     ):
         SimounParallelObservation(SimounParallelObservation(pistons, size=16))
+
+
+def test_agent_names_actions_and_seeds_are_checked_naming_the_agents():
+    env = SimounParallelObservation(JoiningAgents(), size=8)
+    for call in (env.observation_space, env.action_space):
+        with pytest.raises(ValueError, match=r"'nope'\): no such agent.*\['a0', 'a1'\]"):
+            call("nope")
+    with pytest.raises(ValueError, match=r"reset\(seed=...\) takes None or an int"):
+        env.reset(seed=True)
+    env.reset(seed=np.int64(0))
+    with pytest.raises(TypeError, match="takes a dict of one action per agent"):
+        env.step([0])
+    with pytest.raises(ValueError, match=r"actions for \['a9'\], which are no agents"):
+        env.step({"a0": 0, "a9": 0})
+    with pytest.raises(ValueError, match=r"\['a0'\]\.step got the action 2.*Discrete\(2\)"):
+        env.step({"a0": 2})
+    env.step({"a0": 0})
+    # a1 joins at step 2: it acts from the step after the one that showed it
+    env.step({"a0": 0})
+    with pytest.raises(ValueError, match=r"got no action for \['a1'\]"):
+        env.step({"a0": 0})
+    env.step({"a0": 0, "a1": 1})
+
+
+def test_a_render_sized_space_before_reset_names_reset():
+    pistons = pettingzoo.make(
+        "parallel", "butterfly/pistonball-v6", n_pistons=3, render_mode="rgb_array"
+    )
+    env = SimounParallelObservation(pistons, size=None, source="render")
+    with pytest.raises(gym.error.ResetNeeded, match=r"call env.reset\(seed=...\) before"):
+        env.observation_space("piston_0")
+    env.reset(seed=0)
+    assert env.observation_space("piston_0")["frames"].shape[0] == 3

@@ -1,11 +1,13 @@
 """Every wrapper records its constructor arguments: gym.make(env.spec) rebuilds the same chain."""
 
 import inspect
+import json
 
 import gymnasium as gym
 import numpy as np
 import pytest
 import shimmy
+from gymnasium.envs.registration import EnvSpec
 
 import simoun_wrappers
 from simoun_wrappers import (
@@ -122,3 +124,55 @@ def test_a_rebuilt_intrinsic_reward_wrapper_pays_the_same_rewards(name):
         ours, theirs = env.step(action), rebuilt.step(action)
         assert ours[1] == theirs[1]
         assert ours[4]["reward_intrinsic"] == theirs[4]["reward_intrinsic"]
+
+
+NUMPY_CHAINS = {
+    "FrameTriplet": lambda: FrameTriplet(gym.make("CartPole-v1"), num_frames=np.int64(4)),
+    "ActionRepeat": lambda: ActionRepeat(gym.make("CartPole-v1"), repeat=np.uint8(3)),
+    "RandomConvolution": lambda: SimounObservation(
+        RandomConvolution(_cartpole(), np.int64(5)), size=np.int32(16)
+    ),
+    "MultiCamera": lambda: MultiCamera(
+        gym.make("dm_control/cartpole-swingup-v0"), [np.int64(0)], size=(np.int64(12), 20)
+    ),
+    "SimounObservation": lambda: SimounObservation(
+        _cartpole(), size=np.int64(12), grayscale=np.bool_(True), num_frames=np.int32(4)
+    ),
+    "ConstantBonusReward": lambda: ConstantBonusReward(
+        _pixels(), np.float32(0.1), decay=np.float16(1e-3)
+    ),
+    "RNDReward": lambda: RNDReward(_pixels(), _novelty, scale=np.float32(0.3), warmup=np.int64(0)),
+    "ColorShift": lambda: ColorShift(
+        gym.make("dm_control/cartpole-swingup-v0", render_mode="rgb_array"), seed=np.int64(0)
+    ),
+}
+"""wrappers given numpy scalars, which they take as the Python values they hold"""
+
+
+@pytest.mark.parametrize("name", list(NUMPY_CHAINS))
+def test_numpy_arguments_are_recorded_as_python_values(name):
+    kwargs = NUMPY_CHAINS[name]().spec.additional_wrappers[-1].kwargs
+    # a source is recorded by reference (SharedSource), never as JSON
+    written = {key: value for key, value in kwargs.items() if key != "novelty"}
+    assert json.loads(json.dumps(written)) == {
+        key: list(value) if isinstance(value, tuple) else value for key, value in written.items()
+    }
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "FrameTriplet",
+        "ActionRepeat",
+        "RandomConvolution",
+        "SimounObservation",
+        "ConstantBonusReward",
+    ],
+)
+def test_a_spec_of_numpy_arguments_round_trips_through_json(name):
+    # the dm_control ids' entry points are callables, which EnvSpec.to_json refuses
+    env = NUMPY_CHAINS[name]()
+    rebuilt = gym.make(EnvSpec.from_json(env.spec.to_json()))
+    assert rebuilt.observation_space == env.observation_space
+    rebuilt.reset(seed=0)
+    rebuilt.step(rebuilt.action_space.sample())

@@ -4,6 +4,9 @@ built."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -43,7 +46,22 @@ _WEIGHT = real(0.0)
 
 @dataclass
 class AgentConfig:
-    """Everything the agent needs besides the frame shape and the action size."""
+    """Everything the agent needs besides the frame shape and the action size.
+
+    ``AgentConfig(recipe="drqv2")`` is DrQ-v2's agent: a recipe gives its values
+    (:data:`~simoun_agent.config.recipes.RECIPES`) to every field not given, and the fields
+    given override them, as ``--agent.recipe drqv2 --agent.lr 3e-4`` does on the command line
+    (``AgentConfig(recipe="drqv2", lr=3e-4)``). Its values are those for any env; a DMC task's
+    own (DrQ-v2's per-task exploration schedule) come with
+    ``simoun_agent.config.resolve(preset, {"agent.recipe": "drqv2", "env": ...}).agent``.
+    A recipe named later (``config.recipe = "drq"``, ``dataclasses.replace``) changes the name
+    only.
+
+    Example:
+        >>> config = AgentConfig(recipe="drqv2", lr=3e-4)
+        >>> config.actor, config.n_step, config.lr
+        ('deterministic', 3, 0.0003)
+    """
 
     recipe: str | None = setting(
         None, Rule(f"none or one of {', '.join(RECIPES)}", lambda v: v is None or v in RECIPES)
@@ -198,6 +216,26 @@ class AgentConfig:
 
     def __post_init__(self) -> None:
         check_agent_config(self)  # every field, then cross-field
+
+
+def with_recipe(generated_init: Callable[..., None]) -> Callable[..., None]:
+    """``AgentConfig``'s ``__init__``: the dataclass's, given the recipe's values for every
+    field the caller did not give (an unknown recipe is left to the field's rule to refuse)."""
+    names = [f.name for f in dataclasses.fields(AgentConfig)]
+
+    @functools.wraps(generated_init)
+    def __init__(self: AgentConfig, *args: Any, **kwargs: Any) -> None:
+        given = {*names[: len(args)], *kwargs}
+        recipe = args[0] if args else kwargs.get("recipe")
+        if isinstance(recipe, str) and recipe in RECIPES:
+            values = RECIPES[recipe].values_for(None)
+            kwargs.update({key: value for key, value in values.items() if key not in given})
+        generated_init(self, *args, **kwargs)
+
+    return __init__
+
+
+AgentConfig.__init__ = with_recipe(AgentConfig.__init__)  # type: ignore[method-assign]
 
 
 def check_agent_config(config: Any) -> None:

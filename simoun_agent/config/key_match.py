@@ -75,7 +75,9 @@ def score(typed: str, key: str, doc: str) -> float:
     section, _, name = key.rpartition(".")
     typed_words = words(typed_name)
     name_words = words(name)
-    if typed_words == name_words:  # the key itself, spelled with dashes or capitals
+    # the key itself, spelled with dashes or capitals, or with another separator between the
+    # section and the name (agent-lr, agent_lr for agent.lr)
+    if typed_words == name_words or words(typed) == words(key):
         return EXACT
     doc_words = [word for word in words(doc) if word not in STOPWORDS]
     in_name = sum(any(same_word(t, w) for w in name_words) for t in typed_words)

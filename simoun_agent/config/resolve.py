@@ -147,6 +147,10 @@ def from_flat(values: dict[str, Any]) -> TrainConfig:
 
 
 def _build(cls: type, prefix: str, values: dict[str, Any]) -> Any:
+    """``cls`` with every field given: its value in ``values``, else its default. Given in
+    full, an ``AgentConfig`` takes nothing from its recipe by itself: the layers above put
+    the recipe's values in ``values`` (for the run's task), and a saved config that lacks a
+    key means the default, not what the recipe holds today."""
     hints = typing.get_type_hints(cls)
     kwargs = {}
     for f in dataclasses.fields(cls):
@@ -154,6 +158,10 @@ def _build(cls: type, prefix: str, values: dict[str, Any]) -> Any:
             kwargs[f.name] = _build(hints[f.name], prefix + f.name + ".", values)
         elif prefix + f.name in values:
             kwargs[f.name] = values[prefix + f.name]
+        elif f.default is not dataclasses.MISSING:
+            kwargs[f.name] = f.default
+        else:
+            kwargs[f.name] = f.default_factory()  # type: ignore[misc]
     return cls(**kwargs)
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-from simoun_agent.config.agent import AGENT, AgentConfig
+from simoun_agent.config.agent import AGENT, AgentConfig, check_agent_config
 from simoun_agent.config.device import device_problem
 from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, split_env_id
 from simoun_agent.config.presets import PRESETS
@@ -162,8 +162,11 @@ RESUMABLE_FIELDS = (
 
 
 def check_train_config(config: TrainConfig) -> None:
-    """Every field of a ``TrainConfig``, then the constraints between fields."""
+    """Every field of a ``TrainConfig`` and of its ``AgentConfig`` (checked again: either may
+    have been changed since it was built), then the constraints between fields."""
     check_fields(config, "")
+    if isinstance(config.agent, AgentConfig):
+        check_agent_config(config.agent)
     if config.device is not None and (problem := device_problem(config.device)):
         raise fail(config, "", "device", problem)
     if config.replay_capacity < config.agent.batch_size:

@@ -115,6 +115,7 @@ def save_checkpoint(
         "config": config,
         "agent": agent.state_dict(),
         "replay_file": replay_path.name,
+        "replay_mark": replay_mark(replay),
         "rng": capture_rng(),
         "state": state,
     }
@@ -142,6 +143,32 @@ def save_checkpoint(
         if old != replay_path:
             old.unlink(missing_ok=True)
     return path
+
+
+def replay_mark(replay: Any) -> dict[str, Any]:
+    """What tells the replay saved with a checkpoint from another run's of the same shapes:
+    transitions written and the RNG state, seeded from the run's seed and moved by every batch
+    drawn, so a replay of another seed, or of the same run at another step, differs."""
+    return {"written": int(replay.written), "rng": replay.rng.bit_generator.state}
+
+
+def check_replay_mark(payload: dict, replay: Any) -> None:
+    """Refuse the replay file ``replay`` (loaded) when it is not the one saved with the
+    checkpoint ``payload``: copied or linked from another run, or left from another step.
+    Checkpoints written before the mark was kept are taken as they are."""
+    mark = payload.get("replay_mark")
+    if mark is None or mark == replay_mark(replay):
+        return
+    path = payload["replay_path"]
+    if replay.written != mark["written"]:
+        found = f"{replay.written} transitions in the file, {mark['written']} at the checkpoint"
+    else:
+        found = "its random state is another run's: another seed, or another point of a run"
+    raise SetupError(
+        f"{path} (the replay of the checkpoint) is not the one saved with "
+        f"{path.parent / CHECKPOINT_NAME} ({found}), so it was copied or linked from another "
+        "run. Restore this run's own replay and checkpoint from a copy, or start a new run"
+    )
 
 
 def _replay_file_bytes(replay: Any) -> int:

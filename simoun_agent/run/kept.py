@@ -164,6 +164,22 @@ def csv_number(text: str, column: str, line: int) -> float:
         raise Damaged(f"line {line}: {column} is {text!r}, not a number") from None
 
 
+def step_count(text: str) -> int:
+    """The env step written as ``text`` in a kept log: digits, or a float of a whole number
+    (``20.0``, as pandas and spreadsheets write integer columns that had an empty cell), so that
+    every reader of a run's logs takes the same file; :class:`Damaged` saying what is wrong
+    with any other value (a fraction, a sign, a word, a step past :data:`STEP_LIMIT`)."""
+    try:
+        value = float(text) if text.strip() == text and text else math.nan
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < 0 or value != int(value):
+        raise Damaged(f"env_step {text!r} is not a step count (a whole number of steps)")
+    if value >= STEP_LIMIT:
+        raise Damaged(f"env_step {text} is past 2**63, more steps than a run can count")
+    return int(text) if text.isdigit() else int(value)
+
+
 def binary_problem(path: Path) -> str:
     """What is visibly wrong with a binary file that its reader refused: empty, or all zero
     bytes (a disk that lost the data, a copy cut off); else that it cannot be read."""

@@ -17,8 +17,10 @@ import gymnasium as gym
 import torch
 
 from simoun_agent.agent import SimounAgent
-from simoun_agent.config import TrainConfig, from_dict
-from simoun_agent.run.checkpoint import load_checkpoint
+from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
+from simoun_agent.run.checkpoint import check_config, load_checkpoint
+from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
 
@@ -50,6 +52,7 @@ def load_run(path: Path, device: str | None = None, torch_threads: int | None = 
     ``device`` and ``torch_threads`` (None: the run's own) apply before the config's checks.
     """
     payload = load_checkpoint(Path(path))
+    check_config_file(payload)
     machine = {"device": device, "torch_threads": torch_threads}
     config = from_dict(
         {**payload["config"], **{key: value for key, value in machine.items() if value is not None}}
@@ -69,3 +72,28 @@ def load_run(path: Path, device: str | None = None, torch_threads: int | None = 
     agent.load_state_dict(payload["agent"])
     run_dir = payload["replay_path"].parent
     return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
+
+
+def check_config_file(payload: dict) -> None:
+    """Refuse a run directory whose ``config.json`` is not the config of its ``checkpoint.pt``
+    (one of them copied or linked from another run, or the file edited), as ``simoun-train
+    --resume`` does: what is evaluated or analyzed must be the run its directory says it is.
+    A checkpoint without a ``config.json`` beside it (copied on its own) is read as it is."""
+    run_dir = payload["replay_path"].parent
+    path = run_dir / CONFIG_NAME
+    if not present(path):
+        return
+    try:
+        saved = read_json_object(path)
+    except Damaged as err:
+        raise SetupError(
+            f"{path} is damaged: {err}. It should hold the config of the checkpoint beside it; "
+            "restore the file from a copy (simoun-train writes UTF-8 JSON), or move it aside "
+            f"(mv {path} {path}.damaged) to read the checkpoint on its own"
+        ) from None
+    # Both sides read the same way, so keys a version added later compare as equal; the device
+    # is this machine's choice (load_run's ``device``), so a GPU run's reads on a CPU machine.
+    machine = {"device": "cpu"}
+    as_saved = to_dict(from_dict({**saved, **machine}, str(path)))
+    checkpoint = to_dict(from_dict({**payload["config"], **machine}))
+    check_config({"config": checkpoint}, as_saved, run_dir, saved=path)

@@ -16,7 +16,7 @@ from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import STEP_LIMIT, Damaged, read_text
+from simoun_agent.run.kept import Damaged, read_text, step_count
 from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
 
@@ -32,11 +32,14 @@ class CsvLog:
         self.columns: list[str] | None = None
         self.last_row: dict[str, str] | None = None
         """the last row kept on resume (None for a new log)"""
+        self.last_step: int | None = None
+        """env step of the last row in the file (None while it has none)"""
         if resume_step is not None and path.exists():
             self.columns, rows = read_log(path)
             rows = [row for row in rows if int(row["env_step"]) <= resume_step]
             self._rewrite(rows)
             self.last_row = rows[-1] if rows else None
+            self.last_step = None if self.last_row is None else int(self.last_row["env_step"])
         elif path.exists():
             path.unlink()
 
@@ -61,6 +64,7 @@ class CsvLog:
             self._rewrite(rows)
         with self.path.open("a", newline="") as f:
             csv.DictWriter(f, self.columns).writerow(row)
+        self.last_step = int(row["env_step"])
 
 
 def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
@@ -83,16 +87,16 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
         if len(values) != len(columns):
             fields = f"{len(values)} fields where the header has {len(columns)}"
             raise damaged_log(path, f"line {number} has {fields}")
-        if not values[at].isdigit():
-            raise damaged_log(path, f"line {number}'s env_step {values[at]!r} is not a step count")
-        if int(values[at]) >= STEP_LIMIT:
-            raise damaged_log(path, f"line {number}'s env_step {values[at]} is past 2**63, more "
-                              "steps than a run can count")  # fmt: skip
-        if rows and int(values[at]) <= int(rows[-1]["env_step"]):
+        try:
+            step = step_count(values[at])
+        except Damaged as err:
+            raise damaged_log(path, f"line {number}'s {err}") from None
+        if rows and step <= int(rows[-1]["env_step"]):
             raise damaged_log(path, f"line {number}'s env_step {values[at]} does not come after "
                               f"line {number - 1}'s {rows[-1]['env_step']} (rows out of order or "
                               "repeated)")  # fmt: skip
-        rows.append(dict(zip(columns, values, strict=True)))
+        # written back as the run writes it: a resumed log holds one spelling of its steps
+        rows.append({**dict(zip(columns, values, strict=True)), "env_step": str(step)})
     return columns, rows
 
 
@@ -188,6 +192,12 @@ class RunLogger:
                 self.tensorboard.add_scalar(f"eval/{key}", value, env_step)
         self.tensorboard.flush()
         plot_learning_curve(self.run_dir / EVAL_CSV, self.run_dir / CURVE_PNG, self.title)
+
+    def last_steps(self) -> dict[str, int | None]:
+        """The env step of each log's last row, by file name (None for a log with no row yet):
+        saved with a checkpoint, so that a resumed run can tell a log restored from an older
+        copy, which lacks rows the checkpoint had logged."""
+        return {EVAL_CSV: self.eval_log.last_step, TRAIN_CSV: self.train_log.last_step}
 
     def close(self) -> None:
         self.tensorboard.close()

@@ -57,6 +57,7 @@ from simoun_agent.run.checkpoint import (
     SPACE_ERRNOS,
     NoSpace,
     check_config,
+    check_replay_mark,
     check_seed_scheme,
     load_checkpoint,
     remove_leftovers,
@@ -126,7 +127,12 @@ def build(
 ) -> tuple[EnvRunner, gym.Env, SimounAgent, FrameReplay]:
     """The training env's runner (in this process or a background one), the evaluation env,
     the agent and an empty replay; each random stream seeded from its child of the run's
-    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first."""
+    ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first, after
+    the config's own rules (checked again: it may have been changed since it was built)."""
+    try:
+        check_train_config(config)
+    except ValueError as err:
+        raise SetupError(str(err)) from None
     seed = config.seed
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
@@ -306,6 +312,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     check_config(payload, as_saved, run_dir, saved=config_path)
     check_config(payload, to_dict(config), run_dir)
     done = payload["state"]["env_step"]
+    check_logs_reach(run_dir, payload["state"])
     finished = (run_dir / SUMMARY_NAME).exists()
     # At its last step without summary.json, a run stopped in its final evaluation or video.
     if config.total_env_steps < done or (config.total_env_steps == done and finished):
@@ -350,6 +357,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"run's transitions ({found}), so it was copied from another run. Restore this run's "
             "own replay and checkpoint from a copy, or start a new run"
         )
+    check_replay_mark(payload, replay)
     restore_rng(payload["rng"])
     rng = np.random.default_rng()
     rng.bit_generator.state = payload["state"]["trainer_rng"]
@@ -362,13 +370,40 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
 
 
-def checkpoint(run: Run) -> None:
-    """Write the run's checkpoint (raises :class:`~simoun_agent.run.checkpoint.NoSpace`)."""
+def check_logs_reach(run_dir: Path, state: dict[str, Any]) -> None:
+    """Refuse a log that ends before the last row the checkpoint had logged (``state``'s
+    ``logged``): a copy older than the checkpoint, whose missing rows the resumed run would
+    never write again. A log moved aside is started anew, as :func:`damaged_log` says."""
+    done = state["env_step"]
+    for name, logged in state.get("logged", {}).items():
+        path = run_dir / name
+        if logged is None or not path.is_file():
+            continue
+        steps = [int(row["env_step"]) for row in read_log(path)[1]]
+        last = max((step for step in steps if step <= done), default=None)
+        if last is not None and last >= logged:
+            continue
+        ends = "holds no row" if last is None else f"ends at env step {last}"
+        raise SetupError(
+            f"{path} {ends}, but the checkpoint (env step {done}) had logged rows up to env "
+            f"step {logged}: the file is an older copy or was cut short, and the rows in between "
+            f"would be lost for good. Nothing in the run was changed. Restore the newer {name} "
+            f"from a copy; or, to go on without those rows, move it aside (mv {path} "
+            f"{path}.old) and resume again: the run writes a new {name} from env step {done}"
+        )
+
+
+def checkpoint(run: Run, logged: dict[str, int | None] | None = None) -> None:
+    """Write the run's checkpoint (raises :class:`~simoun_agent.run.checkpoint.NoSpace`);
+    ``logged``: the env step of each log's last row (:meth:`RunLogger.last_steps`), which a
+    resumed run checks its logs against."""
     state = {
         "env_step": run.counters.env_step,
         "counters": asdict(run.counters),
         "trainer_rng": run.rng.bit_generator.state,
     }
+    if logged is not None:
+        state["logged"] = logged
     save_checkpoint(
         run.run_dir,
         config=to_dict(run.config),
@@ -465,7 +500,7 @@ class Trainer:
             return
         counters.wall_time_s = self.clock.total()
         try:
-            checkpoint(self.run)
+            checkpoint(self.run, self.logger.last_steps())
         except NoSpace as err:
             self.failed_checkpoints += 1
             if required:

@@ -176,9 +176,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(write_selection(spec, args.archive))
             return 0
         from simoun_lab.minigrid_study.report import write_report
-        from simoun_lab.minigrid_study.runner import finished_runs
+        from simoun_lab.minigrid_study.runner import SPEC_FILE, finished_runs, refuse_foreign_runs
 
         if not finished_runs(spec, args.archive):
+            source = str(args.spec or args.archive / SPEC_FILE)
+            refuse_foreign_runs(spec, args.archive, source)
             raise SetupError(
                 f"--archive {args.archive} holds no finished run of its spec: nothing to report "
                 f"yet; train them with: {PROG} run --archive {args.archive}"

@@ -27,6 +27,7 @@ from simoun_agent.config.rules import is_real
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.kept import (
     Damaged,
+    broken_link,
     csv_number,
     present,
     read_csv_rows,
@@ -117,9 +118,10 @@ def eval_row_problem(row: dict[str, float], before: dict[str, float] | None) -> 
     return None
 
 
-def read_summary(path: Path) -> dict[str, Any]:
-    """A finished run's ``summary.json``; SetupError naming the file when it is damaged, lacks
-    one of :data:`SUMMARY_KEYS` as a number > 0, or its final success rate is no rate in
+def read_summary(path: Path, spec: StudySpec, run: Run) -> dict[str, Any]:
+    """A finished run's ``summary.json``; SetupError naming the file when it is damaged, records
+    another run, lacks one of :data:`SUMMARY_KEYS` as a number > 0, its env_steps is not the
+    run's budget (rounded up to whole rollouts), or its final success rate is no rate in
     [0, 1] or its final return no finite number."""
     try:
         summary = read_json_object(path)
@@ -129,6 +131,16 @@ def read_summary(path: Path) -> dict[str, Any]:
         value = summary.get(key)
         if not (is_real(value) and value > 0):
             raise damaged(path, f"{key} is {json.dumps(value)}, not a number > 0")
+    if summary.get("run") != run.name:  # a copy of another run's would count its results twice
+        raise damaged(path, f"its run is {json.dumps(summary.get('run'))}, not {run.name!r}")
+    rollout = spec.ppo.n_envs * spec.ppo.n_steps  # PPO stops after the rollout that passes it
+    steps, budget = summary["env_steps"], run.task.steps
+    if not budget <= steps < budget + rollout:
+        raise damaged(
+            path,
+            f"env_steps is {json.dumps(steps)}, but a run of {budget} env steps takes from "
+            f"{budget} to {budget + rollout - 1} (whole rollouts of {rollout} steps)",
+        )
     rate, final = summary.get("final_success_rate"), summary.get("final_return_mean")
     if not (is_real(rate) and 0 <= rate <= 1):
         raise damaged(path, f"final_success_rate is {json.dumps(rate)}, not a rate in [0, 1]")
@@ -180,9 +192,35 @@ def describe_change(trained: dict[str, Any], wanted: dict[str, Any], key: str) -
 def read_finished(spec: StudySpec, archive: Path, run: Run) -> dict[str, Any]:
     """A finished run's checked ``summary.json``, its ``config.json`` checked against ``spec``
     (SetupError naming a damaged file)."""
-    summary = read_summary(archive / run.name / SUMMARY)
+    summary = read_summary(archive / run.name / SUMMARY, spec, run)
     check_config(archive / run.name / CONFIG, spec, run)
     return summary
+
+
+def check_run_folder(archive: Path, run: Run) -> None:
+    """SetupError naming a run's place in the archive when something else than a directory
+    stands there (a file, a link to nothing): the run would be left out as unfinished."""
+    path = archive / run.name
+    problem = broken_link(path)
+    if problem is None and present(path) and not path.is_dir():
+        problem = "it is a file, not the run's directory"
+    if problem:
+        raise SetupError(
+            f"{path} (the directory of run {run.name}) is damaged: {problem}. Restore the run "
+            f"from a copy (git checkout -- {path}, for a committed archive), or move it aside "
+            f"(mv {path} {path}.damaged) and run the study again, which trains that run anew"
+        )
+
+
+def finished(spec: StudySpec, archive: Path) -> list[Run]:
+    """The spec's runs finished in the archive, each checked (:func:`read_finished`); SetupError
+    naming a run's damaged directory or file: a damaged run is named, not left out."""
+    for run in spec.runs():
+        check_run_folder(archive, run)
+    done = [r for r in spec.runs() if present(archive / r.name / SUMMARY)]
+    for run in done:
+        read_finished(spec, archive, run)
+    return done
 
 
 class Records:
@@ -192,15 +230,14 @@ class Records:
 
     def __init__(self, spec: StudySpec, archive: Path) -> None:
         self.spec, self.archive = spec, archive
-        self.finished = [r for r in spec.runs() if present(archive / r.name / SUMMARY)]
+        self.finished = finished(spec, archive)
         done = {(r.task.env_id, r.seed, r.arm) for r in self.finished}
         self.used = [
             r
             for r in self.finished
             if all((r.task.env_id, r.seed, arm) in done for arm in spec.arms)
         ]
-        summaries = {r.name: read_finished(spec, archive, r) for r in self.finished}
-        self.summary = {r.name: summaries[r.name] for r in self.used}
+        self.summary = {r.name: read_finished(spec, archive, r) for r in self.used}
         self.eval = {r.name: read_eval(archive / r.name / EVAL_CSV) for r in self.used}
         self.train = {
             r.name: read_rows(archive / r.name / TRAIN_CSV, TRAIN_COLUMNS) for r in self.used

@@ -18,6 +18,8 @@ from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.engine.trial import summary_written
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT
+from simoun_lab.minigrid_study.report import finished as checked_finished
+from simoun_lab.minigrid_study.run import SUMMARY
 from simoun_lab.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_lab.minigrid_study.training import write_json
 from simoun_lab.minigrid_study.trial import MiniGridTrial
@@ -32,6 +34,26 @@ SPEC_FILE = "spec.json"
 def finished_runs(spec: StudySpec, archive: Path) -> list[str]:
     """The names of the spec's runs whose summary is in the archive."""
     return [run.name for run in spec.runs() if summary_written(archive / run.name)]
+
+
+def refuse_foreign_runs(spec: StudySpec, archive: Path, source: str) -> None:
+    """When none of the spec's runs finished in the archive but it holds finished runs of
+    others (a ``spec.json`` of another study copied in), SetupError naming ``source`` (where
+    the spec came from): advice to train the spec's runs would mix two studies."""
+    names = {run.name for run in spec.runs()}
+    others = sorted(
+        str(path.parent.relative_to(archive))
+        for path in archive.glob(f"*/*/*/{SUMMARY}")
+        if str(path.parent.relative_to(archive)) not in names
+    )
+    if others:
+        raise SetupError(
+            f"{archive} holds no finished run of the spec in {source}, but {len(others)} "
+            f"finished runs of another spec (e.g. {others[0]}): {source} is another study's. "
+            f"Restore the archive's own {SPEC_FILE} from a copy (git checkout -- "
+            f"{archive / SPEC_FILE}, for a committed archive), or pass the archive of the study "
+            "that spec ran"
+        )
 
 
 def read_saved_spec(path: Path) -> dict[str, Any]:
@@ -98,6 +120,7 @@ def run_study(
     if concurrent < 1:
         raise SetupError(f"--concurrent must be >= 1, got {concurrent}")
     record_spec(spec, archive)
+    checked_finished(spec, archive)  # before Ray: a damaged finished run fails nothing there
     done = set(finished_runs(spec, archive))
     commit, work = code_version()["commit"], str(work_dir.resolve())
     todo = [MiniGridTrial(spec, run, work, commit) for run in spec.runs() if run.name not in done]

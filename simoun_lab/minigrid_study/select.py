@@ -23,7 +23,7 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import present
 from simoun_lab.minigrid_study.arms import parse_arm
-from simoun_lab.minigrid_study.report import damaged, read_eval, read_finished
+from simoun_lab.minigrid_study.report import check_run_folder, damaged, read_eval, read_finished
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY
 from simoun_lab.minigrid_study.spec import Run, StudySpec
 
@@ -59,6 +59,8 @@ def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
     """Per arm: its area on each finished run and their mean; per entry: the selected setting
     (None while a setting of that entry is still missing runs)."""
     arms: dict[str, dict[str, Any]] = {}
+    for run in spec.runs():  # a run's directory replaced by a file is named, not left out
+        check_run_folder(archive, run)
     for arm in spec.arms:
         runs = [r for r in spec.runs() if r.arm == arm]
         areas = {

@@ -125,6 +125,7 @@ def report(spec: StudySpec, study_dir: Path) -> Path:
             "was run with"
         )
     if not runner.finished_runs(spec, study_dir):
+        runner.refuse_foreign_runs(spec, study_dir, str(saved if present(saved) else "the spec"))
         raise SetupError(
             f"--study-dir {study_dir} holds no finished run of this spec: nothing to report yet"
         )

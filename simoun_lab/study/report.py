@@ -50,6 +50,7 @@ from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, broken_link, present, read_json_object
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_lab import stats
+from simoun_lab.study.checks import check_run_folder
 from simoun_lab.study.choice import SELECTION_FILE, Choice, check_config, read_finished
 from simoun_lab.study.driving import (
     MEASURES,
@@ -981,6 +982,8 @@ def write_study_report(
     named under the protocol."""
     out = report_dir(study_dir / REPORT_DIR)
     runs = phase_runs(spec, EVALUATION, choices)
+    for run in tuning_runs(spec) + runs:  # a damaged run is named, not counted as unfinished
+        check_run_folder(study_dir, run.name)
     for run in runs:  # before simoun-report of the phase, which would leave a damaged one out
         if present(Path(study_dir, run.name, SUMMARY_NAME)):
             check_config(spec, study_dir, run)

@@ -15,12 +15,12 @@ from typing import Any
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, json_kind, present, read_json_object
-from simoun_agent.run.layout import CHECKPOINT_NAME
+from simoun_agent.run.layout import CHECKPOINT_NAME, SUMMARY_NAME
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect
 from simoun_lab.study import archive as archiving
 from simoun_lab.study.archive import GENERALIZATION_CSV
-from simoun_lab.study.checks import check_fixed_spec, check_study
+from simoun_lab.study.checks import check_fixed_spec, check_run_folder, check_study
 from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_lab.study.generalization import play_modes, playable, to_play
 from simoun_lab.study.options import StudyOptions
@@ -128,6 +128,45 @@ def record_problem(record: dict[str, Any]) -> str | None:
     return None
 
 
+def record_path(study_dir: Path, archive: Path | None) -> Path:
+    """Where :func:`load_record` read the study record: the study directory's, else the
+    archive's."""
+    if archive is None or present(study_dir / STUDY_FILE):
+        return study_dir / STUDY_FILE
+    return archive / STUDY_FILE
+
+
+def places(options: StudyOptions) -> list[Path]:
+    """The study directory and the archive (when given): where finished runs are kept."""
+    return [p for p in (options.study_dir, options.archive) if p is not None]
+
+
+def unplanned_runs(record: dict[str, Any], where: list[Path]) -> list[str]:
+    """The finished tuning runs in ``where`` that the study ``record``'s spec does not plan."""
+    planned = {run.name for run in tuning_runs(StudySpec.from_json(record["spec"]))}
+    found = {
+        str(path.parent.relative_to(place))
+        for place in where
+        for path in (place / TUNING).rglob(SUMMARY_NAME)
+    }
+    return sorted(found - planned)
+
+
+def another_study(
+    record: dict[str, Any], spec: StudySpec, spec_path: str, path: Path
+) -> SetupError:
+    """The error for a resumed study whose record at ``path`` is of another study: its spec's
+    name (the stem of the file it ran from) is not this spec's, and the finished runs are not
+    the record's (a spec fixed to go on may be renamed; its runs stay those of the record)."""
+    return SetupError(
+        f"{path} is the record of another study ({record['spec'].get('name')!r}, run from "
+        f"{record['spec_file']}), not of {spec_path} ({spec.name!r}), whose finished runs are "
+        f"here: it was copied from another study. Restore this study's {STUDY_FILE} from a "
+        "copy (the study directory and its archive each keep one), or pass the --study-dir and "
+        "--archive of the study it records"
+    )
+
+
 def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: str) -> None:
     """Refuse ``spec`` when it is not the one the study ``record`` was started with: the error
     says ``problem``, the keys that differ and ``fix``. A record saved before a spec key
@@ -164,7 +203,12 @@ def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[s
         text = spec_text(Path(spec_path))
         return {"spec_file": spec_path, "spec_text": text, "spec": spec.to_json(), "parts": [part]}
     record = load_record(study_dir, archive)
-    changed = check_fixed_spec(record, spec, spec_path, [p for p in (study_dir, archive) if p])
+    try:
+        changed = check_fixed_spec(record, spec, spec_path, places(options))
+    except SetupError:
+        if record["spec"].get("name") != spec.name and unplanned_runs(record, places(options)):
+            raise another_study(record, spec, spec_path, record_path(study_dir, archive)) from None
+        raise
     if changed:  # a fix that leaves every finished run as it ran: the study goes on under it
         part["spec_changed"] = {"keys": changed, "before": record["spec_text"]}
         record.update(spec_file=spec_path, spec_text=spec_text(Path(spec_path)))
@@ -266,6 +310,10 @@ class Phases:
 
     def run(self, phase: str, runs: list[StudyRun]) -> dict[str, list]:
         """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
+        for run in runs:  # before anything is restored or trained: a damaged run is named
+            for where in (self.study_dir, self.archive):
+                if where is not None:
+                    check_run_folder(where, run.name)
         restored = self.restore(runs)
         todo = [run for run in runs if not run.finished(self.study_dir)]
         stop_file = str(self.study_dir / STOP_FILE)
@@ -344,6 +392,8 @@ def report_study(spec: StudySpec, study_dir: Path) -> Path:
         f"{study_dir} holds a study of another spec",
         f"pass the spec it was run with ({record['spec_file']})",
     )
+    for run in tuning_runs(spec):  # before the selection reads them: a damaged run is named
+        check_run_folder(study_dir, run.name)
     code = code_version()
     commit = f"{code['commit']}{' with uncommitted changes' if code['dirty'] else ''}"
     write_study_report(spec, study_dir, record, choose(spec, study_dir), rewritten_by=commit)

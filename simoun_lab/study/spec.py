@@ -156,6 +156,31 @@ class Phase:
         return sum(len(self.seeds[task]) for task in self.tasks)
 
 
+SAVED_KINDS: dict[str, tuple[tuple[type, ...], str]] = {
+    "str": ((str,), "a string"),
+    "list": ((list,), "an array"),
+    "dict": ((dict,), "an object"),
+    "int": ((int,), "a whole number"),
+    "str | None": ((str, type(None)), "a string or null"),
+    "int | None": ((int, type(None)), "a whole number or null"),
+    "float | str": ((int, float, str), "a number or a string"),
+}
+"""What each kind of :class:`StudySpec` field is saved as in ``study.json``."""
+
+
+def saved_kind_problem(name: str, kind: str, value: Any) -> str | None:
+    """What is wrong with the saved value of the spec field ``name`` (of type ``kind``), else
+    None: a string where the recipes' array belongs would read as another spec's recipes."""
+    if kind not in SAVED_KINDS:
+        return None  # a phase: read by Phase, which names what is wrong with it
+    types, need = SAVED_KINDS[kind]
+    if isinstance(value, bool) or not isinstance(value, types):
+        return f"{name} is {json.dumps(value)}, where {need} belongs"
+    if name == "recipes" and not all(isinstance(recipe, str) for recipe in value):
+        return f"recipes is {json.dumps(value)}, where an array of recipe names belongs"
+    return None
+
+
 @dataclass(frozen=True)
 class StudySpec:
     """What a study runs, as read from its TOML file; saved in ``study.json`` and compared when
@@ -242,6 +267,10 @@ class StudySpec:
         problems += [f"an unknown key {key!r}" for key in data if key not in known]
         if problems:
             raise ValueError(f"its spec has {', '.join(problems)}")
+        for field_ in fields(cls):
+            problem = saved_kind_problem(field_.name, str(field_.type), data.get(field_.name))
+            if field_.name in data and problem:
+                raise ValueError(f"its spec's {problem}")
         phases = {}
         for name in PHASES:
             try:

@@ -218,6 +218,12 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         line = int(np.argmax(bad)) + 2  # 1-based, after the header
         raise DamagedRun(f"{path.name} line {line} has an empty, NaN or infinite value")
     steps = curve["env_step"]
+    if np.any(steps != np.floor(steps)):  # whole numbers only, as simoun-train --resume reads them
+        line = int(np.argmax(steps != np.floor(steps))) + 2
+        raise DamagedRun(
+            f"{path.name} line {line}: env_step {steps[line - 2]:g} is not a step count (a whole "
+            "number of steps)"
+        )
     if np.any(steps >= STEP_LIMIT):
         line = int(np.argmax(steps >= STEP_LIMIT)) + 2
         raise DamagedRun(

@@ -11,6 +11,7 @@ under what machine load and with how much CPU time each part of the trial ran.
 from __future__ import annotations
 
 import json
+import math
 import os
 import resource
 import shutil
@@ -194,6 +195,34 @@ def _write_part(run_dir: Path, part: dict[str, Any], replace_last: bool = False)
     atomic_write(run_dir / TRIAL_FILE, lambda tmp: tmp.write_text(text))
 
 
+def _number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+PART_FIELDS: dict[str, tuple[Callable[[Any], bool], str]] = {
+    "cpu_count": (lambda v: _number(v) and v == int(v) and v >= 1, "a whole number of CPUs"),
+    "loadavg": (
+        lambda v: isinstance(v, list) and len(v) == 3 and all(_number(x) and x >= 0 for x in v),
+        "an array of the 1, 5 and 15-minute load averages (3 numbers, 0 or more)",
+    ),
+    "env_step_start": (lambda v: _number(v) and v == int(v) and v >= 0, "an env step count"),
+    "env_step_end": (lambda v: _number(v) and v == int(v) and v >= 0, "an env step count"),
+    "wall_s": (lambda v: _number(v) and v >= 0, "seconds (a number, 0 or more)"),
+    "cpu_s": (lambda v: _number(v) and v >= 0, "seconds (a number, 0 or more)"),
+}
+"""The fields of a ``trial.json`` part that reports compute with, and what each must be."""
+
+
+def part_problem(part: dict[str, Any], number: int) -> str | None:
+    """What is wrong with the ``number``-th part of a ``trial.json`` (a field of
+    :data:`PART_FIELDS` of the wrong type or range), else None; a field not yet written (a part
+    still running has no ``cpu_s``) is left out."""
+    for key, (ok, need) in PART_FIELDS.items():
+        if key in part and not ok(part[key]):
+            return f"part {number}'s {key} is {json.dumps(part[key])}, where {need} belongs"
+    return None
+
+
 def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
     """The parts recorded in a run directory's ``trial.json`` (none without one); SetupError
     naming the file, what is wrong and the fix when it is damaged."""
@@ -206,8 +235,11 @@ def read_trial_parts(run_dir: Path) -> list[dict[str, Any]]:
         problem = str(err)
     else:
         if isinstance(parts, list) and all(isinstance(part, dict) for part in parts):
-            return parts
-        problem = "its parts are not an array of JSON objects (one per part the run ran)"
+            problem = next(filter(None, map(part_problem, parts, range(1, len(parts) + 1))), None)
+            if problem is None:
+                return parts
+        else:
+            problem = "its parts are not an array of JSON objects (one per part the run ran)"
     raise SetupError(
         f"{path} is damaged: {problem}. Restore it from a copy (a study's archive keeps one), or "
         f"move it aside (mv {path} {path}.damaged): the run's CPU time and machine load are then "

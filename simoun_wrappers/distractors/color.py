@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
+from simoun_wrappers._checks import check_action, check_reset_seed, plain
 from simoun_wrappers.distractors._dm_control import (
     check_level,
     check_open,
@@ -95,7 +96,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
             seed: seed of the colour stream; None draws fresh entropy.
         """
         check_single_env(env, "ColorShift")
-        gym.utils.RecordConstructorArgs.__init__(self, level=level, seed=seed)
+        gym.utils.RecordConstructorArgs.__init__(self, level=level, seed=plain(seed))
         gym.Wrapper.__init__(self, env)
         physics = dm_control_physics(env, "ColorShift")
         check_level(level, "ColorShift")
@@ -159,6 +160,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, "ColorShift")
         self._rng = episode_rng(self.seed, seed, self._rng, "ColorShift")
         distance = SHIFT_RANGES[self.level]
         self.colors = {
@@ -168,6 +170,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
         return self.env.reset(seed=seed, options=options)
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, "ColorShift")
         check_open(self.env, "ColorShift")
         return self.env.step(action)
 

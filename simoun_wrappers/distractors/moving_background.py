@@ -8,6 +8,7 @@ from typing import Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
+from simoun_wrappers._checks import check_action, check_reset_seed, plain
 from simoun_wrappers.distractors._dm_control import (
     check_level,
     check_open,
@@ -73,7 +74,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
         """
         check_single_env(env, "MovingBackground")
         gym.utils.RecordConstructorArgs.__init__(
-            self, level=level, videos=None if videos is None else str(videos), seed=seed
+            self, level=level, videos=None if videos is None else str(videos), seed=plain(seed)
         )
         gym.Wrapper.__init__(self, env)
         physics = dm_control_physics(env, "MovingBackground")
@@ -101,6 +102,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        seed = check_reset_seed(seed, "MovingBackground")
         check_open(self.env, "MovingBackground")
         self._rng = episode_rng(self.seed, seed, self._rng, "MovingBackground")
         self._source.start(self._rng)
@@ -108,6 +110,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
         return self.env.reset(seed=seed, options=options)
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        check_action(action, self.action_space, "MovingBackground")
         check_open(self.env, "MovingBackground")
         result = self.env.step(action)
         self._t += 1
