@@ -389,7 +389,8 @@ def test_resume_of_a_read_only_run_directory_is_one_clear_error(finished):
 
 def test_an_unknown_mujoco_gl_is_refused_in_one_line(tmp_path):
     run_dir = tmp_path / "run"
-    argv = run_flags(run_dir, 40, "--env", "dm_control/cartpole-swingup-v0")
+    # action repeat 1: the 40 steps hold more decisions than the warm-up, so nothing is warned of
+    argv = run_flags(run_dir, 40, "--env", "dm_control/cartpole-swingup-v0", "--action-repeat", "1")
     done = subprocess.run(
         [sys.executable, "-m", "simoun_agent.cli.train", *argv],
         capture_output=True,

@@ -64,6 +64,8 @@ def refused(capsys, main, argv) -> str:
         (eval_cli.main, ["RUN", "--env", "Pendulum-v1"], "--env is not a flag of simoun-eval"),
         (eval_cli.main, ["RUN", "--agent.no-curiosity"], "agent.curiosity is a setting of the "
          "run"),
+        (eval_cli.main, ["RUN", "--eval-episodes", "5"], "unknown flag --eval-episodes (did you "
+         "mean --episodes?)"),
     ],
 )  # fmt: skip
 def test_every_command_names_the_flag_an_unknown_one_meant(main, argv, said, capsys):

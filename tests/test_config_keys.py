@@ -66,6 +66,13 @@ def test_an_unknown_recipe_or_preset_name_is_refused_with_the_names():
         resolve("gpu", {})
 
 
+def test_close_keys_read_words_through_their_synonyms():
+    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
+    assert close_keys("frame_size", docs) == ["image_size"]
+    assert close_keys("resolution", docs) == ["image_size"]
+    assert close_keys("frame_skip", docs) == ["action_repeat"]
+
+
 @pytest.mark.parametrize(
     ("typed", "meant"),
     [
@@ -80,10 +87,3 @@ def test_a_key_with_another_separator_is_answered_with_the_key_itself(typed, mea
     with pytest.raises(SetupError) as error:
         resolve("cpu", {typed: 1e-3})
     assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)
-
-
-def test_close_keys_read_words_through_their_synonyms():
-    docs = {key: doc for key, (_, _, doc) in config_fields().items()}
-    assert close_keys("frame_size", docs) == ["image_size"]
-    assert close_keys("resolution", docs) == ["image_size"]
-    assert close_keys("frame_skip", docs) == ["action_repeat"]

@@ -78,7 +78,7 @@ def test_simoun_eval_distraction_writes_table_csv_and_chart(runs, capsys):
 
 def test_each_mode_changes_only_the_pixels_of_the_runs_stack():
     config = resolve(None, {key: TINY[key] for key in ("env", "env_kwargs", "image_size")})
-    action = np.full(1, 0.7, np.float32)
+    action = np.full(2, 0.7, np.float32)  # ball_in_cup takes two forces
     frames = {}
     for mode in MODES:
         env = make_distracted_env(config, mode)

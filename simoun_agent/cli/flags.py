@@ -65,7 +65,7 @@ from simoun_agent.cli.command_flags import (
     takes_positional,
 )
 from simoun_agent.config import TrainConfig
-from simoun_agent.config.key_match import close_keys
+from simoun_agent.config.key_match import NAME_WEIGHT, close_keys, meaning_score
 from simoun_agent.config.keys import (
     FALSE_WORDS,
     NONE_WORDS,
@@ -288,14 +288,18 @@ def refuse_unknown(
             continue
         if spelled := ascii_flag(arg):
             raise lookalike_error(arg, spelled)
-        if reads_runs and (key := run_setting(name)):
+        close = close_keys(name[2:], docs)
+        # a flag of the command that shares a word of the name is meant (--eval-episodes:
+        # --episodes); else a run setting is named as the run's own
+        alike = any(meaning_score(name[2:], key, docs[key]) >= NAME_WEIGHT for key in close)
+        if reads_runs and not alike and (key := run_setting(name)):
             value = "" if config_fields()[key][0] is bool else " ..."
             raise ValueError(
                 f"{name} is not a flag of {prog}{sub}: {key} is a setting of the run, saved in "
                 f"its config.json, and {prog} uses the run's own; it is chosen when the run is "
                 f"trained (simoun-train {name}{value}). `{prog}{sub} --help` lists every flag"
             )
-        matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
+        matches = ["--" + key.replace("_", "-") for key in close]
         hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
