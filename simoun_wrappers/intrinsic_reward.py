@@ -36,6 +36,7 @@ from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
     Raw,
+    claim_normalization,
     make_normalization,
     normalization_name,
 )
@@ -337,6 +338,7 @@ class IntrinsicMechanism(ABC):
         )
         self.signal = self.signal_type(**arguments)
         self.normalization = make_normalization(normalization, **paper)
+        claim_normalization(self.normalization, self)
         self.scored = 0
         """transitions scored so far: the step t of the weight and the warm-up's clock"""
         self._attach(env)

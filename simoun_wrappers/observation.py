@@ -17,10 +17,10 @@ from simoun_wrappers._checks import (
     check_action,
     check_bool,
     check_positive_int,
-    refuse_step_before_reset,
     check_reset_seed,
     is_int,
     plain,
+    refuse_step_before_reset,
 )
 from simoun_wrappers.frames import check_single_env, frame_stack_in
 
