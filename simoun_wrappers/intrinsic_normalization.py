@@ -396,7 +396,7 @@ def make_normalization(normalization: str | Normalization, **paper: float | None
         if given:
             raise unused_maxima(given, normalization)
         return normalization
-    if normalization not in NORMALIZATIONS:
+    if not isinstance(normalization, str) or normalization not in NORMALIZATIONS:
         from difflib import get_close_matches
 
         close = get_close_matches(str(normalization), NORMALIZATIONS, n=1)

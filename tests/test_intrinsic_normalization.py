@@ -362,3 +362,8 @@ def test_an_instance_without_statistics_may_serve_several_wrappers():
     first = RNDReward(cartpole(), Brightness(), normalization=bonus)
     second = RNDReward(cartpole(), Brightness(), normalization=bonus)
     assert first.normalization is second.normalization is bonus
+
+
+def test_a_normalization_of_the_wrong_type_is_refused_naming_the_names():
+    with pytest.raises(ValueError, match=r"normalization=\['none'\] is not one of .*'return_std'"):
+        RNDReward(cartpole(), Brightness(), normalization=["none"])
