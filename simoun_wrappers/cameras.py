@@ -17,6 +17,7 @@ from simoun_wrappers._checks import (
     plain,
     refuse_step_before_reset,
 )
+from simoun_wrappers._spec import CheckedSpecWrapper
 from simoun_wrappers.augment import RandomConvolution
 from simoun_wrappers.distractors._dm_control import check_open, dm_control_physics
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
@@ -84,7 +85,7 @@ def _highway_view(env: gym.Env, viewport: Mapping[str, Any], hw: tuple[int, int]
     return render
 
 
-class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
+class MultiCamera(CheckedSpecWrapper, gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     """Observe N views of the same step, resized to ``size`` and side by side: ``(H, N*W, 3)``.
 
     Each entry of ``cameras`` is one view:
@@ -108,7 +109,9 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     ``close()`` leaves the highway viewers alone: ``EnvViewer.close()`` quits pygame for all.
     The constructor resets ``env`` once (unseeded) to learn the views' sizes: highway-env has
     no road to draw before a reset. That episode is not the user's: ``step()`` before the
-    first ``reset()`` raises Gymnasium's ``ResetNeeded``.
+    first ``reset()`` raises Gymnasium's ``ResetNeeded``. ``env.spec.to_json()`` writes
+    cameras given as names, ids or viewport dicts; a camera function makes it raise a
+    TypeError naming ``cameras`` (``gym.make(env.spec)`` still re-makes the env in-process).
 
     Example:
         >>> import gymnasium as gym
