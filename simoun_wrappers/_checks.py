@@ -5,6 +5,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.error import ResetNeeded
 
 
 def is_int(value: Any) -> bool:
@@ -34,6 +35,18 @@ def check_reset_seed(seed: Any, owner: str) -> int | None:
             f"env.reset(seed=0), or env.reset() to continue the random stream."
         )
     return int(seed)
+
+
+def refuse_step_before_reset(has_reset: bool, owner: str) -> None:
+    """A ResetNeeded when ``owner`` steps before its first ``reset()``. For wrappers whose
+    constructor resets the env to read its first image: that reset satisfies Gymnasium's
+    OrderEnforcing under them, so without this a step would run on an episode the user never
+    started or seeded."""
+    if not has_reset:
+        raise ResetNeeded(
+            f"Cannot call {owner}.step() before reset(); call env.reset(seed=...) first to start "
+            f"a seeded episode."
+        )
 
 
 def check_vector_reset_seed(seed: Any, owner: str, num_envs: int) -> int | list[int | None] | None:

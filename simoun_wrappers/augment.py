@@ -226,7 +226,10 @@ class RandomConvolution(ChainWrapper):
     ``render_mode="rgb_array"``. Kernels come from the wrapper's own RNG: ``reset(seed=s)`` makes
     them reproducible and the env's own RNG is left untouched. It goes *under* the frame stack
     (``SimounObservation(RandomConvolution(env))``); over a stacked env it raises, since it would
-    replace the triplet and its motion channels with a convolved ``render()``.
+    replace the triplet and its motion channels with a convolved ``render()``. Reading pixels
+    from ``render()`` resets the env while the wrapper is built (Gymnasium's
+    ``AddRenderObservation``), so ``step()`` before the first ``reset()`` raises Gymnasium's
+    ``ResetNeeded``: episodes start with the user's ``reset(seed=...)``.
 
     Example:
         >>> import gymnasium as gym
@@ -283,7 +286,7 @@ class RandomConvolution(ChainWrapper):
         if seed is not None:
             self._rng = np.random.default_rng(seed)
         self._kernel_seed = int(self._rng.integers(2**62))
-        return self.env.reset(seed=seed, options=options)
+        return super().reset(seed=seed, options=options)
 
     def _convolve(self, image: np.ndarray) -> np.ndarray:
         import torch

@@ -11,7 +11,13 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from simoun_wrappers._checks import check_action, check_reset_seed, plain
+from simoun_wrappers._checks import (
+    check_action,
+    check_reset_seed,
+    plain,
+    refuse_step_before_reset,
+)
+from simoun_wrappers._spec import CheckedSpecWrapper
 from simoun_wrappers.augment import RandomConvolution
 from simoun_wrappers.distractors._dm_control import check_open, dm_control_physics
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
@@ -79,7 +85,7 @@ def _highway_view(env: gym.Env, viewport: Mapping[str, Any], hw: tuple[int, int]
     return render
 
 
-class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
+class MultiCamera(CheckedSpecWrapper, gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     """Observe N views of the same step, resized to ``size`` and side by side: ``(H, N*W, 3)``.
 
     Each entry of ``cameras`` is one view:
@@ -102,7 +108,10 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     to use.
     ``close()`` leaves the highway viewers alone: ``EnvViewer.close()`` quits pygame for all.
     The constructor resets ``env`` once (unseeded) to learn the views' sizes: highway-env has
-    no road to draw before a reset.
+    no road to draw before a reset. That episode is not the user's: ``step()`` before the
+    first ``reset()`` raises Gymnasium's ``ResetNeeded``. ``env.spec.to_json()`` writes
+    cameras given as names, ids or viewport dicts; a camera function makes it raise a
+    TypeError naming ``cameras`` (``gym.make(env.spec)`` still re-makes the env in-process).
 
     Example:
         >>> import gymnasium as gym
@@ -162,7 +171,9 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
         self._views = [
             functools.partial(self._checked, camera, self._make_view(camera)) for camera in cameras
         ]
+        # the user's episode starts with their own reset(seed=...): step() refuses until then
         self.env.reset()
+        self._has_reset = False
         shapes = [view().shape for view in self._views]
         if len(set(shapes)) != 1:
             raise ValueError(
@@ -220,10 +231,13 @@ class MultiCamera(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         seed = check_reset_seed(seed, "MultiCamera")
         self._check_open()
-        return super().reset(seed=seed, options=options)
+        result = super().reset(seed=seed, options=options)
+        self._has_reset = True
+        return result
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
         check_action(action, self.action_space, "MultiCamera")
+        refuse_step_before_reset(self._has_reset, "MultiCamera")
         self._check_open()
         return super().step(action)
 

@@ -147,7 +147,9 @@ class ConsistencyArguments:
                 or a ``Normalization``; an instance means what its name means (a
                 ``PaperMaxima()`` is ``"paper"``). ``"paper"`` (Eq. 13 as written) is always
                 positive: a bonus for staying alive to an on-policy learner (see
-                docs/intrinsic-rewards.md).
+                docs/intrinsic-rewards.md). An instance keeps one wrapper's running
+                statistics: one already held by another wrapper is refused (build a new one,
+                or pass the name).
             warmup: transitions that get reward 0 while the statistics settle.
             progress: None, or NovelD's alpha: pay ``max(d(s') - alpha * d(s), 0)``.
         """

@@ -26,6 +26,7 @@ zero: documented on each class. Nothing here imports torch.
 from __future__ import annotations
 
 import math
+import weakref
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -44,6 +45,7 @@ __all__ = [
     "ReturnStd",
     "RewardStd",
     "Standardize",
+    "claim_normalization",
     "make_normalization",
 ]
 
@@ -394,7 +396,7 @@ def make_normalization(normalization: str | Normalization, **paper: float | None
         if given:
             raise unused_maxima(given, normalization)
         return normalization
-    if normalization not in NORMALIZATIONS:
+    if not isinstance(normalization, str) or normalization not in NORMALIZATIONS:
         from difflib import get_close_matches
 
         close = get_close_matches(str(normalization), NORMALIZATIONS, n=1)
@@ -408,6 +410,40 @@ def make_normalization(normalization: str | Normalization, **paper: float | None
     if given:
         raise unused_maxima(given, normalization)
     return NORMALIZATIONS[normalization]()
+
+
+_HOLDERS: dict[int, tuple[weakref.ref, weakref.ref]] = {}
+"""``id`` of each instance given to a wrapper -> (the instance, that wrapper), both held weakly:
+a dropped wrapper frees its instance for another, and a user's class need not be hashable"""
+
+
+def claim_normalization(normalization: Normalization, holder: object) -> None:
+    """Make ``holder`` (a wrapper) the one whose running statistics ``normalization`` keeps; a
+    ValueError when another wrapper still holds it. Two wrappers on one instance would mix
+    their statistics (a training and an evaluation env raising one running std) without a
+    word, and a copy would leave the user's instance unused, so it is refused instead. One
+    without statistics (``Raw()``) has nothing to mix and may serve any number of wrappers."""
+    if not normalization.state_dict():
+        return
+    for key in [key for key, (kept, owner) in _HOLDERS.items() if None in (kept(), owner())]:
+        del _HOLDERS[key]
+    kept, owner = _HOLDERS.get(id(normalization), (None, None))
+    other = owner() if kept is not None and kept() is normalization else None
+    if other is not None and other is not holder:
+        name = normalization_name(normalization)
+        by_name = f", or the name normalization={name!r}, which builds one per wrapper" * (
+            name in NORMALIZATIONS
+        )
+        # the built-in classes' reprs are their constructor calls
+        made_again = (
+            repr(normalization) if name in NORMALIZATIONS else f"{type(normalization).__name__}()"
+        )
+        raise ValueError(
+            f"normalization={normalization!r} already keeps the running statistics of another "
+            f"{type(other).__name__}; one instance in two wrappers would mix their statistics. "
+            f"Give each wrapper its own: a new instance (normalization={made_again}){by_name}."
+        )
+    _HOLDERS[id(normalization)] = (weakref.ref(normalization), weakref.ref(holder))
 
 
 def unused_maxima(given: dict[str, float], normalization: str | Normalization) -> ValueError:

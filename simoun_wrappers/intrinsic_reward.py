@@ -32,10 +32,12 @@ from simoun_wrappers._checks import (
     is_real,
     plain,
 )
+from simoun_wrappers._spec import CheckedSpecWrapper
 from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
     Raw,
+    claim_normalization,
     make_normalization,
     normalization_name,
 )
@@ -337,6 +339,7 @@ class IntrinsicMechanism(ABC):
         )
         self.signal = self.signal_type(**arguments)
         self.normalization = make_normalization(normalization, **paper)
+        claim_normalization(self.normalization, self)
         self.scored = 0
         """transitions scored so far: the step t of the weight and the warm-up's clock"""
         self._attach(env)
@@ -457,13 +460,18 @@ class IntrinsicMechanism(ABC):
             self.signal.close()
 
 
-class IntrinsicReward(IntrinsicMechanism, gym.Wrapper, gym.utils.RecordConstructorArgs):
+class IntrinsicReward(
+    IntrinsicMechanism, CheckedSpecWrapper, gym.Wrapper, gym.utils.RecordConstructorArgs
+):
     """``r_e + r_i`` for a single env, ``r_i`` from the class's signal on the triplet reached
     (see :class:`IntrinsicMechanism` for the normalization and the weight).
 
     ``info`` gets ``"reward_extrinsic"`` and ``"reward_intrinsic"`` (``r_i``); the reward returned
     is their sum. Subclasses (``ConsistencyCuriosityReward``, ``RNDReward``,
     ``ConstantBonusReward``) name their ``signal_type`` and give their constructor's signature.
+    A source (function or model) or a ``Normalization`` instance cannot be written as JSON:
+    ``env.spec.to_json()`` raises a TypeError naming it (see ``simoun_wrappers._spec``), while
+    ``gym.make(env.spec)`` re-makes the env in the same process.
     """
 
     vector = False

@@ -20,6 +20,7 @@ from simoun_wrappers._checks import (
     check_reset_seed,
     is_int,
     plain,
+    refuse_step_before_reset,
 )
 from simoun_wrappers.frames import check_single_env, frame_stack_in
 
@@ -362,15 +363,21 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def __init__(self, chain: gym.Env, source_env: gym.Env) -> None:
         gym.Wrapper.__init__(self, chain)
         self._source_env = source_env
+        self._has_reset = False
+        """whether the user reset this wrapper: reading pixels from render() resets the env
+        while the chain is built"""
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         seed = check_reset_seed(seed, type(self).__name__)
-        return self.env.reset(seed=seed, options=options)
+        result = self.env.reset(seed=seed, options=options)
+        self._has_reset = True
+        return result
 
     def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
         check_action(action, self.action_space, type(self).__name__)
+        refuse_step_before_reset(self._has_reset, type(self).__name__)
         return self.env.step(action)
 
     def __reduce__(self) -> tuple:

@@ -108,6 +108,8 @@ class RNDArguments:
             normalization: a name of ``simoun_wrappers.intrinsic_normalization.NORMALIZATIONS``
                 or a ``Normalization``; ``"reward_std"`` divides by the running std of the errors,
                 ``"return_std"`` by that of the discounted intrinsic return as Burda et al. do.
+                An instance keeps one wrapper's running statistics: one already held by
+                another wrapper is refused (build a new one, or pass the name).
             decay: lambda of a weight ``exp(-lambda * t)``, per environment step.
             progress: None, or NovelD's alpha: pay ``max(e(s') - alpha * e(s), 0)``.
         """

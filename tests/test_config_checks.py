@@ -245,3 +245,20 @@ def test_the_flare_recipe_refuses_one_frame_and_takes_two():
     with pytest.raises(SetupError, match=r"--agent.num-frames 1 .*'flare' learns from the latent"):
         resolve(None, {"agent.recipe": "flare", "agent.num_frames": 1})
     assert resolve(None, {"agent.recipe": "flare", "agent.num_frames": 2}).agent.num_frames == 2
+
+
+@pytest.mark.parametrize(
+    ("build", "words"),
+    [
+        (lambda: AgentConfig(recipe=["drq"]), ("AgentConfig.recipe", "drqv2", "not a list")),
+        (lambda: AgentConfig(recipe={"drq": 1}), ("AgentConfig.recipe", "sac", "not a dict")),
+        (lambda: TrainConfig(preset=["cpu"]), ("TrainConfig.preset", "highway", "not a list")),
+        (lambda: AgentConfig(recipe="DrQ"), ("AgentConfig.recipe", "did you mean 'drq'?")),
+    ],
+)
+def test_a_name_field_refuses_a_wrong_type_naming_the_field_and_the_names(build, words):
+    # the registries are dicts: a list or dict looked up in one is unhashable to Python
+    with pytest.raises(ValueError) as refused:
+        build()
+    for word in words:
+        assert word in str(refused.value)

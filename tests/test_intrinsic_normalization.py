@@ -2,6 +2,7 @@
 hand-computed numbers, their guards, and each of them through the wrappers on real envs
 (CartPole's pixels, MiniGrid), with the NovelD progress variant and the constant bonus."""
 
+import gc
 import math
 
 import gymnasium as gym
@@ -340,3 +341,29 @@ def test_a_return_std_state_loads_only_into_as_many_sub_envs():
     again = return_std_envs(2)
     again.load_state_dict(two.state_dict())  # as many sub-envs, or a state before any step
     again.load_state_dict(return_std_envs(2).state_dict())
+
+
+def test_an_instance_held_by_one_wrapper_is_refused_by_another():
+    # a training and an evaluation env on one instance would mix their running statistics
+    norm = ReturnStd(gamma=0.999)
+    train = RNDReward(cartpole(), Brightness(), normalization=norm)
+    with pytest.raises(ValueError, match=r"normalization=ReturnStd\(gamma=0.999\).*'return_std'"):
+        RNDReward(cartpole(), Brightness(), normalization=norm)
+    assert train.normalization is norm
+    # the spec deep-copies the instance, so re-making the wrapper gives it its own
+    assert gym.make(train.spec).normalization is not norm
+    del train
+    gc.collect()
+    assert RNDReward(cartpole(), Brightness(), normalization=norm).normalization is norm
+
+
+def test_an_instance_without_statistics_may_serve_several_wrappers():
+    bonus = Raw()
+    first = RNDReward(cartpole(), Brightness(), normalization=bonus)
+    second = RNDReward(cartpole(), Brightness(), normalization=bonus)
+    assert first.normalization is second.normalization is bonus
+
+
+def test_a_normalization_of_the_wrong_type_is_refused_naming_the_names():
+    with pytest.raises(ValueError, match=r"normalization=\['none'\] is not one of .*'return_std'"):
+        RNDReward(cartpole(), Brightness(), normalization=["none"])

@@ -116,3 +116,12 @@ def test_wrapper_errors():
         RandomConvolution(gym.make("CartPole-v1"))
     with pytest.raises(ValueError, match=r"positive odd int"):
         RandomConvolution(gym.make("CartPole-v1", render_mode="rgb_array"), kernel_size=2)
+
+
+def test_random_convolution_from_renders_refuses_step_before_reset():
+    # AddRenderObservation resets the env while the chain is built; the user's reset starts it
+    env = RandomConvolution(gym.make("CartPole-v1", render_mode="rgb_array"))
+    with pytest.raises(gym.error.ResetNeeded, match=r"call env\.reset\(seed=\.\.\.\)"):
+        env.step(0)
+    env.reset(seed=0)
+    env.step(0)

@@ -168,3 +168,13 @@ def test_cameras_from_a_generator_are_read_once_and_the_wrapper_copies_and_pickl
     ):
         with pytest.raises(ValueError, match=r"size must be a positive int or an \(H, W\) pair"):
             wrap(size=(n for n in [8, 8]))
+
+
+def test_step_before_the_users_reset_is_refused():
+    # the constructor resets the env to read the views' sizes; that episode is not the user's
+    env = MultiCamera(gym.make("CartPole-v1", render_mode="rgb_array"), [lambda e: e.render()], 16)
+    with pytest.raises(gym.error.ResetNeeded, match=r"MultiCamera\.step\(\) before reset\(\)"):
+        env.step(0)
+    env.reset(seed=0)
+    obs, *_ = env.step(0)
+    assert obs.shape == (16, 16, 3)

@@ -23,6 +23,7 @@ from simoun_wrappers import (
     RNDReward,
     SimounObservation,
 )
+from simoun_wrappers.intrinsic_normalization import ReturnStd
 
 gym.register_envs(shimmy)
 
@@ -176,3 +177,50 @@ def test_a_spec_of_numpy_arguments_round_trips_through_json(name):
     assert rebuilt.observation_space == env.observation_space
     rebuilt.reset(seed=0)
     rebuilt.step(rebuilt.action_space.sample())
+
+
+@pytest.mark.parametrize(
+    ("build", "words"),
+    [
+        (
+            lambda: MultiCamera(_cartpole(), [lambda e: e.render()], size=16),
+            ("MultiCamera's cameras=", "camera names or ids"),
+        ),
+        (  # a wrapper above keeps the check: the spec is deep-copied with its class
+            lambda: SimounObservation(
+                MultiCamera(_cartpole(), [lambda e: e.render()], size=16), size=None
+            ),
+            ("MultiCamera's cameras=",),
+        ),
+        (
+            lambda: gym.wrappers.TimeLimit(RNDReward(_pixels(), _novelty), 10),
+            ("RNDReward's novelty=<function _novelty", "RNDReward(env, novelty=...)"),
+        ),
+        (
+            lambda: ConsistencyCuriosityReward(_pixels(), _features),
+            ("ConsistencyCuriosityReward's features=<function _features",),
+        ),
+        (
+            lambda: RNDReward(_pixels(), _novelty, normalization=ReturnStd()),
+            (
+                "RNDReward's novelty=",
+                "RNDReward's normalization=ReturnStd(gamma=0.99)",
+                "'return_std'",
+            ),
+        ),
+    ],
+)
+def test_to_json_names_the_argument_json_cannot_hold(build, words):
+    env = build()
+    with pytest.raises(TypeError) as refused:
+        env.spec.to_json()
+    for word in words:
+        assert word in str(refused.value)
+    # in the same process the spec still re-makes the env
+    gym.make(env.spec).reset(seed=0)
+
+
+def test_a_checked_spec_equals_the_gymnasium_spec_it_writes():
+    env = ConstantBonusReward(_pixels(), 0.1)
+    assert env.spec == EnvSpec.from_json(env.spec.to_json())
+    assert EnvSpec.from_json(env.spec.to_json()) == env.spec

@@ -21,6 +21,7 @@ from simoun_agent.config.rules import (
     is_real,
     knob,
     one_of,
+    optional_name,
     real,
     setting,
 )
@@ -63,9 +64,7 @@ class AgentConfig:
         ('deterministic', 3, 0.0003)
     """
 
-    recipe: str | None = setting(
-        None, Rule(f"none or one of {', '.join(RECIPES)}", lambda v: v is None or v in RECIPES)
-    )
+    recipe: str | None = setting(None, optional_name(RECIPES))
     """name of the agent recipe these values started from (simoun_agent.config.recipes: simoun, drq,
     drqv2, rad, curl, sac and the Fig. 6 encoders); applied before the user's overrides. None:
     these dataclass defaults"""

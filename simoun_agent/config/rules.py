@@ -96,8 +96,24 @@ def one_of(options: Sequence[str]) -> Rule:
     )
 
 
+def optional_name(options: Sequence[str]) -> Rule:
+    """None or one of ``options``, the names of a registry (the recipes, the presets). Only a
+    string is looked up: a list or dict is refused as any wrong name is, where the lookup in a
+    dict registry would fail as unhashable."""
+    names = list(options)
+    return Rule(
+        f"none or one of {', '.join(names)}",
+        lambda v: v is None or (isinstance(v, str) and v in names),
+        suggest=lambda v: did_you_mean_name(v, names),
+    )
+
+
 def did_you_mean_name(typed: Any, options: Sequence[str]) -> str:
-    """`` (did you mean 'dual'?)`` for a mistyped name of ``options``, or empty."""
+    """`` (did you mean 'dual'?)`` for a mistyped name of ``options`` (``'DrQ'`` as well: a
+    name in other letter case), or empty."""
+    folded = {name.lower(): name for name in options}
+    if isinstance(typed, str) and typed.lower() in folded:
+        return f" (did you mean {folded[typed.lower()]!r}?)"
     match = difflib.get_close_matches(str(typed), list(options), n=1) if typed else []
     return f" (did you mean {match[0]!r}?)" if match else ""
 
@@ -219,6 +235,10 @@ def wrong_kind(value: Any, annotation: str) -> tuple[str, str]:
     read as if the number 3 was given."""
     if isinstance(value, str) and "str" not in annotation:
         return repr(value), ", not a str"
+    if isinstance(value, (list, tuple, dict, set)) and not any(
+        kind in annotation for kind in ("list", "tuple", "dict", "Sequence", "Mapping")
+    ):
+        return show(value), f", not a {type(value).__name__}"
     if getattr(value, "ndim", 0):
         return show(value), f", not a {type(value).__module__}.{type(value).__name__}"
     return show(value), ""

@@ -23,6 +23,7 @@ from simoun_agent.config.rules import (
     json_object,
     knob,
     module_name,
+    optional_name,
     setting,
     text,
     with_rule,
@@ -52,9 +53,7 @@ class TrainConfig:
         metadata=with_rule(json_object(fix='e.g. --env-kwargs \'{"config": {"lanes_count": 3}}\'')),
     )
     """extra keyword arguments for gymnasium.make (JSON on the command line)"""
-    preset: str | None = setting(
-        None, Rule(f"none or one of {', '.join(PRESETS)}", lambda v: v is None or v in PRESETS)
-    )
+    preset: str | None = setting(None, optional_name(PRESETS))
     """name of the preset this config started from (informational)"""
     seed: int = setting(
         1, Rule("an int in [0, 2**32)", lambda v: is_int(v) and 0 <= v < 2**32, "e.g. --seed 1")

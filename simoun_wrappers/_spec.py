@@ -1,0 +1,97 @@
+"""``env.spec`` of the wrappers whose arguments may be objects (a camera function, a model, a
+``Normalization`` instance): ``to_json()`` names the argument that JSON cannot hold.
+
+Gymnasium's ``EnvSpec.to_json`` fails inside ``json`` with "Object of type function is not JSON
+serializable", naming neither the wrapper nor the argument. :class:`CheckedSpec` is the same
+spec with a ``to_json`` that looks at every wrapper's arguments first. Gymnasium's wrappers
+stacked above deep-copy the spec, which keeps its class, so the check holds over them too.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from typing import Any
+
+from gymnasium.envs.registration import EnvSpec
+
+# how each object argument can be given as JSON instead, where there is a way
+_JSON_FORMS = {
+    "cameras": "give the cameras as dm_control camera names or ids, or highway-env viewport dicts",
+    "normalization": "pass the normalization's name, e.g. normalization='return_std'",
+}
+
+
+class CheckedSpec(EnvSpec):
+    """An ``EnvSpec`` whose ``to_json()`` refuses, with a TypeError naming the wrapper and the
+    argument, a wrapper argument that JSON cannot hold; otherwise Gymnasium's ``EnvSpec``
+    (equal to an ``EnvSpec`` of the same fields)."""
+
+    def to_json(self) -> str:
+        unwritable = [
+            (wrapper.name, key, value)
+            for wrapper in self.additional_wrappers
+            for key, value in (wrapper.kwargs or {}).items()
+            if not _writable(value)
+        ]
+        if unwritable:
+            raise TypeError(_unwritable(unwritable))
+        return super().to_json()
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, EnvSpec):
+            return NotImplemented
+        return all(
+            getattr(self, f.name) == getattr(other, f.name)
+            for f in dataclasses.fields(EnvSpec)
+            if f.compare
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # as EnvSpec's: a mutable dataclass
+
+
+def checked_spec(spec: EnvSpec | None) -> EnvSpec | None:
+    """``spec`` (a wrapper's own copy) made a :class:`CheckedSpec`, which adds no field."""
+    if spec is not None and not isinstance(spec, CheckedSpec):
+        spec.__class__ = CheckedSpec
+    return spec
+
+
+class CheckedSpecWrapper:
+    """Mixin for a ``gym.Wrapper`` whose recorded arguments may be objects: its ``spec`` is a
+    :class:`CheckedSpec`."""
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        return checked_spec(super().spec)  # type: ignore[misc]
+
+
+def _writable(value: Any) -> bool:
+    try:
+        json.dumps(value)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def _unwritable(arguments: list[tuple[str, str, Any]]) -> str:
+    """The error for the wrapper ``(name, key, value)`` arguments that JSON cannot hold."""
+    from simoun_wrappers.intrinsic_reward import SharedSource
+
+    named, advice = [], []
+    for name, key, value in arguments:
+        held = SharedSource.unwrap(value)  # the spec holds the user's model in a SharedSource
+        shown = repr(held) if len(repr(held)) <= 80 else f"a {type(held).__name__}"
+        named.append(f"{name}'s {key}={shown}")
+        form = _JSON_FORMS.get(key)
+        advice.append(
+            f"to write the spec, {form}"
+            if form
+            else f"elsewhere, build {name}(env, {key}=...) anew"
+        )
+    return (
+        f"env.spec.to_json() cannot write {'; '.join(named)}: JSON holds names, numbers, lists "
+        f"and dicts only. For {key if len(arguments) == 1 else 'these'}: {'; '.join(advice)}. "
+        f"In this process, gym.make(env.spec) (no JSON) re-makes the env, keeping them as they "
+        f"are."
+    )
