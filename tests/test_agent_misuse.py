@@ -393,7 +393,7 @@ def small_agent_config() -> AgentConfig:
     ("field", "value", "said"),
     [
         ("lr", -1, "--agent.lr -1 (AgentConfig.lr) must be a number > 0"),
-        ("discount", 1.5, "(AgentConfig.discount) must be a number >= 0 and <= 1"),
+        ("discount", 1.5, "(AgentConfig.discount) must be a number in [0, 1) (gamma)"),
         ("batch_size", 2.5, "(AgentConfig.batch_size) must be an int >= 1"),
         ("encoder", "single", "(AgentConfig.curiosity): curiosity (Eq. 13) compares"),
     ],

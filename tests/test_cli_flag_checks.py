@@ -527,3 +527,58 @@ def test_simoun_eval_names_its_device_flag_for_a_device_the_machine_lacks(capsys
         said = refused(capsys, eval_cli.main, [str(tmp_path), "--device", "cuda"])
         assert said.startswith("simoun-eval: error: --device cuda: this torch")
         assert "saved config" not in said
+
+
+EVERY_MAIN = [
+    train_cli.main,
+    eval_cli.main,
+    sweep_cli.main,
+    study_cli.main,
+    report_cli.main,
+    analyze_cli.main,
+    minigrid_cli.main,
+    driving_reference.main,
+]
+
+
+@pytest.mark.parametrize("main", EVERY_MAIN)
+def test_every_commands_help_lists_version(main, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["--help"])
+    assert stop.value.code == 0
+    assert "--version: print the installed version and exit." in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("main", EVERY_MAIN)
+@pytest.mark.parametrize("option", ["-V", "-v"])
+def test_an_unknown_short_option_names_version_and_help(main, option, capsys):
+    err = refused(capsys, main, [option])
+    assert f"unknown option {option}:" in err
+    assert "--version prints its version" in err and "--help` lists every flag" in err
+
+
+def test_a_short_option_names_the_long_flags_it_starts_and_negative_numbers_are_values(capsys):
+    assert "(did you mean --env or --env-module or --env-kwargs?)" in refused(
+        capsys, train_cli.main, ["-env", "Pendulum-v1"]
+    )
+    err = refused(capsys, train_cli.main, ["--agent.log-std-min", "-30", "--agent.lr", "-1"])
+    assert "unknown option" not in err and "--agent.lr -1" in err
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "where"),
+    [
+        (train_cli.main, ["--resume", "~/simoun-absent/run"], "--resume"),
+        (train_cli.main, ["--resume=~/simoun-absent/run"], "--resume"),
+        (train_cli.main, ["--run-dir=~/simoun-absent/run"], "--run-dir"),
+        (eval_cli.main, ["~/simoun-absent/run"], "RUN"),
+        (report_cli.main, ["~/simoun-absent"], "DIR"),
+    ],
+)
+def test_a_tilde_the_shell_did_not_expand_is_named_with_the_expanded_path(
+    main, argv, where, capsys
+):
+    err = refused(capsys, main, argv)
+    expanded = os.path.expanduser("~/simoun-absent")
+    assert f"{where} ~/simoun-absent" in err
+    assert "the shell did not expand ~" in err and f"give {expanded}" in err

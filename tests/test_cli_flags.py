@@ -107,6 +107,19 @@ def test_set_into_env_kwargs_gives_the_json_object_to_pass():
         overrides(["--set", "env_kwargs.mode=fast"])
 
 
+def test_set_of_a_value_that_kept_its_quotes_names_the_quotes_and_the_form():
+    with pytest.raises(SetupError) as error:
+        overrides(["--set", """env_kwargs='{"size": 32}'"""])
+    assert str(error.value) == (
+        """cannot read env_kwargs='{"size": 32}': the value still has its outer quotes ('...'), """
+        """so it is one string; drop them, so that the command gets env_kwargs={"size": 32} (in """
+        """a shell, quote the whole word: --set 'env_kwargs={"size": 32}')"""
+    )
+    assert overrides(["--set", """env_kwargs={"size": 32}"""]) == {"env_kwargs": {"size": 32}}
+    with pytest.raises(SetupError, match=r"still has its outer quotes"):
+        overrides(["--set", 'seed="3"'])
+
+
 def test_env_kwargs_are_merged_into_a_presets_own():
     config = resolve("highway-cpu", {"env_kwargs": {"config": {"lanes_count": 2}}})
     assert config.env_kwargs["config"]["lanes_count"] == 2

@@ -122,9 +122,17 @@ def test_bad_value_names_the_flag(key):
             {"total_env_steps": "100"},
             ["--total-env-steps '100' (TrainConfig.total_env_steps)", "(below 2**63), not a str"],
         ),
-        ({"agent.lr": "1e-3"}, ["--agent.lr '1e-3'", "must be a number > 0, not a str"]),
+        ({"agent.lr": "1e-3"}, ["--agent.lr '1e-3'", "must be a number > 0 and <= 1, not a str"]),
         ({"image_size": np.array([64, 64])}, ["--image-size [64 64]", "not a numpy.ndarray"]),
         ({"agent.recipe": 3}, ["unknown recipe --agent.recipe 3; choose one of simoun"]),
+        # a value in the wrong units: pixels for the x / 255 scale, a percentage for a rate
+        (
+            {"agent.recipe": "drqv2", "agent.pixel_offset": 128},
+            ["--agent.pixel-offset 128", ">= -1 and <= 1", "x / 255 scale", "0.5 (DrQ-v2)"],
+        ),
+        ({"agent.lr": 3}, ["--agent.lr 3", "> 0 and <= 1", "1e-3"]),
+        ({"agent.alpha_lr": 10.0}, ["--agent.alpha-lr 10", "> 0 and <= 1"]),
+        ({"agent.discount": 1.0}, ["--agent.discount 1", "[0, 1)", "--agent.discount 0.99"]),
     ],
 )
 def test_messages_give_the_value_and_the_fix(overrides, words):

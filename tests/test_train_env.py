@@ -317,6 +317,34 @@ def test_episode_limits_and_action_repeats_that_leave_one_decision_are_refused()
     assert str(error.value).endswith("set --action-repeat 500 or less (the paper uses 2 to 8)")
 
 
+def test_env_kwargs_whose_episodes_end_at_the_first_step_are_refused_naming_the_key():
+    dmc = "dm_control/cartpole-swingup-v0"
+    with pytest.raises(SetupError) as error:
+        check_task(env_config(dmc, {"task_kwargs": {"time_limit": 0}}))
+    assert "--env-kwargs" in str(error.value)
+    assert "ends at its first step" in str(error.value)
+    assert "task_kwargs.time_limit=0 is the value that ends it" in str(error.value)
+    with pytest.raises(SetupError, match=r"max_episode_steps=1 is the value that ends it"):
+        check_task(env_config("Pendulum-v1", {"max_episode_steps": 1}))
+    assert check_task(env_config("Pendulum-v1", {"max_episode_steps": 2}, action_repeat=1)) == 2
+
+
+def test_a_negative_count_in_env_kwargs_is_refused_naming_the_key():
+    continuous = {"action": {"type": "ContinuousAction"}}
+    negative = {"config": {**continuous, "vehicles_count": -5}}
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("highway-fast-v0", negative))
+    assert str(error.value).startswith(
+        "--env-kwargs: config.vehicles_count=-5 is negative, and highway-fast-v0's "
+        "config.vehicles_count is a count (default 20)"
+    )
+    with pytest.raises(SetupError, match=r"size=-8 is negative"):
+        check_task(env_config("MiniGrid-Empty-8x8-v0", {"size": -8}, env_module="minigrid"))
+    # a key whose default is 0 is a reward here: a negative one is a penalty, and is taken
+    penalty = {"config": {**continuous, "lane_change_reward": -0.5}}
+    check_task(env_config("highway-fast-v0", penalty))
+
+
 gym.register("simoun-test/NeedsMissing-v0", entry_point="simoun_test_absent.envs:Env")
 
 

@@ -244,3 +244,12 @@ def test_a_path_the_run_writes_of_the_wrong_kind_is_named_before_training(
     assert f"move it aside (mv {run_dir / name} {run_dir / name}.aside)" in err
     assert "cannot write to the run directory" not in err and "Traceback" not in err
     assert {path.name: path.read_bytes() for path in run_dir.iterdir() if path.is_file()} == before
+
+
+def test_resume_takes_the_runs_checkpoint_file_for_its_directory(finished_run, tmp_path):
+    run_dir = tmp_path / "copy"
+    shutil.copytree(finished_run, run_dir)
+    checkpoint = run_dir / "checkpoint.pt"
+    assert train_cli.resumed_dir(str(checkpoint)) == run_dir
+    assert train_cli.main(["--resume", str(checkpoint), "--total-env-steps", "60"]) == 0
+    assert read_csv(run_dir / "eval.csv")[-1]["env_step"] == 60

@@ -304,6 +304,31 @@ def refuse_unknown(
         raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
 
 
+SHORT_OPTION = re.compile(r"-[A-Za-z][A-Za-z0-9]*(=.*)?")
+"""A one-dash option (``-V``, ``-v``, ``-n=3``); a negative number is a value, not one."""
+
+
+def refuse_short_options(argv: Sequence[str], flags: dict[str, Flag], prog: str) -> None:
+    """Raise ValueError for a one-dash option other than ``-h``: the commands' flags are long
+    ones, and tyro would answer with its usage box, which names neither ``--version`` nor the
+    long flag meant. A word after an option that takes a value is that value."""
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        if arg == "-h" or not SHORT_OPTION.fullmatch(arg):
+            continue
+        before = flags.get(argv[i - 1]) if i else None
+        if before is not None and before.switch is None:
+            continue
+        letters = arg[1:].partition("=")[0]
+        close = [name for name in flags if name[2:].startswith(letters.lower())][:3]
+        hint = f" (did you mean {' or '.join(close)}?)" if len(letters) > 1 and close else ""
+        raise ValueError(
+            f"unknown option {arg}{hint}: {prog} has long flags only, besides -h; --version "
+            f"prints its version, and `{prog} --help` lists every flag"
+        )
+
+
 def refuse_stray_words(
     argv: Sequence[str], flags: dict[str, Flag], positional: bool, switches: Iterable[str] = ()
 ) -> None:
@@ -567,6 +592,27 @@ def refuse_long_paths(argv: Sequence[str], flags: dict[str, Flag], command: Any)
             )
 
 
+def refuse_unexpanded_home(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError for a path value that starts with a ``~`` the shell did not expand
+    (``--resume=~/runs/a``, a quoted ``'~/runs'``, a script's argument list) and that names
+    nothing as written: it would be read, or made, as a directory called ``~`` here."""
+    for value in given_values(argv, flags, command):
+        text = value.value
+        if text is None or not (text == "~" or text.startswith("~/")) or os.path.exists(text):
+            continue
+        if value.flag is not None:
+            where, path = value.flag, flags[value.flag].path
+        else:
+            where = value.positional.metavar if value.positional else ""
+            path = value.positional is not None and value.positional.path
+        if path:
+            raise ValueError(
+                f"{where} {text}: the shell did not expand ~ (it does not after = or inside "
+                f"quotes), so this names a directory called ~ here, which does not exist; give "
+                f"{os.path.expanduser(text)}"
+            )
+
+
 INT64_END = 2**63
 """Where int64 ends: a count, seed or step at or past it wraps around in numpy and torch."""
 
@@ -605,6 +651,11 @@ def installed_version() -> str:
         return "unknown (not installed)"
 
 
+VERSION_HELP = "--version: print the installed version and exit."
+"""The line every command's help ends its description with: tyro does not list ``--version``,
+which :func:`parse` answers itself."""
+
+
 def parse(
     cls: Any,
     argv: Sequence[str] | None,
@@ -621,19 +672,22 @@ def parse(
     tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
     switches = list(switches)
+    description = f"{description}\n\n{VERSION_HELP}"
     if "--version" in argv:
         print(f"{prog} {installed_version()}")
         sys.exit(0)
     try:
         argv = bool_argv(argv, switches)
-        refuse_unknown_subcommand(argv, cls, prog)
         flags = command_flags(cls, argv)
+        refuse_short_options(argv, flags, prog)
+        refuse_unknown_subcommand(argv, cls, prog)
         refuse_unknown(argv, flags, cls, prog, reads_runs)
         refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
         refuse_switch_values(argv, flags, switches)
         refuse_stray_arguments(argv, flags, cls, prog)
         refuse_empty_values(argv, flags, cls)
         refuse_long_paths(argv, flags, cls)
+        refuse_unexpanded_home(argv, flags, cls)
         refuse_bad_json(argv, flags, cls)
         refuse_repeated(argv, flags)
         refuse_huge_numbers(argv, flags, prog)

@@ -33,6 +33,7 @@ from simoun_agent.cli.config_flags import (
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError, TrainConfig, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
+from simoun_agent.run.layout import CHECKPOINT_NAME
 
 if TYPE_CHECKING:
     from simoun_agent.run.train import Run
@@ -65,7 +66,8 @@ class TrainCommand:
         PATH,
         tyro.conf.arg(
             metavar="RUN_DIR",
-            help="continue a run from its last checkpoint (only "
+            help="continue a run (its directory, or its checkpoint.pt) from its last checkpoint "
+            "(only "
             f"{', '.join(RESUMABLE_FIELDS)} may be changed)",
         ),
     ] = None
@@ -129,6 +131,15 @@ def parse_command(argv: Sequence[str]) -> TrainCommand:
     return parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
 
 
+def resumed_dir(given: str) -> Path:
+    """The run directory ``--resume`` names: the path given, or the directory of the run's
+    checkpoint file when that is given (as ``simoun-eval`` takes either)."""
+    path = Path(given)
+    if path.name == CHECKPOINT_NAME and path.is_file():
+        return path.parent
+    return path
+
+
 def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
     """The run that ``command`` (parsed from ``argv``) asks for, new or resumed; bad input
     exits with status 2."""
@@ -143,7 +154,9 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
                 raise SetupError("--preset does not combine with --resume: a run keeps its config")
             if command.overwrite:
                 raise SetupError("--overwrite starts a run over; it does not combine with --resume")
-            run = loop.resume_run(Path(command.resume), overrides, check=check_eval_distractions)
+            run = loop.resume_run(
+                resumed_dir(command.resume), overrides, check=check_eval_distractions
+            )
         else:
             config = resolve(command.flags.preset, overrides)
             for warning in (check_memory(config), loop.budget_warning(config)):

@@ -43,6 +43,8 @@ AGENT = "agent."
 _POSITIVE = integer(1)
 _RATE = real(0.0, 1.0, open_low=True)
 _WEIGHT = real(0.0)
+_LEARNING_RATE = real(0.0, 1.0, open_low=True, fix="Adam's rates are small, e.g. 1e-3 or 3e-4")
+"""an Adam rate above 1 is a value in the wrong units (a percentage, an exponent)"""
 
 
 @dataclass
@@ -104,7 +106,10 @@ class AgentConfig:
     (feature_dim) on them; the critic's trunk belongs to the critic and so to its EMA target
     (critic_tau), the actor's is trained by the actor loss. Stacked-frame encoders without
     auxiliary losses only"""
-    pixel_offset: float = setting(0.0, finite())
+    pixel_offset: float = setting(
+        0.0,
+        real(-1.0, 1.0, fix="it is on the x / 255 scale, e.g. --agent.pixel-offset 0.5 (DrQ-v2)"),
+    )
     """subtracted from the pixels after x / 255 before the convs (DrQ-v2's Encoder: 0.5)"""
     conv_init: str = setting("orthogonal", one_of(CONV_INITS))
     """initialisation of the conv weights: "orthogonal" (relu gain; DrQ and DrQ-v2's
@@ -131,15 +136,23 @@ class AgentConfig:
     """hidden units of the two-layer transition model G (Eq. 2) and reward model R (Eq. 7)"""
     batch_size: int = setting(512, _POSITIVE)
     """transitions per gradient step"""
-    lr: float = setting(1e-3, real(0.0, open_low=True))
+    lr: float = setting(1e-3, _LEARNING_RATE)
     """Adam learning rate of the encoder, critic, actor and auxiliary heads"""
-    alpha_lr: float = setting(1e-4, real(0.0, open_low=True))
+    alpha_lr: float = setting(1e-4, _LEARNING_RATE)
     """Adam learning rate of the temperature (CURL / SAC-AE value)"""
     alpha_beta: float = setting(
         0.5, Rule("a number in [0, 1) (Adam's beta1)", lambda v: is_real(v) and 0 <= v < 1)
     )
     """Adam beta1 of the temperature optimiser (CURL / SAC-AE value)"""
-    discount: float = setting(0.99, real(0.0, 1.0))
+    discount: float = setting(
+        0.99,
+        Rule(
+            "a number in [0, 1) (gamma)",
+            lambda v: is_real(v) and 0 <= v < 1,
+            "e.g. --agent.discount 0.99 (the default); at 1 the TD target, bootstrapped past "
+            "time limits, grows without bound",
+        ),
+    )
     """gamma of the TD target (Eq. 9)"""
     n_step: int = setting(1, _POSITIVE)
     """steps of reward summed before bootstrapping in the TD target (DrQ-v2 uses 3); cut at

@@ -97,7 +97,27 @@ def parse_value(key: str, text: str, kind: Any) -> Any:
             return _parse_one(text, option)
         except ValueError as error:
             errors.append(str(error))
+    if quoted := _kept_quotes(key, text, kind):
+        raise SetupError(quoted)
     raise SetupError(f"cannot read {key}={text!r}: {'; '.join(errors)}")
+
+
+def _kept_quotes(key: str, text: str, kind: Any) -> str:
+    """The refusal of a value a script or a doubled quoting left inside its quotes
+    (``env_kwargs='{"size": 32}'`` as one word), when the value inside them reads; else empty."""
+    stripped = text.strip()
+    if len(stripped) < 2 or stripped[0] not in "'\"" or stripped[-1] != stripped[0]:
+        return ""
+    inner = stripped[1:-1]
+    try:
+        parse_value(key, inner, kind)
+    except SetupError:
+        return ""
+    return (
+        f"cannot read {key}={stripped}: the value still has its outer quotes "
+        f"({stripped[0]}...{stripped[0]}), so it is one string; drop them, so that the command "
+        f"gets {key}={inner} (in a shell, quote the whole word: --set '{key}={inner}')"
+    )
 
 
 def _is_union(kind: Any) -> bool:

@@ -255,7 +255,9 @@ def _check_make_keywords(env_id: str, kwargs: dict) -> None:
 
 def _creator_defaults(env_id: str) -> dict:
     """The default value of each keyword of ``env_id``'s creator (its registered kwargs over its
-    signature's defaults); only the registered ones when the creator cannot be read."""
+    signature's defaults, and the ``default_config()`` of an env class that has one, as
+    highway-env's, for its ``config`` keyword); only the registered ones when the creator
+    cannot be read."""
     spec = gym.spec(env_id)
     try:
         creator = (
@@ -265,6 +267,8 @@ def _creator_defaults(env_id: str) -> dict:
     except (gym.error.Error, ImportError, AttributeError, TypeError, ValueError):
         return dict(spec.kwargs)
     defaults = {p.name: p.default for p in parameters if p.default is not p.empty}
+    if "config" in defaults and callable(getattr(creator, "default_config", None)):
+        defaults["config"] = creator.default_config()
     return {**defaults, **spec.kwargs}
 
 
@@ -274,8 +278,10 @@ def _is_number(value: object) -> bool:
 
 def _check_value_kinds(env_id: str, kwargs: dict) -> None:
     """SetupError for a string given where the creator's default is a number, or a number where
-    it is a string: the env would take it and fail later, mid-run, on arithmetic."""
+    it is a string: the env would take it and fail later, mid-run, on arithmetic; and for a
+    negative count (:func:`_check_counts`)."""
     defaults = _creator_defaults(env_id)
+    _check_counts(env_id, kwargs, defaults)
     for key, value in kwargs.items():
         default = defaults.get(key)
         if value is None:  # many creators take None for "their own default"
@@ -290,6 +296,36 @@ def _check_value_kinds(env_id: str, kwargs: dict) -> None:
             f"--env-kwargs: {key}={value!r} does not fit {env_id}: its {key!r} is {kind} "
             f"(default {default!r}); e.g. '{json.dumps({key: default})}', or drop it"
         )
+
+
+def _check_counts(env_id: str, kwargs: dict, defaults: dict, prefix: str = "") -> None:
+    """SetupError for a negative number given to a keyword (or a key of a dict keyword, such as
+    highway-env's ``config``, at any depth) whose default is a whole number of at least 1: such
+    a keyword is a count, size, frequency or duration (``vehicles_count``, ``lanes_count``,
+    ``size``), and envs take a negative one without a word and run a degenerate task. A zero
+    default is left alone: those are often rewards, where a negative value is a penalty."""
+    for key, value in kwargs.items():
+        default = defaults.get(key) if isinstance(defaults, dict) else None
+        name = f"{prefix}{key}"
+        if isinstance(value, dict) and isinstance(default, dict):
+            _check_counts(env_id, value, default, f"{name}.")
+        elif _is_count(default) and _is_number(value) and value < 0:
+            example = json.dumps(_nested(name, default))
+            raise SetupError(
+                f"--env-kwargs: {name}={value!r} is negative, and {env_id}'s {name} is a count "
+                f"(default {default!r}); give a whole number of at least 0, e.g. "
+                f"'{example}', or drop {name}"
+            )
+
+
+def _is_count(default: object) -> bool:
+    return isinstance(default, int) and not isinstance(default, bool) and default >= 1
+
+
+def _nested(name: str, value: object) -> dict:
+    """``"config.lanes_count", 4`` -> ``{"config": {"lanes_count": 4}}``."""
+    head, _, rest = name.partition(".")
+    return {head: _nested(rest, value) if rest else value}
 
 
 def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
@@ -388,13 +424,14 @@ def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
     )
 
 
-def _first_step(env: gym.Env) -> None:
-    """Reset ``env``, take one middle action and render."""
+def _first_step(env: gym.Env) -> bool:
+    """Reset ``env``, take one middle action and render; whether that step ended the episode."""
     env.reset(seed=0)
     space = env.action_space
     middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
-    env.step(middle)
+    _, _, terminated, truncated, _ = env.step(middle)
     env.render()
+    return bool(terminated or truncated)
 
 
 def check_first_step(env: gym.Env, config: TrainConfig) -> None:
@@ -402,7 +439,7 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
     an env that stores a keyword's value unchecked fails here, before a run is spent, rather
     than at its first training step."""
     try:
-        _first_step(env)
+        ended = _first_step(env)
     except ENV_VALUE_ERRORS as err:
         culprit = faulty_key(config)
         at_fault = f"; {culprit} is the value it cannot use" if culprit else ""
@@ -411,6 +448,17 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
             f"{_kwargs_text(config.env_kwargs)} but failed at its first reset and step "
             f"({type(err).__name__}: {err}){at_fault}. Fix the values or drop --env-kwargs"
         ) from None
+    if ended:
+        # an episode that ends at its first step holds no decision to learn from, and every
+        # evaluation returns the one step's reward: the run would train on nothing
+        culprit = faulty_key(config)
+        at_fault = f"; {culprit} is the value that ends it" if culprit else ""
+        raise SetupError(
+            f"--env-kwargs {json.dumps(config.env_kwargs)}: an episode of {config.env} made "
+            f"with {_kwargs_text(config.env_kwargs)} ends at its first step, so the agent "
+            f"would have no decision to learn from{at_fault}. Give it a longer episode (a time "
+            "limit, duration or step limit of several steps) or drop that key"
+        )
 
 
 MAX_PROBED_KEYS = 12
@@ -452,7 +500,7 @@ def _without(kwargs: dict, path: tuple[str, ...]) -> dict:
 
 def _works(config: TrainConfig, kwargs: dict) -> bool:
     """Whether ``config``'s env, made with ``kwargs`` for its ``--env-kwargs``, is made, reset
-    and stepped."""
+    and stepped without its episode ending at that first step."""
     try:
         env = gym.make(
             config.env, render_mode="rgb_array", **_make_kwargs(replace(config, env_kwargs=kwargs))
@@ -460,12 +508,11 @@ def _works(config: TrainConfig, kwargs: dict) -> bool:
     except (*ENV_VALUE_ERRORS, *MAKE_ERRORS):
         return False
     try:
-        _first_step(env)
+        return not _first_step(env)
     except ENV_VALUE_ERRORS:
         return False
     finally:
         env.close()
-    return True
 
 
 def _check_env(env: gym.Env, env_id: str) -> None:
@@ -529,6 +576,13 @@ def check_decisions(config: TrainConfig, limit: int | None) -> None:
     repeat = config.resolved_action_repeat()
     if limit is None or limit // repeat >= MIN_EPISODE_DECISIONS:
         return
+    if limit < MIN_EPISODE_DECISIONS:
+        source = "--env-kwargs" if config.env_kwargs else config.env
+        raise SetupError(
+            f"{source}: an episode of {config.env} ends after {limit} env step, which holds "
+            "no agent decision whose outcome the agent could see; give it a longer episode "
+            f"(e.g. --env-kwargs '{{\"max_episode_steps\": {MIN_EPISODE_DECISIONS * 50}}}')"
+        )
     given = "" if config.action_repeat is not None else ", the paper's value for this task"
     decisions = max(1, math.ceil(limit / repeat))
     raise SetupError(
