@@ -45,7 +45,7 @@ from reliability_trial import (
 
 SEED2 = trained("seed2", "--seed", "2")
 DEAD_PID = 999_999  # a writer long gone: above the pid_max of most machines (32768 here)
-FUTURE = 2_000_000_000  # 2033-05-18, seconds since the epoch
+FUTURE = 2_000_000_000  # a time stamp years ahead, seconds since the epoch
 ELSEWHERE = "/home/alice/experiments/pointreach-s1"
 
 
