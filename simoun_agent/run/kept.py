@@ -178,13 +178,18 @@ def csv_lines(path: Path) -> list[list[str]]:
     return lines
 
 
-def read_csv_rows(path: Path, columns: Sequence[str] = ()) -> list[dict[str, str]]:
+def read_csv_rows(
+    path: Path, columns: Sequence[str] = (), empty_ok: bool = False
+) -> list[dict[str, str]]:
     """The rows of the CSV file ``path`` under its header line, values as text (blank lines
-    skipped); :class:`Damaged` for what :func:`csv_lines` refuses, no header line, a header
-    without one of ``columns``, or a row whose fields do not fit the header (a line cut short
-    or two run together). OSError for a file that cannot be read."""
+    skipped); :class:`Damaged` for what :func:`csv_lines` refuses, an empty file (no rows where
+    ``empty_ok``: a reader that says what an empty log means for its run), a header without
+    one of ``columns``, or a row whose fields do not fit the header (a line cut short or two
+    run together). OSError for a file that cannot be read."""
     lines = csv_lines(path)
     if not any(lines):
+        if empty_ok:
+            return []
         raise Damaged("it is empty")
     header = lines[0]
     missing = [column for column in columns if column not in header]

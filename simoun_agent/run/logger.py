@@ -108,8 +108,10 @@ def damaged_log(path: Path, problem: str) -> SetupError:
 
 def read_csv(path: Path) -> list[dict[str, float]]:
     """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty);
-    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes."""
-    return [{k: float(v or "nan") for k, v in row.items()} for row in read_csv_rows(path)]
+    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes; an empty
+    file has no rows."""
+    rows = read_csv_rows(path, empty_ok=True)
+    return [{k: float(v or "nan") for k, v in row.items()} for row in rows]
 
 
 def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:
