@@ -109,8 +109,7 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
 def check_run_folder(where: Path, name: str) -> None:
     """SetupError naming the run ``name``'s place in the study directory or archive ``where``
     when something else than a directory stands there (a file, a link to nothing or to a folder
-    it is in): the run
-    would be taken for one not finished, and counted or trained as such."""
+    it is in): the run would be taken for one not finished, and counted or trained as such."""
     path = where / name
     problem = folder_problem(path)
     if problem:
