@@ -213,8 +213,13 @@ def finished_run(run_dir):
     return run_dir
 
 
+def comment_first(path):
+    path.write_text("# trained on the lab laptop\n" + path.read_text())
+
+
 STEP = "env_step 1111111111111111111111111111111111111111"
 KEPT_DAMAGES = [
+    ("eval.csv", comment_first, "line 1 is a comment ('# trained on the lab laptop'): CSV has"),
     ("config.json", utf16, "it is saved as UTF-16 text, not UTF-8"),
     ("config.json", nul_in_first_line, "line 1 holds a NUL byte"),
     ("config.json", link_to_nothing, "it is a symbolic link to "),
@@ -232,6 +237,7 @@ KEPT_DAMAGES = [
         *(("simoun-train", *damage) for damage in KEPT_DAMAGES),
         ("simoun-train", "train.csv", nul_in_first_line, "line 1 holds a NUL byte"),
         ("simoun-train", "train.csv", huge_step, f"{STEP} is past 2**63"),
+        ("simoun-train", "train.csv", comment_first, "line 1 is a comment"),
         *(("simoun-report", *damage) for damage in KEPT_DAMAGES),
         # a resume refuses a config.json that is not a file before reading it
         ("simoun-report", "config.json", named_pipe, "it is a named pipe (FIFO), not a regular"),
@@ -302,3 +308,35 @@ def test_steps_written_as_whole_floats_read_as_steps_by_resume_and_report(tmp_pa
         read_log(path)
     with pytest.raises(DamagedRun, match=r"line 3: env_step 20.5 is not a step count"):
         read_curve(path)
+
+
+def test_a_summary_of_another_run_is_named_by_the_report(tmp_path, capsys):
+    run_dir = finished_run(tmp_path / "run")
+    summary = {"env_step": 60, "wall_time_s": 2.0, "final_eval": {"return_mean": -15.96}}
+    (run_dir / "summary.json").write_text(json.dumps(summary))
+    err = refusal("simoun-report", run_dir, capsys)
+    assert "summary.json's final return -15.96 is not the 2 of the last evaluation in " in err
+    assert "(env step 60): the two files are of different runs" in err
+
+
+def spaced(path):
+    """``path`` written with a space after each comma, as a person or a spreadsheet may."""
+    path.write_text(path.read_text().replace(",", ", "))
+
+
+def test_a_log_with_a_space_after_each_comma_reads_as_written_and_resumes_under_its_header(
+    trained_run, tmp_path
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    header = (run_dir / "eval.csv").read_text().splitlines()[0]
+    rows = read_csv(run_dir / "eval.csv")
+    spaced(run_dir / "eval.csv")
+    spaced(run_dir / "train.csv")
+    assert read_csv(run_dir / "eval.csv") == rows
+    assert report_cli.main([str(run_dir), "--out", str(tmp_path / "report")]) == 0
+    assert train_cli.main(["--resume", str(run_dir), "--total-env-steps", "80"]) == 0
+    lines = (run_dir / "eval.csv").read_text().splitlines()
+    assert lines[0] == header  # the resumed rows go under the run's columns, none added
+    assert read_csv(run_dir / "eval.csv")[: len(rows)] == rows
+    assert read_csv(run_dir / "eval.csv")[-1]["env_step"] == 80
+    assert all(line.count(",") == header.count(",") for line in lines)

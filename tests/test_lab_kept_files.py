@@ -147,6 +147,8 @@ def test_a_damaged_json_file_is_named_by_the_shared_reader(damage, tmp_path):
         ("step,return_mean\n0,1\n", "its first line has no env_step column"),
         ("env_step,return_mean\n0,1\n20\n", "line 3 has 1 fields where the header has 2"),
         ("env_step\n" + "1" * 200_000 + "\n", "it is not a CSV file (field larger than"),
+        ("# seed 1\nenv_step,return_mean\n0,1\n", "line 1 is a comment ('# seed 1'): CSV has"),
+        ("env_step,return_mean\n0,1\n# outlier\n", "line 3 is a comment ('# outlier'): CSV has"),
     ],
 )
 def test_a_damaged_csv_file_is_named_by_the_shared_reader(text, problem, tmp_path):
@@ -166,6 +168,8 @@ def test_the_shared_csv_reader_reads_rows_as_written_and_names_a_value_that_is_n
     assert csv_number("1.5", "return_mean", 3) == 1.5
     with pytest.raises(Damaged, match="line 3: return_mean is 'x', not a number"):
         csv_number("x", "return_mean", 3)
+    path.write_text("env_step, return_mean\n0, 1.5\n")  # a space after each comma
+    assert read_csv_rows(path, ("return_mean",)) == [{"env_step": "0", "return_mean": "1.5"}]
 
 
 @pytest.fixture
@@ -588,3 +592,27 @@ def test_a_resumed_study_with_the_record_of_another_study_names_it(dmc_archive, 
     )
     with pytest.raises(SetupError, match=re.escape(f"{path} is the record of another study")):
         open_study(load_spec(DMC_SPEC), str(DMC_SPEC), options)
+
+
+def linked_to_its_folder(path: Path) -> None:
+    shutil.rmtree(path)
+    path.symlink_to("..")
+
+
+LOOP = "is damaged: it is a symbolic link to .., a folder it is in (a loop), not the run's"
+
+
+def test_a_minigrid_run_linked_to_its_own_folder_is_named_by_report_and_select(minigrid_archive):
+    path = minigrid_archive / MINIGRID_RUNS[0]
+    linked_to_its_folder(path)
+    for command in ("report", "select"):
+        printed = refused(minigrid_cli.main, command, "--archive", str(minigrid_archive))
+        assert f"{path} (the directory of run {MINIGRID_RUNS[0]}) {LOOP}" in printed
+        assert f"mv {path} {path}.damaged" in printed
+
+
+def test_a_study_run_linked_to_its_own_folder_is_named_by_the_report(dmc_archive):
+    path = dmc_archive / EVALUATION_RUN
+    linked_to_its_folder(path)
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{path} (the directory of run {EVALUATION_RUN}) {LOOP}" in printed

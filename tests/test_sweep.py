@@ -31,6 +31,7 @@ from simoun_lab.sweep.grid import (
     parse_seeds,
     split_values,
 )
+from simoun_lab.sweep.trainable import finished
 
 TINY = override(
     tiny_flags(total_env_steps=60),
@@ -590,3 +591,47 @@ def test_an_emptied_trial_is_listed_by_the_report_and_trained_anew_on_resume(
     assert f"- {TRIAL.format(1)}: its directory is empty (the trial has not started" in table
     spec = SweepSpec.load(sweep_dir)
     check_trial_dirs(spec, sweep_dir)  # nothing to refuse: the trial starts over
+
+
+def linked_to_nothing(run_dir: Path) -> None:
+    shutil.rmtree(run_dir)
+    run_dir.symlink_to("nowhere")
+
+
+def linked_to_its_folder(run_dir: Path) -> None:
+    shutil.rmtree(run_dir)
+    run_dir.symlink_to("..")
+
+
+TRIAL_LINKS = [
+    (linked_to_nothing, "it is a symbolic link to nowhere, which does not exist"),
+    (linked_to_its_folder, "it is a symbolic link to .., a folder it is in (a loop)"),
+]
+
+
+@pytest.mark.parametrize(("damage", "said"), TRIAL_LINKS)
+def test_a_trial_linked_to_nothing_or_to_its_own_folder_is_named_by_resume_and_report(
+    trained_sweep, tmp_path, capsys, damage, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    damage(run_dir)
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(1)}: {run_dir} (its run directory) is damaged: {said}" in err
+    assert f"or remove what stands there (rm {run_dir}) so that the trial trains anew" in err
+    assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
+    table = (tmp_path / "out" / "report.md").read_text()
+    assert f"- {TRIAL.format(1)}: its directory is damaged: {said}" in table
+
+
+def test_a_trial_moved_out_of_the_sweep_and_linked_back_is_read_as_the_run(trained_sweep, tmp_path):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    shutil.move(run_dir, tmp_path / "outside")
+    run_dir.symlink_to(tmp_path / "outside")
+    spec = SweepSpec.load(sweep_dir)
+    check_trial_dirs(spec, sweep_dir)  # nothing to refuse: the trial is there, finished
+    assert all(finished(trial) for trial in spec.trials(sweep_dir))
+    assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
+    (row,) = list(csv.DictReader((tmp_path / "out" / "report.csv").open()))
+    assert row["n"] == "2"

@@ -253,3 +253,56 @@ def test_resume_takes_the_runs_checkpoint_file_for_its_directory(finished_run, t
     assert train_cli.resumed_dir(str(checkpoint)) == run_dir
     assert train_cli.main(["--resume", str(checkpoint), "--total-env-steps", "60"]) == 0
     assert read_csv(run_dir / "eval.csv")[-1]["env_step"] == 60
+
+
+def link_to_nothing(path):
+    if path.is_dir():
+        shutil.rmtree(path)
+    path.unlink(missing_ok=True)
+    path.symlink_to(f"/nowhere/{path.name}")
+
+
+@pytest.mark.parametrize(
+    ("name", "fix"),
+    [
+        ("tb", "Point the link at a directory that exists, or remove it (rm {path}) and the run"),
+        ("learning_curve.png", "Remove the link (rm {path}): the run writes the file anew"),
+    ],
+)
+def test_a_path_the_run_writes_that_links_to_nothing_is_named_before_training(
+    finished_run, tmp_path, capsys, name, fix
+):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    path = run_dir / name
+    link_to_nothing(path)
+    with pytest.raises(SystemExit) as exit_info:
+        train_cli.main(["--resume", str(run_dir), "--total-env-steps", "60"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"it is a symbolic link to /nowhere/{name}, which does not exist" in err
+    assert fix.format(path=path) in err and "Traceback" not in err
+    assert path.is_symlink()  # left as it was
+
+
+def trained_on_a_gpu(run_dir):
+    """``run_dir``'s config.json and checkpoint as a run trained with device cuda leaves them."""
+    config = json.loads((run_dir / "config.json").read_text())
+    (run_dir / "config.json").write_text(json.dumps({**config, "device": "cuda"}))
+    payload = torch.load(run_dir / "checkpoint.pt", weights_only=False)
+    payload["config"]["device"] = "cuda"
+    torch.save(payload, run_dir / "checkpoint.pt")
+
+
+def test_a_run_trained_on_a_gpu_resumes_with_device_cpu(finished_run, tmp_path, capsys):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    trained_on_a_gpu(run_dir)
+    resume = ["--resume", str(run_dir), "--total-env-steps", "60"]
+    if not torch.cuda.is_available():  # the advice given where the GPU is missing
+        with pytest.raises(SystemExit):
+            train_cli.main(resume)
+        assert "use --device cpu (device='cpu')" in capsys.readouterr().err
+    assert train_cli.main([*resume, "--device", "cpu"]) == 0
+    assert json.loads((run_dir / "config.json").read_text())["device"] == "cpu"
+    assert json.loads((run_dir / "summary.json").read_text())["env_step"] == 60

@@ -154,10 +154,12 @@ RESUMABLE_FIELDS = (
     "video",
     "env_process",
     "torch_threads",
+    "device",
     "eval_distraction",
 )
 """Fields a resumed run may change: how long and how it runs and reports, not what it learns
-(torch_threads changes speed only); every other field must match the saved config."""
+(torch_threads changes speed only; device is where the run goes on: a run trained on a GPU
+resumes on a machine without one); every other field must match the saved config."""
 
 
 def check_train_config(config: TrainConfig) -> None:

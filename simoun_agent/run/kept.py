@@ -12,6 +12,7 @@ its command.
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import math
@@ -49,10 +50,36 @@ class Damaged(ValueError):
 
 
 def broken_link(path: Path) -> str | None:
-    """What is wrong with ``path`` when it is a symbolic link to nothing, else None (an existing
-    file's ``exists()`` is True, a missing one's is False: a link to nothing looks missing)."""
-    if path.is_symlink() and not path.exists():
+    """What is wrong with ``path`` when it is a symbolic link to nothing or a chain of links
+    that loops, else None (an existing file's ``exists()`` is True, a missing one's is False:
+    such a link looks missing)."""
+    if not path.is_symlink():
+        return None
+    try:
+        os.stat(path)
+    except OSError as err:
+        if err.errno == errno.ELOOP:
+            return f"it is a symbolic link to {os.readlink(path)}, which leads back to itself"
         return f"it is a symbolic link to {os.readlink(path)}, which does not exist"
+    return None
+
+
+def folder_problem(path: Path) -> str | None:
+    """What is wrong with the run folder at ``path`` when something else than a run's directory
+    stands there, else None (nothing there is not a problem: a run not started): a symbolic
+    link to nothing or that loops (:func:`broken_link`), a link to a folder it is in (a reader
+    walking the runs would go round in it, and a run trained there would write into the
+    folder above), or a file. A link to a copy of the run elsewhere is a run."""
+    problem = broken_link(path)
+    if problem:
+        return problem
+    if path.is_symlink() and path.resolve() in (here := path.parent.resolve(), *here.parents):
+        return (
+            f"it is a symbolic link to {os.readlink(path)}, a folder it is in (a loop), not the "
+            "run's directory"
+        )
+    if present(path) and not path.is_dir():
+        return "it is a file, not the run's directory"
     return None
 
 
@@ -131,16 +158,38 @@ def read_json_object(path: Path) -> dict[str, Any]:
     return value
 
 
-def read_csv_rows(path: Path, columns: Sequence[str] = ()) -> list[dict[str, str]]:
-    """The rows of the CSV file ``path`` under its header line, values as text (blank lines
-    skipped); :class:`Damaged` for what :func:`read_text` refuses, text that is not CSV, no
-    header line, a header without one of ``columns``, or a row whose fields do not fit the
-    header (a line cut short or two run together). OSError for a file that cannot be read."""
+def csv_lines(path: Path) -> list[list[str]]:
+    """The fields of each line of the CSV file ``path``, blanks after a comma dropped (``1, 2``
+    as a person or a spreadsheet writes it reads as ``1,2``: every reader of a run's logs, and
+    a resumed run's writer, takes one header whichever way it is spaced); :class:`Damaged` for
+    what :func:`read_text` refuses, text that is not CSV, or a comment line (``# ...``), which
+    CSV does not have and which would be read as the header or a row. OSError for a file that
+    cannot be read."""
     try:
-        lines = list(csv.reader(io.StringIO(read_text(path), newline="")))
+        lines = list(csv.reader(io.StringIO(read_text(path), newline=""), skipinitialspace=True))
     except csv.Error as err:
         raise Damaged(f"it is not a CSV file ({err})") from None
+    for number, values in enumerate(lines, start=1):
+        if values and values[0].lstrip().startswith("#"):
+            raise Damaged(
+                f"line {number} is a comment ({values[0][:40]!r}): CSV has no comments; remove "
+                "that line"
+            )
+    return lines
+
+
+def read_csv_rows(
+    path: Path, columns: Sequence[str] = (), empty_ok: bool = False
+) -> list[dict[str, str]]:
+    """The rows of the CSV file ``path`` under its header line, values as text (blank lines
+    skipped); :class:`Damaged` for what :func:`csv_lines` refuses, an empty file (no rows where
+    ``empty_ok``: a reader that says what an empty log means for its run), a header without
+    one of ``columns``, or a row whose fields do not fit the header (a line cut short or two
+    run together). OSError for a file that cannot be read."""
+    lines = csv_lines(path)
     if not any(lines):
+        if empty_ok:
+            return []
         raise Damaged("it is empty")
     header = lines[0]
     missing = [column for column in columns if column not in header]

@@ -9,14 +9,13 @@ the whole run, resumed parts included.
 from __future__ import annotations
 
 import csv
-import io
 import math
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, read_text, step_count
+from simoun_agent.run.kept import Damaged, csv_lines, read_csv_rows, step_count
 from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
 
@@ -58,8 +57,7 @@ class CsvLog:
             self.columns = list(row)
             self._rewrite([])
         elif any(key not in self.columns for key in row):
-            with self.path.open(newline="", encoding="utf-8-sig") as f:
-                rows = list(csv.DictReader(f))
+            rows = read_csv_rows(self.path)
             self.columns += [key for key in row if key not in self.columns]
             self._rewrite(rows)
         with self.path.open("a", newline="") as f:
@@ -73,11 +71,9 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
     the user's file stays as it is."""
     try:
-        lines = list(csv.reader(io.StringIO(read_text(path), newline="")))
+        lines = csv_lines(path)
     except Damaged as err:
         raise damaged_log(path, str(err)) from None
-    except csv.Error as err:
-        raise damaged_log(path, f"it is not a CSV file ({err})") from None
     if not lines or "env_step" not in lines[0]:
         problem = "it is empty" if not lines else "its first line has no env_step column"
         raise damaged_log(path, problem)
@@ -112,8 +108,9 @@ def damaged_log(path: Path, problem: str) -> SetupError:
 
 def read_csv(path: Path) -> list[dict[str, float]]:
     """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty);
-    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes."""
-    rows = csv.DictReader(io.StringIO(read_text(path), newline=""))
+    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes; an empty
+    file has no rows."""
+    rows = read_csv_rows(path, empty_ok=True)
     return [{k: float(v or "nan") for k, v in row.items()} for row in rows]
 
 

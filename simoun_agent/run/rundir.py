@@ -128,8 +128,17 @@ def wrong_kind(run_dir: Path) -> str | None:
     """What is wrong with the first path a trainer writes in ``run_dir`` that is the wrong kind
     of thing (a directory or a named pipe where a file goes, a file where ``tb/`` goes), with
     the fix; None when each is missing or of its kind. A run that met it would fail after
-    training, when it writes the path, or take it for a directory it cannot write to."""
+    training, when it writes the path, or take it for a directory it cannot write to. A
+    symbolic link to nothing (a run copied from another machine) is named here where the run
+    only writes the path; the files it reads back name theirs when they are read."""
     tensorboard = run_dir / TENSORBOARD_DIR
+    link = broken_link(tensorboard)
+    if link:
+        return (
+            f"{tensorboard}, where the run writes its TensorBoard logs, is damaged: {link}. "
+            f"Point the link at a directory that exists, or remove it (rm {tensorboard}) and the "
+            "run writes a new tb/"
+        )
     if tensorboard.exists() and not tensorboard.is_dir():
         return (
             f"{tensorboard} is a file where the run writes its TensorBoard logs (a directory); "
@@ -137,6 +146,12 @@ def wrong_kind(run_dir: Path) -> str | None:
         )
     for name in WRITTEN_FILES:
         path = run_dir / name
+        link = None if name in READ_BACK else broken_link(path)
+        if link:
+            return (
+                f"{path} is damaged: {link}. Remove the link (rm {path}): the run writes the "
+                "file anew"
+            )
         problem = not_a_file(path)
         if problem:
             fix = "restore the file from a copy" if name in READ_BACK else "the run writes it anew"

@@ -294,7 +294,11 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"but {', '.join(fixed)} was given another value than the run's. Drop it, or start a "
             "new run to change it."
         )
-    config = from_dict(saved, str(config_path))
+    # the saved device need not exist here when another is given: a run trained on a GPU goes
+    # on with --device cpu (the given one is checked below, as a flag)
+    config = from_dict(
+        {**saved, "device": None} if "device" in overrides else saved, str(config_path)
+    )
     as_saved = to_dict(config)
     for log in (EVAL_CSV, TRAIN_CSV):
         if (run_dir / log).exists():

@@ -27,8 +27,8 @@ from simoun_agent.config.rules import is_real
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.kept import (
     Damaged,
-    broken_link,
     csv_number,
+    folder_problem,
     present,
     read_csv_rows,
     read_json_object,
@@ -199,11 +199,10 @@ def read_finished(spec: StudySpec, archive: Path, run: Run) -> dict[str, Any]:
 
 def check_run_folder(archive: Path, run: Run) -> None:
     """SetupError naming a run's place in the archive when something else than a directory
-    stands there (a file, a link to nothing): the run would be left out as unfinished."""
+    stands there (a file, a link to nothing or to a folder it is in): the run would be left out
+    as unfinished."""
     path = archive / run.name
-    problem = broken_link(path)
-    if problem is None and present(path) and not path.is_dir():
-        problem = "it is a file, not the run's directory"
+    problem = folder_problem(path)
     if problem:
         raise SetupError(
             f"{path} (the directory of run {run.name}) is damaged: {problem}. Restore the run "

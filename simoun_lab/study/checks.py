@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
-from simoun_agent.run.kept import Damaged, broken_link, present, read_json_object
+from simoun_agent.run.kept import Damaged, folder_problem, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
@@ -108,12 +108,10 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
 
 def check_run_folder(where: Path, name: str) -> None:
     """SetupError naming the run ``name``'s place in the study directory or archive ``where``
-    when something else than a directory stands there (a file, a link to nothing): the run
-    would be taken for one not finished, and counted or trained as such."""
+    when something else than a directory stands there (a file, a link to nothing or to a folder
+    it is in): the run would be taken for one not finished, and counted or trained as such."""
     path = where / name
-    problem = broken_link(path)
-    if problem is None and present(path) and not path.is_dir():
-        problem = "it is a file, not the run's directory"
+    problem = folder_problem(path)
     if problem:
         raise SetupError(
             f"{path} (the directory of run {name}) is damaged: {problem}. Restore the run from a "

@@ -32,7 +32,7 @@ from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.kept import Damaged, folder_problem, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_lab.sweep.saved import saved_problem
 
@@ -346,13 +346,20 @@ class SweepSpec:
         return spec
 
 
+DAMAGED_DIR = "its directory is damaged: "
+
+
 def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     """What is wrong with a started trial's run directory: its config.json missing while other
     files are there, damaged, or recording another env, seed or ``grid`` value than the trial's
     (a run copied in from elsewhere, a config.json replaced); None for a trial not started (no
     directory, or an empty one) and for one whose config.json is its own. The answer starts
-    with the name config.json."""
+    with the name config.json, or with "its directory" when no run's directory stands in the
+    trial's place (:func:`~simoun_agent.run.kept.folder_problem`)."""
     run_dir = Path(trial.run_dir)
+    problem = folder_problem(run_dir)
+    if problem:
+        return DAMAGED_DIR + problem
     if not run_dir.is_dir() or not any(run_dir.iterdir()):
         return None
     path = run_dir / CONFIG_NAME
@@ -377,6 +384,14 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
     (:func:`trial_problem`), before the sweep counts it as finished or goes on from it."""
     for trial in spec.trials(sweep_dir):
         problem = trial_problem(trial, spec.grid)
+        if problem and not problem.startswith(CONFIG_NAME):
+            run_dir = trial.run_dir
+            raise SetupError(
+                f"trial {trial.name}: {run_dir} (its run directory) is damaged: "
+                f"{problem.removeprefix(DAMAGED_DIR)}; restore the trial from a copy (or point "
+                f"the link at it), or remove what stands there (rm {run_dir}) so that the trial "
+                "trains anew"
+            )
         if problem:
             run_dir = trial.run_dir
             raise SetupError(

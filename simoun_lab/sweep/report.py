@@ -37,6 +37,7 @@ import functools
 import itertools
 import json
 import math
+import os
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -51,12 +52,25 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import STEP_LIMIT, Damaged, present, read_json_object, read_text
+from simoun_agent.run.kept import (
+    STEP_LIMIT,
+    Damaged,
+    folder_problem,
+    present,
+    read_json_object,
+    read_text,
+)
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import read_csv
 from simoun_agent.run.rundir import make_output_dir
 from simoun_lab import stats
-from simoun_lab.sweep.grid import BASE_VARIANT, SWEEP_FILE, SweepSpec, trial_problem
+from simoun_lab.sweep.grid import (
+    BASE_VARIANT,
+    DAMAGED_DIR,
+    SWEEP_FILE,
+    SweepSpec,
+    trial_problem,
+)
 from simoun_lab.sweep.report_plots import Band, plot_panels
 
 REPORT_MD = "report.md"
@@ -175,17 +189,38 @@ def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
     whose config.json, eval.csv or summary.json cannot be read is left out and, when
     ``damaged`` is given, named there with the file and what is wrong with it."""
     records = []
-    # a wildcard, as rglob(CONFIG_NAME) leaves out a config.json that links to nothing
-    for config_path in sorted(p for p in root.rglob("*.json") if p.name == CONFIG_NAME):
-        relative = config_path.relative_to(root).parts
-        if relative[0] == "tune" or any(part.startswith(".") for part in relative):
-            continue
+    for config_path in config_paths(root, [] if damaged is None else damaged):
         try:
             records.append(read_run(config_path))
         except DamagedRun as err:
             if damaged is not None:
                 damaged.append(f"{config_path.parent.relative_to(root).as_posix()}: {err}")
     return records
+
+
+def config_paths(root: Path, damaged: list[str]) -> list[Path]:
+    """Every run's ``config.json`` under ``root`` (a link to nothing included: its run is named
+    as damaged), Tune's records under ``tune/`` and hidden folders skipped. A link to a folder
+    is followed (a run moved elsewhere and linked back is a run), each folder once; a link to a
+    folder it is in (a loop) is named in ``damaged``, not walked round."""
+    found: list[Path] = []
+    seen = {os.path.realpath(root)}
+    for top, folders, files in os.walk(root, followlinks=True):
+        here = Path(top)
+        kept = []
+        for name in sorted(folders):
+            path = here / name
+            if name.startswith(".") or (here == root and name == "tune"):
+                continue
+            problem = folder_problem(path) if path.is_symlink() else None
+            if problem:
+                damaged.append(f"{path.relative_to(root).as_posix()}: {DAMAGED_DIR}{problem}")
+            elif (real := os.path.realpath(path)) not in seen:
+                seen.add(real)
+                kept.append(name)
+        folders[:] = kept
+        found += [here / CONFIG_NAME] if CONFIG_NAME in files else []
+    return sorted(found)
 
 
 def read_json(path: Path) -> dict[str, Any]:
@@ -271,6 +306,15 @@ def check_summary(summary: dict[str, Any], curve: dict[str, np.ndarray]) -> None
         raise DamagedRun(
             f"{SUMMARY_NAME} says the run ended at env step {summary['env_step']:g}, but the "
             f"last evaluation in {EVAL_CSV} is at {curve['env_step'][-1]:g}"
+        )
+    # a summary.json copied from another run of the same length (another seed) ends at the
+    # same step: its final return is then not the one the run's last evaluation logged
+    last = float(curve["return_mean"][-1])
+    if not math.isclose(value, last, rel_tol=1e-6, abs_tol=1e-9):
+        raise DamagedRun(
+            f"{SUMMARY_NAME}'s final return {value:g} is not the {last:g} of the last evaluation "
+            f"in {EVAL_CSV} (env step {summary['env_step']:g}): the two files are of different "
+            "runs (one copied from another run, or edited)"
         )
 
 
