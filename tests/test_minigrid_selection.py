@@ -96,6 +96,9 @@ def test_the_rule_picks_the_highest_mean_area_once_every_setting_has_finished(tm
             config = json.loads((run_dir / "config.json").read_text())
             config.update(run=f"{TASK}/{arm}/s{seed}", spec=spec.to_json())
             (run_dir / "config.json").write_text(json.dumps(config))
+            summary = json.loads((run_dir / "summary.json").read_text())
+            summary.update(run=f"{TASK}/{arm}/s{seed}")
+            (run_dir / "summary.json").write_text(json.dumps(summary))
     hand = {
         arm: np.mean(
             [
