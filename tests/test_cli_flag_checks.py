@@ -373,6 +373,37 @@ def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
 
 
 @pytest.mark.parametrize(
+    ("archive", "work", "said"),
+    [
+        ("mgt", "mgt", "--archive mgt is the --work-dir itself"),
+        ("mgt", "mgt/wd", "--work-dir mgt/wd is inside --archive mgt"),
+        ("wd/mgt", "wd", "--archive wd/mgt is inside --work-dir wd"),
+    ],
+)
+def test_a_minigrid_archive_that_is_or_nests_the_work_dir_is_refused_before_ray(
+    archive, work, said, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    Path(archive).mkdir(parents=True)
+    err = refused(capsys, minigrid_cli.main, ["run", "--archive", archive, "--work-dir", work])
+    assert said in err and "pass directories apart from each other" in err
+    assert not Path(work, "tune").exists() and not Path(archive, "spec.json").exists()
+
+
+@pytest.mark.parametrize(("archive", "said"), [("study/kept", "--archive {}/study/kept is inside"),
+                                               (".", "/study is inside --archive {};")])  # fmt: skip
+def test_a_study_archive_nested_with_the_study_dir_is_refused_before_ray(
+    archive, said, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    spec = Path(__file__).parents[1] / "docs/studies/dmc100k.toml"
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", "study",
+                                           "--archive", archive])  # fmt: skip
+    assert said.format(tmp_path) in err
+    assert not (tmp_path / "study").exists()
+
+
+@pytest.mark.parametrize(
     ("argv", "said"),
     [
         (["--env-kwargs", '{"a": 1, "a": 2}'], "--env-kwargs: the key 'a' is given twice"),
