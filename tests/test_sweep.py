@@ -297,6 +297,15 @@ def error_of(argv: list[str], capsys) -> str:
             "'dm_control/cartpole-swingup-v1'; did you mean dm_control/cartpole-swingup-v0",
         ),
         (["--envs", "CartPole-v1"], "--envs CartPole-v1: CartPole-v1 has action space Discrete(2)"),
+        (["--envs", "simoun/PointReach-v0;Pendulum-v1"], "--envs 'simoun/PointReach-v0;Pendulum-v1'"
+         ": values separated by ';'; --envs takes comma-separated values, e.g. --envs "
+         "simoun/PointReach-v0,Pendulum-v1"),
+        (["--envs", "simoun/PointReach-v0 | Pendulum-v1"], "e.g. --envs "
+         "simoun/PointReach-v0,Pendulum-v1"),
+        (["--envs", "simoun/PointReach-v0 Pendulum-v1"], "values separated by ' '"),
+        (["--seeds", "0;1"], "--seeds takes comma-separated values, e.g. --seeds 0,1"),
+        (["--grid", "agent.lr=1e-3|3e-4"], "e.g. --grid agent.lr=1e-3,3e-4"),
+        (["--envs", "NoSuchEnv-v0"], "or MODULE:ID (e.g. minigrid:"),
         (["--env", "MiniGrid-Empty-5x5-v0", "--env-module", "minigrid"], "Discrete(7)"),
     ],
 )  # fmt: skip

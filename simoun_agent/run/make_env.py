@@ -129,7 +129,7 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
     raise SetupError(
         f"unknown environment id {env_id!r}; {hint} Pass a registered Gymnasium id "
         "(e.g. dm_control/cartpole-swingup-v0, highway-v0, simoun/PointReach-v0), or "
-        "MODULE:ID (--env minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
+        "MODULE:ID (e.g. minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
         "on import."
     )
 
