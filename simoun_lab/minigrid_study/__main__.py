@@ -87,7 +87,7 @@ class Report:
     archive: Path = ARCHIVE
     """the study's records"""
     spec: Path | None = None
-    """a JSON spec (None: the archive's spec.json)"""
+    """a JSON spec, or a TOML one with the same keys (None: the archive's spec.json)"""
 
 
 @dataclass
