@@ -137,7 +137,10 @@ def test_set_without_a_key_shows_the_form(capsys):
         (["--preset", "cpu"], "--preset cpu trains on dm_control/cartpole-swingup-v0, not "
          "highway-env: the reference drivers steer a highway-env car; choose one of highway, "
          "highway-cpu"),
-        (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
+        (["--preset", "cpux"], "--preset 'cpux': unknown preset; choose one of highway, "
+         "highway-cpu\n"),
+        (["--preset", "HIGHWAY-CPU"], "--preset 'HIGHWAY-CPU': unknown preset (did you mean "
+         "'highway-cpu'?); choose one of highway, highway-cpu\n"),
         (["--video", "lane.txt"], "--video lane.txt: a video is written as .gif or .mp4"),
         (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
         (["--json", "refs.csv"], "--json refs.csv: the metrics file is written as .json"),
