@@ -393,8 +393,10 @@ def test_a_minigrid_archive_that_is_or_nests_the_work_dir_is_refused_before_ray(
     assert not Path(work, "tune").exists() and not Path(archive, "spec.json").exists()
 
 
-@pytest.mark.parametrize(("archive", "said"), [("study/kept", "--archive {}/study/kept is inside"),
-                                               (".", "/study is inside --archive {};")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("archive", "said"),
+    [("study/kept", "--archive {}/study/kept is inside"), (".", "/study is inside --archive {};")],
+)
 def test_a_study_archive_nested_with_the_study_dir_is_refused_before_ray(
     archive, said, tmp_path, capsys, monkeypatch
 ):

@@ -358,7 +358,7 @@ def test_at_wall_time_uses_the_last_evaluation_within_it_of_runs_that_trained_pa
     assert float(row["final_return_mean"]) == pytest.approx(evaluations[1]["return_mean"])
     assert int(row["env_steps"]) == 60
     beyond = evaluations[-1]["wall_time_s"] + 100
-    with pytest.raises(report.SetupError, match="--at-wall-time .* leaves every run out") as err:
+    with pytest.raises(report.SetupError, match=r"--at-wall-time .* leaves every run out") as err:
         report.write_report(root, tmp_path / "beyond", budget=("wall_time_s", beyond))
     example = float(str(err.value).split("e.g. --at-wall-time ")[1].split(",")[0])
     report.write_report(root, tmp_path / "example", budget=("wall_time_s", example))

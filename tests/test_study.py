@@ -368,6 +368,9 @@ BAD_SPECS = [
      "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
      "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\nenv_steps = 40\n\n[resources]',
+     "unknown config key 'env_steps' (the study sets total_env_steps itself: give it as "
+     "env_steps in [tuning] and [evaluation])", "env_steps = 40"),
     ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = ["simoun_no_auxx"]',
      "unknown recipe 'simoun_no_auxx' (did you mean 'simoun_no_aux'?)"),
     ("max_concurrent_trials = 2", MAX + '[diagnostics]\ndrq = ["simoun_no_aux"]',

@@ -284,6 +284,8 @@ def error_of(argv: list[str], capsys) -> str:
         (["--grid", "agent.lr"], "--grid takes KEY=V1,V2"),
         (["--grid", "agent.lr=1e-3,,3e-4"], "has an empty value"),
         (["--grid", "seed=1,2"], "use --seeds"),
+        (["--grid", "seeds=1,2"], "unknown config key 'seeds' (the sweep sets seed itself: give it "
+         "as --seeds)"),
         (["--seeds", "5-2"], "the range '5-2' runs backwards; write it low-high, e.g. --seeds 2-5"),
         (["--seeds", "a"], "cannot read 'a'"),
         (["--seed", "3", "--seeds", "0-1"], "give the seeds once"),

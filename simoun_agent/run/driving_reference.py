@@ -234,7 +234,8 @@ def highway_presets() -> list[str]:
 
 
 def close_preset(name: str) -> str:
-    """`` (did you mean 'x'?)`` for the highway preset closest to ``name`` in any case, or ``""``."""
+    """`` (did you mean 'x'?)`` for the highway preset closest to ``name`` in any case, else
+    ``""``."""
     by_lower = {preset.lower(): preset for preset in highway_presets()}
     hint = difflib.get_close_matches(name.lower(), by_lower, n=1)
     return f" (did you mean {by_lower[hint[0]]!r}?)" if hint else ""

@@ -1,8 +1,9 @@
 """The study's design as data: tasks, budgets, seeds, arms, PPO's hyperparameters, evaluation.
 
 A spec is a JSON file (``docs/studies/minigrid/spec.json`` is the study's), or a TOML file
-(``.toml``) with the same keys, as ``simoun-study`` reads it; every value has a default here, so a spec names only what it changes. One ``StudySpec`` gives every arm the same
-PPO settings, budgets, seeds and evaluation episodes.
+(``.toml``) with the same keys, as ``simoun-study`` reads it; every value has a default here, so
+a spec names only what it changes. One ``StudySpec`` gives every arm the same PPO settings,
+budgets, seeds and evaluation episodes.
 """
 
 from __future__ import annotations
@@ -10,12 +11,12 @@ from __future__ import annotations
 import dataclasses
 import json
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import tomllib
 
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import json_value
@@ -289,4 +290,6 @@ def toml_values(text: str, path: Path, label: str, quiet: bool = False) -> dict 
     except tomllib.TOMLDecodeError as err:
         if quiet:
             return None
-        raise SetupError(f"{label} {path} is not valid TOML ({err}); fix the syntax there") from None
+        raise SetupError(
+            f"{label} {path} is not valid TOML ({err}); fix the syntax there"
+        ) from None

@@ -60,7 +60,6 @@ from typing import Any
 from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
 from simoun_agent.config.keys import (
     HELP_FIX,
-    close_match,
     config_fields,
     config_sections,
     parse_value,
@@ -70,7 +69,7 @@ from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
-from simoun_lab.sweep.grid import MAX_SEEDS, parse_seeds
+from simoun_lab.sweep.grid import MAX_SEEDS, close_key_here, parse_seeds
 
 try:
     import tomllib
@@ -386,8 +385,9 @@ class _Reader:
             raise self.fail(("grid_overrides",), 'give a list of grid keys, e.g. ["agent.n_step"]')
         for key in overrides:
             if key not in self.fields:
+                hint = close_key_here(key, STUDY_SETS, "the study")
                 raise self.fail(
-                    ("grid_overrides",), f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}"
+                    ("grid_overrides",), f"unknown config key {key!r}{hint}; {HELP_FIX}"
                 )
         grid = self.grid(data["grid"], every, preset, base, overrides)
         tuning = self.phase(data["tuning"], "tuning")
@@ -494,7 +494,8 @@ class _Reader:
         if key in STUDY_SETS:
             raise self.fail(where, f"the study sets {key} itself; give it as {STUDY_SETS[key]}")
         if key not in self.fields:
-            raise self.fail(where, f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
+            hint = close_key_here(key, STUDY_SETS, "the study")
+            raise self.fail(where, f"unknown config key {key!r}{hint}; {HELP_FIX}")
         for recipe, fixed in fixed_by(key, recipes).items():
             raise self.fail(
                 where,

@@ -28,6 +28,7 @@ from typing import Any
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.envs import env_label
+from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
@@ -114,7 +115,7 @@ def check_commas(flag: str, text: str, key: str = "", spaces: bool = True) -> No
     instead of commas: read as one value, it would be refused for a false reason, or taken as
     one."""
     for value in split_values(text):
-        if value[:1] in "[{\"":
+        if value[:1] in '[{"':
             continue  # a JSON value may hold any of these
         found = [sep for sep in OTHER_SEPARATORS if sep in value]
         if spaces and len(value.split()) > 1:
@@ -135,7 +136,24 @@ def check_key(key: str, flag: str) -> None:
         raise SetupError(f"{flag} cannot set {key}: the sweep sets it; use {DEDICATED[key]}")
     known = config_fields()
     if key not in known:
-        raise SetupError(f"{flag}: unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
+        hint = close_key_here(key, DEDICATED, "the sweep")
+        raise SetupError(f"{flag}: unknown config key {key!r}{hint}; {HELP_FIX}")
+
+
+def close_key_here(key: str, set_here: dict[str, str], setter: str) -> str:
+    """``" (did you mean agent.lr?)"`` for an unknown config ``key``, naming only keys that can
+    be given where it was: the keys of ``set_here`` are set by ``setter`` itself (each mapped
+    to where to give it instead), so the closest of them is answered with that place."""
+    if any(known.startswith(key + ".") for known in config_fields()):
+        return close_match(key)  # a section: one of its fields
+    docs = {known: doc for known, (_, _, doc) in config_fields().items()}
+    matches = close_keys(key, docs)
+    allowed = [match for match in matches if match not in set_here]
+    if allowed:
+        return f" (did you mean {' or '.join(allowed)}?)"
+    if matches:
+        return f" ({setter} sets {matches[0]} itself: give it as {set_here[matches[0]]})"
+    return ""
 
 
 def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
