@@ -57,13 +57,14 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
+from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.keys import (
     HELP_FIX,
     config_fields,
     config_sections,
     parse_value,
 )
+from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
@@ -554,6 +555,19 @@ class _Reader:
         except SetupError as err:
             raise self.fail(where, str(err)) from None
 
+    def example_value(
+        self, key: str, value: Any, where: tuple[str, ...], preset: str | None, base: dict
+    ) -> str:
+        """A valid value of ``key`` in TOML, for an example: ``value`` when it is one (a
+        single value given where a list is wanted), else the value the study's base gives."""
+        try:
+            good = self.typed(key, value, where) if not isinstance(value, list) else None
+        except SetupError:
+            good = None
+        if good is None:
+            good = flatten(to_dict(resolve(preset, base))).get(key)
+        return '"none"' if good is None else json.dumps(good)
+
     def grid(
         self,
         value: Any,
@@ -578,8 +592,9 @@ class _Reader:
                 line = key_line(self.source.text, ("base", *key.split(".")))
                 raise self.fail(path, f"{key} is in [base] too (line {line}); keep it in one place")
             if not isinstance(values, list) or not values:
+                example = self.example_value(key, values, path, preset, base)
                 raise self.fail(
-                    path, f"give a non-empty list of values, e.g. {key} = [{show(values)}, ...]"
+                    path, f"give a non-empty list of values, e.g. {key} = [{example}, ...]"
                 )
             typed = [self.typed(key, v, path) for v in values]
             if len({show(v) for v in typed}) < len(typed):
