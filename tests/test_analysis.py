@@ -218,6 +218,18 @@ def test_analyze_refuses_numbers_out_of_range_naming_the_flag(runs, tmp_path, ca
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("command", ["bias", "masks"])
+def test_analyze_blames_a_bad_device_on_the_flag_not_the_run(command, runs, tmp_path, capsys):
+    run = str(runs["dual_interactive"])
+    with pytest.raises(SystemExit) as exit_info:
+        main([command, run, "--device", "gpu", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2
+    assert "--device gpu: device type 'gpu' is not supported here; use cpu, cuda" in err
+    assert "saved config" not in err
+    assert not (tmp_path / "out").exists()
+
+
 def test_bias_refuses_one_run_given_twice(runs, tmp_path, capsys):
     run = runs["stacked"]
     (tmp_path / "link").symlink_to(run)

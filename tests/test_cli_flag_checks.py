@@ -137,7 +137,10 @@ def test_set_without_a_key_shows_the_form(capsys):
         (["--preset", "cpu"], "--preset cpu trains on dm_control/cartpole-swingup-v0, not "
          "highway-env: the reference drivers steer a highway-env car; choose one of highway, "
          "highway-cpu"),
-        (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
+        (["--preset", "cpux"], "--preset 'cpux': unknown preset; choose one of highway, "
+         "highway-cpu\n"),
+        (["--preset", "HIGHWAY-CPU"], "--preset 'HIGHWAY-CPU': unknown preset (did you mean "
+         "'highway-cpu'?); choose one of highway, highway-cpu\n"),
         (["--video", "lane.txt"], "--video lane.txt: a video is written as .gif or .mp4"),
         (["--video", "nowhere/lane.gif"], "the folder nowhere does not exist"),
         (["--json", "refs.csv"], "--json refs.csv: the metrics file is written as .json"),
@@ -370,6 +373,39 @@ def test_a_study_archive_that_is_the_study_dir_is_refused_before_ray(
                                            "--archive", archive])  # fmt: skip
     assert f"--archive {tmp_path / archive} is the --study-dir itself" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["other"]
+
+
+@pytest.mark.parametrize(
+    ("archive", "work", "said"),
+    [
+        ("mgt", "mgt", "--archive mgt is the --work-dir itself"),
+        ("mgt", "mgt/wd", "--work-dir mgt/wd is inside --archive mgt"),
+        ("wd/mgt", "wd", "--archive wd/mgt is inside --work-dir wd"),
+    ],
+)
+def test_a_minigrid_archive_that_is_or_nests_the_work_dir_is_refused_before_ray(
+    archive, work, said, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    Path(archive).mkdir(parents=True)
+    err = refused(capsys, minigrid_cli.main, ["run", "--archive", archive, "--work-dir", work])
+    assert said in err and "pass directories apart from each other" in err
+    assert not Path(work, "tune").exists() and not Path(archive, "spec.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("archive", "said"),
+    [("study/kept", "--archive {}/study/kept is inside"), (".", "/study is inside --archive {};")],
+)
+def test_a_study_archive_nested_with_the_study_dir_is_refused_before_ray(
+    archive, said, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    spec = Path(__file__).parents[1] / "docs/studies/dmc100k.toml"
+    err = refused(capsys, study_cli.main, ["run", str(spec), "--study-dir", "study",
+                                           "--archive", archive])  # fmt: skip
+    assert said.format(tmp_path) in err
+    assert not (tmp_path / "study").exists()
 
 
 @pytest.mark.parametrize(

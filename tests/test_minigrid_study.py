@@ -229,6 +229,26 @@ def test_simoun_study_refuses_a_bad_minigrid_toml_spec_naming_the_key(text, said
     assert status == 2 and said in printed and "Traceback" not in printed
 
 
+def test_the_minigrid_study_reads_a_toml_spec_and_tells_a_sac_one_apart(tmp_path):
+    toml_spec = tmp_path / "tiny.toml"
+    toml_spec.write_text(TINY_TOML)
+    renamed = tmp_path / "tiny.spec"
+    renamed.write_text(TINY_TOML)
+    assert load_spec(toml_spec) == load_spec(renamed) == load_ppo_spec(str(toml_spec))
+    assert load_spec(toml_spec).arms == ("ppo", "consistency", "rnd")
+    sac = tmp_path / "spec.toml"
+    sac.write_text(Path("docs/studies/dmc100k.toml").read_text())
+    with pytest.raises(SetupError) as refused:
+        load_spec(sac)
+    said = str(refused.value)
+    assert said.startswith(f"--spec {sac} is a SAC study's spec (it has recipes)")
+    assert f"simoun-study plan {sac}" in said and "comment" not in said
+    broken = tmp_path / "broken.toml"
+    broken.write_text(TINY_TOML.replace("evaluations = 2", "evaluations = "))
+    with pytest.raises(SetupError, match=f"--spec {broken} is not valid TOML .*line 2"):
+        load_spec(broken)
+
+
 def test_a_sac_spec_is_not_read_as_a_minigrid_one():
     assert is_ppo_spec("docs/studies/minigrid-v2/tuning/spec.json")
     assert not is_ppo_spec("docs/studies/dmc100k.toml")

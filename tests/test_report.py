@@ -310,8 +310,23 @@ def test_at_step_counts_only_runs_with_an_evaluation_at_that_step(runs_dir, grid
     assert rows["eval_every=60"]["n"] == "2" and rows["eval_every=40"]["n"] == "0"
     table = (tmp_path / "at-60" / report.REPORT_MD).read_text()
     assert "- c: no evaluation at 60 env steps (last before it 40, next 80)" in table
-    report.write_report(root, tmp_path / "at-200", budget=("env_step", 200))
-    assert "- c: reached only 120 env steps" in (tmp_path / "at-200" / report.REPORT_MD).read_text()
+
+
+def test_a_budget_that_leaves_every_run_out_is_refused_naming_the_steps_the_runs_have(
+    runs_dir, grid_run, tmp_path, capsys
+):
+    root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "runs")
+    shutil.copytree(grid_run, root / "c")
+    with pytest.raises(SystemExit) as exit_info:
+        report_cli.main([str(root), "--at-step", "25", "--out", str(tmp_path / "at-25")])
+    assert exit_info.value.code == 2
+    message = capsys.readouterr().err
+    assert "--at-step 25 leaves every run out" in message
+    assert "the runs evaluate at 40, 60, 80, 120" in message
+    assert "e.g. --at-step 120" in message
+    assert not (tmp_path / "at-25").exists()
+    with pytest.raises(report.SetupError, match="--at-step 200 leaves every run out"):
+        report.write_report(root, tmp_path / "at-200", budget=("env_step", 200))
 
 
 def test_a_row_holds_runs_of_one_evaluation_grid(runs_dir, grid_run, tmp_path):
@@ -342,11 +357,12 @@ def test_at_wall_time_uses_the_last_evaluation_within_it_of_runs_that_trained_pa
     assert row["n"] == "1"
     assert float(row["final_return_mean"]) == pytest.approx(evaluations[1]["return_mean"])
     assert int(row["env_steps"]) == 60
-    beyond = evaluations[2]["wall_time_s"] + 100
-    report.write_report(root, tmp_path / "beyond", budget=("wall_time_s", beyond))
-    assert rows_of(tmp_path / "beyond")[0]["n"] == "0"
-    trained = f"trained only {evaluations[2]['wall_time_s']:.0f} s"
-    assert f"- a-s0: {trained}" in (tmp_path / "beyond" / report.REPORT_MD).read_text()
+    beyond = evaluations[-1]["wall_time_s"] + 100
+    with pytest.raises(report.SetupError, match=r"--at-wall-time .* leaves every run out") as err:
+        report.write_report(root, tmp_path / "beyond", budget=("wall_time_s", beyond))
+    example = float(str(err.value).split("e.g. --at-wall-time ")[1].split(",")[0])
+    report.write_report(root, tmp_path / "example", budget=("wall_time_s", example))
+    assert rows_of(tmp_path / "example")[0]["n"] == "1"
 
 
 def test_a_seed_counts_once_the_finished_run_then_the_most_recent_kept(runs_dir, tmp_path):

@@ -285,6 +285,8 @@ def error_of(argv: list[str], capsys) -> str:
         (["--grid", "agent.lr"], "--grid takes KEY=V1,V2"),
         (["--grid", "agent.lr=1e-3,,3e-4"], "has an empty value"),
         (["--grid", "seed=1,2"], "use --seeds"),
+        (["--grid", "seeds=1,2"], "unknown config key 'seeds' (the sweep sets seed itself: give it "
+         "as --seeds)"),
         (["--seeds", "5-2"], "the range '5-2' runs backwards; write it low-high, e.g. --seeds 2-5"),
         (["--seeds", "a"], "cannot read 'a'"),
         (["--seed", "3", "--seeds", "0-1"], "give the seeds once"),
@@ -298,6 +300,15 @@ def error_of(argv: list[str], capsys) -> str:
             "'dm_control/cartpole-swingup-v1'; did you mean dm_control/cartpole-swingup-v0",
         ),
         (["--envs", "CartPole-v1"], "--envs CartPole-v1: CartPole-v1 has action space Discrete(2)"),
+        (["--envs", "simoun/PointReach-v0;Pendulum-v1"], "--envs 'simoun/PointReach-v0;Pendulum-v1'"
+         ": values separated by ';'; --envs takes comma-separated values, e.g. --envs "
+         "simoun/PointReach-v0,Pendulum-v1"),
+        (["--envs", "simoun/PointReach-v0 | Pendulum-v1"], "e.g. --envs "
+         "simoun/PointReach-v0,Pendulum-v1"),
+        (["--envs", "simoun/PointReach-v0 Pendulum-v1"], "values separated by ' '"),
+        (["--seeds", "0;1"], "--seeds takes comma-separated values, e.g. --seeds 0,1"),
+        (["--grid", "agent.lr=1e-3|3e-4"], "e.g. --grid agent.lr=1e-3,3e-4"),
+        (["--envs", "NoSuchEnv-v0"], "or MODULE:ID (e.g. minigrid:"),
         (["--env", "MiniGrid-Empty-5x5-v0", "--env-module", "minigrid"], "Discrete(7)"),
     ],
 )  # fmt: skip

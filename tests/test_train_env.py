@@ -283,6 +283,17 @@ def test_an_env_id_that_cannot_be_made_is_refused_naming_it_and_the_fix():
         )
 
 
+def test_a_highway_task_without_continuous_actions_is_named_in_one_sentence_with_a_fix():
+    continuous = {"config": {"action": {"type": "ContinuousAction"}}}
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("merge-v0", continuous))
+    assert str(error.value) == (
+        'merge-v0 does not support continuous actions (config.action={"type": '
+        '"ContinuousAction"}, which the agents need to drive); pick a highway-env task that '
+        "does, e.g. highway-fast-v0"
+    )
+
+
 def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
     highway = {"config": {"action": {"type": "ContinuousAction"}, "lanes_count": 0}}
     with pytest.raises(SetupError) as error:

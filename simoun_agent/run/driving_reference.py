@@ -21,6 +21,7 @@ them, which a driving study's report (DIR: its study directory) shows beside the
 
 from __future__ import annotations
 
+import difflib
 import math
 import shlex
 import sys
@@ -227,6 +228,19 @@ def check_output(flag: str, path: Path, what: str, suffixes: tuple[str, ...], ex
     make_output_dir(path.parent, flag)
 
 
+def highway_presets() -> list[str]:
+    """The presets this command takes: those made for highway-env."""
+    return [name for name, preset in PRESETS.items() if preset.envs == "highway"]
+
+
+def close_preset(name: str) -> str:
+    """`` (did you mean 'x'?)`` for the highway preset closest to ``name`` in any case, else
+    ``""``."""
+    by_lower = {preset.lower(): preset for preset in highway_presets()}
+    hint = difflib.get_close_matches(name.lower(), by_lower, n=1)
+    return f" (did you mean {by_lower[hint[0]]!r}?)" if hint else ""
+
+
 def check_command(args: DrivingReferenceCommand) -> TrainConfig:
     """The preset's config, with every value of ``args`` checked before an episode is played;
     SetupError naming the flag and a value that works."""
@@ -234,9 +248,12 @@ def check_command(args: DrivingReferenceCommand) -> TrainConfig:
         raise SetupError(f"--episodes must be 1 or more, got {args.episodes}; e.g. --episodes 20")
     if args.seed < 0:
         raise SetupError(f"--seed must be 0 or more, got {args.seed}; e.g. --seed 1000")
+    highway = highway_presets()
+    if args.preset not in PRESETS:
+        raise SetupError(f"--preset {args.preset!r}: unknown preset{close_preset(args.preset)}; "
+                         f"choose one of {', '.join(highway)}")  # fmt: skip
     config = resolve(args.preset, {"device": "cpu"})
     if not is_highway(config.env):
-        highway = [name for name, preset in PRESETS.items() if preset.envs == "highway"]
         raise SetupError(
             f"--preset {args.preset} trains on {config.env}, not highway-env: the reference "
             f"drivers steer a highway-env car; choose one of {', '.join(highway)}"

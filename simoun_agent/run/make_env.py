@@ -129,7 +129,7 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
     raise SetupError(
         f"unknown environment id {env_id!r}; {hint} Pass a registered Gymnasium id "
         "(e.g. dm_control/cartpole-swingup-v0, highway-v0, simoun/PointReach-v0), or "
-        "MODULE:ID (--env minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
+        "MODULE:ID (e.g. minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
         "on import."
     )
 
@@ -413,6 +413,12 @@ def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
     if not config.env_kwargs:
         return SetupError(f"gymnasium.make({config.env!r}) failed: {message}")
     culprit = faulty_key(config)
+    if culprit and no_continuous_actions(config, culprit):
+        # highway-env then fails deep in the task's reward code: its error explains nothing
+        return SetupError(
+            f"{config.env} does not support continuous actions ({culprit}, which the agents "
+            "need to drive); pick a highway-env task that does, e.g. highway-fast-v0"
+        )
     if culprit:
         return SetupError(
             f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} cannot use {culprit} "
@@ -421,6 +427,18 @@ def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
     return SetupError(
         f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({message}). "
         "Fix or drop --env-kwargs"
+    )
+
+
+def no_continuous_actions(config: TrainConfig, culprit: str) -> bool:
+    """Whether ``culprit`` (:func:`faulty_key`) is the continuous action type a highway-env
+    task cannot be made with."""
+    action = config.env_kwargs.get("config", {}).get("action", {})
+    return (
+        is_highway(config.env)
+        and culprit.startswith("config.action")
+        and isinstance(action, dict)
+        and action.get("type") == "ContinuousAction"
     )
 
 

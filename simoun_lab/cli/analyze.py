@@ -23,6 +23,7 @@ from tyro.constructors import PrimitiveConstructorSpec
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
+from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import CHECKPOINT_NAME
 
 # The analyses' modules (torch, the agent, the envs) are imported by the functions that run
@@ -283,6 +284,13 @@ MAX_SEED = 2**63
 """--seed seeds numpy's and torch's generators: torch takes at most a 64-bit integer"""
 
 
+def check_device(device: str | None) -> None:
+    """SetupError naming ``--device`` when this machine has no such device, before any run is
+    loaded (the run's saved config would otherwise be blamed for it)."""
+    if device is not None and (problem := device_problem(device)):
+        raise SetupError(f"--device {device}: {problem}")
+
+
 def check_numbers(args: Masks | Bias) -> None:
     """SetupError naming the first numeric flag out of range, before any run is loaded."""
     if isinstance(args, Masks):
@@ -339,6 +347,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse(Command, argv, PROG, DESCRIPTION)
     name = "masks" if isinstance(args, Masks) else "bias"
     try:
+        check_device(args.device)
         check_numbers(args)
         if isinstance(args, Bias):
             check_distinct_runs(args.runs)

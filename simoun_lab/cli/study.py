@@ -35,6 +35,7 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_lab.engine.ray_start import load_ray
+from simoun_lab.study.archive import check_archive_apart
 from simoun_lab.study.options import StudyOptions
 
 PROG = "simoun-study"
@@ -162,17 +163,12 @@ def outputs(options: Run) -> dict[str, Path]:
 
 def check_outputs(options: Run) -> None:
     """Refuse an output directory that cannot be written (:func:`check_output_dir`), and an
-    archive that is the study directory itself (the archive is the finished runs' copy, kept
-    apart from the working records), creating nothing."""
+    archive that is, holds or lies in the study directory (:func:`check_archive_apart`),
+    creating nothing."""
     for flag, path in outputs(options).items():
         check_output_dir(path, flag)
-    archive = options.archive
-    if archive is not None and archive.resolve() == options.study_dir.resolve():
-        raise SetupError(
-            f"--archive {archive} is the --study-dir itself; the archive keeps a copy of the "
-            "finished runs apart from the study directory: pass another directory (e.g. "
-            "docs/studies/NAME), or leave --archive out"
-        )
+    if options.archive is not None:
+        check_archive_apart(options.archive, options.study_dir, "--study-dir", "docs/studies/NAME")
 
 
 def absolute(args: Run) -> Run:

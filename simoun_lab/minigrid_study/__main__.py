@@ -87,7 +87,7 @@ class Report:
     archive: Path = ARCHIVE
     """the study's records"""
     spec: Path | None = None
-    """a JSON spec (None: the archive's spec.json)"""
+    """a JSON spec, or a TOML one with the same keys (None: the archive's spec.json)"""
 
 
 @dataclass
@@ -164,9 +164,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
         if isinstance(args, Run):
             from simoun_lab.minigrid_study.runner import run_study
+            from simoun_lab.study.archive import check_archive_apart
 
             check_output_dir(args.archive, "--archive")
             check_output_dir(args.work_dir, "--work-dir")
+            check_archive_apart(args.archive, args.work_dir, "--work-dir", str(ARCHIVE))
             outcome = run_study(spec, args.archive, args.work_dir, args.address, args.concurrent)
             print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
             return 1 if outcome["failed"] else 0

@@ -1,8 +1,9 @@
 """The study's design as data: tasks, budgets, seeds, arms, PPO's hyperparameters, evaluation.
 
-A spec is a JSON file (``docs/studies/minigrid/spec.json`` is the study's); every value has a
-default here, so a spec names only what it changes. One ``StudySpec`` gives every arm the same
-PPO settings, budgets, seeds and evaluation episodes.
+A spec is a JSON file (``docs/studies/minigrid/spec.json`` is the study's), or a TOML file
+(``.toml``) with the same keys, as ``simoun-study`` reads it; every value has a default here, so
+a spec names only what it changes. One ``StudySpec`` gives every arm the same PPO settings,
+budgets, seeds and evaluation episodes.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import tomllib
 
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import json_value
@@ -236,20 +238,31 @@ def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
     return build(StudySpec, values, where)
 
 
+SAC_SPEC_KEYS = ("recipes", "tuning", "base", "grid")
+"""Top-level keys of a SAC study's TOML spec (``simoun-study``), none of them a PPO spec's
+(nor a misspelling of one)."""
+
+
 def load_spec(path: Path, label: str = "--spec") -> StudySpec:
-    """The spec in the JSON file ``path``; errors name it as ``label`` (the flag or argument it
-    was given by)."""
+    """The spec in the JSON file ``path``, or in the TOML file when it ends in ``.toml`` or is
+    TOML and not JSON; errors name it as ``label`` (the flag or argument it was given by)."""
+    is_toml = Path(path).suffix.lower() == ".toml"
     try:
         text = read_text(Path(path))
-        values = json_value(text)
+        values = toml_values(text, path, label) if is_toml else json_value(text)
     except FileNotFoundError:
         raise SetupError(f"{label} {path}: no such file") from None
     except Damaged as err:
+        kind = "TOML" if is_toml else "JSON"
         raise SetupError(
-            f"{label} {path} cannot be read ({err}); pass a JSON spec saved as UTF-8 text"
+            f"{label} {path} cannot be read ({err}); pass a {kind} spec saved as UTF-8 text"
         ) from None
     except json.JSONDecodeError as err:
-        raise SetupError(f"{label} {path} is not valid JSON: {json_problem(text, err)}") from None
+        # a TOML spec under another name reads as TOML, as simoun-study reads it
+        values = toml_values(text, path, label, quiet=True)
+        if not values:
+            problem = json_problem(text, err)
+            raise SetupError(f"{label} {path} is not valid JSON: {problem}") from None
     except ValueError as err:  # a key given twice
         raise SetupError(f"{label} {path}: {err}") from None
     if not isinstance(values, dict):
@@ -259,4 +272,24 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
             "tuning/spec.json does"
             + (", or leave --spec out to use the archive's" if label == "--spec" else "")
         )
+    sac = [key for key in SAC_SPEC_KEYS if key in values]
+    if sac and "arms" not in values:
+        raise SetupError(
+            f"{label} {path} is a SAC study's spec (it has {sac[0]}), not a MiniGrid PPO spec; "
+            f"plan and run it with simoun-study (simoun-study plan {path}), or pass a MiniGrid "
+            "spec such as docs/studies/minigrid-v2/tuning/spec.json"
+        )
     return spec_from_dict(values, str(path))
+
+
+def toml_values(text: str, path: Path, label: str, quiet: bool = False) -> dict | None:
+    """The tables of the TOML ``text`` read from ``path``; SetupError naming the file and the
+    line of a syntax error (None instead when ``quiet``)."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        if quiet:
+            return None
+        raise SetupError(
+            f"{label} {path} is not valid TOML ({err}); fix the syntax there"
+        ) from None

@@ -17,7 +17,7 @@ import tomllib
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.kept import Damaged, present, read_text
-from simoun_lab.minigrid_study.spec import StudySpec, load_spec, spec_from_dict
+from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 from simoun_lab.study.runner import PPO_SPEC_FILE, STUDY_FILE, StudyOptions
 
 __all__ = ["is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
@@ -41,10 +41,10 @@ def is_ppo_spec(path: str) -> bool:
 
 
 def load_ppo_spec(path: str) -> StudySpec:
-    """The MiniGrid PPO spec at ``path``, JSON or TOML; SetupError naming the file and key."""
-    if Path(path).suffix.lower() == ".json":
-        return load_spec(Path(path), label="the study spec")
-    return spec_from_dict(_toml(Path(path)) or {}, path)
+    """The MiniGrid PPO spec at ``path``, JSON or TOML (by its suffix, as
+    :func:`~simoun_lab.minigrid_study.spec.load_spec` reads it); SetupError naming the file and
+    key."""
+    return load_spec(Path(path), label="the study spec")
 
 
 def plan(spec: StudySpec, path: str) -> str:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME, TRAIN_CSV
 from simoun_lab.engine.launcher import archive_files, read_run_files
@@ -23,6 +24,26 @@ GENERALIZATION_CSV = "generalization.csv"
 
 RUN_FILES = (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, TRIAL_FILE, GENERALIZATION_CSV, SUMMARY_NAME)
 """What the archive keeps of a finished run, ``summary.json`` last (its mark of a whole copy)."""
+
+
+def check_archive_apart(archive: Path, other: Path, other_flag: str, example: str) -> None:
+    """Refuse an ``--archive`` that is the working directory ``other`` (given as ``other_flag``),
+    lies inside it or holds it: the archive is the finished runs' copy, and runs found under
+    one would be read twice, or the records it keeps removed with the working directory.
+    ``example`` is a directory apart to suggest."""
+    kept, work = archive.resolve(), other.resolve()
+    if kept == work:
+        problem = f"--archive {archive} is the {other_flag} itself"
+    elif work in kept.parents:
+        problem = f"--archive {archive} is inside {other_flag} {other}"
+    elif kept in work.parents:
+        problem = f"{other_flag} {other} is inside --archive {archive}"
+    else:
+        return
+    raise SetupError(
+        f"{problem}; the archive keeps a copy of the finished runs apart from the {other_flag} "
+        f"records: pass directories apart from each other (e.g. --archive {example})"
+    )
 
 
 def copy_file(source: Path, target: Path) -> None:

@@ -77,10 +77,13 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
             try:
                 made[env] = check_task(config)
             except SetupError as err:
+                said = str(err).rstrip(".")
+                if not said.startswith(config.env):
+                    said = f"{config.env} cannot be trained by the recipes: {said}"
                 raise source.error(
                     (phase, "tasks"),
-                    f"{config.env} cannot be trained by the recipes: {err} Replace it in "
-                    f"[{phase}] tasks (the spec is read before anything runs).",
+                    f"{said}. Replace it in [{phase}] tasks (the spec is read before anything "
+                    "runs).",
                 ) from None
         try:
             check_replay(config, made[env], SPEC_KEYS)

@@ -57,20 +57,20 @@ from dataclasses import MISSING, asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve
+from simoun_agent.config import PRESETS, RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.keys import (
     HELP_FIX,
-    close_match,
     config_fields,
     config_sections,
     parse_value,
 )
+from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
-from simoun_lab.sweep.grid import MAX_SEEDS, parse_seeds
+from simoun_lab.sweep.grid import MAX_SEEDS, close_key_here, parse_seeds
 
 try:
     import tomllib
@@ -386,8 +386,9 @@ class _Reader:
             raise self.fail(("grid_overrides",), 'give a list of grid keys, e.g. ["agent.n_step"]')
         for key in overrides:
             if key not in self.fields:
+                hint = close_key_here(key, STUDY_SETS, "the study")
                 raise self.fail(
-                    ("grid_overrides",), f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}"
+                    ("grid_overrides",), f"unknown config key {key!r}{hint}; {HELP_FIX}"
                 )
         grid = self.grid(data["grid"], every, preset, base, overrides)
         tuning = self.phase(data["tuning"], "tuning")
@@ -494,7 +495,8 @@ class _Reader:
         if key in STUDY_SETS:
             raise self.fail(where, f"the study sets {key} itself; give it as {STUDY_SETS[key]}")
         if key not in self.fields:
-            raise self.fail(where, f"unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
+            hint = close_key_here(key, STUDY_SETS, "the study")
+            raise self.fail(where, f"unknown config key {key!r}{hint}; {HELP_FIX}")
         for recipe, fixed in fixed_by(key, recipes).items():
             raise self.fail(
                 where,
@@ -553,6 +555,19 @@ class _Reader:
         except SetupError as err:
             raise self.fail(where, str(err)) from None
 
+    def example_value(
+        self, key: str, value: Any, where: tuple[str, ...], preset: str | None, base: dict
+    ) -> str:
+        """A valid value of ``key`` in TOML, for an example: ``value`` when it is one (a
+        single value given where a list is wanted), else the value the study's base gives."""
+        try:
+            good = self.typed(key, value, where) if not isinstance(value, list) else None
+        except SetupError:
+            good = None
+        if good is None:
+            good = flatten(to_dict(resolve(preset, base))).get(key)
+        return '"none"' if good is None else json.dumps(good)
+
     def grid(
         self,
         value: Any,
@@ -577,8 +592,9 @@ class _Reader:
                 line = key_line(self.source.text, ("base", *key.split(".")))
                 raise self.fail(path, f"{key} is in [base] too (line {line}); keep it in one place")
             if not isinstance(values, list) or not values:
+                example = self.example_value(key, values, path, preset, base)
                 raise self.fail(
-                    path, f"give a non-empty list of values, e.g. {key} = [{show(values)}, ...]"
+                    path, f"give a non-empty list of values, e.g. {key} = [{example}, ...]"
                 )
             typed = [self.typed(key, v, path) for v in values]
             if len({show(v) for v in typed}) < len(typed):

@@ -28,6 +28,7 @@ from typing import Any
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.config.envs import env_label
+from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
@@ -59,6 +60,7 @@ would be built in memory before anything could refuse it."""
 def parse_seeds(text: str) -> list[int]:
     """``"0-4"`` -> [0, 1, 2, 3, 4]; ``"0,2,5"`` and mixes like ``"0-2,7"`` work too; at most
     :data:`MAX_SEEDS` seeds."""
+    check_commas("--seeds", text, spaces=False)
     seeds: list[int] = []
     for part in text.split(","):
         match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
@@ -103,6 +105,30 @@ def split_values(text: str) -> list[str]:
     return [value.strip() for value in values]
 
 
+OTHER_SEPARATORS = ";|"
+"""Separators a list flag is sometimes given with instead of commas."""
+
+
+def check_commas(flag: str, text: str, key: str = "", spaces: bool = True) -> None:
+    """Raise SetupError when the list ``text`` of ``flag`` (``--envs``, ``--seeds``, or
+    ``--grid`` with ``key``) separates its values by ``;``, ``|`` (or, with ``spaces``, blanks)
+    instead of commas: read as one value, it would be refused for a false reason, or taken as
+    one."""
+    for value in split_values(text):
+        if value[:1] in '[{"':
+            continue  # a JSON value may hold any of these
+        found = [sep for sep in OTHER_SEPARATORS if sep in value]
+        if spaces and len(value.split()) > 1:
+            found.append(" ")
+        if found:
+            parts = [part for part in re.split(r"[;|\s]+", text) if part]
+            given = f"{key}={text}" if key else text
+            raise SetupError(
+                f"{flag} {given!r}: values separated by {found[0]!r}; {flag} takes "
+                f"comma-separated values, e.g. {flag} {key}{'=' if key else ''}{','.join(parts)}"
+            )
+
+
 def check_key(key: str, flag: str) -> None:
     """Raise SetupError for a key that is no config key (with the closest ones) or that the sweep
     sets itself."""
@@ -110,7 +136,24 @@ def check_key(key: str, flag: str) -> None:
         raise SetupError(f"{flag} cannot set {key}: the sweep sets it; use {DEDICATED[key]}")
     known = config_fields()
     if key not in known:
-        raise SetupError(f"{flag}: unknown config key {key!r}{close_match(key)}; {HELP_FIX}")
+        hint = close_key_here(key, DEDICATED, "the sweep")
+        raise SetupError(f"{flag}: unknown config key {key!r}{hint}; {HELP_FIX}")
+
+
+def close_key_here(key: str, set_here: dict[str, str], setter: str) -> str:
+    """``" (did you mean agent.lr?)"`` for an unknown config ``key``, naming only keys that can
+    be given where it was: the keys of ``set_here`` are set by ``setter`` itself (each mapped
+    to where to give it instead), so the closest of them is answered with that place."""
+    if any(known.startswith(key + ".") for known in config_fields()):
+        return close_match(key)  # a section: one of its fields
+    docs = {known: doc for known, (_, _, doc) in config_fields().items()}
+    matches = close_keys(key, docs)
+    allowed = [match for match in matches if match not in set_here]
+    if allowed:
+        return f" (did you mean {' or '.join(allowed)}?)"
+    if matches:
+        return f" ({setter} sets {matches[0]} itself: give it as {set_here[matches[0]]})"
+    return ""
 
 
 def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
@@ -127,6 +170,7 @@ def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
         check_key(key, f"--grid {pair}")
         if key in grid:
             raise SetupError(f"--grid names {key} twice; give all its values in one --grid")
+        check_commas("--grid", text.strip(), key, spaces=False)
         texts = split_values(text)
         if not text.strip() or any(not value for value in texts):
             raise SetupError(
@@ -232,6 +276,8 @@ class SweepSpec:
             # to reach the trials' own processes too
             base = {**base, "env_module": base_config.env_module}
         seed_list = parse_seeds(seeds) if seeds is not None else [base_config.seed]
+        if envs is not None:
+            check_commas("--envs", envs)
         env_list = split_values(envs) if envs is not None else [base_config.env]
         if not all(env_list):
             raise SetupError(f"--envs {envs!r} has an empty id; e.g. --envs simoun/PointReach-v0")

@@ -596,6 +596,57 @@ def shortfall(record: RunRecord, column: str, budget: float) -> str | None:
     return None
 
 
+BUDGET_FLAGS = {"env_step": "--at-step", "wall_time_s": "--at-wall-time"}
+"""The command-line flag of each budget column."""
+
+
+def check_budget_keeps_a_run(records: list[RunRecord], column: str, budget: float) -> None:
+    """Raise SetupError when runs with evaluations exist but none counts at ``budget`` of
+    ``column``: a report of empty rows compares nothing. The message names the flag, the
+    budgets the runs do reach and one that keeps them all."""
+    curves = [record.curve[column] for record in records if len(record.curve[column])]
+    if not curves:
+        return
+    flag = BUDGET_FLAGS[column]
+    if column == "env_step":
+        # the evaluation at step 0 is before any training: no budget to compare at
+        reached = [{float(x) for x in curve if x > 0} for curve in curves]
+        steps = sorted(set.union(*reached))
+        if not steps:
+            return
+        shared = set.intersection(*reached)
+        example = max(shared) if shared else steps[-1]
+        raise SetupError(
+            f"{flag} {budget:g} leaves every run out: no run has an evaluation at {budget:g} env "
+            f"steps (the runs evaluate at {listed(steps)}); pass one of those, e.g. {flag} "
+            f"{example:g}, or leave {flag} out to compare the runs at their ends"
+        )
+    longest = max(float(curve.max()) for curve in curves)
+    example = round_down(min(float(curve.max()) for curve in curves))
+    raise SetupError(
+        f"{flag} {budget:g} leaves every run out: no run trained that long with an evaluation "
+        f"within it (the longest trained {longest:.3g} s, by its last evaluation); pass a budget "
+        f"every run reached, e.g. {flag} {example:g}, or leave {flag} out to compare the runs "
+        "at their ends"
+    )
+
+
+def round_down(value: float) -> float:
+    """``value`` rounded down to three significant digits (a budget it still reaches)."""
+    if value <= 0:
+        return value
+    scale = 10.0 ** (2 - math.floor(math.log10(value)))
+    return math.floor(value * scale) / scale
+
+
+def listed(values: list[float], most: int = 8) -> str:
+    """``values`` as ``a, b, c`` (the first and last three with ``...`` between when long)."""
+    shown = [f"{value:g}" for value in values]
+    if len(shown) > most:
+        shown = [*shown[:3], "...", *shown[-3:]]
+    return ", ".join(shown)
+
+
 def drop_duplicate_seeds(runs: list[RunRecord]) -> tuple[list[RunRecord], list[tuple]]:
     """One run per seed: of two runs with one seed (a plain run and a sweep trial of the same
     config), the one that counts (finished or at the budget) is kept, then one that did not
@@ -647,7 +698,8 @@ class Comparison:
 def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Comparison:
     """Find the runs under ``root``, cut them at ``budget`` (:func:`at_budget`), group them,
     keep one evaluation grid per row (:func:`one_evaluation_grid`) and one run per seed
-    (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run."""
+    (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run, or when
+    ``budget`` leaves out every run that has evaluations (:func:`check_budget_keeps_a_run`)."""
     root = Path(root)
     if not root.exists():
         raise SetupError(
@@ -693,6 +745,8 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
                 reasons[record.run_dir] = shortfall(record, column, value) or ""
                 record.summary = None
             cut_records.append(cut or record)
+        if not any(record.summary is not None for record in cut_records):
+            check_budget_keeps_a_run(records, column, value)
         records = cut_records
     comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
     comparison.damaged = damaged
