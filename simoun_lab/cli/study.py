@@ -35,7 +35,6 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_lab.engine.ray_start import load_ray
-from simoun_lab.study.archive import check_archive_apart
 from simoun_lab.study.options import StudyOptions
 
 PROG = "simoun-study"
@@ -168,6 +167,8 @@ def check_outputs(options: Run) -> None:
     for flag, path in outputs(options).items():
         check_output_dir(path, flag)
     if options.archive is not None:
+        from simoun_lab.study.archive import check_archive_apart  # torch: after the flags
+
         check_archive_apart(options.archive, options.study_dir, "--study-dir", "docs/studies/NAME")
 
 
