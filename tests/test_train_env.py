@@ -12,7 +12,13 @@ from simoun_agent.config import SetupError, resolve
 from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
-from simoun_agent.run.make_env import check_task, episode_limit, make_env, video_fps
+from simoun_agent.run.make_env import (
+    check_task,
+    ensure_registered,
+    episode_limit,
+    make_env,
+    video_fps,
+)
 from simoun_agent.run.video import write_video
 
 
@@ -368,3 +374,13 @@ def test_an_env_whose_package_is_missing_is_refused_with_the_install():
             "'simoun_test_absent', which is not installed (pip install simoun_test_absent); "
             "pick another --env"
         )
+
+
+def test_several_env_ids_joined_by_commas_are_named_as_several():
+    ids = "dm_control/cartpole-swingup-v0,dm_control/cheetah-run-v0"
+    with pytest.raises(SetupError) as refused:
+        ensure_registered(ids)
+    assert f"{ids!r} is 2 environment ids joined by commas; an env takes one id" in str(
+        refused.value
+    )
+    assert f"simoun-sweep --envs {ids}" in str(refused.value)

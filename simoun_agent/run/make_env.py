@@ -119,6 +119,13 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
                 ) from None
         if env_id in gym.registry:
             return
+    several = [part.strip() for part in env_id.split(",")]
+    if len(several) > 1 and all(part in gym.registry for part in several):
+        raise SetupError(
+            f"{env_id!r} is {len(several)} environment ids joined by commas; an env takes one "
+            f"id (e.g. {several[0]}): train one run per env, or sweep them with simoun-sweep "
+            f"--envs {','.join(several)}"
+        )
     matches = difflib.get_close_matches(env_id, list(gym.registry), n=5, cutoff=0.6)
     hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
     if module is not None:
