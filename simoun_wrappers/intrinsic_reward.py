@@ -32,7 +32,7 @@ from simoun_wrappers._checks import (
     is_real,
     plain,
 )
-from simoun_wrappers._spec import CheckedSpecWrapper
+from simoun_wrappers._spec import CheckedSpecWrapper, SharedSource
 from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
@@ -144,31 +144,6 @@ def finite_sum(extrinsic: np.ndarray, intrinsic: np.ndarray) -> np.ndarray:
     with np.errstate(over="ignore"):
         total = np.add(extrinsic, intrinsic, dtype=np.float64)
     return np.clip(total, -LARGEST, LARGEST)
-
-
-class SharedSource:
-    """A source as recorded in ``env.spec``: kept by reference, never deep-copied.
-
-    Every wrapper stacked above ours deep-copies the spec (SB3's ``Monitor`` reads ``env.spec``),
-    which would copy a ``CuriosityModel``'s weights and frame buffer (measured: about 1 s and
-    85 MB with an unpooled 84x84 buffer) and wait for its update thread.
-    ``gym.make(env.spec)`` hands this holder back to the constructor, which unwraps it,
-    so a rebuilt env shares the original source, as it does when nothing is stacked above.
-    """
-
-    def __init__(self, source: Any) -> None:
-        self.source = source
-
-    def __deepcopy__(self, memo: dict[int, Any]) -> SharedSource:
-        return self
-
-    def __repr__(self) -> str:
-        return f"SharedSource({self.source!r})"
-
-    @staticmethod
-    def unwrap(source: Any) -> Any:
-        """``source`` itself, or the source a :class:`SharedSource` holds."""
-        return source.source if isinstance(source, SharedSource) else source
 
 
 class SourceProtocol(NamedTuple):
