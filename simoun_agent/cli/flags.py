@@ -563,10 +563,11 @@ PATH_MAX = 4096
 """Bytes in a whole path at most, its final NUL included (Linux)."""
 
 
-def refuse_long_paths(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
-    """Raise ValueError for a path value the file system cannot hold: a name longer than
-    :data:`NAME_MAX` bytes, or a path of :data:`PATH_MAX` bytes or more. The operating system
-    would refuse it from inside whichever step touches it first, with a traceback."""
+def path_values(
+    argv: Sequence[str], flags: dict[str, Flag], command: Any
+) -> Iterator[tuple[str, str]]:
+    """(where it was given: the flag or the positional's name, the text) of each path value of
+    ``argv``."""
     for value in given_values(argv, flags, command):
         if value.value is None:
             continue
@@ -575,11 +576,18 @@ def refuse_long_paths(argv: Sequence[str], flags: dict[str, Flag], command: Any)
         else:
             where = value.positional.metavar if value.positional else ""
             path = value.positional is not None and value.positional.path
-        if not path:
-            continue
-        size = len(os.fsencode(value.value))
-        longest = max((len(os.fsencode(name)) for name in value.value.split("/")), default=0)
-        short = value.value if len(value.value) <= 60 else value.value[:40] + "..."
+        if path:
+            yield where, value.value
+
+
+def refuse_long_paths(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> None:
+    """Raise ValueError for a path value the file system cannot hold: a name longer than
+    :data:`NAME_MAX` bytes, or a path of :data:`PATH_MAX` bytes or more. The operating system
+    would refuse it from inside whichever step touches it first, with a traceback."""
+    for where, text in path_values(argv, flags, command):
+        size = len(os.fsencode(text))
+        longest = max((len(os.fsencode(name)) for name in text.split("/")), default=0)
+        short = text if len(text) <= 60 else text[:40] + "..."
         if size >= PATH_MAX:
             raise ValueError(
                 f"{where} {short}: the path is {size} bytes long, past the file system's limit "
@@ -596,16 +604,8 @@ def refuse_unexpanded_home(argv: Sequence[str], flags: dict[str, Flag], command:
     """Raise ValueError for a path value that starts with a ``~`` the shell did not expand
     (``--resume=~/runs/a``, a quoted ``'~/runs'``, a script's argument list) and that names
     nothing as written: it would be read, or made, as a directory called ``~`` here."""
-    for value in given_values(argv, flags, command):
-        text = value.value
-        if text is None or not (text == "~" or text.startswith("~/")) or os.path.exists(text):
-            continue
-        if value.flag is not None:
-            where, path = value.flag, flags[value.flag].path
-        else:
-            where = value.positional.metavar if value.positional else ""
-            path = value.positional is not None and value.positional.path
-        if path:
+    for where, text in path_values(argv, flags, command):
+        if (text == "~" or text.startswith("~/")) and not os.path.exists(text):
             raise ValueError(
                 f"{where} {text}: the shell did not expand ~ (it does not after = or inside "
                 f"quotes), so this names a directory called ~ here, which does not exist; give "
