@@ -1,0 +1,3 @@
+"""The eighth reliability trial's cases: files (see reliability_trial.py)."""
+
+CASES: list[dict] = []
