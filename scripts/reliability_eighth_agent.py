@@ -160,7 +160,8 @@ RUN_FLAGS = [
     ("train", env("highway-fast-v0", "--env-kwargs",
                   '{"config": {"action": {"type": "ContinuousAction", "longitudinal": false}}}'),
      "longitudinal", True),
-    ("train", env("highway-fast-v0", "--env-kwargs", highway(""), "--cameras", "2"), "cameras"),
+    ("train", env("highway-fast-v0", "--env-kwargs", highway(""), "--cameras", "2"), "cameras",
+     True),
     # other ids of the families
     ("train", tiny("--env", "dmc/cartpole-swingup-v0"), ("dmc", "dm_control")),
     ("train", pendulum("--cameras", "2"), "cameras"),
@@ -190,7 +191,7 @@ RUNS = [
     ("train", ["--resume", "moved/tiny", "--total-env-steps", "60"], "", True, (moved,)),
     ("train", [*RESUME, "--device", "cuda"], ("cuda", "device")),
     ("train", ["--resume", "{run}/tb", "--total-env-steps", "60"], ("tb", "--resume")),
-    ("train", ["--resume", ".", "--total-env-steps", "60"], ("--resume", "checkpoint", "'.'")),
+    ("train", ["--resume", ".", "--total-env-steps", "60"], ("--resume", "checkpoint", ". is not")),
     ("train", ["--resume", "{run}", "--total-env-steps", "-60"], "--total-env-steps"),
     ("train", [*RESUME, "--agent.conv-init", "delta_orthogonal"], "conv_init"),
     ("train", [*RESUME, "--agent.no-channels-last"], "channels_last", True),
