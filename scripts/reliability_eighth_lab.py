@@ -113,7 +113,7 @@ FLAGS = [
     ("sweep", ["--resume", "--sweep-dir", "sw", "--cpus-per-trial", "2"], "--cpus-per-trial",
      True, (SW,)),
     ("sweep", ["--resume", "--sweep-dir", "sw", "--total-env-steps", "20"],
-     ("--total-env-steps", "40")),
+     ("--total-env-steps", "40"), False, (SW,)),
     # simoun-study plan, run, report
     ("study", ["plan", EZ_NAME, "--probe-updates", "0"], "", True, (EZ_FILE,)),
     ("study", ["plan", "arch/study.json"], "study.json", False, (ARCH,)),
