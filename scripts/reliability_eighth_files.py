@@ -415,9 +415,9 @@ API_CASES = [
     api(LOAD + "from pathlib import Path; " + HALVE + "load_run('run')", "checkpoint.pt"),
     api(LOAD + LR + "load_run('run')", ("lr", "config.json")),
     api(CSV + "rows = read_csv('run/eval.csv'); assert rows[-1]['env_step'] == 40", "", True),
-    api(CSV + HASH + "read_csv('run/eval.csv')", ("eval.csv", "comment")),
-    api(CSV + "read_csv('run/summary.json')", "summary.json"),
-    api(CSV + "read_csv('run')", "run"),
+    api(CSV + HASH + "read_csv(p)", ("eval.csv", "comment")),
+    api(CSV + "from pathlib import Path; read_csv(Path('run/summary.json'))", "summary.json"),
+    api(CSV + "from pathlib import Path; read_csv(Path('run'))", "run"),
     api(CSV + "from pathlib import Path; p = Path('run/train.csv'); "
         "p.write_bytes(p.read_text().encode('utf-16')); read_log(p)", "train.csv"),
     api(CSV + "from pathlib import Path; p = Path('run/eval.csv'); "
@@ -427,7 +427,7 @@ API_CASES = [
         True),
     api(CKPT + "load_checkpoint('run/replay-40.npz')", "replay-40.npz"),
     api(CKPT + "load_checkpoint('run/config.json')", "config.json"),
-    api(CKPT + "load_checkpoint('run')", ("run", "checkpoint")),
+    api(CKPT + "load_checkpoint('run')", "", True),
     api(CKPT + "open('run/checkpoint.pt', 'w').close(); load_checkpoint('run/checkpoint.pt')",
         "checkpoint.pt"),
     api(LOAD + "import os; os.remove('run/checkpoint.pt'); os.mkdir('run/checkpoint.pt'); "
