@@ -9,7 +9,7 @@ of shapes, configs and frames, configs changed with ``dataclasses.replace``; ``r
 ``from_dict`` and ``to_dict`` given what a user writes in Python instead of on the command line;
 Gymnasium's RecordVideo, FrameStackObservation, DtypeObservation, ResizeObservation,
 NormalizeReward and vector ClipReward around and under the wrappers, SyncVectorEnv built by hand,
-``reset`` with a positional seed or options, envs with their own time limit; the intrinsic rewards
+``reset`` with a positional seed, envs with their own time limit; the intrinsic rewards
 given lambdas, torch tensors, models of another size and arguments of another normalisation; the
 PettingZoo wrapper's render, state, and envs without a render mode; replays of a kept run and files
 of another kind given to ``FrameReplay.load``, and PointReach's own arguments and through the
