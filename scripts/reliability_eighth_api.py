@@ -200,7 +200,7 @@ EIGHTH_CODES = [
      f"{C}), (32, 32)), size=None, source='observation'); {STEP}", ""),
     (f"w.SimounObservation({C}, size=16, source='observation')", ("source", "observation")),
     (f"e = w.SimounObservation({P}, size=(16, 24)); {STEP}; "
-     "assert e.observation_space.shape[-2:] == (16, 24), e.observation_space", ""),
+     "assert e.observation_space['frames'].shape[-2:] == (16, 24), e.observation_space", ""),
     (f"e = {S}; e.reset(0)", "seed"),
     ("e = w.SimounObservation(gym.make('Pendulum-v1', render_mode='rgb_array', "
      "max_episode_steps=3), size=16); e.reset(seed=0); "
