@@ -302,10 +302,10 @@ def test_a_highway_task_without_continuous_actions_is_named_in_one_sentence_with
 
 
 def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
-    highway = {"config": {"action": {"type": "ContinuousAction"}, "lanes_count": 0}}
+    highway = {"config": {"action": {"type": "ContinuousAction"}, "vehicles_density": "high"}}
     with pytest.raises(SetupError) as error:
         check_task(env_config("highway-fast-v0", highway))
-    assert "highway-fast-v0 cannot use config.lanes_count=0 (making it failed: " in str(error.value)
+    assert 'cannot use config.vehicles_density="high" (making it failed: ' in str(error.value)
     assert str(error.value).endswith("Fix or drop that key")
     # a misspelled action type: only dropping the dict that holds it makes the env work
     typo = {"config": {"action": {"type": "ContinousAction"}}}
