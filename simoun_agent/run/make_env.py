@@ -455,8 +455,8 @@ def no_continuous_actions(config: TrainConfig, culprit: str) -> bool:
 
 def _first_step(env: gym.Env) -> bool:
     """Reset ``env``, take one middle action and render; whether that step ended the episode.
-    Raises the ValueError or TypeError of :func:`check_render` for a render that holds no
-    image (a side of 0, not uint8 (H, W, 3)) when the env learns from its renders."""
+    Raises :class:`UnusableRender` for a render that holds no frame (a side of 0, not a uint8
+    (H, W, 3) image) when the agent's frames would come from the renders."""
     env.reset(seed=0)
     space = env.action_space
     middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
@@ -488,7 +488,8 @@ class UnusableRender(ValueError):
 def check_first_step(env: gym.Env, config: TrainConfig) -> None:
     """Reset ``env`` (made with ``config``'s ``--env-kwargs``), take one middle action and render:
     an env that stores a keyword's value unchecked fails here, before a run is spent, rather
-    than at its first training step."""
+    than at its first training step, and so does one whose render holds no frame (a render
+    width of 0)."""
     try:
         ended = _first_step(env)
     except UnusableRender as err:
