@@ -213,9 +213,19 @@ class CuriosityModel(OnlineModel):
     config_type = CuriosityConfig
 
     def _smallest_frame(self) -> tuple[int, str, int]:
-        interactive = self.config.interactive
-        needs = "the conv paths" + (" and the interactive module" if interactive else "")
-        return min_image_size(AgentConfig(encoder=self._encoder_name())), needs, 32
+        config = self.config
+        needs = "the conv paths" + (" and the interactive module" if config.interactive else "")
+        smallest = min_image_size(AgentConfig(encoder=self._encoder_name()))
+        kernel = config.random_conv_kernel
+        if config.contrastive_weight and kernel > smallest:
+            # L_con's positives are a random convolution of the encoded frames: a kernel wider
+            # than them sees only padding, and would fail at the first update, in the background
+            needs += (
+                f" and the random convolution of CuriosityConfig.random_conv_kernel={kernel} "
+                "(or lower it, e.g. to 3)"
+            )
+            smallest = kernel
+        return smallest, needs, max(32, smallest)
 
     def _encoder_name(self) -> str:
         return "dual_interactive" if self.config.interactive else "dual"

@@ -309,6 +309,26 @@ def test_a_stray_argument_is_refused_naming_it(main, argv, said, capsys):
 
 
 @pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (train_cli.main, ["--no-video", "agent.lr=1e-3"], "--no-video is a switch and takes no "
+         "value, and a KEY=VALUE setting is not given bare: write --set agent.lr=1e-3 or "
+         "--agent.lr 1e-3; got 'agent.lr=1e-3'"),
+        (train_cli.main, ["agent.lr=1e-3"], "unexpected argument 'agent.lr=1e-3': simoun-train "
+         "takes no positional argument (every value goes with its --flag); a KEY=VALUE setting "
+         "is not given bare: write --set agent.lr=1e-3 or --agent.lr 1e-3"),
+        (train_cli.main, ["--overwrite", "+agent.batch_size=8"], "write --set "
+         "agent.batch_size=8 or --agent.batch-size 8"),
+        (sweep_cli.main, ["--resume", "seed=3"], "write --set seed=3 or --seed 3"),
+        (eval_cli.main, ["RUN", "--no-video", "episodes=3"], "a KEY=VALUE setting is not given "
+         "bare: write --episodes 3"),
+    ],
+)  # fmt: skip
+def test_a_bare_key_value_setting_is_answered_with_the_forms_that_take_it(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
     "argv",
     [["masks", "RUN", "--video", "--steps", "2"], ["masks", "RUN", "--video", "mp4", "--steps",
      "2"], ["masks", "--video", "RUN"], ["bias", "--out", "o", "RUN", "RUN2"]],

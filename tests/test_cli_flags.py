@@ -10,7 +10,7 @@ from simoun_agent.config import SetupError, resolve
 
 
 def overrides(argv: list[str]) -> dict:
-    return overrides_from(train_cli.parse_command(argv).flags, argv)
+    return overrides_from(train_cli.parse_command(argv).flags, argv, train_cli.TrainCommand)
 
 
 def test_a_value_equal_to_the_presets_still_beats_the_recipe():
@@ -90,6 +90,44 @@ def test_set_preset_is_refused_pointing_at_the_preset_flag():
     ):
         overrides(["--set", "preset=cpu"])
     assert overrides(["--preset", "cpu", "--set", "preset=cpu"]) == {}
+
+
+def test_set_preset_of_no_preset_says_so_with_the_presets():
+    with pytest.raises(SetupError) as error:
+        overrides(["--set", "preset=nope"])
+    assert str(error.value).startswith(
+        "--set preset=nope: 'nope' is no preset; the presets are cartpole-swingup, "
+    )
+    assert "one is applied by --preset NAME (e.g. --preset cpu), not by --set" in str(error.value)
+    with pytest.raises(SetupError, match=r"'cpux' is no preset \(did you mean 'cpu'\?\)"):
+        overrides(["--set", "preset=cpux"])
+
+
+@pytest.mark.parametrize(
+    ("pair", "said"),
+    [
+        ("resume=runs/a", "--set resume=runs/a: resume is not a config key but the flag "
+         "--resume; give --resume runs/a instead"),
+        ("overwrite=true", "overwrite is not a config key but the flag --overwrite; give "
+         "--overwrite instead"),
+        ("overwrite=false", "the flag --overwrite; leave --overwrite out"),
+    ],
+)  # fmt: skip
+def test_set_of_a_command_flag_points_at_the_flag(pair, said):
+    with pytest.raises(SetupError) as error:
+        overrides(["--set", pair])
+    assert said in str(error.value)
+
+
+def test_set_of_a_sweep_flag_points_at_the_flag(capsys):
+    from simoun_lab.cli import sweep as sweep_cli
+
+    with pytest.raises(SystemExit) as stop:
+        sweep_cli.main(["--set", "sweep_dir=s"])
+    assert stop.value.code == 2
+    assert "sweep_dir is not a config key but the flag --sweep-dir; give --sweep-dir s" in (
+        capsys.readouterr().err
+    )
 
 
 def test_set_with_spaces_around_the_equals_sign_says_so():

@@ -97,3 +97,64 @@ def test_a_train_config_is_refused_just_below_the_smallest_size(cameras):
         r"\(TrainConfig.image_size=23\) or more",
     ):
         resolve(None, {**agent, "image_size": 22})
+
+
+def test_a_reducing_kernel_too_wide_for_the_frames_names_every_setting_that_fixes_it():
+    with pytest.raises(SetupError) as error:
+        resolve(None, {"image_size": 32, "agent.reduce_kernel": 41})
+    message = str(error.value)
+    assert message.startswith(
+        "--image-size 32 (TrainConfig.image_size): too small for the conv trunk of encoder "
+        "'dual_interactive' with --agent.reduce-kernel 41 (AgentConfig.reduce_kernel=41); set "
+    )
+    for fix in (
+        "--image-size 95 (TrainConfig.image_size=95) or more",
+        "--agent.reduce-kernel 9 (AgentConfig.reduce_kernel=9) or less",
+        "--agent.encoder dual (AgentConfig.encoder='dual')",
+    ):
+        assert fix in message
+    # each fix it names works: 32 -> 15 -> 13 -> 11 -> 9 through the trunk
+    assert resolve(None, {"image_size": 95, "agent.reduce_kernel": 41}).image_size == 95
+    assert resolve(None, {"image_size": 32, "agent.reduce_kernel": 9}).agent.reduce_kernel == 9
+    dual = {"image_size": 32, "agent.reduce_kernel": 41, "agent.encoder": "dual"}
+    assert resolve(None, dual).agent.encoder == "dual"
+
+
+def test_a_frame_the_trunk_alone_cannot_take_is_answered_with_the_image_size_only():
+    with pytest.raises(SetupError) as error:
+        resolve(None, {"image_size": 12})
+    assert "--agent.reduce-kernel" not in str(error.value).partition("; set ")[2].split(" (")[0]
+    assert "--image-size 19 (TrainConfig.image_size=19) or more" in str(error.value)
+    assert "--agent.encoder dual" not in str(error.value)
+
+
+def test_a_random_conv_kernel_wider_than_the_frames_is_refused_before_training():
+    with pytest.raises(SetupError) as error:
+        resolve(None, {"image_size": 32, "agent.random_conv_kernel": 33})
+    message = str(error.value)
+    assert message.startswith(
+        "--agent.random-conv-kernel 33 (AgentConfig.random_conv_kernel): the random convolution"
+    )
+    for fix in (
+        "--agent.random-conv-kernel 3 (AgentConfig.random_conv_kernel=3)",
+        "any odd value up to 31",
+        "--image-size 33 (TrainConfig.image_size=33) or more",
+        "--agent.contrastive-view shift",
+    ):
+        assert fix in message
+    assert resolve(None, {"image_size": 32, "agent.random_conv_kernel": 31}).image_size == 32
+    assert resolve(None, {"image_size": 33, "agent.random_conv_kernel": 33}).image_size == 33
+    # a kernel nothing runs is no problem: L_con off, or its positive a shift
+    for unused in ({"agent.contrastive_weight": 0.0}, {"agent.contrastive_view": "shift"}):
+        resolve(None, {"image_size": 32, "agent.random_conv_kernel": 33, **unused})
+
+
+def test_the_agent_refuses_frames_its_random_convolution_or_reducing_conv_cannot_take():
+    from simoun_agent import SimounAgent
+
+    small = AgentConfig(batch_size=8, num_filters=4, random_conv_kernel=33)
+    with pytest.raises(ValueError, match=r"random_conv_kernel=33 is wider than the 32x32 frames"):
+        SimounAgent((3, 32, 32), 1, small)
+    wide = AgentConfig(batch_size=8, num_filters=4, reduce_kernel=41)
+    with pytest.raises(ValueError, match=r"lower AgentConfig.reduce_kernel=41 to 9 or less"):
+        SimounAgent((3, 32, 32), 1, wide)

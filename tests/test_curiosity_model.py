@@ -149,3 +149,16 @@ def test_agent_features_expose_a_simoun_agents_encoder():
     assert f_a.shape == (1, 3, 16) and info["reward_intrinsic"] > 0
     with pytest.raises(TypeError, match="encoder_features"):
         AgentFeatures(torch.nn.Linear(2, 2))
+
+
+def test_a_random_conv_kernel_wider_than_the_encoded_frames_is_refused_when_built():
+    space = gym.spaces.Box(-2, 2, (1,))
+    wide = CuriosityConfig(**{**TINY, "random_conv_kernel": 33})
+    with pytest.raises(ValueError) as error:
+        CuriosityModel((3, 32, 32), space, wide, device="cpu")
+    assert "CuriosityConfig.random_conv_kernel=33 (or lower it, e.g. to 3) need H, W >= 33" in (
+        str(error.value)
+    )
+    CuriosityModel((3, 32, 32), space, CuriosityConfig(**{**TINY, "random_conv_kernel": 31}), "cpu")
+    off = CuriosityConfig(**{**TINY, "random_conv_kernel": 33, "contrastive_weight": 0.0})
+    CuriosityModel((3, 32, 32), space, off, device="cpu")

@@ -13,6 +13,7 @@ from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
 from simoun_agent.run.make_env import (
+    check_env_kwargs,
     check_task,
     ensure_registered,
     episode_limit,
@@ -301,10 +302,10 @@ def test_a_highway_task_without_continuous_actions_is_named_in_one_sentence_with
 
 
 def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
-    highway = {"config": {"action": {"type": "ContinuousAction"}, "lanes_count": 0}}
+    highway = {"config": {"action": {"type": "ContinuousAction"}, "vehicles_density": "high"}}
     with pytest.raises(SetupError) as error:
         check_task(env_config("highway-fast-v0", highway))
-    assert "highway-fast-v0 cannot use config.lanes_count=0 (making it failed: " in str(error.value)
+    assert 'cannot use config.vehicles_density="high" (making it failed: ' in str(error.value)
     assert str(error.value).endswith("Fix or drop that key")
     # a misspelled action type: only dropping the dict that holds it makes the env work
     typo = {"config": {"action": {"type": "ContinousAction"}}}
@@ -352,8 +353,8 @@ def test_a_negative_count_in_env_kwargs_is_refused_naming_the_key():
     with pytest.raises(SetupError) as error:
         check_task(env_config("highway-fast-v0", negative))
     assert str(error.value).startswith(
-        "--env-kwargs: config.vehicles_count=-5 is negative, and highway-fast-v0's "
-        "config.vehicles_count is a count (default 20)"
+        "--env-kwargs: config.vehicles_count=-5 (highway-fast-v0's number of other vehicles) "
+        "must be a whole number >= 0"
     )
     with pytest.raises(SetupError, match=r"size=-8 is negative"):
         check_task(env_config("MiniGrid-Empty-8x8-v0", {"size": -8}, env_module="minigrid"))
@@ -384,3 +385,67 @@ def test_several_env_ids_joined_by_commas_are_named_as_several():
         refused.value
     )
     assert f"simoun-sweep --envs {ids}" in str(refused.value)
+
+
+HIGHWAY_CONTINUOUS = {"action": {"type": "ContinuousAction"}}
+
+
+@pytest.mark.parametrize(
+    ("given", "said"),
+    [
+        ({"simulation_frequency": 0}, "config.simulation_frequency=0 (highway-fast-v0's "
+         "simulation steps per second) must be a number > 0; e.g. "
+         "'{\"config\": {\"simulation_frequency\": 5}}' (its default)"),
+        ({"simulation_frequency": -1}, "config.simulation_frequency=-1 (highway-fast-v0's "
+         "simulation steps per second) must be a number > 0"),
+        ({"policy_frequency": 0}, "config.policy_frequency=0 (highway-fast-v0's agent "
+         "decisions per second) must be a number > 0"),
+        ({"policy_frequency": 10}, "config.policy_frequency=10 is above "
+         "config.simulation_frequency=5 for highway-fast-v0"),
+        ({"simulation_frequency": 0.5}, "config.policy_frequency=1 is above "
+         "config.simulation_frequency=0.5"),
+        ({"duration": 0}, "config.duration=0 (highway-fast-v0's episode length in seconds) "
+         "must be a number > 0"),
+        ({"lanes_count": 0}, "config.lanes_count=0 (highway-fast-v0's number of lanes) must be "
+         "a whole number >= 1"),
+        ({"lanes_count": 2.5}, "config.lanes_count=2.5"),
+        ({"vehicles_count": -1}, "config.vehicles_count=-1"),
+        ({"controlled_vehicles": 0}, "config.controlled_vehicles=0"),
+        ({"vehicles_density": 0}, "config.vehicles_density=0"),
+        ({"scaling": -1}, "config.scaling=-1"),
+    ],
+)  # fmt: skip
+def test_a_highway_config_value_that_breaks_the_task_is_refused_naming_the_key(given, said):
+    kwargs = {"config": {**HIGHWAY_CONTINUOUS, **given}}
+    with pytest.raises(SetupError) as error:
+        check_env_kwargs("highway-fast-v0", kwargs)
+    assert str(error.value).startswith(f"--env-kwargs: {said}")
+    fix = "set config.simulation_frequency to" if "is above" in said else "or drop config."
+    assert fix in str(error.value)
+
+
+def test_a_simulation_frequency_of_zero_is_refused_before_a_run_is_spent():
+    zero = {"config": {**HIGHWAY_CONTINUOUS, "simulation_frequency": 0}}
+    with pytest.raises(SetupError, match=r"config.simulation_frequency=0 .* must be a number > 0"):
+        check_task(env_config("highway-fast-v0", zero))
+    # values that keep the task are taken: no traffic, a faster policy within the simulation
+    kept = {"vehicles_count": 0, "policy_frequency": 5, "simulation_frequency": 5, "duration": 2}
+    assert check_env_kwargs("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **kept}}) is None
+    penalty = {"config": {**HIGHWAY_CONTINUOUS, "collision_reward": -3}}
+    assert check_env_kwargs("highway-fast-v0", penalty) is None
+
+
+def test_an_env_that_renders_no_frame_is_refused_at_set_up_naming_the_key():
+    dmc = "dm_control/cartpole-swingup-v0"
+    zero_width = env_config(dmc, {"render_kwargs": {"width": 0}})
+    with pytest.raises(SetupError) as error:
+        check_task(zero_width)
+    message = str(error.value)
+    assert message.startswith('--env-kwargs {"render_kwargs": {"width": 0}}: ')
+    assert "returned an array of shape (240, 0, 3)" in message
+    assert "render_kwargs.width=0 is the value that spoils it" in message
+    assert '\'{"render_kwargs": {"width": 32, "height": 32, "camera_id": 0}}\'' in message
+    # built without the check (a sweep's trial, a resumed run), it is refused all the same
+    with pytest.raises(SetupError, match=r"--env-kwargs .* gives no frames to learn from"):
+        make_env(zero_width)
+    assert check_task(env_config(dmc, {"render_kwargs": {"width": 48, "height": 40}})) == 1000

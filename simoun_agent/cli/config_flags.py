@@ -21,6 +21,7 @@ from typing import Annotated, Any
 
 import tyro
 
+from simoun_agent.cli.command_flags import Flag, command_flags
 from simoun_agent.cli.flags import empty_value, negated
 from simoun_agent.config import PRESETS, RECIPES, SetupError, TrainConfig, resolve
 from simoun_agent.config.keys import (
@@ -31,6 +32,7 @@ from simoun_agent.config.keys import (
     config_fields,
     parse_value,
 )
+from simoun_agent.config.rules import did_you_mean_name
 
 PRESETS_HELP = "start from a named preset: " + ", ".join(PRESETS)
 RECIPES_HELP = "agent recipes (--agent.recipe NAME):\n" + "\n".join(
@@ -105,10 +107,11 @@ def config_switches() -> list[str]:
     return [key_flag(key) for key, (kind, _, _) in config_fields().items() if kind is bool]
 
 
-def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
+def overrides_from(flags: ConfigFlags, argv: Sequence[str], command: Any = None) -> dict[str, Any]:
     """``{"agent.lr": 3e-4, ...}``: the config keys whose flag ``argv`` names, with the values
     tyro read into ``flags`` (a list key's values also split at commas, as ``--set`` does), then
-    the ``--set`` pairs, typed."""
+    the ``--set`` pairs, typed. ``command`` is the command's dataclass: a ``--set`` of one of its
+    own flags (``--set resume=RUN``) is answered with that flag."""
     known = config_flags()
     fields = config_fields()
     check_given_once(argv, flags.set)
@@ -129,26 +132,45 @@ def overrides_from(flags: ConfigFlags, argv: Sequence[str]) -> dict[str, Any]:
             raise SetupError(f"--set takes KEY=VALUE, got {pair!r}; e.g. --set agent.lr=3e-4")
         if key == "preset" and value == flags.preset:
             continue  # the label --preset gives anyway
-        check_set_key(key, value, pair)
+        check_set_key(key, value, pair, own_flags(command, argv))
         given[key] = parse_value(key, value, fields[key][0])
     return given
 
 
-def check_set_key(key: str, value: str, pair: str) -> None:
+def own_flags(command: Any, argv: Sequence[str]) -> dict[str, tuple[str, Flag]]:
+    """The flags of ``command`` (a command's dataclass; None: none) that set no config key, by
+    the name ``--set`` would give them: ``{"resume": ("--resume", Flag(...)), ...}``."""
+    if command is None:
+        return {}
+    return {
+        name[2:].replace("-", "_"): (name, flag)
+        for name, flag in command_flags(command, argv).items()
+        if not flag.config and flag.switch is not False and name not in ("--set", "--preset")
+    }
+
+
+def check_set_key(
+    key: str, value: str, pair: str, own: dict[str, tuple[str, Flag]] | None = None
+) -> None:
     """SetupError for the key of ``--set KEY=VALUE`` that is no config key, with the fix for
     the common ways of getting it wrong: spaces around ``=``, ``preset`` (a label that
-    ``--preset`` sets with the preset's values), a key inside ``env_kwargs``; else the close
-    matches of :func:`~simoun_agent.config.keys.check_keys`."""
+    ``--preset`` sets with the preset's values; an unknown name with the presets), a flag of
+    the command (``own``, :func:`own_flags`: ``--set resume=RUN`` for ``--resume RUN``), a key
+    inside ``env_kwargs``; else the close matches of
+    :func:`~simoun_agent.config.keys.check_keys`."""
     if key != key.strip() or value != value.lstrip():
         raise SetupError(
             f"--set {pair!r}: KEY=VALUE takes no spaces around '='; write "
             f"--set {key.strip()}={value.strip()}"
         )
     if key == "preset":
-        raise SetupError(
-            f"--set preset={value} would only label the run: a preset's values are applied by "
-            f"--preset; give --preset {value} instead"
-        )
+        raise SetupError(set_preset_problem(value))
+    if own and key in own:
+        name, flag = own[key]
+        fix = f"give {name} {value} instead"
+        if flag.switch is not None:  # a switch: given alone, or left out
+            fix = f"leave {name} out" if value.lower() in FALSE_WORDS else f"give {name} instead"
+        raise SetupError(f"--set {pair}: {key} is not a config key but the flag {name}; {fix}")
     section, dot, inner = key.partition(".")
     if dot and section == "env_kwargs":
         try:
@@ -160,6 +182,21 @@ def check_set_key(key: str, value: str, pair: str) -> None:
             f"--env-kwargs '{json.dumps({inner: typed})}'"
         )
     check_keys([key])  # an unknown key fails here, with its close matches
+
+
+def set_preset_problem(value: str) -> str:
+    """Why ``--set preset=VALUE`` is refused: a preset's values are applied by ``--preset``, and
+    an unknown name is no preset at all (named with the presets there are)."""
+    if value not in PRESETS:
+        return (
+            f"--set preset={value}: {value!r} is no preset{did_you_mean_name(value, PRESETS)}; "
+            f"the presets are {', '.join(PRESETS)}, and one is applied by --preset NAME (e.g. "
+            "--preset cpu), not by --set"
+        )
+    return (
+        f"--set preset={value} would only label the run: a preset's values are applied by "
+        f"--preset; give --preset {value} instead"
+    )
 
 
 def check_given_once(argv: Sequence[str], pairs: Sequence[str]) -> None:

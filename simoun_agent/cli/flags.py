@@ -343,8 +343,33 @@ def refuse_stray_words(
             break
         flag = flags.get(arg)
         meant_as_flag = following.startswith("-") or ascii_flag(following)
-        if flag is not None and flag.switch is not None and not meant_as_flag:
-            raise ValueError(f"{switch_use(arg, flag, switches)}; got {following!r}")
+        if flag is None or flag.switch is None or meant_as_flag:
+            continue
+        if forms := setting_forms(following, flags):
+            raise ValueError(
+                f"{arg} is a switch and takes no value, and a KEY=VALUE setting is not given "
+                f"bare: write {forms}; got {following!r}"
+            )
+        raise ValueError(f"{switch_use(arg, flag, switches)}; got {following!r}")
+
+
+SETTING_WORD = re.compile(r"[+~]{0,2}([A-Za-z_][A-Za-z0-9_.-]*)=(.*)", re.DOTALL)
+"""A ``KEY=VALUE`` word, as Hydra takes overrides (``agent.lr=1e-3``, ``+agent.lr=1e-3``)."""
+
+
+def setting_forms(word: str, flags: dict[str, Flag]) -> str:
+    """For a ``KEY=VALUE`` word typed bare (Hydra's way), the forms in which the command takes
+    that setting: ``--set agent.lr=1e-3 or --agent.lr 1e-3`` (each one it has); empty for any
+    other word."""
+    match = SETTING_WORD.fullmatch(word)
+    if match is None:
+        return ""
+    key, value = match.groups()
+    forms = [f"--set {key}={value}"] if "--set" in flags else []
+    flag = "--" + key.replace("_", "-")
+    if flag in flags:
+        forms.append(f"{flag} {value}")
+    return " or ".join(forms)
 
 
 def switch_use(name: str, flag: Flag, switches: Iterable[str]) -> str:
@@ -502,9 +527,14 @@ def refuse_stray_arguments(
         )
     for value in given_values(argv, flags, command):
         if value.flag is None and value.positional is None:
+            forms = setting_forms(value.value, flags)
+            hint = (
+                f"; a KEY=VALUE setting is not given bare: write {forms}"
+                if forms
+                else f"; `{prog}{sub} --help` lists its flags"
+            )
             raise ValueError(
-                f"unexpected argument {value.value!r}: {prog}{sub} takes {takes}; "
-                f"`{prog}{sub} --help` lists its flags"
+                f"unexpected argument {value.value!r}: {prog}{sub} takes {takes}{hint}"
             )
 
 

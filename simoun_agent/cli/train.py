@@ -148,7 +148,7 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
     from simoun_agent.run.memory import check_memory, threads_warning
 
     try:
-        overrides = overrides_from(command.flags, argv)
+        overrides = overrides_from(command.flags, argv, TrainCommand)
         if command.resume:
             if command.flags.preset:
                 raise SetupError("--preset does not combine with --resume: a run keeps its config")

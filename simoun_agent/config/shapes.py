@@ -115,6 +115,33 @@ def frame_fits(agent: EncoderSettings, height: int, width: int) -> bool:
     return min(height, width) >= min_image_size(agent)
 
 
+class ContrastiveSettings(Protocol):
+    """The fields of an ``AgentConfig`` that decide whether L_con's positive is a random
+    convolution of the frames, and of which kernel."""
+
+    contrastive_view: str
+    contrastive_weight: float
+    random_conv_kernel: int
+
+
+def uses_random_conv(agent: ContrastiveSettings) -> bool:
+    """Whether the agent of ``agent`` runs a random convolution over its frames (the
+    contrastive positive of Eq. 3): an L_con of weight above 0 with the view "random_conv"."""
+    return bool(agent.contrastive_weight) and agent.contrastive_view == "random_conv"
+
+
+def kernel_fits(agent: ContrastiveSettings, height: int, width: int) -> bool:
+    """Whether the random convolution of ``agent`` (when it has one) fits frames of ``height``
+    x ``width``: a kernel wider than the frame would see only its zero padding."""
+    return not uses_random_conv(agent) or agent.random_conv_kernel <= min(height, width)
+
+
+def largest_odd(size: int) -> int:
+    """The largest odd number up to ``size`` (at least 1): the widest random-convolution kernel
+    a frame side of ``size`` takes."""
+    return max(1, size if size % 2 else size - 1)
+
+
 def check_channel_first(shape: tuple[int, int, int]) -> None:
     """Refuse a frame shape that looks channel-last (H, W, C), with the channel-first one."""
     channels, height, width = shape
@@ -125,7 +152,11 @@ def check_channel_first(shape: tuple[int, int, int]) -> None:
         )
 
 
-def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: EncoderSettings) -> None:
+class AgentSettings(EncoderSettings, ContrastiveSettings, Protocol):
+    """The fields of an ``AgentConfig`` that decide which frames its agent takes."""
+
+
+def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: AgentSettings) -> None:
     """What ``SimounAgent`` is built for: channel-first frames its encoder accepts, and at least
     one action dimension. Raises ValueError naming the argument and the fix."""
     shape = tuple(frame_shape) if isinstance(frame_shape, Sequence) else (frame_shape,)
@@ -152,8 +183,24 @@ def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: Encod
         )
     if not frame_fits(agent, height, width):
         smallest = min_image_size(agent)
+        reduce = conv_output_size(min(height, width))  # the widest reducing conv that fits
+        lower = (
+            f", or lower AgentConfig.reduce_kernel={agent.reduce_kernel} to {reduce} or less"
+            if ENCODER_SHAPES[agent.encoder].interactive and reduce >= 1
+            else ""
+        )
         raise ValueError(
             f"frames of {height}x{width} are too small for the conv trunk of encoder "
             f"{agent.encoder!r}, which needs at least {smallest}x{smallest}; resize them, e.g. "
-            f"SimounObservation(env, size={max(smallest, 84)})"
+            f"SimounObservation(env, size={max(smallest, 84)}){lower}"
+        )
+    if not kernel_fits(agent, height, width):
+        side = min(height, width)
+        raise ValueError(
+            f"AgentConfig.random_conv_kernel={agent.random_conv_kernel} is wider than the "
+            f"{height}x{width} frames, which the random convolution of L_con's positives "
+            f"(Eq. 3) runs over; set random_conv_kernel=3 (Lee et al. 2020) or another odd "
+            f"value up to {largest_odd(side)}, resize the frames to at least "
+            f"{agent.random_conv_kernel}x{agent.random_conv_kernel} (SimounObservation(env, "
+            f"size=...)), or contrastive_view='shift'"
         )

@@ -28,7 +28,14 @@ from simoun_agent.config.rules import (
     text,
     with_rule,
 )
-from simoun_agent.config.shapes import frame_fits, min_image_size
+from simoun_agent.config.shapes import (
+    ENCODER_SHAPES,
+    conv_output_size,
+    frame_fits,
+    kernel_fits,
+    largest_odd,
+    min_image_size,
+)
 
 _POSITIVE = integer(1)
 
@@ -180,12 +187,50 @@ def check_train_config(config: TrainConfig) -> None:
             f"({knob(config.agent, AGENT, 'batch_size', batch)}); set "
             f"{knob(config, '', 'replay_capacity', batch)} or more, or lower the batch size",
         )
-    if not frame_fits(config.agent, config.image_size, config.image_size * config.cameras):
+    check_frame_size(config)
+
+
+def check_frame_size(config: TrainConfig) -> None:
+    """The frame size against every conv that runs over the frames: the encoder's (its
+    reducing conv too) and the random convolution of L_con's positives. Each refusal names
+    every flag that would fix it, the agent's as well as ``--image-size``."""
+    size, agent = config.image_size, config.agent
+    if not frame_fits(agent, size, size * config.cameras):
+        raise fail(config, "", "image_size", too_small_for_encoder(config))
+    if not kernel_fits(agent, size, size * config.cameras):
+        kernel = agent.random_conv_kernel
         raise fail(
-            config,
-            "",
-            "image_size",
-            f"too small for the conv trunk of encoder {config.agent.encoder!r}; it needs "
-            f"{knob(config, '', 'image_size', min_image_size(config.agent))} or more (the paper "
-            "uses 84)",
+            agent,
+            AGENT,
+            "random_conv_kernel",
+            f"the random convolution of L_con's positives (Eq. 3) runs over the {size}x{size} "
+            f"frames of {knob(config, '', 'image_size', size)}, and a kernel wider than the "
+            f"frame sees only its padding; set {knob(agent, AGENT, 'random_conv_kernel', 3)} "
+            f"(the paper's; any odd value up to {largest_odd(size)}), or "
+            f"{knob(config, '', 'image_size', kernel)} or more, or "
+            f"{knob(agent, AGENT, 'contrastive_view', 'shift')}",
         )
+
+
+def too_small_for_encoder(config: TrainConfig) -> str:
+    """Why ``config.image_size`` is too small for its encoder, and every setting that fixes it:
+    the image size, and for the interactive encoder its reducing kernel and an encoder without
+    that conv, where the trunk alone fits."""
+    agent, size = config.agent, config.image_size
+    fixes = [f"{knob(config, '', 'image_size', min_image_size(agent))} or more"]
+    if not ENCODER_SHAPES[agent.encoder].interactive:
+        return (
+            f"too small for the conv trunk of encoder {agent.encoder!r}; set {fixes[0]} (the "
+            "paper uses 84)"
+        )
+    widest = conv_output_size(size)  # the side of the trunk's last map: the widest reducing conv
+    if widest >= 1:
+        fixes.append(
+            knob(agent, AGENT, "reduce_kernel", widest) + (" or less" if widest > 1 else "")
+        )
+        fixes.append(f"{knob(agent, AGENT, 'encoder', 'dual')}, which has no reducing conv")
+    return (
+        f"too small for the conv trunk of encoder {agent.encoder!r} with "
+        f"{knob(agent, AGENT, 'reduce_kernel', agent.reduce_kernel)}; set "
+        f"{', or '.join(fixes)} (the paper uses 84, with a reducing kernel of 3)"
+    )

@@ -28,8 +28,9 @@ from gymnasium.wrappers import RescaleAction
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
+from simoun_agent.run.highway_config import check_highway_config
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
-from simoun_wrappers.observation import image_layout
+from simoun_wrappers.observation import check_render, image_layout
 
 HIGHWAY_VIEWPORTS = (
     {"centering_position": [0.85, 0.5], "scaling": 2.0},
@@ -285,9 +286,12 @@ def _is_number(value: object) -> bool:
 
 def _check_value_kinds(env_id: str, kwargs: dict) -> None:
     """SetupError for a string given where the creator's default is a number, or a number where
-    it is a string: the env would take it and fail later, mid-run, on arithmetic; and for a
+    it is a string: the env would take it and fail later, mid-run, on arithmetic; for a
+    highway-env config value that breaks the task (:func:`check_highway_config`); and for a
     negative count (:func:`_check_counts`)."""
     defaults = _creator_defaults(env_id)
+    if is_highway(env_id):
+        check_highway_config(env_id, kwargs.get("config"), defaults.get("config"))
     _check_counts(env_id, kwargs, defaults)
     for key, value in kwargs.items():
         default = defaults.get(key)
@@ -450,21 +454,53 @@ def no_continuous_actions(config: TrainConfig, culprit: str) -> bool:
 
 
 def _first_step(env: gym.Env) -> bool:
-    """Reset ``env``, take one middle action and render; whether that step ended the episode."""
+    """Reset ``env``, take one middle action and render; whether that step ended the episode.
+    Raises :class:`UnusableRender` for a render that holds no frame (a side of 0, not a uint8
+    (H, W, 3) image) when the agent's frames would come from the renders."""
     env.reset(seed=0)
     space = env.action_space
     middle = (space.low + space.high) / 2 if isinstance(space, spaces.Box) else space.sample()
     _, _, terminated, truncated, _ = env.step(middle)
-    env.render()
+    frame = env.render()
+    if image_layout(env.observation_space) is None:  # the frames come from the renders
+        try:
+            check_render(frame, "simoun")
+        except (TypeError, ValueError):
+            raise UnusableRender(frame) from None
     return bool(terminated or truncated)
+
+
+class UnusableRender(ValueError):
+    """An env's rgb_array render that holds no frame to learn from (a side of 0, not a uint8
+    (H, W, 3) image); its text says what the render returned."""
+
+    def __init__(self, frame: object) -> None:
+        if isinstance(frame, np.ndarray):
+            what = f"an array of shape {frame.shape} and dtype {frame.dtype}"
+        else:
+            what = "None" if frame is None else f"a {type(frame).__name__}"
+        super().__init__(
+            f"its render() returned {what}, and simoun learns from uint8 (H, W, 3) frames with "
+            "H, W >= 1"
+        )
 
 
 def check_first_step(env: gym.Env, config: TrainConfig) -> None:
     """Reset ``env`` (made with ``config``'s ``--env-kwargs``), take one middle action and render:
     an env that stores a keyword's value unchecked fails here, before a run is spent, rather
-    than at its first training step."""
+    than at its first training step, and so does one whose render holds no frame (a render
+    width of 0)."""
     try:
         ended = _first_step(env)
+    except UnusableRender as err:
+        culprit = faulty_key(config)
+        at_fault = f"; {culprit} is the value that spoils it" if culprit else ""
+        raise SetupError(
+            f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} made with "
+            f"{_kwargs_text(config.env_kwargs)} renders no usable frame: {err}{at_fault}. "
+            f"Give it a render width and height of at least 1{_render_example(config)}, or drop "
+            "the render settings from --env-kwargs"
+        ) from None
     except ENV_VALUE_ERRORS as err:
         culprit = faulty_key(config)
         at_fault = f"; {culprit} is the value it cannot use" if culprit else ""
@@ -484,6 +520,15 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
             f"would have no decision to learn from{at_fault}. Give it a longer episode (a time "
             "limit, duration or step limit of several steps) or drop that key"
         )
+
+
+def _render_example(config: TrainConfig) -> str:
+    """`` (e.g. '{"render_kwargs": ...}')``: the render settings of a dm_control task at the
+    run's image size, which simoun gives it when --env-kwargs names none; empty for others."""
+    if not config.env.startswith("dm_control/"):
+        return ""
+    render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
+    return f" (e.g. '{json.dumps({'render_kwargs': render})}')"
 
 
 MAX_PROBED_KEYS = 12
@@ -655,13 +700,17 @@ def make_env(
     if config.cameras > 1 or is_highway(config.env):
         env = _multi_camera(env, config)
         size = None
-    return SimounObservation(
-        env,
-        size=size,
-        grayscale=config.grayscale,
-        num_frames=config.agent.num_frames,
-        motion=False,
-    )
+    try:
+        return SimounObservation(
+            env,
+            size=size,
+            grayscale=config.grayscale,
+            num_frames=config.agent.num_frames,
+            motion=False,
+        )
+    except (TypeError, ValueError) as err:  # the env's frames: its first render, their size
+        source = f"--env-kwargs {json.dumps(config.env_kwargs)}" if config.env_kwargs else "--env"
+        raise SetupError(f"{source}: {config.env} gives no frames to learn from: {err}") from None
 
 
 def _multi_camera(env: gym.Env, config: TrainConfig) -> MultiCamera:

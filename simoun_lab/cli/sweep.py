@@ -212,7 +212,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
     try:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
-        spec = sweep_spec(args, overrides_from(args.flags, argv), sweep_dir)
+        spec = sweep_spec(args, overrides_from(args.flags, argv, SweepCommand), sweep_dir)
         check_trial_dirs(spec, sweep_dir)
         check_output_dir(sweep_dir, "--sweep-dir")
         gpus_wanted(args.gpus_per_trial)
