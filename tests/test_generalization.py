@@ -146,8 +146,8 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
         (["--eval-distraction", "train"], "is the run's own evaluation"),
         (
             ["--eval-distraction", "none"],
-            "for no distraction, leave --eval-distraction out (the run's own evaluation always "
-            "runs); choose from color_easy, color_hard, video_easy, video_hard (",
+            "each one of color_easy, color_hard, video_easy, video_hard ('none': for no "
+            "distraction, leave it out: the run's own evaluation always runs)",
         ),
         (["--env", "simoun/PointReach-v0", "--eval-distraction", "video_hard"], "dm_control"),
     ],
