@@ -269,4 +269,4 @@ def test_eval_distraction_takes_the_suites_modes():
 
     assert DISTRACTION_MODES == tuple(name for name in DISTRACTIONS if name != "train")
     config = resolve("cpu", {"eval_distraction": list(DISTRACTION_MODES)})
-    assert config.eval_distraction == DISTRACTION_MODES
+    assert tuple(config.eval_distraction) == DISTRACTION_MODES
