@@ -62,25 +62,7 @@ def evaluate(
     """
     check_players(agent, env)
     check_episodes(episodes, seed)
-    check_bool(record, "evaluate(record=...)")
-    if on_episode is not None:
-        check_callable(
-            on_episode,
-            "evaluate(on_episode=...)",
-            "on_episode(index, episode_return)",
-            (0, 0.0),
-            "pass a function of the episode's index and return, e.g. "
-            "on_episode=lambda i, r: print(i, r), or None",
-        )
-    if stop is not None:
-        check_callable(
-            stop,
-            "evaluate(stop=...)",
-            "stop() before every step",
-            (),
-            "pass a function of no arguments that returns True to stop, e.g. "
-            "stop=lambda: False, or None",
-        )
+    check_options(record, on_episode, stop)
     driving = driving_metrics.is_driving_env(env)
     returns, lengths, drives, frames = [], [], [], []
     with torch.random.fork_rng():
@@ -164,6 +146,30 @@ def check_episodes(episodes: Any, seed: Any) -> None:
             f"evaluate(seed=...) must be an int >= 0 (episode i resets with seed + i), got "
             f"{seed!r} ({type(seed).__name__}); e.g. seed=run.first_seed, the run's own "
             "evaluation seeds"
+        )
+
+
+def check_options(record: Any, on_episode: Any, stop: Any) -> None:
+    """A TypeError unless ``record`` is a bool and ``on_episode`` and ``stop`` are None or
+    callables their calls fit (a truthy ``record="no"`` would record)."""
+    check_bool(record, "evaluate(record=...)")
+    if on_episode is not None:
+        check_callable(
+            on_episode,
+            "evaluate(on_episode=...)",
+            "on_episode(index, episode_return)",
+            (0, 0.0),
+            "pass a function of the episode's index and return, e.g. "
+            "on_episode=lambda i, r: print(i, r), or None",
+        )
+    if stop is not None:
+        check_callable(
+            stop,
+            "evaluate(stop=...)",
+            "stop() before every step",
+            (),
+            "pass a function of no arguments that returns True to stop, e.g. "
+            "stop=lambda: False, or None",
         )
 
 
