@@ -1,6 +1,8 @@
 """Argument checks shared by the wrappers."""
 
-from collections.abc import Mapping, Sequence
+import functools
+import inspect
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -35,6 +37,25 @@ def check_reset_seed(seed: Any, owner: str) -> int | None:
             f"env.reset(seed=0), or env.reset() to continue the random stream."
         )
     return int(seed)
+
+
+def keyword_reset(reset: Callable) -> Callable:
+    """``reset`` refusing positional arguments with a TypeError that names the wrapper the user
+    made and ``seed``: Python's own names the class that defines ``reset`` (a base class the
+    user never made). Its signature stays Gymnasium's, keyword-only ``seed`` and ``options``
+    (``inspect.signature`` reads it through ``__wrapped__``)."""
+
+    @functools.wraps(reset)
+    def checked(self: Any, *args: Any, **kwargs: Any) -> Any:
+        if args:
+            raise TypeError(
+                f"{type(self).__name__}.reset() takes 1 positional argument but "
+                f"{len(args) + 1} were given: seed and options are keyword-only, as in every "
+                f"Gymnasium env; e.g. env.reset(seed={args[0]!r:.20})"
+            )
+        return reset(self, **kwargs)
+
+    return checked
 
 
 def refuse_step_before_reset(has_reset: bool, owner: str) -> None:
@@ -196,3 +217,36 @@ def check_finite_positive(value: Any, name: str, fix: str) -> None:
     ``fix`` says what to pass instead."""
     if not (is_real(value) and np.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}; {fix}")
+
+
+def check_callable(value: Any, name: str, call: str, args: tuple, fix: str) -> None:
+    """A TypeError for a ``value`` of the argument ``name`` that is not callable, or whose
+    signature cannot take ``args`` (how it will be called, written as ``call``): without this
+    it fails at its first call, far from where it was given, with Python's message naming
+    neither the argument nor the call. A signature that cannot be read (some builtins) is
+    taken as it is; ``fix`` says what to pass instead."""
+    if not callable(value):
+        raise TypeError(
+            f"{name} must be a callable, called as {call}, got {type(value).__name__} "
+            f"{value!r:.60}; {fix}"
+        )
+    problem = _bind_problem(value, args)
+    if problem is not None:
+        raise TypeError(
+            f"{name} is called as {call}, which its signature {problem[0]} does not take "
+            f"({problem[1]}); {fix}"
+        )
+
+
+def _bind_problem(func: Callable, args: tuple) -> tuple[str, str] | None:
+    """(the signature, why) when ``func(*args)`` does not match ``func``'s signature; None
+    when it does, or when the signature cannot be read."""
+    try:
+        signature = inspect.signature(func)
+    except (TypeError, ValueError):
+        return None
+    try:
+        signature.bind(*args)
+    except TypeError as err:
+        return str(signature), str(err)
+    return None

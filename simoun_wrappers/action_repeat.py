@@ -8,7 +8,13 @@ from typing import Any, SupportsFloat
 
 import gymnasium as gym
 
-from simoun_wrappers._checks import check_action, check_positive_int, check_reset_seed, plain
+from simoun_wrappers._checks import (
+    check_action,
+    check_positive_int,
+    check_reset_seed,
+    keyword_reset,
+    plain,
+)
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 
 
@@ -54,6 +60,7 @@ class ActionRepeat(gym.Wrapper, gym.utils.RecordConstructorArgs):
         )
         self.repeat = int(repeat)
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:

@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.wrappers import TransformObservation
 
-from simoun_wrappers._checks import check_reset_seed, is_int, plain
+from simoun_wrappers._checks import check_reset_seed, is_int, keyword_reset, plain
 from simoun_wrappers.frames import check_single_env, refuse_over_frame_stack
 from simoun_wrappers.observation import ChainWrapper, image_layout, pixel_env
 
@@ -279,6 +279,7 @@ class RandomConvolution(ChainWrapper):
         self._generator = torch.Generator()
         self._kernel_seed = 0
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:

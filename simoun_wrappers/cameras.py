@@ -14,6 +14,7 @@ from gymnasium import spaces
 from simoun_wrappers._checks import (
     check_action,
     check_reset_seed,
+    keyword_reset,
     plain,
     refuse_step_before_reset,
 )
@@ -226,6 +227,7 @@ class MultiCamera(CheckedSpecWrapper, gym.ObservationWrapper, gym.utils.RecordCo
     def render_mode(self) -> str:
         return "rgb_array"
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:

@@ -12,7 +12,13 @@ from gymnasium.error import ResetNeeded
 from gymnasium.vector.utils import batch_space
 from gymnasium.wrappers import FrameStackObservation
 
-from simoun_wrappers._checks import check_action, check_positive_int, check_reset_seed, plain
+from simoun_wrappers._checks import (
+    check_action,
+    check_positive_int,
+    check_reset_seed,
+    keyword_reset,
+    plain,
+)
 
 MAX_STACK_BYTES = 2**30
 """The largest stack ``FrameTriplet`` or ``FrameStack`` builds (1 GiB: over 12,000 RGB frames of
@@ -108,6 +114,7 @@ class FrameTriplet(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self._ring = FrameRing(self.num_frames, space.shape, space.dtype)
         self._has_reset = False
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:

@@ -26,10 +26,12 @@ from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 
 from simoun_wrappers._checks import (
     check_action,
+    check_callable,
     check_reset_seed,
     check_vector_reset_seed,
     is_int,
     is_real,
+    keyword_reset,
     plain,
 )
 from simoun_wrappers._spec import CheckedSpecWrapper, SharedSource
@@ -181,6 +183,14 @@ class IntrinsicSignal(ABC):
             raise TypeError(
                 f"{wanted.argument} must be a {wanted.protocol.__name__} ({wanted.expects}), got "
                 f"{type(self.source).__name__}. Use e.g. {wanted.example}."
+            )
+        if wanted is not None:
+            check_callable(
+                self.source,
+                wanted.argument,
+                f"{wanted.argument}(triplets)",
+                (None,),
+                f"it must take one argument ({wanted.expects}), e.g. {wanted.example}.",
             )
 
     @abstractmethod
@@ -456,6 +466,7 @@ class IntrinsicReward(
         self._read = env_triplet_reader(env, type(self).__name__)
         self._last_triplet: np.ndarray | None = None
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
@@ -512,6 +523,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
         self._prev_dones = np.zeros(self.num_envs, dtype=bool)
         self._last_triplets: np.ndarray | None = None
 
+    @keyword_reset
     def reset(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:

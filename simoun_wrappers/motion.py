@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from simoun_wrappers._checks import check_action, check_reset_seed
+from simoun_wrappers._checks import check_action, check_reset_seed, keyword_reset
 from simoun_wrappers.frames import check_single_env
 
 
@@ -96,6 +96,7 @@ class ResidualMotion(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
             )
         self.observation_space = spaces.Dict({"frames": space, "motion": motion_space(space)})
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, Any], dict[str, Any]]:

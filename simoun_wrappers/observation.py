@@ -19,6 +19,7 @@ from simoun_wrappers._checks import (
     check_positive_int,
     check_reset_seed,
     is_int,
+    keyword_reset,
     plain,
     refuse_step_before_reset,
 )
@@ -367,6 +368,7 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         """whether the user reset this wrapper: reading pixels from render() resets the env
         while the chain is built"""
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:

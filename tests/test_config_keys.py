@@ -44,7 +44,7 @@ def test_a_saved_config_with_a_misspelled_key_is_refused_with_the_close_match():
     saved = to_dict(resolve("cpu", {}))
     saved["agent"]["bach_size"] = saved["agent"].pop("batch_size")
     with pytest.raises(SetupError) as error:
-        from_dict(saved)
+        from_dict(saved, "saved config")
     assert str(error.value).startswith(
         "saved config: unknown config key agent.bach_size (did you mean agent.batch_size?)"
     )

@@ -322,3 +322,10 @@ def test_a_feature_source_that_returns_no_pair_is_named_with_what_it_must_return
     envs.reset(seed=0)
     with pytest.raises(ValueError, match="must return the tuple"):
         envs.step(np.array([0, 1]))
+
+
+def test_a_feature_source_without_the_triplets_argument_is_refused_when_built():
+    with pytest.raises(TypeError, match=r"^features is called as features\(triplets\), which its"):
+        ConsistencyCuriosityReward(cartpole(), lambda: (0, 0))
+    with pytest.raises(TypeError, match=r"signature \(\) does not take"):
+        ConsistencyCuriosityVectorReward(make_vec(2), lambda: (0, 0))

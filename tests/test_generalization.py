@@ -10,7 +10,14 @@ import pytest
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
 from simoun_agent.config import SetupError, resolve
-from simoun_agent.generalization import DISTRACTIONS, check_supported, make_distracted_env
+from simoun_agent.generalization import (
+    DISTRACTIONS,
+    check_supported,
+    distractor,
+    make_distracted_env,
+    parse_distractions,
+)
+from simoun_agent.generalization.evaluation import evaluate_runs
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -146,8 +153,8 @@ def test_training_with_distraction_curves_leaves_training_unchanged(runs):
         (["--eval-distraction", "train"], "is the run's own evaluation"),
         (
             ["--eval-distraction", "none"],
-            "for no distraction, leave --eval-distraction out (the run's own evaluation always "
-            "runs); choose from color_easy, color_hard, video_easy, video_hard (",
+            "each one of color_easy, color_hard, video_easy, video_hard ('none': for no "
+            "distraction, leave it out: the run's own evaluation always runs)",
         ),
         (["--env", "simoun/PointReach-v0", "--eval-distraction", "video_hard"], "dm_control"),
     ],
@@ -158,3 +165,44 @@ def test_bad_eval_distraction_is_refused_before_training(tmp_path, capsys, flags
     assert exit_info.value.code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "run" / "config.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "said"),
+    [
+        (
+            lambda: parse_distractions(["color_easy", None]),
+            TypeError,
+            r"^parse_distractions\(text=\.\.\.\): item 1 of the list is NoneType None, not a mode",
+        ),
+        (
+            lambda: parse_distractions(3),
+            TypeError,
+            r"^parse_distractions\(text=\.\.\.\) takes mode names, as one comma-separated str or",
+        ),
+        (
+            lambda: make_distracted_env("dm_control/cartpole-swingup-v0", "color_easy"),
+            TypeError,
+            r"^make_distracted_env\(config=\.\.\.\) takes the run's TrainConfig .*got str",
+        ),
+        (
+            lambda: check_supported({"env": "dm_control/cartpole-swingup-v0"}, ["color_easy"]),
+            TypeError,
+            r"^check_supported\(config=\.\.\.\) takes the run's TrainConfig",
+        ),
+        (lambda: distractor(None), TypeError, r"^distractor\(name=\.\.\.\) takes one mode name"),
+        (
+            lambda: distractor("color_easy,video_easy"),
+            SetupError,
+            r"^distractor\(name=\.\.\.\) takes one mode, got 'color_easy,video_easy'; call it once",
+        ),
+        (
+            lambda: evaluate_runs("runs/a", ["train"], 1),
+            TypeError,
+            r"^evaluate_runs\(run_dirs=\.\.\.\) takes a list of run directories, got the one path",
+        ),
+    ],
+)
+def test_the_suites_functions_name_an_argument_of_the_wrong_type(call, error, said):
+    with pytest.raises(error, match=said):
+        call()

@@ -1,5 +1,7 @@
 """RNDReward / RNDVectorReward and RNDModel on real MiniGrid pixels, against hand computations."""
 
+import functools
+
 import gymnasium as gym
 import minigrid  # noqa: F401  (registers the MiniGrid-* ids)
 import numpy as np
@@ -236,3 +238,32 @@ def test_bad_arguments_are_refused_with_the_fix():
     env = RNDReward(pixels(), lambda triplets: np.zeros(len(triplets)), warmup=0)
     env.reset(seed=0)
     assert env.step(0)[4]["reward_intrinsic"] == 0.0  # a zero error is an error like any
+
+
+@pytest.mark.parametrize(
+    ("novelty", "said"),
+    [
+        (lambda: 0.0, r"signature \(\) does not take \(too many positional arguments\)"),
+        (lambda a, b: a, r"signature \(a, b\) does not take \(missing a required argument: 'b'\)"),
+    ],
+)
+def test_a_novelty_source_that_cannot_take_the_triplets_is_refused_when_built(novelty, said):
+    start = r"^novelty is called as novelty\(triplets\), which its "
+    with pytest.raises(TypeError, match=start + said):
+        RNDReward(pixels(), novelty, warmup=0)
+    with pytest.raises(TypeError, match=r"it must take one argument .*RNDModel.for_env\(env\)"):
+        RNDVectorReward(make_vec(1, AutoresetMode.NEXT_STEP), novelty, warmup=0)
+
+
+def test_sources_whose_signature_takes_the_triplets_are_accepted():
+    # a partial, a builtin-backed callable, an optional second argument and a model all bind
+    for novelty in (
+        functools.partial(np.mean, axis=(1, 2, 3, 4)),
+        lambda triplets, scale=1.0: np.zeros(len(triplets)),
+        Brightness(),
+        RNDModel.for_env(pixels(), RNDConfig(**TINY, background=False), device="cpu"),
+    ):
+        env = RNDReward(pixels(), novelty, warmup=0)
+        env.reset(seed=0)
+        env.step(0)
+        env.close()

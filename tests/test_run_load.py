@@ -3,6 +3,8 @@ distraction evaluation: a run trained on another device loads on this machine wi
 
 import json
 
+import gymnasium as gym
+import numpy as np
 import pytest
 import torch
 from test_train_resume import TINY
@@ -12,6 +14,7 @@ from simoun_agent.config import SetupError, resolve
 from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
+from simoun_agent.run.evaluate import evaluate
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
 from simoun_agent.run.load import load_run
 from simoun_lab.cli import analyze as analyze_cli
@@ -87,3 +90,74 @@ def test_simoun_analyze_draws_masks_of_a_gpu_run_on_cpu(gpu_run, tmp_path):
     argv = ["masks", str(gpu_run), "--steps", "2", "--device", "cpu", "--out", str(out)]
     assert analyze_cli.main(argv) == 0
     assert (out / "ep0-step0002.npz").is_file()
+
+
+@pytest.fixture(scope="module")
+def loaded(gpu_run):
+    run = load_run(gpu_run, device=torch.device("cpu"))  # a torch.device, saved as its string
+    assert run.config.device == "cpu"
+    yield run
+    run.env.close()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "error", "said"),
+    [
+        ({"path": None}, TypeError, r"^load_run\(path=\.\.\.\) must be a run directory or its "),
+        ({"device": "gpu"}, SetupError, r"^load_run\(device='gpu'\): device type 'gpu' is not "),
+        ({"device": 0}, TypeError, r"^load_run\(device=\.\.\.\) must be a str, a torch.device"),
+        ({"torch_threads": 0}, SetupError, r"^load_run\(torch_threads=\.\.\.\) must be an int"),
+        ({"torch_threads": "2"}, SetupError, r"got '2' \(str\); e.g. torch_threads=1$"),
+        ({"torch_threads": True}, SetupError, r"got True \(bool\)"),
+    ],
+)
+def test_load_runs_own_arguments_are_named_not_blamed_on_the_saved_file(
+    gpu_run, arguments, error, said
+):
+    with pytest.raises(error, match=said) as raised:
+        load_run(**{"path": gpu_run, "device": "cpu", **arguments})
+    assert "damaged" not in str(raised.value) and "saved config" not in str(raised.value)
+
+
+def test_evaluate_takes_its_arguments_as_documented(loaded):
+    episodes = []
+    metrics, frames = evaluate(
+        loaded.agent,
+        loaded.env,
+        np.int64(1),
+        loaded.first_seed,
+        record=np.bool_(True),
+        on_episode=lambda index, episode_return: episodes.append(index),
+        stop=lambda: False,
+    )
+    assert episodes == [0] and frames and "return_mean" in metrics
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "said"),
+    [
+        ({"episodes": 0}, ValueError, r"^evaluate\(episodes=\.\.\.\) must be an int >= 1, got 0 "),
+        ({"episodes": 1.5}, ValueError, r"got 1.5 \(float\); e.g. episodes=10$"),
+        ({"episodes": "1"}, ValueError, r"got '1' \(str\)"),
+        ({"seed": -1}, ValueError, r"^evaluate\(seed=\.\.\.\) must be an int >= 0"),
+        ({"record": "yes"}, TypeError, r"^evaluate\(record=\.\.\.\) must be True or False"),
+        ({"on_episode": "print"}, TypeError, r"^evaluate\(on_episode=\.\.\.\) must be a callable"),
+        ({"on_episode": lambda: None}, TypeError, r"on_episode\(index, episode_return\)"),
+        ({"stop": True}, TypeError, r"^evaluate\(stop=\.\.\.\) must be a callable"),
+        ({"stop": lambda now: now}, TypeError, r"signature \(now\) does not take"),
+        ({"swap": True}, TypeError, r"^evaluate takes the agent first and the env second"),
+        ({"env": "pendulum"}, TypeError, r"must give SimounObservation's frames .*run\.env"),
+        ({"env": "agent"}, TypeError, r"^evaluate\(env=\.\.\.\) must be a Gymnasium env"),
+        ({"agent": "env"}, TypeError, r"^evaluate\(agent=\.\.\.\) must have act\(frames"),
+    ],
+)
+def test_evaluate_refuses_a_wrong_argument_naming_it_before_any_episode(
+    loaded, change, error, said
+):
+    players = {"agent": loaded.agent, "env": loaded.env, "pendulum": gym.make("Pendulum-v1")}
+    arguments = {"agent": loaded.agent, "env": loaded.env, "episodes": 1, "seed": 0}
+    arguments.update({key: players.get(value, value) for key, value in change.items()})
+    if arguments.pop("swap", False):
+        arguments["agent"], arguments["env"] = loaded.env, loaded.agent
+    with pytest.raises(error, match=said):
+        evaluate(**arguments)

@@ -210,3 +210,63 @@ def test_a_config_changed_after_it_was_resolved_is_checked_again_before_a_run_is
     change(config)
     with pytest.raises(SetupError, match=said.replace("(", r"\(").replace(")", r"\)")):
         build(config)
+
+
+@pytest.mark.parametrize(
+    ("data", "said"),
+    [
+        (
+            lambda d: resolve("cpu", {}),
+            r"^from_dict\(data\) takes a dict of config keys .*got TrainConfig; it is a config "
+            r"already: use it as it is .*or pass to_dict\(config\)$",
+        ),
+        (
+            lambda d: {**d, "agent": []},
+            r"^from_dict\(data\): data\['agent'\] must be a dict of AgentConfig fields, got list",
+        ),
+        (
+            lambda d: {**d, "agent": {**d["agent"], "lr": "1e-3"}},
+            r"^from_dict\(data\): data\['agent'\]\['lr'\] is '1e-3' \(str\), which must be a "
+            r"number > 0 and <= 1; e.g. data\['agent'\]\['lr'\] = 0.001 \(the default\)$",
+        ),
+        (lambda d: {**d, "nope": 1}, r"^from_dict\(data\): unknown config key nope; to_dict"),
+    ],
+)
+def test_from_dict_of_a_python_value_names_the_key_and_the_type_it_takes(data, said):
+    with pytest.raises(SetupError, match=said) as error:
+        from_dict(data(to_dict(resolve("cpu", {}))))
+    assert "damaged" not in str(error.value) and "version" not in str(error.value)
+
+
+def test_from_dict_of_a_file_keeps_saying_how_to_restore_it():
+    saved = to_dict(resolve("cpu", {}))
+    with pytest.raises(SetupError, match=r"^run/config.json: agent holds list where a JSON object"):
+        from_dict({**saved, "agent": []}, "run/config.json")
+    with pytest.raises(SetupError, match=r"^run/config.json: agent.lr is \"1e-3\".*restore the"):
+        from_dict({**saved, "agent": {**saved["agent"], "lr": "1e-3"}}, "run/config.json")
+
+
+@pytest.mark.parametrize(
+    ("modes", "said"),
+    [
+        ("colour_easy", r"\(a list, not one string: did you mean \['color_easy'\]\?\)"),
+        ("video_hard", r"\(a list, not one string: did you mean \['video_hard'\]\?\)"),
+        (["colour_easy"], r"\('colour_easy': did you mean 'color_easy'\?\)"),
+        (["video_hard", "vidoe_hrad"], r"\('vidoe_hrad': did you mean 'video_hard'\?\)"),
+        (["train"], r"\('train' is the run's own evaluation, which always runs; leave it out\)"),
+        (["zzz"], r"\('zzz' is not one\)"),
+    ],
+)
+def test_eval_distraction_names_are_checked_at_resolve_with_the_close_match(modes, said):
+    with pytest.raises(SetupError, match=said) as error:
+        resolve("cpu", {"eval_distraction": modes})
+    assert "in Python eval_distraction=['video_hard', 'color_easy']" in str(error.value)
+
+
+def test_eval_distraction_takes_the_suites_modes():
+    from simoun_agent.config.train import DISTRACTION_MODES
+    from simoun_agent.generalization import DISTRACTIONS
+
+    assert DISTRACTION_MODES == tuple(name for name in DISTRACTIONS if name != "train")
+    config = resolve("cpu", {"eval_distraction": list(DISTRACTION_MODES)})
+    assert tuple(config.eval_distraction) == DISTRACTION_MODES

@@ -2,6 +2,7 @@
 silently wrong observation. Headless import order and SDL's signal handlers."""
 
 import copy
+import inspect
 import os
 import pickle
 import signal
@@ -449,3 +450,22 @@ def test_every_wrapper_checks_its_reset_seed_and_takes_numpy_ints(name):
     pairs = [(first[k], again[k]) for k in first] if isinstance(first, dict) else [(first, again)]
     for a, b in pairs:
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", list(CHAINS))
+def test_a_positional_reset_seed_is_refused_naming_the_wrapper_and_seed(name):
+    env = CHAINS[name]()
+    parameters = inspect.signature(env.reset).parameters
+    assert [(p.name, p.kind) for p in parameters.values()] == [
+        ("seed", inspect.Parameter.KEYWORD_ONLY),
+        ("options", inspect.Parameter.KEYWORD_ONLY),
+    ]
+    with pytest.raises(TypeError) as error:
+        env.reset(0)
+    assert str(error.value).startswith(
+        f"{type(env).__name__}.reset() takes 1 positional argument but 2 were given: seed and "
+        "options are keyword-only"
+    )
+    assert "env.reset(seed=0)" in str(error.value)
+    env.reset(seed=0)
+    env.close()

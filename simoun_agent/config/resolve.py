@@ -175,22 +175,21 @@ SAVED_BEFORE = {"agent.next_state_encoder": "online"}
 key was added with this value as its default, which the default has since left."""
 
 
-def from_dict(data: dict[str, Any], where: str = "saved config") -> TrainConfig:
+def from_dict(data: dict[str, Any], where: str | None = None) -> TrainConfig:
     """Inverse of :func:`to_dict`; raises SetupError for keys this version does not know, or
-    for ``data`` that is not a dict (a damaged file, named by ``where``). A key the config
-    predates takes its :data:`SAVED_BEFORE` value if it has one (what the run did), else this
-    version's default."""
+    for ``data`` that is not a dict of config keys. ``where`` names the file ``data`` was read
+    from, whose errors say how to restore it; None (a value built in Python) has them name the
+    key and the type it takes. A key the config predates takes its :data:`SAVED_BEFORE` value
+    if it has one (what the run did), else this version's default."""
+    blame = _FileBlame(where) if where is not None else _ValueBlame()
     if not isinstance(data, dict):
-        raise SetupError(
-            f"{where} holds {type(data).__name__} where a JSON object of config keys belongs: "
-            "it is damaged; restore it from a copy, or train the run again"
-        )
+        raise SetupError(blame.not_a_dict(data))
+    for prefix, cls in config_sections().items():
+        section = _section_value(data, prefix)
+        if prefix and section is not None and not isinstance(section, dict):
+            raise SetupError(blame.not_a_section(prefix.rstrip("."), cls, section))
     flat = {**SAVED_BEFORE, **flatten(data)}
-    check_keys(
-        flat,
-        where,
-        "it was written by another version of simoun; use that version, or train it again",
-    )
+    check_keys(flat, blame.source, blame.unknown_fix)
     known = config_fields()
     sections = config_sections()
     for key, value in flat.items():
@@ -200,13 +199,87 @@ def from_dict(data: dict[str, Any], where: str = "saved config") -> TrainConfig:
         name = key.rpartition(".")[2]
         rule = rules_of(sections[key.removesuffix(name)])[name]
         if not rule.ok(value):
-            raise SetupError(
-                f"{where}: {key} is {json.dumps(value)}, which must be {rule.need}; the file is "
-                f"damaged or was edited: set {key} there to what the run was trained with (the "
-                f"default is {json.dumps(default)}), restore the file from a copy, or train the "
-                "run again"
-            )
+            need = rule.need + (rule.suggest(value) if rule.suggest else "")
+            raise SetupError(blame.bad_value(key, value, need, default))
     try:
         return from_flat(flat)
     except SetupError as err:  # a cross-field check, spelled as flags: say where it came from
-        raise SetupError(f"{where} does not hold a valid config: {err}") from None
+        raise SetupError(f"{blame.source} does not hold a valid config: {err}") from None
+
+
+def _section_value(data: dict[str, Any], prefix: str) -> Any:
+    """What ``data`` holds at the section ``prefix`` (``"agent."``); None where it is absent."""
+    value: Any = data
+    for part in prefix.split(".")[:-1]:
+        if not isinstance(value, dict):
+            return None
+        value = value.get(part)
+    return value
+
+
+def _python_key(key: str) -> str:
+    """``"agent.lr"`` -> ``"data['agent']['lr']"``, the key as Python indexes the dict."""
+    return "data" + "".join(f"[{part!r}]" for part in key.split("."))
+
+
+class _FileBlame:
+    """from_dict's refusals of a config read from a file: it is damaged or edited."""
+
+    def __init__(self, where: str) -> None:
+        self.source = where
+        self.unknown_fix = (
+            "it was written by another version of simoun; use that version, or train it again"
+        )
+
+    def not_a_dict(self, data: Any) -> str:
+        return (
+            f"{self.source} holds {type(data).__name__} where a JSON object of config keys "
+            "belongs: it is damaged; restore it from a copy, or train the run again"
+        )
+
+    def not_a_section(self, key: str, cls: type, value: Any) -> str:
+        return (
+            f"{self.source}: {key} holds {type(value).__name__} where a JSON object of "
+            f"{cls.__name__} fields belongs: it is damaged; restore it from a copy, or train "
+            "the run again"
+        )
+
+    def bad_value(self, key: str, value: Any, need: str, default: Any) -> str:
+        return (
+            f"{self.source}: {key} is {json.dumps(value, default=repr)}, which must be {need}; "
+            f"the file is damaged or was edited: set {key} there to what the run was trained "
+            f"with (the default is {json.dumps(default)}), restore the file from a copy, or "
+            "train the run again"
+        )
+
+
+class _ValueBlame:
+    """from_dict's refusals of a value built in Python: the key and the type it takes."""
+
+    source = "from_dict(data)"
+    unknown_fix = "to_dict(TrainConfig()) lists every key, or resolve(None, {...}) takes flat ones"
+
+    def not_a_dict(self, data: Any) -> str:
+        hint = (
+            "; it is a config already: use it as it is (dataclasses.replace(config, ...) to "
+            "change it), or pass to_dict(config)"
+            if dataclasses.is_dataclass(data)
+            else "; e.g. from_dict(to_dict(config))"
+        )
+        return (
+            f"from_dict(data) takes a dict of config keys (what to_dict(config) returns), got "
+            f"{type(data).__name__}{hint}"
+        )
+
+    def not_a_section(self, key: str, cls: type, value: Any) -> str:
+        return (
+            f"from_dict(data): {_python_key(key)} must be a dict of {cls.__name__} fields, got "
+            f"{type(value).__name__} {value!r:.60}; e.g. {_python_key(key)} = "
+            f"to_dict(config)[{key.rpartition('.')[2]!r}], or leave it out for the defaults"
+        )
+
+    def bad_value(self, key: str, value: Any, need: str, default: Any) -> str:
+        return (
+            f"from_dict(data): {_python_key(key)} is {value!r:.60} ({type(value).__name__}), "
+            f"which must be {need}; e.g. {_python_key(key)} = {default!r} (the default)"
+        )

@@ -7,7 +7,9 @@ How a run's config is resolved from presets, recipes and the user's overrides:
 from __future__ import annotations
 
 import dataclasses
+import difflib
 from dataclasses import dataclass, field
+from typing import Any
 
 from simoun_agent.config.agent import AGENT, AgentConfig, check_agent_config
 from simoun_agent.config.device import device_problem
@@ -38,6 +40,57 @@ from simoun_agent.config.shapes import (
 )
 
 _POSITIVE = integer(1)
+
+DISTRACTION_MODES = ("color_easy", "color_hard", "video_easy", "video_hard")
+"""DMC-GB's test modes, the names ``eval_distraction`` takes (the suite's wrappers of them:
+:data:`simoun_agent.generalization.DISTRACTIONS`, whose ``train`` is the run's own env)."""
+
+_UNDISTRACTED = ("train", "none", "null", "off", "no", "clean")
+"""What a user writes for the run's own, undistracted evaluation."""
+
+
+def _is_modes(value: Any) -> bool:
+    return isinstance(value, (tuple, list)) and all(
+        isinstance(name, str) and name in DISTRACTION_MODES for name in value
+    )
+
+
+def _closest_modes(value: Any) -> str:
+    """The fix of a refused ``eval_distraction``: one string given for the list (its names
+    corrected), the undistracted evaluation named (it always runs), or a misspelled mode's
+    close match; empty when there is none."""
+    if isinstance(value, str):
+        names = [name.strip() for name in value.split(",") if name.strip()]
+        corrected = [_closest_mode(name) or name for name in names]
+        return f" (a list, not one string: did you mean {corrected!r}?)"
+    if not isinstance(value, (tuple, list)):
+        return ""
+    wrong = [name for name in value if name not in DISTRACTION_MODES]
+    if not wrong or not isinstance(wrong[0], str):
+        return ""
+    if wrong[0] == "train":
+        return " ('train' is the run's own evaluation, which always runs; leave it out)"
+    if wrong[0].lower() in _UNDISTRACTED:
+        return (
+            f" ({wrong[0]!r}: for no distraction, leave it out: the run's own evaluation always "
+            "runs)"
+        )
+    close = _closest_mode(wrong[0])
+    return f" ({wrong[0]!r}: did you mean {close!r}?)" if close else f" ({wrong[0]!r} is not one)"
+
+
+def _closest_mode(name: str) -> str | None:
+    match = difflib.get_close_matches(name.lower(), DISTRACTION_MODES, n=1, cutoff=0.6)
+    return match[0] if match else None
+
+
+_DISTRACTION_MODES_RULE = Rule(
+    f"a list of distraction modes, each one of {', '.join(DISTRACTION_MODES)}",
+    _is_modes,
+    "e.g. --eval-distraction video_hard,color_easy, or in Python "
+    "eval_distraction=['video_hard', 'color_easy']",
+    _closest_modes,
+)
 
 
 @dataclass
@@ -97,14 +150,7 @@ class TrainConfig:
     """environment steps between evaluations (run at the next episode end)"""
     eval_episodes: int = setting(10, _POSITIVE)
     """episodes per evaluation (deterministic actions)"""
-    eval_distraction: tuple[str, ...] = setting(
-        (),
-        Rule(
-            "a list of distraction mode names",
-            lambda v: isinstance(v, (tuple, list)) and all(isinstance(m, str) and m for m in v),
-            "e.g. --eval-distraction video_hard (simoun_agent.generalization.DISTRACTIONS)",
-        ),
-    )
+    eval_distraction: tuple[str, ...] = setting((), _DISTRACTION_MODES_RULE)
     """distraction modes also evaluated at every evaluation, as test curves beside the training
     env's (dm_control tasks; repeat the flag, e.g. --eval-distraction video_hard; modes in
     simoun_agent.generalization.DISTRACTIONS)"""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,7 +49,12 @@ def evaluate_runs(
     seeds), so the modes differ only by the distraction. Raises SetupError for a run that
     cannot be loaded or a mode its env does not support, before any episode is played.
     """
-    loaded = [load_run(Path(run_dir), device) for run_dir in run_dirs]
+    if isinstance(run_dirs, (str, os.PathLike)):
+        raise TypeError(
+            f"evaluate_runs(run_dirs=...) takes a list of run directories, got the one path "
+            f"{str(run_dirs)!r}; e.g. run_dirs=[{str(run_dirs)!r}]"
+        )
+    loaded = [load_run(run_dir, device) for run_dir in run_dirs]
     for run in loaded:
         check_supported(run.config, modes, videos)
     labels = _labels([run.run_dir for run in loaded])

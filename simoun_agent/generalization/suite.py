@@ -11,6 +11,7 @@ import difflib
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 
@@ -47,9 +48,10 @@ def parse_distractions(
     ones ``flag`` takes), duplicates dropped; ``undistracted`` says how ``flag``'s command is
     given no distraction.
 
-    Raises SetupError for an unknown name, suggesting the closest one.
+    Raises SetupError for an unknown name, suggesting the closest one, and TypeError for
+    ``text`` that is neither a string nor a list of strings.
     """
-    parts = text.split(",") if isinstance(text, str) else list(text)
+    parts = _mode_texts(text, "parse_distractions(text=...)")
     names = [part.strip() for part in parts if part.strip()]
     if not names:
         raise SetupError(f"{flag} is empty; pass modes from {', '.join(modes)}")
@@ -68,12 +70,55 @@ def parse_distractions(
     return list(dict.fromkeys(names))
 
 
+def _mode_texts(text: Any, argument: str) -> list[str]:
+    """The names of ``text`` (``"color_easy,video_hard"`` or a list of names) still to check;
+    TypeError naming ``argument`` for anything else, where ``.strip()`` or iteration would
+    fail with Python's message."""
+    example = "e.g. 'color_easy,video_hard' or ['color_easy', 'video_hard']"
+    if isinstance(text, str):
+        return text.split(",")
+    if not isinstance(text, (list, tuple)):
+        raise TypeError(
+            f"{argument} takes mode names, as one comma-separated str or a list of str, got "
+            f"{type(text).__name__} {text!r:.60}; {example}"
+        )
+    for index, part in enumerate(text):
+        if not isinstance(part, str):
+            raise TypeError(
+                f"{argument}: item {index} of the list is {type(part).__name__} {part!r:.40}, "
+                f"not a mode name (a str); choose from {', '.join(DISTRACTIONS)}; {example}"
+            )
+    return list(text)
+
+
+def check_run_config(config: Any, function: str) -> None:
+    """A TypeError naming ``function``'s ``config`` when it is not a run's TrainConfig (an env
+    id given in its place, say)."""
+    if not isinstance(config, TrainConfig):
+        raise TypeError(
+            f"{function}(config=...) takes the run's TrainConfig (e.g. run.config of "
+            f"simoun_agent.run.load.load_run(RUN_DIR)), got {type(config).__name__} "
+            f"{config!r:.60}; for an env id, build a config first: "
+            "simoun_agent.config.resolve(None, {'env': ENV_ID})"
+        )
+
+
 def distractor(name: str, videos: str | Path | None = None) -> Callable[[gym.Env], gym.Env] | None:
     """The wrapper of mode ``name`` for ``make_env(config, distractor)``; None for ``train``.
 
     ``videos`` is a folder of video files played by the ``video_*`` modes instead of the
     procedural background (DMC-GB's video folders, or DAVIS clips as mp4).
     """
+    if not isinstance(name, str):
+        raise TypeError(
+            f"distractor(name=...) takes one mode name (a str), got {type(name).__name__} "
+            f"{name!r:.60}; choose from {', '.join(DISTRACTIONS)}"
+        )
+    if "," in name:
+        raise SetupError(
+            f"distractor(name=...) takes one mode, got {name!r}; call it once per mode "
+            "(parse_distractions(text) splits a comma-separated list)"
+        )
     (name,) = parse_distractions([name])
     entry = DISTRACTIONS[name]
     if entry is None:
@@ -92,6 +137,7 @@ def check_supported(
     The distractors change a MuJoCo scene, so any mode but ``train`` needs a dm_control task;
     a ``videos`` folder must hold a readable video. Checked before any episode is played.
     """
+    check_run_config(config, "check_supported")
     if not names:
         return
     distracted = [name for name in parse_distractions(names) if DISTRACTIONS[name] is not None]
@@ -119,6 +165,7 @@ def make_distracted_env(
     """
     from simoun_agent.run.make_env import make_env
 
+    check_run_config(config, "make_distracted_env")
     check_supported(config, [name], videos)
     return make_env(config, distractor(name, videos))
 
@@ -128,6 +175,7 @@ def check_eval_distractions(config: TrainConfig) -> list[str]:
 
     ``train`` is refused: it is the run's own evaluation, which always runs.
     """
+    check_run_config(config, "check_eval_distractions")
     flag = "--eval-distraction"
     if "train" in config.eval_distraction:
         raise SetupError(

@@ -14,6 +14,7 @@ import torch
 
 from simoun_agent.config import SetupError
 from simoun_agent.run import driving_metrics
+from simoun_wrappers._checks import check_bool, check_callable, is_int
 
 
 class EvaluationStopped(Exception):
@@ -52,12 +53,16 @@ def evaluate(
 
     ``on_episode(index, return)`` is called after each episode (progress reports). ``stop()`` is
     asked before every step: True raises :class:`EvaluationStopped` (a Ctrl-C during training).
-    A NaN or infinite reward raises :class:`NonFiniteReward`.
+    A NaN or infinite reward raises :class:`NonFiniteReward`. Arguments of the wrong kind
+    raise TypeError or ValueError naming them, before any episode is played.
 
     Returns:
         metrics (return_mean/std/min/max, length_mean, and driving measures) and, when
         ``record``, the first episode's frames as the agent saw them.
     """
+    check_players(agent, env)
+    check_episodes(episodes, seed)
+    check_options(record, on_episode, stop)
     driving = driving_metrics.is_driving_env(env)
     returns, lengths, drives, frames = [], [], [], []
     with torch.random.fork_rng():
@@ -99,6 +104,73 @@ def evaluate(
     if drives:
         metrics.update(driving_metrics.summarize(drives))
     return metrics, frames
+
+
+def check_players(agent: Any, env: Any) -> None:
+    """A TypeError unless ``agent`` acts (``act(frames, deterministic=True)``) and ``env`` is
+    a Gymnasium env giving SimounObservation's frames; the two swapped are named as such."""
+    example = "e.g. evaluate(run.agent, run.env, episodes, run.first_seed)"
+    if isinstance(agent, gym.Env) and callable(getattr(env, "act", None)):
+        raise TypeError(
+            f"evaluate takes the agent first and the env second, got the env "
+            f"{type(agent).__name__} as agent and the {type(env).__name__} as env; swap them, "
+            f"{example}"
+        )
+    if not callable(getattr(agent, "act", None)):
+        raise TypeError(
+            f"evaluate(agent=...) must have act(frames, deterministic) (a SimounAgent or a "
+            f"RandomPolicy), got {type(agent).__name__}; {example}"
+        )
+    if not isinstance(env, gym.Env):
+        raise TypeError(
+            f"evaluate(env=...) must be a Gymnasium env, got {type(env).__name__}; {example}"
+        )
+    space = env.observation_space
+    if not (isinstance(space, gym.spaces.Dict) and "frames" in space.spaces):
+        raise TypeError(
+            f"evaluate(env=...) must give SimounObservation's frames (a Dict observation with "
+            f"'frames'), but {env} gives {space}; pass the run's own env (run.env), or wrap it "
+            "as the run did: simoun_wrappers.SimounObservation(env, size=...)"
+        )
+
+
+def check_episodes(episodes: Any, seed: Any) -> None:
+    """A ValueError unless ``episodes`` is an int >= 1 and ``seed`` an int >= 0."""
+    if not (is_int(episodes) and episodes >= 1):
+        raise ValueError(
+            f"evaluate(episodes=...) must be an int >= 1, got {episodes!r} "
+            f"({type(episodes).__name__}); e.g. episodes=10"
+        )
+    if not (is_int(seed) and seed >= 0):
+        raise ValueError(
+            f"evaluate(seed=...) must be an int >= 0 (episode i resets with seed + i), got "
+            f"{seed!r} ({type(seed).__name__}); e.g. seed=run.first_seed, the run's own "
+            "evaluation seeds"
+        )
+
+
+def check_options(record: Any, on_episode: Any, stop: Any) -> None:
+    """A TypeError unless ``record`` is a bool and ``on_episode`` and ``stop`` are None or
+    callables their calls fit (a truthy ``record="no"`` would record)."""
+    check_bool(record, "evaluate(record=...)")
+    if on_episode is not None:
+        check_callable(
+            on_episode,
+            "evaluate(on_episode=...)",
+            "on_episode(index, episode_return)",
+            (0, 0.0),
+            "pass a function of the episode's index and return, e.g. "
+            "on_episode=lambda i, r: print(i, r), or None",
+        )
+    if stop is not None:
+        check_callable(
+            stop,
+            "evaluate(stop=...)",
+            "stop() before every step",
+            (),
+            "pass a function of no arguments that returns True to stop, e.g. "
+            "stop=lambda: False, or None",
+        )
 
 
 class RandomPolicy:

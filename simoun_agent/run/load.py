@@ -10,19 +10,23 @@ device, whatever device string they were saved from.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import torch
 
 from simoun_agent.agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
+from simoun_agent.config.device import device_problem
 from simoun_agent.run.checkpoint import check_config, load_checkpoint
 from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
+from simoun_wrappers._checks import is_int
 
 
 @dataclass
@@ -46,17 +50,22 @@ class LoadedRun:
         return first_eval_seed(self.config.seed)
 
 
-def load_run(path: Path, device: str | None = None, torch_threads: int | None = None) -> LoadedRun:
+def load_run(
+    path: str | os.PathLike,
+    device: str | torch.device | None = None,
+    torch_threads: int | None = None,
+) -> LoadedRun:
     """Rebuild the run of ``path`` (its directory or checkpoint.pt); SetupError when it cannot.
 
-    ``device`` and ``torch_threads`` (None: the run's own) apply before the config's checks.
+    ``device`` (a str or torch.device) and ``torch_threads`` (None: the run's own) apply before
+    the config's checks; a value of theirs that this machine cannot use is refused naming the
+    argument (the saved files are not at fault).
     """
+    check_run_path(path)
+    machine = machine_values(device, torch_threads)
     payload = load_checkpoint(Path(path))
     check_config_file(payload)
-    machine = {"device": device, "torch_threads": torch_threads}
-    config = from_dict(
-        {**payload["config"], **{key: value for key, value in machine.items() if value is not None}}
-    )
+    config = from_dict({**payload["config"], **machine}, "saved config")
     if config.torch_threads:
         # torch's default of one thread per core oversubscribes a shared machine: 3 episodes
         # of a cpu-preset checkpoint took 63 and 47 s with 2 threads, 19 and 31 s with the
@@ -72,6 +81,39 @@ def load_run(path: Path, device: str | None = None, torch_threads: int | None = 
     agent.load_state_dict(payload["agent"])
     run_dir = payload["replay_path"].parent
     return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
+
+
+def check_run_path(path: Any) -> None:
+    """A TypeError naming ``path`` when it is no path at all (pathlib's names no argument)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(
+            f"load_run(path=...) must be a run directory or its checkpoint.pt, as a str or "
+            f"os.PathLike, got {type(path).__name__} {path!r:.60}; e.g. load_run('runs/my-run')"
+        )
+
+
+def machine_values(device: Any, torch_threads: Any) -> dict[str, Any]:
+    """load_run's ``device`` (as its string) and ``torch_threads``, the ones given, to set over
+    the saved config; TypeError or SetupError naming the argument when this machine cannot use
+    it."""
+    values: dict[str, Any] = {}
+    if device is not None:
+        if not isinstance(device, (str, torch.device)):
+            raise TypeError(
+                f"load_run(device=...) must be a str, a torch.device or None (the run's own), "
+                f"got {type(device).__name__} {device!r:.60}; e.g. device='cpu'"
+            )
+        values["device"] = str(device)
+        if problem := device_problem(values["device"]):
+            raise SetupError(f"load_run(device={values['device']!r}): {problem}")
+    if torch_threads is not None:
+        if not (is_int(torch_threads) and 1 <= torch_threads < 2**63):
+            raise SetupError(
+                f"load_run(torch_threads=...) must be an int >= 1 or None (the run's own), got "
+                f"{torch_threads!r} ({type(torch_threads).__name__}); e.g. torch_threads=1"
+            )
+        values["torch_threads"] = int(torch_threads)
+    return values
 
 
 def check_config_file(payload: dict) -> None:
@@ -95,5 +137,5 @@ def check_config_file(payload: dict) -> None:
     # is this machine's choice (load_run's ``device``), so a GPU run's reads on a CPU machine.
     machine = {"device": "cpu"}
     as_saved = to_dict(from_dict({**saved, **machine}, str(path)))
-    checkpoint = to_dict(from_dict({**payload["config"], **machine}))
+    checkpoint = to_dict(from_dict({**payload["config"], **machine}, "saved config"))
     check_config({"config": checkpoint}, as_saved, run_dir, saved=path)

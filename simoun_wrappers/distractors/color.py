@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
-from simoun_wrappers._checks import check_action, check_reset_seed, plain
+from simoun_wrappers._checks import check_action, check_reset_seed, keyword_reset, plain
 from simoun_wrappers.distractors._dm_control import (
     check_level,
     check_open,
@@ -157,6 +157,7 @@ class ColorShift(gym.Wrapper, gym.utils.RecordConstructorArgs):
             found.append(name)
         return found
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:

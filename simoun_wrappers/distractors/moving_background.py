@@ -8,7 +8,7 @@ from typing import Any, SupportsFloat
 import gymnasium as gym
 import numpy as np
 
-from simoun_wrappers._checks import check_action, check_reset_seed, plain
+from simoun_wrappers._checks import check_action, check_reset_seed, keyword_reset, plain
 from simoun_wrappers.distractors._dm_control import (
     check_level,
     check_open,
@@ -99,6 +99,7 @@ class MovingBackground(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self._source.start(self._rng)
         self._t = 0
 
+    @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
