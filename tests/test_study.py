@@ -893,3 +893,16 @@ def test_a_study_is_refused_the_archive_of_a_minigrid_study(tmp_path):
     with pytest.raises(SetupError, match="holds runs of a MiniGrid PPO study"):
         open_study(spec_from(str(spec_path)), str(spec_path), options)
     assert not (archive / "study.json").exists()
+
+
+def test_plan_refuses_gpus_per_trial_for_runs_on_the_cpu(tmp_path, capsys):
+    resources = "max_concurrent_trials = 2"
+    text = SPEC.replace(resources, f"{resources}\ngpus_per_trial = 1")
+    path = write_spec(tmp_path / "gpus.toml", text)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(path), "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    line = key_line(text, ("resources", "gpus_per_trial"))
+    assert f"{path}:{line}: [resources] gpus_per_trial: gpus_per_trial = 1 and [base] " in err
+    assert 'device = "cpu" contradict each other' in err and "set it to 0" in err

@@ -352,7 +352,7 @@ def test_a_cuda_trial_given_no_gpu_is_refused_naming_both_flags(tmp_path):
         with pytest.raises(SetupError) as refused:
             check_devices(spec.trials(tmp_path), 0.0, grid)
         assert f"--gpus-per-trial 0 and {said}" in str(refused.value)
-        assert "pass --gpus-per-trial 1" in str(refused.value)
+        assert "set --gpus-per-trial to 1" in str(refused.value)
         check_devices(spec.trials(tmp_path), None, grid)  # auto follows the device
     cpu = SweepSpec(None, {"device": "cpu"}, {}, [0], ["simoun/PointReach-v0"])
     check_devices(cpu.trials(tmp_path), 0.0, {})

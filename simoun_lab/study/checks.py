@@ -28,6 +28,7 @@ from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
 from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
 from simoun_lab.study.spec import Source, StudySpec, spec_text
+from simoun_lab.sweep.grid import devices_problem
 
 MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
 """The keys a memory refusal asks to change, looked up in the spec to name their line."""
@@ -129,6 +130,24 @@ def task_error(
     )
 
 
+def check_study_devices(source: Source, spec: StudySpec, config: TrainConfig) -> None:
+    """Refuse [resources] gpus_per_trial when it contradicts the device a run trains on
+    (:func:`~simoun_lab.sweep.grid.devices_problem`), naming the gpus_per_trial line."""
+    if spec.gpus_per_trial == "auto":
+        return
+    gpus = float(spec.gpus_per_trial)
+    place = key_place(spec, config.env, "device")
+    device_said = f"[{place[0]}] device = {json.dumps(config.device)}" if place else "device"
+    problem = devices_problem(
+        config.device,
+        gpus,
+        (f"gpus_per_trial = {gpus:g}", "gpus_per_trial"),
+        (device_said, "device"),
+    )
+    if problem:
+        raise source.error(("resources", "gpus_per_trial"), problem)
+
+
 def check_run_config(
     source: Source, spec: StudySpec, phase: str, config: TrainConfig, limit: int | None
 ) -> None:
@@ -172,6 +191,7 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
             except SetupError as err:
                 raise task_error(source, spec, phase, config, err) from None
         check_run_config(source, spec, phase, config, made[env])
+        check_study_devices(source, spec, config)
         try:
             check_replay(config, made[env], SPEC_KEYS)
         except SetupError as err:

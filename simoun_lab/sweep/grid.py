@@ -565,37 +565,51 @@ def check_trial_config(config: TrainConfig, grid: dict[str, list[Any]]) -> None:
 
 def check_devices(trials: list[Trial], gpus: float | None, grid: dict[str, list[Any]]) -> None:
     """Refuse ``--gpus-per-trial`` (``gpus``; None: auto, which follows the device) when it
-    contradicts a trial's ``--device`` (or ``--grid device``): GPUs reserved for a trial that
-    trains on the CPU (or on MPS, which Ray does not count) cap the trials run at once for
-    nothing, and a CUDA device is hidden by Ray from a trial that reserves no GPU."""
+    contradicts a trial's ``--device`` (or ``--grid device``) (:func:`devices_problem`)."""
     if gpus is None:
         return
     for trial in trials:
         # as given, not resolved: resolving asks this machine for the device, and the trials
         # may run on other machines of the cluster
         device = trial.overrides.get("device", resolve(trial.preset, {}).device)
-        if device is None:
-            continue  # cuda when the trial sees a GPU, else the CPU: either fits
         if "device" in grid:
-            given, fix = f"--grid device={device} (trial {trial.name})", "--grid device"
+            given, key = f"--grid device={device} (trial {trial.name})", "--grid device"
         else:
-            given, fix = f"--device {device}", "--device"
-        cuda = device.startswith("cuda")
-        if gpus > 0 and not cuda:
-            raise SetupError(
-                f"--gpus-per-trial {gpus:g} and {given} contradict each other: each trial would "
-                f"reserve {gpus:g} GPU{'s' * (gpus != 1)} it never uses, and the GPUs, not the "
-                f"CPUs, would cap how many trials run at once; drop --gpus-per-trial (auto "
-                f"reserves none for a {device} trial) or pass --gpus-per-trial 0, or give "
-                f"{fix} cuda to train on the GPUs"
-            )
-        if gpus == 0 and cuda:
-            raise SetupError(
-                f"--gpus-per-trial 0 and {given} contradict each other: Ray shows no GPU to a "
-                f"trial that reserves none, so it could not train on {device}; pass "
-                f"--gpus-per-trial 1 (or drop it: auto gives each trial one when the cluster "
-                f"has GPUs), or give {fix} cpu"
-            )
+            given, key = f"--device {device}", "--device"
+        problem = devices_problem(
+            device, gpus, (f"--gpus-per-trial {gpus:g}", "--gpus-per-trial"), (given, key)
+        )
+        if problem:
+            raise SetupError(problem)
+
+
+def devices_problem(
+    device: str | None, gpus: float, gpus_given: tuple[str, str], device_given: tuple[str, str]
+) -> str | None:
+    """What is contradictory in a trial that trains on ``device`` with ``gpus`` GPUs reserved,
+    each given as (what was said, the key to change): GPUs reserved for a trial that trains on
+    the CPU (or on MPS, which Ray does not count) cap the trials run at once for nothing, and
+    Ray hides the GPUs from a trial that reserves none, so a CUDA device fails in it. None when
+    they fit (a device left unset takes cuda when the trial sees a GPU, else the CPU)."""
+    if device is None:
+        return None
+    (gpus_said, gpus_key), (device_said, device_key) = gpus_given, device_given
+    cuda = device.startswith("cuda")
+    if gpus > 0 and not cuda:
+        return (
+            f"{gpus_said} and {device_said} contradict each other: each trial would reserve "
+            f"{gpus:g} GPU{'s' * (gpus != 1)} it never uses, and the GPUs, not the CPUs, would "
+            f"cap how many trials run at once; drop {gpus_key} (auto reserves none for a "
+            f"{device} trial) or set it to 0, or set {device_key} to cuda to train on the GPUs"
+        )
+    if gpus == 0 and cuda:
+        return (
+            f"{gpus_said} and {device_said} contradict each other: Ray shows no GPU to a trial "
+            f"that reserves none, so it could not train on {device}; set {gpus_key} to 1 (or "
+            f"drop it: auto gives each trial one when the cluster has GPUs), or set {device_key} "
+            "to cpu"
+        )
+    return None
 
 
 def typed(overrides: dict[str, Any]) -> dict[str, Any]:
