@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
-import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
+import ray  # the lab extra: a missing install fails instead of skipping
 from broken_envs import NAN_REACH_ID
 from flag_lists import override
 
@@ -32,6 +32,7 @@ from simoun_lab.sweep.grid import (
     parse_seeds,
     split_values,
 )
+from simoun_lab.sweep.launch import gpus_per_trial
 from simoun_lab.sweep.trainable import finished
 
 TINY = override(
@@ -684,3 +685,10 @@ def test_a_trial_moved_out_of_the_sweep_and_linked_back_is_read_as_the_run(train
     assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
     (row,) = list(csv.DictReader((tmp_path / "out" / "report.csv").open()))
     assert row["n"] == "2"
+
+
+def test_auto_gpus_refuse_a_cuda_trial_on_a_cluster_without_gpus(ray_address):
+    assert ray.cluster_resources().get("GPU", 0) == 0  # the tests' local instance
+    with pytest.raises(SetupError, match="the Ray cluster has no GPU"):
+        gpus_per_trial(ray, "auto", "cuda")
+    assert gpus_per_trial(ray, "auto", "mps") == gpus_per_trial(ray, "auto", None) == 0.0
