@@ -594,3 +594,13 @@ def test_a_hand_edited_json_spec_is_told_where_and_why_it_is_not_json(edit, said
     with pytest.raises(SetupError) as refused:
         load_ppo_spec(str(path))
     assert str(refused.value).startswith(f"the study spec {path} is not valid JSON: {said}")
+
+
+def test_a_study_record_given_as_a_minigrid_spec_is_named_with_its_spec(tmp_path):
+    docs = Path(__file__).resolve().parents[1] / "docs" / "studies"
+    record = shutil.copy(docs / "dmc100k" / "study.json", tmp_path / "study.json")
+    with pytest.raises(SetupError) as refused:
+        load_spec(record)
+    said = str(refused.value)
+    assert f"--spec {record} is a study's record" in said and "not a study spec" in said
+    assert "docs/studies/dmc100k.toml" in said and "unknown key" not in said

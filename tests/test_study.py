@@ -803,3 +803,106 @@ def test_a_minigrid_archive_given_a_sac_spec_is_told_its_kind(tmp_path, capsys):
     archive = Path(shutil.copytree("docs/studies/minigrid-v2/tuning", tmp_path / "mgt"))
     err = report_refused(archive, capsys)
     assert f"{archive} holds runs of a MiniGrid PPO study ({archive / 'spec.json'})" in err
+
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "studies"
+"""The committed studies: their specs and archives."""
+
+
+@pytest.mark.parametrize("name", ["study.json", "record.toml"])
+def test_plan_names_a_study_record_given_as_its_spec(name, tmp_path, capsys):
+    record = shutil.copy(DOCS / "dmc100k" / "study.json", tmp_path / name)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(record)])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{record} is a study's record (the study.json that simoun-study run keeps" in err
+    assert "not a study spec; pass the spec file the study was run from, " in err
+    assert "docs/studies/dmc100k.toml" in err and "unknown key" not in err
+
+
+@pytest.mark.parametrize(
+    ("base", "key", "said"),
+    [
+        (
+            "env_kwargs = { nope = 1 }",
+            "env_kwargs",
+            "simoun/PointReach-v0 cannot be trained with it: env_kwargs: simoun/PointReach-v0 "
+            "takes no keyword 'nope'; it accepts: max_steps, size, step_size",
+        ),
+        (
+            'env_module = "nosuchmodule"',
+            "env_module",
+            "env_module 'nosuchmodule' is not installed, so the ids it registers are unknown; pip "
+            "install nosuchmodule (or the package that provides nosuchmodule), or drop env_module",
+        ),
+        (
+            "action_repeat = 15",
+            "action_repeat",
+            "action_repeat 15 (TrainConfig.action_repeat): an episode of simoun/PointReach-v0 "
+            "ends after 20 env steps",
+        ),
+        (
+            'eval_distraction = ["color_easy"]',
+            "eval_distraction",
+            "eval_distraction color_easy needs a dm_control task (it recolours or re-renders a "
+            "MuJoCo scene), but this run trains on simoun/PointReach-v0; leave color_easy out of "
+            "eval_distraction",
+        ),
+    ],
+)
+def test_plan_blames_a_bad_env_setting_on_its_own_line(base, key, said, tmp_path, capsys):
+    text = SPEC.replace("[grid]", f"{base}\n\n[grid]")
+    path = write_spec(tmp_path / "edited.toml", text)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(path), "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"{path}:{key_line(text, ('base', key))}: [base] {key}: " in err, err
+    assert said in err and "[tuning] tasks" not in err and " --" not in err, err
+
+
+def test_a_study_is_refused_an_archive_of_another_study_and_leaves_it_unchanged(tmp_path, capsys):
+    archive = Path(shutil.copytree(DOCS / "dmc100k", tmp_path / "arch"))
+    kept = (archive / "study.json").read_bytes()
+    spec_path = DOCS / "highway50k.toml"
+    said = (
+        f"--archive {archive} holds another study, 'dmc100k' (run from "
+        "docs/studies/dmc100k.toml), not the study 'highway50k'"
+    )
+    for flags in ({"resume": True}, {"resume": True, "allow_other_commit": True}, {}):
+        options = StudyOptions(study_dir=tmp_path / "s", archive=archive, **flags)
+        with pytest.raises(SetupError, match=re.escape(said)):
+            open_study(spec_from(str(spec_path)), str(spec_path), options)
+    argv = ["run", str(spec_path), "--study-dir", str(tmp_path / "s"), "--archive", str(archive)]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main([*argv, "--resume", "--allow-other-commit"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert said in err and "to continue 'dmc100k', pass its spec" in err and "commit" not in err
+    assert (archive / "study.json").read_bytes() == kept
+    assert not (tmp_path / "s" / "study.json").exists()
+
+
+def test_a_study_is_refused_the_archive_of_a_minigrid_study(tmp_path):
+    archive = tmp_path / "mg"
+    archive.mkdir()
+    shutil.copy(DOCS / "minigrid" / "spec.json", archive / "spec.json")
+    spec_path = write_spec(tmp_path / "tiny.toml")
+    options = StudyOptions(study_dir=tmp_path / "s", archive=archive)
+    with pytest.raises(SetupError, match="holds runs of a MiniGrid PPO study"):
+        open_study(spec_from(str(spec_path)), str(spec_path), options)
+    assert not (archive / "study.json").exists()
+
+
+def test_plan_refuses_gpus_per_trial_for_runs_on_the_cpu(tmp_path, capsys):
+    resources = "max_concurrent_trials = 2"
+    text = SPEC.replace(resources, f"{resources}\ngpus_per_trial = 1")
+    path = write_spec(tmp_path / "gpus.toml", text)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(path), "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    line = key_line(text, ("resources", "gpus_per_trial"))
+    assert f"{path}:{line}: [resources] gpus_per_trial: gpus_per_trial = 1 and [base] " in err
+    assert 'device = "cpu" contradict each other' in err and "set it to 0" in err

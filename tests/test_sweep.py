@@ -13,12 +13,12 @@ import time
 from pathlib import Path
 
 import pytest
-import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
+import ray  # the lab extra: a missing install fails instead of skipping
 from broken_envs import NAN_REACH_ID
 from flag_lists import override
 
 from benchmarks.sweep import tiny_flags
-from simoun_agent.config import resolve
+from simoun_agent.config import SetupError, resolve
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
@@ -27,10 +27,12 @@ from simoun_lab.cli import sweep as cli
 from simoun_lab.sweep.grid import (
     SWEEP_FILE,
     SweepSpec,
+    check_devices,
     check_trial_dirs,
     parse_seeds,
     split_values,
 )
+from simoun_lab.sweep.launch import gpus_per_trial
 from simoun_lab.sweep.trainable import finished
 
 TINY = override(
@@ -310,6 +312,30 @@ def error_of(argv: list[str], capsys) -> str:
         (["--grid", "agent.lr=1e-3|3e-4"], "e.g. --grid agent.lr=1e-3,3e-4"),
         (["--envs", "NoSuchEnv-v0"], "or MODULE:ID (e.g. minigrid:"),
         (["--env", "MiniGrid-Empty-5x5-v0", "--env-module", "minigrid"], "Discrete(7)"),
+        (["--grid", "agent.lr=[1e-3,3e-4]"], "--grid 'agent.lr=[1e-3,3e-4]': --grid takes each "
+         "value, comma-separated, not a list in brackets; write --grid agent.lr=1e-3,3e-4"),
+        (["--grid", "agent.n_step=(1, 3)"], "write --grid agent.n_step=1,3"),
+        (["--grid", "agent.n_step=1-3"], "--grid 'agent.n_step=1-3': --grid takes each value, "
+         "comma-separated, not a range; write --grid agent.n_step=1,2,3"),
+        (["--grid", "agent.lr=fast"], "--grid 'agent.lr=fast': cannot read agent.lr='fast': "
+         "expected float; --grid takes comma-separated values, e.g. --grid agent.lr=V1,V2"),
+        (["--seeds", "[0,1]"], "--seeds takes the seeds comma-separated, not a list in brackets; "
+         "write --seeds 0,1"),
+        (["--envs", "[simoun/PointReach-v0, Pendulum-v1]"], "write --envs "
+         "simoun/PointReach-v0,Pendulum-v1"),
+        (["--grid", "eval_distraction=color_easy,color_hard"], "--grid eval_distraction "
+         "color_easy needs a dm_control task (it recolours or re-renders a MuJoCo scene), but "
+         "this run trains on simoun/PointReach-v0; leave color_easy out of --grid "
+         "eval_distraction"),
+        (["--eval-distraction", "video_hard"], "trial base/simoun-PointReach-v0/s1: "
+         "--eval-distraction video_hard needs a dm_control task"),
+        (["--grid", "action_repeat=1,100"], "trial action_repeat=100/simoun-PointReach-v0/s1: "
+         "--action-repeat 100 (TrainConfig.action_repeat) is longer than the whole run"),
+        (["--grid", "action_repeat=1,15"], "trial action_repeat=15/simoun-PointReach-v0/s1: "
+         "--action-repeat 15 (TrainConfig.action_repeat): an episode of simoun/PointReach-v0 "
+         "ends after 20 env steps"),
+        (["--gpus-per-trial", "0.5"], "--gpus-per-trial 0.5 and --device cpu contradict each "
+         "other: each trial would reserve 0.5 GPUs it never uses"),
     ],
 )  # fmt: skip
 def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, capsys):
@@ -318,6 +344,19 @@ def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, cap
     err = error_of([*base, *flags, "--sweep-dir", str(sweep_dir)], capsys)
     assert message in err
     assert not sweep_dir.exists()
+
+
+def test_a_cuda_trial_given_no_gpu_is_refused_naming_both_flags(tmp_path):
+    for grid, said in (({}, "--device cuda"), ({"device": ["cuda", "cpu"]}, "--grid device=cuda")):
+        base = {} if grid else {"device": "cuda"}
+        spec = SweepSpec(None, base, grid, [0], ["simoun/PointReach-v0"])
+        with pytest.raises(SetupError) as refused:
+            check_devices(spec.trials(tmp_path), 0.0, grid)
+        assert f"--gpus-per-trial 0 and {said}" in str(refused.value)
+        assert "set --gpus-per-trial to 1" in str(refused.value)
+        check_devices(spec.trials(tmp_path), None, grid)  # auto follows the device
+    cpu = SweepSpec(None, {"device": "cpu"}, {}, [0], ["simoun/PointReach-v0"])
+    check_devices(cpu.trials(tmp_path), 0.0, {})
 
 
 def test_a_replay_or_a_batch_the_run_cannot_hold_is_refused_before_ray_starts(tmp_path, capsys):
@@ -646,3 +685,10 @@ def test_a_trial_moved_out_of_the_sweep_and_linked_back_is_read_as_the_run(train
     assert report_cli.main([str(sweep_dir), "--out", str(tmp_path / "out")]) == 0
     (row,) = list(csv.DictReader((tmp_path / "out" / "report.csv").open()))
     assert row["n"] == "2"
+
+
+def test_auto_gpus_refuse_a_cuda_trial_on_a_cluster_without_gpus(ray_address):
+    assert ray.cluster_resources().get("GPU", 0) == 0  # the tests' local instance
+    with pytest.raises(SetupError, match="the Ray cluster has no GPU"):
+        gpus_per_trial(ray, "auto", "cuda")
+    assert gpus_per_trial(ray, "auto", "mps") == gpus_per_trial(ray, "auto", None) == 0.0

@@ -170,13 +170,13 @@ def make_distracted_env(
     return make_env(config, distractor(name, videos))
 
 
-def check_eval_distractions(config: TrainConfig) -> list[str]:
-    """``config.eval_distraction`` checked (names, a dm_control task); SetupError otherwise.
+def check_eval_distractions(config: TrainConfig, flag: str = "--eval-distraction") -> list[str]:
+    """``config.eval_distraction`` checked (names, a dm_control task); SetupError otherwise,
+    naming ``flag``, where the modes were given (a sweep's ``--grid eval_distraction``).
 
     ``train`` is refused: it is the run's own evaluation, which always runs.
     """
     check_run_config(config, "check_eval_distractions")
-    flag = "--eval-distraction"
     if "train" in config.eval_distraction:
         raise SetupError(
             f"{flag} train is the run's own evaluation, which always runs; name distraction "
@@ -189,5 +189,10 @@ def check_eval_distractions(config: TrainConfig) -> list[str]:
         if config.eval_distraction
         else []
     )
-    check_supported(config, names)
+    if names and not config.env.startswith("dm_control/"):
+        raise SetupError(
+            f"{flag} {names[0]} needs a dm_control task (it recolours or re-renders a MuJoCo "
+            f"scene), but this run trains on {config.env}; leave {names[0]} out of {flag} (the "
+            "run's own evaluation always runs), or train on a dm_control task"
+        )
     return names

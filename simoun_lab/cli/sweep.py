@@ -40,6 +40,7 @@ from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import (
     SWEEP_FILE,
     SweepSpec,
+    check_devices,
     check_runnable,
     check_trial_dirs,
     gpus_wanted,
@@ -215,7 +216,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         spec = sweep_spec(args, overrides_from(args.flags, argv, SweepCommand), sweep_dir)
         check_trial_dirs(spec, sweep_dir)
         check_output_dir(sweep_dir, "--sweep-dir")
-        gpus_wanted(args.gpus_per_trial)
+        check_devices(spec.trials(sweep_dir), gpus_wanted(args.gpus_per_trial), spec.grid)
         ray = load_ray()
     except SetupError as err:
         fail(PROG, err)
@@ -232,7 +233,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
     try:
-        check_runnable(todo, "--envs" if args.envs or len(spec.envs) > 1 else "--env")
+        check_runnable(todo, "--envs" if args.envs or len(spec.envs) > 1 else "--env", spec.grid)
     except SetupError as err:
         fail(PROG, err)
     print(f"sweep {sweep_dir}: {len(todo)} trials to run, {done} already finished", flush=True)

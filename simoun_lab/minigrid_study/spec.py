@@ -23,6 +23,7 @@ from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
 from simoun_agent.run.kept import Damaged, json_kind, json_problem, read_text
 from simoun_lab.minigrid_study.arms import ARMS, arm_settings
+from simoun_lab.study.record_file import record_not_spec
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -265,6 +266,9 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
             raise SetupError(f"{label} {path} is not valid JSON: {problem}") from None
     except ValueError as err:  # a key given twice
         raise SetupError(f"{label} {path}: {err}") from None
+    record = record_not_spec(values, path, label)
+    if record is not None:
+        raise record
     if not isinstance(values, dict):
         raise SetupError(
             f"{label} {path} holds {json_kind(values)}, not the object of a study spec "

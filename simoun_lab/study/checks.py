@@ -15,7 +15,9 @@ evaluation started would select another setting.
 from __future__ import annotations
 
 import json
+import re
 import sys
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +28,7 @@ from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
 from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
 from simoun_lab.study.spec import Source, StudySpec, spec_text
+from simoun_lab.sweep.grid import devices_problem
 
 MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
 """The keys a memory refusal asks to change, looked up in the spec to name their line."""
@@ -54,13 +57,122 @@ def memory_line(spec: StudySpec, task: str) -> tuple[str, ...]:
     """Where a memory refusal points: the first memory key the spec sets (grid, the task's
     table, base), else the [base] table."""
     for key in MEMORY_KEYS:
-        if key in spec.grid:
-            return ("grid", *key.split("."))
-        if key in spec.task_config.get(task, {}):
-            return ("tasks", task, *key.split("."))
-        if key in spec.base:
-            return ("base", *key.split("."))
+        place = key_place(spec, task, key)
+        if place is not None:
+            return place
     return ("base",)
+
+
+def key_place(spec: StudySpec, task: str, key: str) -> tuple[str, ...] | None:
+    """Where the spec gives config ``key`` for ``task``: its [grid], the task's own table, or
+    [base] (the first that holds it, as they override each other); None when it does not."""
+    if key in spec.grid:
+        return ("grid", *key.split("."))
+    if key in spec.task_config.get(task, {}):
+        return ("tasks", task, *key.split("."))
+    if key in spec.base:
+        return ("base", *key.split("."))
+    return None
+
+
+ENV_SETTINGS = ("env_module", "env_kwargs", "cameras", "action_repeat")
+"""Config keys that change how a task's env is made or stepped: a task refused with one of them
+that the spec sets, and made without it, is refused for that key, not for the task."""
+
+FLAG = re.compile(r"--([a-z][a-z0-9-]*(?:\.[a-z][a-z0-9-]*)*)")
+"""A command-line flag in a message (``--env-kwargs``, ``--agent.batch-size``)."""
+
+
+def in_spec_terms(message: str) -> str:
+    """``message`` with each config flag spelled as the spec's key (``--env-kwargs`` ->
+    ``env_kwargs``), and the command line's fix for a module spelled as the spec's."""
+    message = message.replace("drop the module from --env", "drop env_module")
+    return FLAG.sub(lambda flag: flag[1].replace("-", "_"), message)
+
+
+def setting_at_fault(spec: StudySpec, config: TrainConfig) -> tuple[str, ...] | None:
+    """Where the spec gives the env setting (:data:`ENV_SETTINGS`) without which ``config``'s
+    task is made and stepped, for a task refused with it; None when the task itself is at
+    fault (an unknown id, discrete actions), or when no setting the spec gives is."""
+    for key in ENV_SETTINGS:
+        place = key_place(spec, config.env, key)
+        if place is None:
+            continue
+        try:
+            check_task(replace(config, **{key: DEFAULTS[key]}))
+        except SetupError:
+            continue
+        return place
+    return None
+
+
+DEFAULTS = {item.name: getattr(TrainConfig(), item.name) for item in fields(TrainConfig)}
+"""A run's config values when nothing sets them."""
+
+
+def task_error(
+    source: Source, spec: StudySpec, phase: str, config: TrainConfig, err: SetupError
+) -> SetupError:
+    """The refusal of a task the recipes cannot train on, at the spec's line: the env setting
+    at fault (:func:`setting_at_fault`), in the spec's terms, else the phase's tasks."""
+    said = str(err).rstrip(".")
+    place = setting_at_fault(spec, config)
+    if place is not None:
+        return source.error(
+            place,
+            f"{config.env} cannot be trained with it: {in_spec_terms(said)}",
+        )
+    if not said.startswith(config.env):
+        said = f"{config.env} cannot be trained by the recipes: {said}"
+    return source.error(
+        (phase, "tasks"),
+        f"{said}. Replace it in [{phase}] tasks (the spec is read before anything runs).",
+    )
+
+
+def check_study_devices(source: Source, spec: StudySpec, config: TrainConfig) -> None:
+    """Refuse [resources] gpus_per_trial when it contradicts the device a run trains on
+    (:func:`~simoun_lab.sweep.grid.devices_problem`), naming the gpus_per_trial line."""
+    if spec.gpus_per_trial == "auto":
+        return
+    gpus = float(spec.gpus_per_trial)
+    place = key_place(spec, config.env, "device")
+    device_said = f"[{place[0]}] device = {json.dumps(config.device)}" if place else "device"
+    problem = devices_problem(
+        config.device,
+        gpus,
+        (f"gpus_per_trial = {gpus:g}", "gpus_per_trial"),
+        (device_said, "device"),
+    )
+    if problem:
+        raise source.error(("resources", "gpus_per_trial"), problem)
+
+
+def check_run_config(
+    source: Source, spec: StudySpec, phase: str, config: TrainConfig, limit: int | None
+) -> None:
+    """``simoun-train``'s checks of one run's config against its task (its evaluation
+    distractions, its action repeat against the episodes and the budget), naming the spec's
+    line of the key at fault."""
+    from simoun_agent.generalization import check_eval_distractions
+    from simoun_agent.run.make_env import check_decisions
+    from simoun_agent.run.train import check_budget
+
+    task = config.env
+    try:
+        check_eval_distractions(config, "eval_distraction")
+    except SetupError as err:
+        place = key_place(spec, task, "eval_distraction") or ("base",)
+        raise source.error(place, str(err)) from None
+    for check, keys in (
+        (lambda: check_decisions(config, limit), ("action_repeat",)),
+        (lambda: check_budget(config), ("action_repeat",)),
+    ):
+        try:
+            check()
+        except SetupError as err:
+            place = key_place(spec, task, keys[0]) or (phase, "tasks")
+            raise source.error(place, f"{task}: {in_spec_terms(str(err))}") from None
 
 
 def check_study(spec: StudySpec, spec_path: str) -> None:
@@ -77,14 +189,9 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
             try:
                 made[env] = check_task(config)
             except SetupError as err:
-                said = str(err).rstrip(".")
-                if not said.startswith(config.env):
-                    said = f"{config.env} cannot be trained by the recipes: {said}"
-                raise source.error(
-                    (phase, "tasks"),
-                    f"{said}. Replace it in [{phase}] tasks (the spec is read before anything "
-                    "runs).",
-                ) from None
+                raise task_error(source, spec, phase, config, err) from None
+        check_run_config(source, spec, phase, config, made[env])
+        check_study_devices(source, spec, config)
         try:
             check_replay(config, made[env], SPEC_KEYS)
         except SetupError as err:

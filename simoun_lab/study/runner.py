@@ -34,6 +34,7 @@ from simoun_lab.study.plan import (
     tuning_runs,
 )
 from simoun_lab.study.provenance import code_version, same_code
+from simoun_lab.study.record_file import RECORD_KEYS
 from simoun_lab.study.report import REPORT_DIR, REPORT_MD, write_study_report
 from simoun_lab.study.spec import StudySpec, load_spec, spec_text
 from simoun_lab.sweep import launch
@@ -81,9 +82,6 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
         "the study, or pass the --study-dir (or --archive) of the study to continue"
     )
 
-
-RECORD_KEYS = ("spec_file", "spec_text", "spec", "parts")
-"""Keys every study record holds (:func:`open_study`)."""
 
 PART_KEYS = ("commit", "dirty", "version")
 """Keys every part of a study record holds: the code it ran (:func:`code_version`)."""
@@ -186,9 +184,60 @@ def check_same_spec(record: dict[str, Any], spec: StudySpec, problem: str, fix: 
         )
 
 
+def planned_names(spec: StudySpec) -> set[str]:
+    """The names of every run ``spec`` plans (an evaluation run's name holds no setting)."""
+    return {run.name for run in tuning_runs(spec) + evaluation_runs(spec)}
+
+
+def finished_names(where: Path) -> set[str]:
+    """The names of the finished runs of both phases under ``where``."""
+    return {
+        str(path.parent.relative_to(where))
+        for phase in (TUNING, EVALUATION)
+        for path in (where / phase).rglob(SUMMARY_NAME)
+    }
+
+
+def of_this_spec(record: dict[str, Any], spec: StudySpec, where: Path) -> bool:
+    """Whether the study ``record`` kept in ``where`` is a study of ``spec``: its name, or,
+    for a spec fixed under another name, a finished run under ``where`` that ``spec`` plans."""
+    if record["spec"].get("name") == spec.name:
+        return True
+    return bool(finished_names(where) & planned_names(spec))
+
+
+def check_own_places(spec: StudySpec, spec_path: str, options: StudyOptions) -> None:
+    """Refuse a --study-dir or --archive that holds another study, before anything is read
+    from it or written into it: a MiniGrid PPO study's runs, or the record of a study that is
+    not ``spec``'s (:func:`of_this_spec`), which running this study would write over."""
+    for where, flag in ((options.study_dir, "--study-dir"), (options.archive, "--archive")):
+        if where is None:
+            continue
+        if present(where / PPO_SPEC_FILE) and not present(where / STUDY_FILE):
+            raise SetupError(
+                f"{flag} {where} holds runs of a MiniGrid PPO study ({where / PPO_SPEC_FILE}), "
+                f"not of the SAC study of {spec_path}; pass another {flag} (a new directory, or "
+                "the one of this study)"
+            )
+        if not present(where / STUDY_FILE):
+            continue
+        record = read_record(where / STUDY_FILE)
+        if of_this_spec(record, spec, where):
+            continue
+        theirs = record["spec"].get("name")
+        raise SetupError(
+            f"{flag} {where} holds another study, {theirs!r} (run from {record['spec_file']}), "
+            f"not the study {spec.name!r} of {spec_path}; this study would write its record and "
+            f"runs over that one. Pass the {flag} of this study, or a new directory; to continue "
+            f"{theirs!r}, pass its spec ({record['spec_file']})"
+        )
+
+
 def open_study(spec: StudySpec, spec_path: str, options: StudyOptions) -> dict[str, Any]:
-    """The study record, new or resumed (same spec and, unless allowed, same commit)."""
+    """The study record, new or resumed (same study, same spec and, unless allowed, same
+    commit)."""
     study_dir, archive = options.study_dir, options.archive
+    check_own_places(spec, spec_path, options)  # first: the other checks read what is there
     code = code_version()
     part = {"started_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"), **code}
     if not options.resume:

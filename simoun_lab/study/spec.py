@@ -68,6 +68,7 @@ from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
+from simoun_lab.study.record_file import record_not_spec
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
 from simoun_lab.sweep.grid import MAX_SEEDS, close_key_here, parse_seeds
@@ -317,8 +318,19 @@ def load_spec(path: Path | str) -> StudySpec:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
+        record = record_not_spec(json_or_none(text), path, "the study spec")
+        if record is not None:
+            raise record from None
         raise SetupError(f"{path}: not valid TOML ({err}); fix the syntax there") from None
     return _Reader(Source(path, text)).spec(data, path.stem)
+
+
+def json_or_none(text: str) -> Any:
+    """``text`` read as JSON, None when it is not JSON."""
+    try:
+        return json.loads(text)
+    except ValueError:
+        return None
 
 
 def spec_text(path: Path) -> str:

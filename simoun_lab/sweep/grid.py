@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.config import SetupError, resolve
+from simoun_agent.config import SetupError, TrainConfig, resolve
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
@@ -60,6 +60,12 @@ would be built in memory before anything could refuse it."""
 def parse_seeds(text: str) -> list[int]:
     """``"0-4"`` -> [0, 1, 2, 3, 4]; ``"0,2,5"`` and mixes like ``"0-2,7"`` work too; at most
     :data:`MAX_SEEDS` seeds."""
+    listed = listed_values(text)
+    if listed is not None:
+        raise SetupError(
+            f"--seeds {text!r}: --seeds takes the seeds comma-separated, not a list in brackets; "
+            f"write --seeds {','.join(listed)}"
+        )
     check_commas("--seeds", text, spaces=False)
     seeds: list[int] = []
     for part in text.split(","):
@@ -177,11 +183,57 @@ def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
                 f"--grid {pair!r} has an empty value; give at least one, comma-separated, e.g. "
                 f"--grid {key}=V1,V2"
             )
-        values = [parse_value(key, value, fields[key][0]) for value in texts]
+        values = [grid_value(key, text, value, fields[key][0]) for value in texts]
         if len(set(map(show, values))) < len(values):
             raise SetupError(f"--grid {pair!r} repeats a value; list each value once")
         grid[key] = values
     return grid
+
+
+def grid_value(key: str, text: str, value: str, kind: Any) -> Any:
+    """One value of ``--grid key=text`` read as ``key``'s type; SetupError naming ``--grid`` and
+    its comma-separated form when it cannot be read, built from the values given when the whole
+    ``text`` is written as a list (``[1e-3,3e-4]``) or a range (``1-3``)."""
+    try:
+        return parse_value(key, value, kind)
+    except SetupError as err:
+        said = f"--grid '{key}={text}'"
+        values = listed_values(text) or range_values(text)
+        if values is None:
+            raise SetupError(
+                f"{said}: {err}; --grid takes comma-separated values, e.g. --grid {key}=V1,V2"
+            ) from None
+        form = "a list in brackets" if text.strip()[:1] in "[(" else "a range"
+        raise SetupError(
+            f"{said}: --grid takes each value, comma-separated, not {form}; write "
+            f"--grid {key}={','.join(values)}"
+        ) from None
+
+
+def listed_values(text: str) -> list[str] | None:
+    """The values of ``text`` written as a bracketed list (``[1e-3, 3e-4]``, ``(1, 3)``), else
+    None."""
+    stripped = text.strip()
+    if len(stripped) < 2 or (stripped[0], stripped[-1]) not in (("[", "]"), ("(", ")")):
+        return None
+    values = [value.strip().strip("'\"") for value in stripped[1:-1].split(",")]
+    return values if all(values) else None
+
+
+GRID_RANGE = re.compile(r"\s*(\d+)\s*(?:-|\.\.|:|\u2013)\s*(\d+)\s*")
+"""A range of whole numbers as a list flag is sometimes given it: ``1-3``, ``1..3``, ``1:3``."""
+
+
+def range_values(text: str) -> list[str] | None:
+    """The whole numbers of ``text`` written as a range low-high (``1-3``: 1, 2, 3; at most
+    :data:`MAX_SEEDS`), else None."""
+    match = GRID_RANGE.fullmatch(text)
+    if match is None:
+        return None
+    first, last = sorted((int(match[1]), int(match[2])))
+    if last - first >= MAX_SEEDS:
+        return None
+    return [str(number) for number in range(first, last + 1)]
 
 
 def gpus_wanted(wanted: str) -> float | None:
@@ -277,6 +329,12 @@ class SweepSpec:
             base = {**base, "env_module": base_config.env_module}
         seed_list = parse_seeds(seeds) if seeds is not None else [base_config.seed]
         if envs is not None:
+            listed = listed_values(envs)
+            if listed is not None:
+                raise SetupError(
+                    f"--envs {envs!r}: --envs takes the ids comma-separated, not a list in "
+                    f"brackets; write --envs {','.join(listed)}"
+                )
             check_commas("--envs", envs)
         env_list = split_values(envs) if envs is not None else [base_config.env]
         if not all(env_list):
@@ -447,15 +505,22 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
             )
 
 
-def check_runnable(trials: list[Trial], envs_flag: str) -> None:
-    """Make each trial's env once and estimate each configuration's memory on this machine,
-    before Ray starts any trial: SetupError naming the flag and the fix for the first that
-    cannot run (an unknown id with its close matches, discrete actions, frames or a replay
-    the memory cannot hold). ``envs_flag`` is the flag that gave the envs."""
+def check_runnable(
+    trials: list[Trial], envs_flag: str, grid: dict[str, list[Any]] | None = None
+) -> None:
+    """Run ``simoun-train``'s checks of a new run on every trial, before Ray starts any: make
+    each trial's env once, check each trial's config against its env (its evaluation
+    distractions, action repeat and budget) and estimate each configuration's memory on this
+    machine. SetupError naming the flag (or the ``grid`` key, ``--grid``) and the fix for the
+    first that cannot run (an unknown id with its close matches, discrete actions, a
+    distraction mode the env cannot take, frames or a replay the memory cannot hold).
+    ``envs_flag`` is the flag that gave the envs."""
     # here, not at the top: reading and saving a grid needs neither torch nor the env suites
-    from simoun_agent.run.make_env import check_task
+    from simoun_agent.run.make_env import check_decisions, check_task
     from simoun_agent.run.memory import check_memory, check_replay
+    from simoun_agent.run.train import budget_warning
 
+    grid = grid or {}
     made: dict[str, int | None] = {}
     measured: set[str] = set()
     for trial in trials:
@@ -468,6 +533,8 @@ def check_runnable(trials: list[Trial], envs_flag: str) -> None:
             except SetupError as err:
                 raise SetupError(f"{envs_flag} {trial.env}: {err}") from None
         try:
+            check_trial_config(config, grid)
+            check_decisions(config, made[env])  # the action repeat may differ by trial
             check_replay(config, made[env])
         except SetupError as err:
             raise SetupError(f"trial {trial.name}: {err}") from None
@@ -479,8 +546,70 @@ def check_runnable(trials: list[Trial], envs_flag: str) -> None:
                 warning = check_memory(config)
             except SetupError as err:
                 raise SetupError(f"trial {trial.name}: {err}") from None
-            if warning:
-                print(f"simoun-sweep: warning: trial {trial.name}: {warning}", file=sys.stderr)
+            for said in (warning, budget_warning(config)):
+                if said:
+                    print(f"simoun-sweep: warning: trial {trial.name}: {said}", file=sys.stderr)
+
+
+def check_trial_config(config: TrainConfig, grid: dict[str, list[Any]]) -> None:
+    """``simoun-train``'s checks of a new run's config on its own (its evaluation distractions
+    against its env, one agent decision within its budget), the modes named as the sweep was
+    given them (``--grid eval_distraction`` when the grid sets them)."""
+    from simoun_agent.generalization import check_eval_distractions
+    from simoun_agent.run.train import check_budget
+
+    gridded = "eval_distraction" in grid
+    check_eval_distractions(config, "--grid eval_distraction" if gridded else "--eval-distraction")
+    check_budget(config)
+
+
+def check_devices(trials: list[Trial], gpus: float | None, grid: dict[str, list[Any]]) -> None:
+    """Refuse ``--gpus-per-trial`` (``gpus``; None: auto, which follows the device) when it
+    contradicts a trial's ``--device`` (or ``--grid device``) (:func:`devices_problem`)."""
+    if gpus is None:
+        return
+    for trial in trials:
+        # as given, not resolved: resolving asks this machine for the device, and the trials
+        # may run on other machines of the cluster
+        device = trial.overrides.get("device", resolve(trial.preset, {}).device)
+        if "device" in grid:
+            given, key = f"--grid device={device} (trial {trial.name})", "--grid device"
+        else:
+            given, key = f"--device {device}", "--device"
+        problem = devices_problem(
+            device, gpus, (f"--gpus-per-trial {gpus:g}", "--gpus-per-trial"), (given, key)
+        )
+        if problem:
+            raise SetupError(problem)
+
+
+def devices_problem(
+    device: str | None, gpus: float, gpus_given: tuple[str, str], device_given: tuple[str, str]
+) -> str | None:
+    """What is contradictory in a trial that trains on ``device`` with ``gpus`` GPUs reserved,
+    each given as (what was said, the key to change): GPUs reserved for a trial that trains on
+    the CPU (or on MPS, which Ray does not count) cap the trials run at once for nothing, and
+    Ray hides the GPUs from a trial that reserves none, so a CUDA device fails in it. None when
+    they fit (a device left unset takes cuda when the trial sees a GPU, else the CPU)."""
+    if device is None:
+        return None
+    (gpus_said, gpus_key), (device_said, device_key) = gpus_given, device_given
+    cuda = device.startswith("cuda")
+    if gpus > 0 and not cuda:
+        return (
+            f"{gpus_said} and {device_said} contradict each other: each trial would reserve "
+            f"{gpus:g} GPU{'s' * (gpus != 1)} it never uses, and the GPUs, not the CPUs, would "
+            f"cap how many trials run at once; drop {gpus_key} (auto reserves none for a "
+            f"{device} trial) or set it to 0, or set {device_key} to cuda to train on the GPUs"
+        )
+    if gpus == 0 and cuda:
+        return (
+            f"{gpus_said} and {device_said} contradict each other: Ray shows no GPU to a trial "
+            f"that reserves none, so it could not train on {device}; set {gpus_key} to 1 (or "
+            f"drop it: auto gives each trial one when the cluster has GPUs), or set {device_key} "
+            "to cpu"
+        )
+    return None
 
 
 def typed(overrides: dict[str, Any]) -> dict[str, Any]:

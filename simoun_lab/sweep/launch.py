@@ -33,7 +33,13 @@ def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
     gpus = gpus_wanted(wanted)
     if gpus is None:
         has_gpus = ray.cluster_resources().get("GPU", 0) > 0
-        return 1.0 if has_gpus and device != "cpu" else 0.0
+        if not has_gpus and device is not None and device.startswith("cuda"):
+            raise SetupError(
+                f"the trials train on device {device} (--device, or a study's [base] device), "
+                "but the Ray cluster has no GPU (so gpus_per_trial auto gives them none); train "
+                "on device cpu, or run on a cluster with GPUs"
+            )
+        return 1.0 if has_gpus and device not in ("cpu", "mps") else 0.0
     return gpus
 
 
