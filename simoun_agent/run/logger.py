@@ -119,16 +119,26 @@ def read_csv(
     path: str | os.PathLike[str], columns: Sequence[str] = ("env_step",)
 ) -> list[dict[str, float]]:
     """Rows of a CSV written by :class:`CsvLog` (a str or a path), numbers as floats (NaN where
-    empty); :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes: a
-    first line of numbers (the header deleted), a header without one of ``columns``, a value
-    that is not a number (its line and column named), a JSON file; TypeError when ``path`` is
-    neither a str nor a path. An empty file has no rows."""
+    empty); :class:`~simoun_agent.run.kept.Damaged` (a ValueError) naming the file for text no
+    run writes (:func:`log_values`); TypeError when ``path`` is neither a str nor a path. An
+    empty file has no rows."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(
             f"read_csv's path must be a str or a pathlib.Path of a CSV log, not "
             f"{type(path).__name__}; pass read_csv('RUN_DIR/eval.csv')"
         )
-    rows = read_csv_rows(Path(path), columns, empty_ok=True)
+    try:
+        return log_values(Path(path), columns)
+    except Damaged as err:
+        raise Damaged(f"{path} is damaged: {err}") from None
+
+
+def log_values(path: Path, columns: Sequence[str] = ("env_step",)) -> list[dict[str, float]]:
+    """:func:`read_csv` for a caller that names the file itself: :class:`Damaged` saying what
+    is wrong for a first line of numbers (the header deleted), a header without one of
+    ``columns``, a value that is not a number (its line and column named), a JSON file, and
+    what :func:`~simoun_agent.run.kept.read_csv_rows` refuses."""
+    rows = read_csv_rows(path, columns, empty_ok=True)
     return [
         {column: csv_number(text, column, line) for column, text in row.items()}
         for line, row in enumerate(rows, start=2)

@@ -61,7 +61,7 @@ from simoun_agent.run.kept import (
     read_text,
 )
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
-from simoun_agent.run.logger import read_csv
+from simoun_agent.run.logger import log_values
 from simoun_agent.run.rundir import make_output_dir
 from simoun_lab import stats
 from simoun_lab.sweep.grid import (
@@ -249,7 +249,7 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     if not path.is_file() and not path.is_symlink():
         return {key: np.zeros(0) for key in CURVE_COLUMNS}
     try:
-        rows = read_csv(path, columns=())  # the missing columns are named below, all at once
+        rows = log_values(path, columns=())  # the missing columns are named below, all at once
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
     except (OSError, ValueError, TypeError, csv.Error) as err:
