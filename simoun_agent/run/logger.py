@@ -130,7 +130,7 @@ def read_csv(
     try:
         return log_values(Path(path), columns)
     except Damaged as err:
-        raise Damaged(f"{path} is damaged: {err}") from None
+        raise Damaged(f"{path} cannot be read as a CSV log: {err}") from None
 
 
 def log_values(path: Path, columns: Sequence[str] = ("env_step",)) -> list[dict[str, float]]:

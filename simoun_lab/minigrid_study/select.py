@@ -94,7 +94,7 @@ def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
 def write_selection(spec: StudySpec, archive: Path) -> Path:
     """Write ``selection.json`` and ``selection.md`` into ``archive``; return the Markdown's
     path."""
-    check_output_files([archive / f"{SELECTION}.json", archive / f"{SELECTION}.md"], "--archive")
+    check_output_files([archive / f"{SELECTION}.json", archive / f"{SELECTION}.md"])
     result = select(spec, archive)
     if not any(record["areas"] for record in result["arms"].values()):
         raise SetupError(

@@ -857,8 +857,8 @@ def update_cost_section(
     ]
     if placed:  # the figure is linked only where it is drawn
         lines += ["", f"![IQM curves at measured update costs]({COST_CURVES_PNG})"]
-    for reason, recipes in left_out.items():
-        lines += ["", f"Not drawn ({reason}): {', '.join(recipes)}."]
+    for reason, names in left_out.items():
+        lines += ["", f"Not drawn ({reason}): {', '.join(names)}."]
     if placed:
         plot_curves(
             [r for r in recipes if any(p.run.recipe == r for p in placed)],
