@@ -465,6 +465,14 @@ def test_a_study_report_file_that_is_a_folder_is_named_before_the_report(name, d
     assert f"mv {path} {path}.aside" in printed
 
 
+def test_a_study_report_file_that_is_a_folder_is_named_before_the_study_runs(tmp_path):
+    path = tmp_path / "study" / "report" / "report.md"
+    path.mkdir(parents=True)
+    printed = refused(study_cli.main, "run", str(DMC_SPEC), "--study-dir", str(tmp_path / "study"))
+    assert f"cannot write {path} (it is a directory, not a regular file)" in printed
+    assert sorted(p.name for p in (tmp_path / "study").rglob("*")) == ["report", "report.md"]
+
+
 def test_a_deleted_tuning_folder_is_named_as_missing_not_as_unfinished_runs(dmc_archive):
     shutil.rmtree(dmc_archive / "tuning")
     printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
