@@ -614,6 +614,21 @@ def test_a_sweep_json_base_changed_after_its_trials_ran_is_refused_on_resume(
     assert "already finished" not in capsys.readouterr().out
 
 
+def test_a_trial_config_differing_from_a_default_names_the_version_as_a_cause(
+    trained_sweep, tmp_path, capsys
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    path = sweep_dir / TRIAL.format(2) / "config.json"
+    config = json.loads(path.read_text())
+    default = config["agent"]["critic_tau"]
+    config["agent"]["critic_tau"] = default / 2  # a default that changed since the trial ran
+    path.write_text(json.dumps(config))
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(2)} was trained with agent.critic_tau {default / 2}" in err
+    assert "or this version of simoun gives a default another value" in err
+    assert "resume with the version of simoun that started the sweep" in err
+
+
 def test_a_sweep_extended_or_given_other_cpus_on_resume_keeps_its_trials(trained_sweep, tmp_path):
     sweep_dir = copy_sweep(trained_sweep, tmp_path)
     spec = SweepSpec.load(sweep_dir)

@@ -167,10 +167,7 @@ def csv_lines(path: Path) -> list[list[str]]:
     be read as the header or a row. OSError for a file that cannot be read."""
     text = read_text(path)
     if text.lstrip()[:1] in ("{", "["):
-        raise Damaged(
-            f"it looks like JSON (it begins with {text.lstrip()[0]!r}), not a CSV log; read it "
-            "with json.load, or pass the CSV file meant (eval.csv, train.csv)"
-        )
+        raise Damaged(f"it looks like JSON (it begins with {text.lstrip()[0]!r}), not a CSV log")
     try:
         lines = list(csv.reader(io.StringIO(text, newline=""), skipinitialspace=True))
     except csv.Error as err:

@@ -436,22 +436,41 @@ moved, ``--cpus-per-trial`` and ``--total-env-steps`` given with ``--resume``, a
 bar, none of which changes what the trial learns."""
 
 
-def config_differences(trial: Trial) -> list[str]:
+def config_differences(trial: Trial) -> dict[str, tuple[Any, Any]]:
     """Each key the started trial's config.json (read whole by :func:`trial_problem`) records
-    with another value than the sweep gives the trial (its base, preset and grid, resolved),
-    as ``key saved, given by the sweep``; :data:`RESUMED_AS_GIVEN` and keys a run of an older
+    with another value than the sweep gives the trial (its base, preset and grid, resolved):
+    key -> (saved, given by the sweep); :data:`RESUMED_AS_GIVEN` and keys a run of an older
     version did not save are left out. A resumed trial goes on with its saved config, so such
-    a key means ``sweep.json`` was changed after the trial started."""
+    a key means ``sweep.json`` was changed after the trial started, or, for a key the sweep
+    leaves to its default, that this version's default differs."""
     path = Path(trial.run_dir) / CONFIG_NAME
     if not present(path):
-        return []
+        return {}
     saved = flatten(read_json_object(path))
     wanted = flatten(to_dict(resolve(trial.preset, trial.overrides)))
-    return [
-        f"{key} {show(_plain(saved[key]))} where the sweep gives {show(_plain(value))}"
+    return {
+        key: (_plain(saved[key]), _plain(value))
         for key, value in wanted.items()
         if key in saved and key not in RESUMED_AS_GIVEN and _plain(saved[key]) != _plain(value)
-    ]
+    }
+
+
+def differences_refusal(trial: Trial, sweep_dir: Path, differences: dict) -> SetupError:
+    """The refusal of a trial whose config.json differs from the sweep (:func:`config_differences`),
+    with the causes its keys allow and the fixes."""
+    values = "; ".join(
+        f"{key} {show(saved)} where the sweep gives {show(given)}"
+        for key, (saved, given) in differences.items()
+    )
+    defaults = any(key not in trial.overrides for key in differences)
+    cause = " or this version of simoun gives a default another value" if defaults else ""
+    version = ", resume with the version of simoun that started the sweep" if defaults else ""
+    return SetupError(
+        f"trial {trial.name} was trained with {values} ({Path(trial.run_dir, CONFIG_NAME)}), and "
+        f"a resumed trial keeps its own config: {Path(sweep_dir, SWEEP_FILE)} was changed after "
+        f"the trial started,{cause}. Restore {SWEEP_FILE} as it was (the values the trial was "
+        f"trained with){version}, or start a new sweep in a new --sweep-dir"
+    )
 
 
 def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
@@ -477,13 +496,7 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
             )
         differences = config_differences(trial)
         if differences:
-            raise SetupError(
-                f"trial {trial.name} was trained with {'; '.join(differences)} "
-                f"({Path(trial.run_dir, CONFIG_NAME)}): {Path(sweep_dir, SWEEP_FILE)} was changed "
-                "after the trial started, and a resumed trial keeps its own config. Restore "
-                f"{SWEEP_FILE} as it was (the values the trial was trained with), or start a new "
-                "sweep in a new --sweep-dir"
-            )
+            raise differences_refusal(trial, sweep_dir, differences)
 
 
 def check_runnable(trials: list[Trial], envs_flag: str) -> None:
