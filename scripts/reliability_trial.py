@@ -3450,6 +3450,7 @@ def child(case: dict, here: Path, run: Path, out: Path) -> None:
     os.dup2(fd, 1)
     os.dup2(fd, 2)
     status: object = 0
+    kinds = ""  # the error's class and its bases, for classify
     if case.get("guard"):
         os.environ["RAY_ADDRESS"] = GUARD
     try:
@@ -3469,10 +3470,12 @@ def child(case: dict, here: Path, run: Path, out: Path) -> None:
     except Exception as err:  # the API's errors, read below
         origin = traceback.extract_tb(err.__traceback__)[-1].filename
         status = f"{type(err).__name__} from {origin}: {err}"
+        if type(err).__module__.startswith("simoun"):
+            kinds = " ".join(kind.__name__ for kind in type(err).__mro__)
     sys.stdout.flush()
     sys.stderr.flush()
     with open(out, "a") as f:
-        f.write(f"\n@@STATUS {status}\n")
+        f.write(f"\n@@KINDS {kinds}\n@@STATUS {status}\n")
     os._exit(0)
 
 
@@ -3485,7 +3488,8 @@ def named(case: dict, text: str) -> bool:
 def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
     """(clear | unclear | wrong, the message's first line)."""
     status = text.rpartition("@@STATUS ")[2].strip() if "@@STATUS" in text else "?"
-    body = text.rpartition("@@STATUS")[0]
+    body, mark, kinds = text.rpartition("@@STATUS")[0].rpartition("\n@@KINDS ")
+    body, kinds = (body, kinds) if mark else (kinds, "")
     lines = [line for line in body.splitlines() if "error" in line.lower() or "Error" in line]
     message = lines[-1] if lines else status
     if timed_out:
@@ -3499,8 +3503,11 @@ def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
             return ("clear" if case["ok"] else "wrong"), "accepted"
         kind, _, rest = status.partition(" from ")
         inside = "/site-packages/" in rest.partition(":")[0]
-        if inside or kind not in {"ValueError", "TypeError", "ResetNeeded", "SetupError",
-                                   "FileNotFoundError", "InvalidAction", "Error"}:  # fmt: skip
+        # an error class of the project's own counts as the refusal it derives from (Damaged is
+        # a ValueError): the child lists the class and its bases
+        refusals = {"ValueError", "TypeError", "ResetNeeded", "SetupError", "FileNotFoundError",
+                    "InvalidAction", "Error"}  # fmt: skip
+        if inside or not {kind, *kinds.split()} & refusals:
             return "wrong", status
         if case["ok"]:  # valid input may be refused only where the case names what for
             return ("clear" if case["names"] and named(case, status) else "wrong"), status

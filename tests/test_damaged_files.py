@@ -2,8 +2,10 @@
 config's object belongs, a value of the wrong type; an empty or cut log) is named as damaged,
 with the fix, instead of failing inside the code, and is left as it was."""
 
+import gzip
 import json
 import os
+import re
 import shutil
 
 import pytest
@@ -340,3 +342,94 @@ def test_a_log_with_a_space_after_each_comma_reads_as_written_and_resumes_under_
     assert read_csv(run_dir / "eval.csv")[: len(rows)] == rows
     assert read_csv(run_dir / "eval.csv")[-1]["env_step"] == 80
     assert all(line.count(",") == header.count(",") for line in lines)
+
+
+def test_read_csv_takes_a_str_or_a_path_and_names_any_other_argument(trained_run):
+    path = trained_run / "eval.csv"
+    assert read_csv(str(path)) == read_csv(path)
+    assert read_csv(str(path))[-1]["env_step"] == 60
+    with pytest.raises(TypeError, match=re.escape("read_csv's path must be a str or a")):
+        read_csv(3)
+
+
+@pytest.mark.parametrize(
+    ("damage", "problem"),
+    [
+        (lambda p: p.write_text(p.read_text().split("\n", 1)[1]), "holds numbers where the header"),
+        (lambda p: p.write_text(p.read_text().replace("env_step", "step")), "has no env_step"),
+        (lambda p: p.write_text('{"env_step": 20}\n'), "it looks like JSON (it begins with '{')"),
+        (lambda p: p.write_text(p.read_text().rstrip("\n") + "x\n"), "line 3: wall_time_s is "),
+    ],
+    ids=["header deleted", "header renamed", "json", "a word for a number"],
+)
+def test_read_csv_names_a_log_no_run_writes(trained_run, damage, problem, tmp_path):
+    path = shutil.copy(trained_run / "eval.csv", tmp_path / "eval.csv")
+    damage(path)
+    with pytest.raises(ValueError, match=re.escape(problem)) as refusal:
+        read_csv(path)
+    assert str(refusal.value).startswith(f"{path} cannot be read as a CSV log: ")
+
+
+def test_a_word_in_a_number_column_is_named_by_line_and_column_in_the_report(
+    trained_run, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    path = run_dir / "eval.csv"
+    path.write_text(path.read_text().rstrip("\n").rpartition(",")[0] + ",n/a\n")
+    with pytest.raises(SystemExit):
+        report_cli.main([str(run_dir), "--out", str(tmp_path / "report"), "--at-wall-time", "0.1"])
+    assert "eval.csv is damaged: line 3: wall_time_s is 'n/a', not a number" in (
+        capsys.readouterr().err
+    )
+
+
+def test_a_header_deleted_from_a_log_is_named_on_resume(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    path = run_dir / "eval.csv"
+    path.write_text(path.read_text().split("\n", 1)[1])
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{path} is damaged: its first line (0," in err
+    assert "the header line is missing" in err
+
+
+def test_a_packed_replay_is_named_with_the_command_that_unpacks_it(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (replay,) = run_dir.glob("replay-*.npz")
+    with replay.open("rb") as source, gzip.open(f"{replay}.gz", "wb") as packed:
+        shutil.copyfileobj(source, packed)
+    replay.unlink()
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{replay} (the replay of the checkpoint) is missing, but {replay.name}.gz" in err
+    assert f"gunzip -k {replay}.gz" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["eval", "--episodes", "1", "--no-video", "--overwrite"], "metrics.json"),
+        (["eval", "--episodes", "1", "--distraction", "color_easy", "--overwrite"],
+         "generalization.png"),
+        (["bias", "--pairs", "8", "--overwrite"], "bias.json"),
+        (["masks", "--steps", "2", "--overwrite"], "ep0-step1.png"),
+        (["report"], "report.md"),
+    ],
+    ids=lambda value: value[0] if isinstance(value, list) else None,
+)  # fmt: skip
+def test_an_output_file_that_is_a_folder_is_refused_before_the_work(
+    trained_run, argv, name, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    out = tmp_path / "out"
+    (out / name).mkdir(parents=True)
+    (out / name / "kept").write_text("an earlier output")
+    command, *flags = argv
+    main = {"eval": eval_cli.main, "report": report_cli.main}.get(command, analyze_cli.main)
+    args = [str(run_dir), *flags, "--out", str(out)]
+    with pytest.raises(SystemExit) as stop:
+        main(args if main is not analyze_cli.main else [command, *args])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert f"cannot write {out / name} (it is a directory, not a regular file)" in err
+    assert f"mv {out / name} {out / name}.aside" in err and "or pass another --out" in err
+    assert "Traceback" not in err
+    assert sorted(path.name for path in out.iterdir()) == [name]  # nothing written before

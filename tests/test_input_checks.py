@@ -330,7 +330,10 @@ DAMAGES = {
     "config.json ": ("", "config.json is damaged: it is empty"),
     "config.json  ": ("[1]", "config.json is damaged: it holds an array, not a JSON object"),
     "eval.csv": ("", "eval.csv holds no evaluation, but the run finished"),
-    "eval.csv ": ("env_step,return_mean,wall_time_s\nx,1,2\n", "eval.csv cannot be read"),
+    "eval.csv ": (
+        "env_step,return_mean,wall_time_s\nx,1,2\n",
+        "eval.csv is damaged: line 2: env_step is 'x', not a number",
+    ),
     "eval.csv  ": (
         "env_step,return_mean,wall_time_s\n0,nan,1\n",
         "eval.csv line 2 has an empty, NaN or infinite value",

@@ -381,9 +381,119 @@ def test_a_damaged_update_cost_file_is_named_with_the_command_that_writes_it(
     path = tmp_path / UPDATE_COST_JSON
     damage(path)
     with pytest.raises(SetupError, match=re.escape(problem)) as refusal:
-        read_update_costs(tmp_path)
+        read_update_costs(load_spec(DMC_SPEC), tmp_path)
     assert f"{path} is damaged" in str(refusal.value)
     assert "python benchmarks/recipe_update.py --selection" in str(refusal.value)
+
+
+UPDATE_COSTS = {
+    "baseline": "drq",
+    "ratio": {"drq": 1.0, "simoun": 2.1},
+    "ms_per_update": {"drq": 2.0, "simoun": 4.2},
+    "task": "dm_control/cartpole-swingup-v0",
+    "action_repeat": 8,
+    "command": "python benchmarks/recipe_update.py --json update_cost.json",
+    "commit": "0" * 40,
+    "machine": "a test machine",
+}
+"""an update_cost.json of the dmc100k study as benchmarks/recipe_update.py writes it"""
+
+
+@pytest.mark.parametrize(
+    ("changes", "problem"),
+    [
+        ({"baseline": "sac"}, 'its baseline is "sac", which is not a recipe of this study'),
+        ({"ratio": {"drq": 1.0, "simoun": "2.1x"}}, 'its ratio.simoun is "2.1x", which must'),
+        ({"ratio": {"drq": 1.0, "simoun": 0}}, "its ratio.simoun is 0, which must be a positive"),
+        ({"ratio": {"drq": True}}, "its ratio.drq is true, which must be a positive number"),
+        ({"ms_per_update": {"drq": -2.0, "simoun": 4.2}}, "its ms_per_update.drq is -2.0"),
+        ({"ms_per_update": {"drq": 2.0}}, "ratio has simoun, which ms_per_update does not"),
+    ],
+)
+def test_an_update_cost_value_the_report_cannot_use_is_named_before_the_report(
+    changes, problem, dmc_archive
+):
+    path = dmc_archive / UPDATE_COST_JSON
+    path.write_text(json.dumps({**UPDATE_COSTS, **changes}))
+    before = sorted(p.relative_to(dmc_archive) for p in dmc_archive.rglob("*"))
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{path} is damaged: {problem}" in printed
+    assert f"mv {path} {path}.damaged" in printed
+    assert sorted(p.relative_to(dmc_archive) for p in dmc_archive.rglob("*")) == before
+
+
+def test_a_non_finite_update_cost_ratio_is_named(dmc_archive):
+    path = dmc_archive / UPDATE_COST_JSON
+    path.write_text(json.dumps({**UPDATE_COSTS, "ratio": {"drq": 1.0, "simoun": float("nan")}}))
+    with pytest.raises(SetupError, match=re.escape("its ratio.simoun is NaN, which must be")):
+        read_update_costs(load_spec(DMC_SPEC), dmc_archive)
+
+
+def test_the_update_cost_figure_is_linked_only_when_drawn(dmc_archive):
+    (dmc_archive / UPDATE_COST_JSON).write_text(json.dumps(UPDATE_COSTS))
+    status, printed = run_main(
+        study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive)
+    )
+    assert status == 0, printed[-3000:]
+    report = (dmc_archive / "report" / "report.md").read_text()
+    figure = dmc_archive / "report" / "iqm_wall_time_update_cost.png"
+    assert "(iqm_wall_time_update_cost.png)" in report and figure.stat().st_size > 1000
+    assert "Not drawn (no ratio in the file): drqv2, rad, curl." in report
+    figure.unlink()
+    (dmc_archive / UPDATE_COST_JSON).write_text(
+        json.dumps({**UPDATE_COSTS, "ratio": {}, "ms_per_update": {}})
+    )
+    status, printed = run_main(
+        study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive)
+    )
+    assert status == 0, printed[-3000:]
+    report = (dmc_archive / "report" / "report.md").read_text()
+    assert "iqm_wall_time_update_cost.png" not in report and not figure.exists()
+    assert "Not drawn (no ratio in the file): simoun, drq, drqv2, rad, curl." in report
+
+
+@pytest.mark.parametrize(
+    "name", ["report.md", "scores.csv", "iqm_curves.png", "evaluation/report.md"]
+)
+def test_a_study_report_file_that_is_a_folder_is_named_before_the_report(name, dmc_archive):
+    path = dmc_archive / "report" / name
+    shutil.rmtree(path, ignore_errors=True)
+    path.unlink(missing_ok=True)
+    path.mkdir(parents=True)
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"cannot write {path} (it is a directory, not a regular file)" in printed
+    assert f"mv {path} {path}.aside" in printed
+
+
+def test_a_study_report_file_that_is_a_folder_is_named_before_the_study_runs(tmp_path):
+    path = tmp_path / "study" / "report" / "report.md"
+    path.mkdir(parents=True)
+    printed = refused(study_cli.main, "run", str(DMC_SPEC), "--study-dir", str(tmp_path / "study"))
+    assert f"cannot write {path} (it is a directory, not a regular file)" in printed
+    assert sorted(p.name for p in (tmp_path / "study").rglob("*")) == ["report", "report.md"]
+
+
+def test_a_deleted_tuning_folder_is_named_as_missing_not_as_unfinished_runs(dmc_archive):
+    shutil.rmtree(dmc_archive / "tuning")
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{dmc_archive / 'tuning'}, the folder of the study's tuning runs, is missing" in printed
+    assert "restore it from a copy" in printed and "has not finished" not in printed
+
+
+@pytest.mark.parametrize(
+    ("command", "name"),
+    [("report", "report/report.md"), ("report", "report/MiniGrid-DoorKey-6x6-v0_success.png"),
+     ("select", "selection.md"), ("select", "selection.json")],
+)  # fmt: skip
+def test_a_minigrid_output_file_that_is_a_folder_is_named_before_the_work(
+    command, name, minigrid_archive
+):
+    path = minigrid_archive / name
+    path.mkdir(parents=True)
+    printed = refused(minigrid_cli.main, command, "--archive", str(minigrid_archive))
+    assert f"cannot write {path} (it is a directory, not a regular file)" in printed
+    assert f"mv {path} {path}.aside" in printed
+    assert not (minigrid_archive / "report" / "report.md").is_file()
 
 
 @pytest.mark.parametrize("damage", [utf16, named_pipe, link_to_nothing], ids=lambda d: d.__name__)

@@ -662,7 +662,7 @@ def test_update_cost_ratios_place_each_run_on_the_baselines_clock(dmc_study, tmp
     chosen = {"simoun": {"agent.n_step": 1}, "sac": {"agent.n_step": 1}}
     results = [read_result(copy, run) for run in evaluation_runs(spec, chosen)]
     placed, left_out = cost_curves(results, costs)
-    assert left_out == ["simoun_no_aux"]
+    assert left_out == {"no ratio in the file": ["simoun_no_aux"]}
     by_recipe = {r.run.recipe: r.curve for r in placed}
     np.testing.assert_allclose(by_recipe["sac"]["cost_time_s"], by_recipe["sac"]["wall_time_s"])
     np.testing.assert_allclose(  # one sac run: its clock is its own wall time

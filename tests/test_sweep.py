@@ -2,6 +2,7 @@
 and --resume, and the bad inputs it refuses."""
 
 import csv
+import dataclasses
 import json
 import re
 import shutil
@@ -627,6 +628,57 @@ def test_a_trial_run_that_is_not_the_trials_own_is_refused_on_resume(
     assert f"trial {TRIAL.format(1)}: {run_dir / said}" in err
     assert f"move the run directory aside (mv {run_dir} {run_dir}.aside)" in err
     assert "already finished" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "said"),
+    [
+        ("agent.lr", 0.01, "agent.lr 0.001 where the sweep gives 0.01"),
+        ("image_size", 48, "image_size 24 where the sweep gives 48"),
+        ("agent.recipe", "drq", "agent.recipe none where the sweep gives drq"),
+    ],
+)
+def test_a_sweep_json_base_changed_after_its_trials_ran_is_refused_on_resume(
+    trained_sweep, tmp_path, capsys, key, value, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    path = sweep_dir / "sweep.json"
+    saved = json.loads(path.read_text())
+    saved["base"][key] = value
+    path.write_text(json.dumps(saved))
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(1)} was trained with {said}" in err
+    assert f"{path} was changed after the trial started" in err
+    assert "Restore sweep.json as it was" in err and "a new --sweep-dir" in err
+    assert "already finished" not in capsys.readouterr().out
+
+
+def test_a_trial_config_differing_from_a_default_names_the_version_as_a_cause(
+    trained_sweep, tmp_path, capsys
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    path = sweep_dir / TRIAL.format(2) / "config.json"
+    config = json.loads(path.read_text())
+    default = config["agent"]["critic_tau"]
+    config["agent"]["critic_tau"] = default / 2  # a default that changed since the trial ran
+    path.write_text(json.dumps(config))
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(2)} was trained with agent.critic_tau {default / 2}" in err
+    assert "or this version of simoun gives a default another value" in err
+    assert "resume with the version of simoun that started the sweep" in err
+
+
+def test_a_sweep_extended_or_given_other_cpus_on_resume_keeps_its_trials(trained_sweep, tmp_path):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    spec = SweepSpec.load(sweep_dir)
+    check_trial_dirs(spec.extended(2 * spec.total_env_steps()), sweep_dir)
+    check_trial_dirs(dataclasses.replace(spec, cpus_per_trial=2), sweep_dir)
+
+
+def test_a_sweep_loads_from_its_directory_or_its_sweep_json(trained_sweep):
+    spec = SweepSpec.load(trained_sweep)
+    assert SweepSpec.load(trained_sweep / "sweep.json") == spec
+    assert SweepSpec.load(str(trained_sweep)) == spec
 
 
 def test_an_emptied_trial_is_listed_by_the_report_and_trained_anew_on_resume(

@@ -210,6 +210,14 @@ def test_atomic_write_leaves_nothing_when_the_write_fails(tmp_path):
     assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["file.txt"]
 
 
+def test_atomic_write_names_a_directory_in_place_of_its_file_and_leaves_it(tmp_path):
+    target = tmp_path / "report.md"
+    (target / "kept").mkdir(parents=True)
+    with pytest.raises(ValueError, match=f"cannot write {target}: it is a directory, not a file"):
+        atomic_write(target, lambda tmp: tmp.write_text("new"))
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["kept", "report.md"]
+
+
 def test_a_nan_reward_in_an_evaluation_stops_with_a_checkpoint_naming_step_and_value(
     tmp_path, capsys
 ):

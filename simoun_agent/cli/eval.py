@@ -156,7 +156,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 f"{out} holds an earlier evaluation; pass --overwrite to replace it, or --out DIR "
                 "to write this one elsewhere"
             )
-        created = make_output_dir(out)
+        created = make_output_dir(out, files=(METRICS_NAME, VIDEO_NAME))
         seed = args.seed if args.seed is not None else first_eval_seed(config.seed)
         agent = RandomPolicy(env.action_space.shape[0], seed) if args.random_policy else run.agent
     except SetupError as err:
@@ -191,7 +191,12 @@ def evaluate_distractions(args: EvalCommand) -> int:
     if args.random_policy:
         fail(PROG, "--random-policy does not combine with --distraction")
     from simoun_agent.generalization.evaluation import evaluate_runs
-    from simoun_agent.generalization.report import TABLE_CSV, default_out, write_report
+    from simoun_agent.generalization.report import (
+        REPORT_FILES,
+        TABLE_CSV,
+        default_out,
+        write_report,
+    )
     from simoun_agent.generalization.suite import parse_distractions
 
     run_dirs = [Path(path) for path in args.checkpoint]
@@ -210,7 +215,7 @@ def evaluate_distractions(args: EvalCommand) -> int:
                 f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
                 "or --out DIR to write this one elsewhere"
             )
-        created = make_output_dir(out)
+        created = make_output_dir(out, files=REPORT_FILES)
         with stop_at_once():
             results = evaluate_runs(
                 run_dirs,

@@ -14,6 +14,8 @@ from simoun_agent.run.atomic import atomic_write
 TABLE_MD = "generalization.md"
 TABLE_CSV = "generalization.csv"
 CHART_PNG = "generalization.png"
+REPORT_FILES = (TABLE_MD, TABLE_CSV, CHART_PNG)
+"""The files :func:`write_report` writes."""
 
 
 def default_out(run_dirs: list[Path]) -> Path:

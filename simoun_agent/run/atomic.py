@@ -13,12 +13,21 @@ import re
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from simoun_agent.config.errors import SetupError
+
 _TEMPORARY = re.compile(r"^\..+\.(?P<pid>\d+)\.tmp(\.[^.]+)?$")
 """The name :func:`atomic_write` gives its temporary: ``.<stem>.<pid>.tmp<suffix>``."""
 
 
 def atomic_write(path: Path, write: Callable[[Path], None]) -> None:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it to ``path``."""
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it to ``path``;
+    SetupError naming ``path`` when a directory stands there, which no rename replaces (the
+    commands check their outputs before their work: this names one they did not)."""
+    if path.is_dir() and not path.is_symlink():
+        raise SetupError(
+            f"cannot write {path}: it is a directory, not a file; move it aside (mv {path} "
+            f"{path}.aside) and run the command again"
+        )
     tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
     try:
         write(tmp)

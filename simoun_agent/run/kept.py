@@ -162,11 +162,14 @@ def csv_lines(path: Path) -> list[list[str]]:
     """The fields of each line of the CSV file ``path``, blanks after a comma dropped (``1, 2``
     as a person or a spreadsheet writes it reads as ``1,2``: every reader of a run's logs, and
     a resumed run's writer, takes one header whichever way it is spaced); :class:`Damaged` for
-    what :func:`read_text` refuses, text that is not CSV, or a comment line (``# ...``), which
-    CSV does not have and which would be read as the header or a row. OSError for a file that
-    cannot be read."""
+    what :func:`read_text` refuses, text that is not CSV, a JSON file (``{...}``, a run's other
+    kind of kept file), or a comment line (``# ...``), which CSV does not have and which would
+    be read as the header or a row. OSError for a file that cannot be read."""
+    text = read_text(path)
+    if text.lstrip()[:1] in ("{", "["):
+        raise Damaged(f"it looks like JSON (it begins with {text.lstrip()[0]!r}), not a CSV log")
     try:
-        lines = list(csv.reader(io.StringIO(read_text(path), newline=""), skipinitialspace=True))
+        lines = list(csv.reader(io.StringIO(text, newline=""), skipinitialspace=True))
     except csv.Error as err:
         raise Damaged(f"it is not a CSV file ({err})") from None
     for number, values in enumerate(lines, start=1):
@@ -183,15 +186,19 @@ def read_csv_rows(
 ) -> list[dict[str, str]]:
     """The rows of the CSV file ``path`` under its header line, values as text (blank lines
     skipped); :class:`Damaged` for what :func:`csv_lines` refuses, an empty file (no rows where
-    ``empty_ok``: a reader that says what an empty log means for its run), a header without
-    one of ``columns``, or a row whose fields do not fit the header (a line cut short or two
-    run together). OSError for a file that cannot be read."""
+    ``empty_ok``: a reader that says what an empty log means for its run), a first line of
+    numbers (:func:`header_problem`), a header without one of ``columns``, or a row whose
+    fields do not fit the header (a line cut short or two run together). OSError for a file
+    that cannot be read."""
     lines = csv_lines(path)
     if not any(lines):
         if empty_ok:
             return []
         raise Damaged("it is empty")
     header = lines[0]
+    problem = header_problem(header)
+    if problem:
+        raise Damaged(problem)
     missing = [column for column in columns if column not in header]
     if missing:
         raise Damaged(f"its first line has no {', '.join(missing)} column")
@@ -200,6 +207,29 @@ def read_csv_rows(
             fields = f"{len(values)} fields where the header has {len(header)}"
             raise Damaged(f"line {number} has {fields}")
     return [dict(zip(header, values, strict=True)) for values in lines[1:] if values]
+
+
+def is_number(text: str) -> bool:
+    """Whether ``text`` reads as a number (``nan`` and ``inf`` included)."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def header_problem(header: Sequence[str]) -> str | None:
+    """What is wrong with the first line ``header`` of a CSV file when it holds numbers where
+    the column names go (the header line deleted: the first row would name the columns and be
+    lost), else None. No file the project writes names a column with a number."""
+    numbers = [name for name in header if is_number(name)]
+    if not numbers:
+        return None
+    shown = ",".join(header[:4]) + (",..." if len(header) > 4 else "")
+    return (
+        f"its first line ({shown}) holds numbers where the header of column names goes: the "
+        "header line is missing (deleted, or the file cut at its start)"
+    )
 
 
 def csv_number(text: str, column: str, line: int) -> float:

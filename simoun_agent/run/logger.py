@@ -10,12 +10,21 @@ from __future__ import annotations
 
 import csv
 import math
+import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, csv_lines, read_csv_rows, step_count
+from simoun_agent.run.kept import (
+    Damaged,
+    csv_lines,
+    csv_number,
+    header_problem,
+    read_csv_rows,
+    step_count,
+)
 from simoun_agent.run.layout import CURVE_PNG, EVAL_CSV, TENSORBOARD_DIR, TRAIN_CSV
 
 
@@ -75,8 +84,8 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     except Damaged as err:
         raise damaged_log(path, str(err)) from None
     if not lines or "env_step" not in lines[0]:
-        problem = "it is empty" if not lines else "its first line has no env_step column"
-        raise damaged_log(path, problem)
+        problem = "it is empty" if not lines else header_problem(lines[0])
+        raise damaged_log(path, problem or "its first line has no env_step column")
     columns, at = lines[0], lines[0].index("env_step")
     rows = []
     for number, values in enumerate(lines[1:], start=2):
@@ -106,12 +115,34 @@ def damaged_log(path: Path, problem: str) -> SetupError:
     )
 
 
-def read_csv(path: Path) -> list[dict[str, float]]:
-    """Rows of a CSV written by :class:`CsvLog`, numbers as floats (NaN where empty);
-    :class:`~simoun_agent.run.kept.Damaged` (a ValueError) for text no run writes; an empty
-    file has no rows."""
-    rows = read_csv_rows(path, empty_ok=True)
-    return [{k: float(v or "nan") for k, v in row.items()} for row in rows]
+def read_csv(
+    path: str | os.PathLike[str], columns: Sequence[str] = ("env_step",)
+) -> list[dict[str, float]]:
+    """Rows of a CSV written by :class:`CsvLog` (a str or a path), numbers as floats (NaN where
+    empty); :class:`~simoun_agent.run.kept.Damaged` (a ValueError) naming the file for text no
+    run writes (:func:`log_values`); TypeError when ``path`` is neither a str nor a path. An
+    empty file has no rows."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(
+            f"read_csv's path must be a str or a pathlib.Path of a CSV log, not "
+            f"{type(path).__name__}; pass read_csv('RUN_DIR/eval.csv')"
+        )
+    try:
+        return log_values(Path(path), columns)
+    except Damaged as err:
+        raise Damaged(f"{path} cannot be read as a CSV log: {err}") from None
+
+
+def log_values(path: Path, columns: Sequence[str] = ("env_step",)) -> list[dict[str, float]]:
+    """:func:`read_csv` for a caller that names the file itself: :class:`Damaged` saying what
+    is wrong for a first line of numbers (the header deleted), a header without one of
+    ``columns``, a value that is not a number (its line and column named), a JSON file, and
+    what :func:`~simoun_agent.run.kept.read_csv_rows` refuses."""
+    rows = read_csv_rows(path, columns, empty_ok=True)
+    return [
+        {column: csv_number(text, column, line) for column, text in row.items()}
+        for line, row in enumerate(rows, start=2)
+    ]
 
 
 def plot_learning_curve(eval_csv: Path, png: Path, title: str) -> None:

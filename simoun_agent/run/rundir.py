@@ -16,6 +16,7 @@ import fcntl
 import os
 import shutil
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 from typing import IO
 
@@ -48,13 +49,40 @@ def refuse_a_file(path: Path, flag: str) -> None:
         )
 
 
-def check_output_dir(path: Path, flag: str) -> None:
+def check_output_files(paths: Iterable[Path], flag: str | None = None) -> None:
+    """Raise SetupError naming the first of ``paths``, files a command is about to write, where
+    something else than a file stands (a directory, a named pipe ...: an earlier output
+    replaced, or made by hand); the fix names ``flag``, the output directory's, where the user
+    may pass another. A command checks its files before its work, which the write at its end
+    would otherwise lose. A path that is missing, a file, or a link (replaced as it stands) is
+    fine."""
+    for path in paths:
+        problem = None if path.is_symlink() else not_a_file(path)
+        if problem:
+            other = f"or pass another {flag}" if flag else "and run the command again"
+            raise SetupError(
+                f"cannot write {path} ({problem}), which this command writes as a file; move "
+                f"it aside (mv {path} {path}.aside) {other}"
+            )
+
+
+def output_files(directory: Path, names: Iterable[str]) -> list[Path]:
+    """The paths in ``directory`` a command writes, by name or glob pattern (``ep*-step*.png``:
+    those an earlier run of it left)."""
+    if not directory.is_dir():
+        return []
+    return [path for name in names for path in sorted(directory.glob(name))]
+
+
+def check_output_dir(path: Path, flag: str, files: Iterable[str] = ()) -> None:
     """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
     written: it is a file, a folder on its way is a file or a symbolic link that loops or leads
     nowhere, a name is too long, or the nearest folder of it that exists takes no new folder
-    (not writable, a read-only mount, a kernel file system such as /proc). Leaves nothing
-    behind (its probe folder is removed at once), so a command can check before the work whose
-    set-up takes long (Ray) rather than fail after it."""
+    (not writable, a read-only mount, a kernel file system such as /proc); or when one of the
+    ``files`` (names or glob patterns) the command writes in it is something else than a file
+    (:func:`check_output_files`). Leaves nothing behind (its probe folder is removed at once),
+    so a command can check before the work whose set-up takes long (Ray) rather than fail
+    after it."""
     try:
         refuse_a_file(path, flag)
         reason = unwritable(path.absolute())
@@ -64,6 +92,7 @@ def check_output_dir(path: Path, flag: str) -> None:
         raise SetupError(
             f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
         )
+    check_output_files(output_files(path, files), flag)
 
 
 def unwritable(path: Path) -> str | None:
@@ -88,12 +117,14 @@ def unwritable(path: Path) -> str | None:
     return None
 
 
-def make_output_dir(path: Path, flag: str = "--out") -> bool:
-    """Create ``path`` (with its parents) and check that it can be written. Returns True when
-    it did not exist before, so a caller that stops later can remove what it made; raises
-    SetupError naming ``flag`` (and leaves no empty directory behind) when it cannot."""
+def make_output_dir(path: Path, flag: str = "--out", files: Iterable[str] = ()) -> bool:
+    """Create ``path`` (with its parents) and check that it can be written, and that none of
+    ``files`` (names or glob patterns) the command writes in it is something else than a file
+    (:func:`check_output_dir`). Returns True when it did not exist before, so a caller that
+    stops later can remove what it made; raises SetupError naming ``flag`` (and leaves no empty
+    directory behind) when it cannot."""
     created = not path.exists()
-    check_output_dir(path, flag)
+    check_output_dir(path, flag, files)
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / ".write-test"

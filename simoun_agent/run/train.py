@@ -66,7 +66,7 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EvaluationStopped, NonFiniteReward, evaluate, metrics_json
-from simoun_agent.run.kept import Damaged, binary_problem, broken_link, read_text
+from simoun_agent.run.kept import Damaged, binary_problem, broken_link, present, read_text
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -327,10 +327,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"(e.g. --total-env-steps {done + config.eval_every}) to train it further"
         )
     if not payload["replay_path"].is_file():
-        raise SetupError(
-            f"{payload['replay_path']} (the replay of the checkpoint) is missing; the run cannot "
-            "continue exactly. Start a new run."
-        )
+        raise SetupError(missing_replay(payload["replay_path"]))
     env, eval_env, agent, empty = build(config, check)
     try:
         agent.load_state_dict(payload["agent"])
@@ -372,6 +369,27 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     (run_dir / SUMMARY_NAME).unlink(missing_ok=True)
     write_config(run_dir, config)
     return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
+
+
+UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
+"""A compressed file's suffix -> the command that restores the file beside it."""
+
+
+def missing_replay(path: Path) -> str:
+    """The refusal for the checkpoint's replay missing at ``path``: where a compressed copy
+    lies beside it (the replay packed by hand to save space), the command that unpacks it."""
+    copies = [path.with_name(path.name + suffix) for suffix in UNPACK]
+    packed = next((copy for copy in copies if present(copy)), None)
+    if packed is not None:
+        return (
+            f"{path} (the replay of the checkpoint) is missing, but {packed.name} lies beside "
+            f"it: unpack it ({UNPACK[packed.suffix]} -k {packed}) and resume again; the run "
+            "reads the replay as it was saved"
+        )
+    return (
+        f"{path} (the replay of the checkpoint) is missing; the run cannot continue exactly. "
+        "Restore it from a copy, or start a new run."
+    )
 
 
 def check_logs_reach(run_dir: Path, state: dict[str, Any]) -> None:

@@ -50,8 +50,9 @@ def play_episode(agent: SimounAgent, env: gym.Env, seed: int) -> Episode:
 
 
 def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--out") -> None:
-    """Create ``out``; refuse when it cannot be written, or when it already holds one of
-    ``names`` (glob patterns) and ``overwrite`` is off."""
+    """Create ``out``; refuse when it cannot be written, when it already holds one of ``names``
+    (glob patterns) and ``overwrite`` is off, or when one of them is something else than a file
+    (a directory), which the write after the work would fail on."""
     existing = (
         sorted(p.name for pattern in names for p in out.glob(pattern)) if out.is_dir() else []
     )
@@ -61,4 +62,4 @@ def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--
             f"{out} already holds results ({shown}); pass --overwrite to replace them, or "
             f"another {flag}"
         )
-    make_output_dir(out, flag)
+    make_output_dir(out, flag, names)

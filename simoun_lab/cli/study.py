@@ -33,7 +33,12 @@ import tyro
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
-from simoun_agent.run.rundir import check_output_dir, make_output_dir
+from simoun_agent.run.rundir import (
+    check_output_dir,
+    check_output_files,
+    make_output_dir,
+    output_files,
+)
 from simoun_lab.engine.ray_start import load_ray
 from simoun_lab.study.options import StudyOptions
 
@@ -161,11 +166,14 @@ def outputs(options: Run) -> dict[str, Path]:
 
 
 def check_outputs(options: Run) -> None:
-    """Refuse an output directory that cannot be written (:func:`check_output_dir`), and an
-    archive that is, holds or lies in the study directory (:func:`check_archive_apart`),
-    creating nothing."""
+    """Refuse an output directory that cannot be written (:func:`check_output_dir`), a folder
+    where the report written after the runs goes, and an archive that is, holds or lies in the
+    study directory (:func:`check_archive_apart`), creating nothing."""
+    from simoun_lab.study.report import REPORT_DIR, REPORT_FILES  # numpy: after the flags
+
     for flag, path in outputs(options).items():
         check_output_dir(path, flag)
+    check_output_files(output_files(options.study_dir / REPORT_DIR, REPORT_FILES))
     if options.archive is not None:
         from simoun_lab.study.archive import check_archive_apart  # torch: after the flags
 

@@ -144,7 +144,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             check_probes(args.probes)
             check_settings(args.settings, lambda field: "--settings." + field.replace("_", "-"))
-            check_output_dir(args.out, "--out")
+            check_output_dir(args.out, "--out", ("probe.md", "probe.csv"))
             if not args.out.parent.is_dir():
                 raise SetupError(
                     f"--out {args.out}: its folder {args.out.parent.absolute()} does not exist; "

@@ -506,8 +506,8 @@ def plot_training(records: Records, out: Path) -> list[str]:
 
 def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
+    out = report_dir(archive / "report", (REPORT, "*_success.png", "*_intrinsic.png"))
     records = Records(spec, archive)
-    out = report_dir(archive / "report")
     total = len(spec.runs())
     lines = [
         "# MiniGrid PPO study: does an intrinsic reward help PPO from pixels?",

@@ -102,6 +102,14 @@ def check_config(spec: StudySpec, study_dir: Path, run: StudyRun) -> None:
 def run_score(spec: StudySpec, study_dir: Path, run: StudyRun) -> float:
     """The selection rule's score of one finished tuning run, from its ``eval.csv``."""
     run_dir = Path(study_dir, run.name)
+    phase_dir = Path(study_dir, run.phase)
+    if not present(phase_dir):  # every run of the phase is gone, not one unfinished
+        raise SetupError(
+            f"{phase_dir}, the folder of the study's {run.phase} runs, is missing (deleted, or "
+            "left out of a copy), so no setting can be selected; restore it from a copy (the "
+            f"study directory and its archive each keep one), or resume the study, which trains "
+            f"every {run.phase} run again"
+        )
     if not present(run_dir / SUMMARY_NAME):  # a damaged summary is named, not taken for none
         raise SetupError(
             f"the tuning run {run.name} has not finished, so no setting can be selected yet; "

@@ -33,8 +33,9 @@ known maximum).
 from __future__ import annotations
 
 import csv
+import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -45,10 +46,11 @@ from simoun_agent import table
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.resolve import flatten
-from simoun_agent.config.rules import show
+from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, broken_link, present, read_json_object
 from simoun_agent.run.layout import SUMMARY_NAME
+from simoun_agent.run.rundir import check_output_files, output_files
 from simoun_lab import stats
 from simoun_lab.study.checks import check_run_folder
 from simoun_lab.study.choice import SELECTION_FILE, Choice, check_config, read_finished
@@ -88,6 +90,15 @@ UPDATE_COST_JSON = "update_cost.json"
 ``action_repeat``, ``command``, ``commit`` and ``machine``."""
 
 COST_CURVES_PNG = "iqm_wall_time_update_cost.png"
+
+REPORT_FILES = (
+    REPORT_MD,
+    SCORES_CSV,
+    CURVES_PNG,
+    COST_CURVES_PNG,
+    *(f"{phase}/{name}" for phase in (TUNING, EVALUATION) for name in sweep_report.REPORT_FILES),
+)
+"""The files the report writes in its directory (names and paths under it)."""
 
 
 @dataclass
@@ -708,10 +719,11 @@ UPDATE_COST_KEYS = (
 """The keys of :data:`UPDATE_COST_JSON` the report reads."""
 
 
-def read_update_costs(study_dir: Path) -> dict[str, Any] | None:
+def read_update_costs(spec: StudySpec, study_dir: Path) -> dict[str, Any] | None:
     """The study's ``update_cost.json`` (:data:`UPDATE_COST_JSON`), None when there is none;
-    SetupError naming the file, what is wrong and how to write it again when it is damaged or
-    lacks a key the report reads."""
+    SetupError naming the file, what is wrong and how to write it again when it is damaged,
+    lacks a key the report reads, or holds a value the report cannot use
+    (:func:`update_cost_problem`)."""
     path = study_dir / UPDATE_COST_JSON
     if not present(path):
         return None
@@ -720,18 +732,43 @@ def read_update_costs(study_dir: Path) -> dict[str, Any] | None:
     except Damaged as err:
         problem = str(err)
     else:
-        missing = [key for key in UPDATE_COST_KEYS if key not in costs]
-        tables = [key for key in ("ratio", "ms_per_update") if not isinstance(costs.get(key), dict)]
-        if not missing and not tables:
+        problem = update_cost_problem(spec, costs)
+        if problem is None:
             return costs
-        problem = (
-            f"it has no {', '.join(missing)}" if missing else f"its {tables[0]} is not an object"
-        )
     raise SetupError(
         f"{path} is damaged: {problem}. Write it again with `python benchmarks/recipe_update.py "
         f"--selection {study_dir / SELECTION_FILE} --json {path}`, or move it aside (mv {path} "
         f"{path}.damaged) to report the runs' own wall times"
     )
+
+
+def update_cost_problem(spec: StudySpec, costs: dict[str, Any]) -> str | None:
+    """What is wrong with the contents ``costs`` of ``update_cost.json``, else None: a key the
+    report reads missing, a baseline that is not one of the study's recipes (no run gives its
+    clock), a ratio or time per update that is not a positive number (``"2.1x"``, 0, NaN), or
+    a recipe with a ratio and no time per update."""
+    missing = [key for key in UPDATE_COST_KEYS if key not in costs]
+    if missing:
+        return f"it has no {', '.join(missing)}"
+    recipes = spec.recipes + list(spec.ablations())
+    if costs["baseline"] not in recipes:
+        return (
+            f"its baseline is {json.dumps(costs['baseline'])}, which is not a recipe of this study "
+            f"({', '.join(recipes)}): no run of it gives the clock the ratios stretch"
+        )
+    for key in ("ratio", "ms_per_update"):
+        if not isinstance(costs[key], dict):
+            return f"its {key} is not an object"
+        for recipe, value in costs[key].items():
+            if not (is_real(value) and value > 0):
+                return (
+                    f"its {key}.{recipe} is {json.dumps(value)}, which must be a positive "
+                    "number (such as 2.1, without a unit)"
+                )
+    untimed = [recipe for recipe in costs["ratio"] if recipe not in costs["ms_per_update"]]
+    if untimed:
+        return f"ratio has {', '.join(untimed)}, which ms_per_update does not"
+    return None
 
 
 def baseline_clock(results: list[RunResult], baseline: str) -> dict[str, tuple]:
@@ -752,30 +789,39 @@ def baseline_clock(results: list[RunResult], baseline: str) -> dict[str, tuple]:
 
 def cost_curves(
     results: list[RunResult], costs: dict[str, Any]
-) -> tuple[list[RunResult], list[str]]:
+) -> tuple[list[RunResult], dict[str, list[str]]]:
     """The runs with ``cost_time_s`` on their curves: the baseline's clock on their task at
-    their evaluation steps, times their recipe's update-cost ratio; and the recipes left out
-    (no ratio in the file)."""
+    their evaluation steps, times their recipe's update-cost ratio; and the recipes left out,
+    by reason (no ratio in the file; no finished run of the baseline on their task)."""
     clocks = baseline_clock(results, costs["baseline"])
-    placed, left_out = [], []
+    placed: list[RunResult] = []
+    left_out: dict[str, list[str]] = {}
     for result in results:
         ratio = costs["ratio"].get(result.run.recipe)
-        if ratio is None or result.run.task not in clocks:
-            left_out.append(result.run.recipe)
+        reason = (
+            "no ratio in the file"
+            if ratio is None
+            else f"no finished run of {costs['baseline']} on their task"
+            if result.run.task not in clocks
+            else None
+        )
+        if reason:
+            recipes = left_out.setdefault(reason, [])
+            recipes += [result.run.recipe] if result.run.recipe not in recipes else []
             continue
         steps, wall = clocks[result.run.task]
         curve = dict(result.curve)
         curve["cost_time_s"] = ratio * np.interp(curve["env_step"], steps, wall)
         placed.append(RunResult(**{**result.__dict__, "curve": curve}))
-    return placed, list(dict.fromkeys(left_out))
+    return placed, left_out
 
 
 def update_cost_section(
-    spec: StudySpec, results: list[RunResult], study_dir: Path, out: Path
+    spec: StudySpec, results: list[RunResult], costs: dict[str, Any] | None, out: Path
 ) -> list[str]:
-    """IQM curves against wall time at the measured update costs, with where the ratios came
-    from; without ``update_cost.json``, how to measure them."""
-    costs = read_update_costs(study_dir)
+    """IQM curves against wall time at the measured update costs ``costs``
+    (:func:`read_update_costs`), with where the ratios came from; without ``update_cost.json``
+    (None), how to measure them."""
     lines = ["", "## Wall time at update costs measured side by side", ""]
     if costs is None:
         return [
@@ -808,11 +854,11 @@ def update_cost_section(
         "evaluations included, is charged at the update's ratio: where updates take a share u "
         f"of {baseline}'s step, the true ratio is u x ratio + 1 - u, and the gaps between "
         "curves are drawn wider than they are, either way.",
-        "",
-        f"![IQM curves at measured update costs]({COST_CURVES_PNG})",
     ]
-    if left_out:
-        lines += ["", f"Not drawn (no ratio in the file): {', '.join(left_out)}."]
+    if placed:  # the figure is linked only where it is drawn
+        lines += ["", f"![IQM curves at measured update costs]({COST_CURVES_PNG})"]
+    for reason, names in left_out.items():
+        lines += ["", f"Not drawn ({reason}): {', '.join(names)}."]
     if placed:
         plot_curves(
             [r for r in recipes if any(p.run.recipe == r for p in placed)],
@@ -980,7 +1026,8 @@ def write_study_report(
     Counts the finished evaluation runs (the missing ones are listed). ``rewritten_by``: the
     commit of the code writing the report again after the study (``simoun-study report``),
     named under the protocol."""
-    out = report_dir(study_dir / REPORT_DIR)
+    out = report_dir(study_dir / REPORT_DIR, REPORT_FILES)
+    costs = read_update_costs(spec, study_dir)  # before the work, which a bad file would lose
     runs = phase_runs(spec, EVALUATION, choices)
     for run in tuning_runs(spec) + runs:  # a damaged run is named, not counted as unfinished
         check_run_folder(study_dir, run.name)
@@ -1008,7 +1055,7 @@ def write_study_report(
             lines += diagnostics_section(spec, results)
         if spec.generalization:
             lines += generalization_section(spec, results)
-        lines += update_cost_section(spec, results, study_dir, out)
+        lines += update_cost_section(spec, results, costs, out)
     if missing:
         lines += ["", "## Evaluation runs not finished (not counted)", ""]
         lines += [f"- {name}" for name in missing]
@@ -1019,9 +1066,11 @@ def write_study_report(
     return sorted(p for p in out.rglob("*") if p.is_file())
 
 
-def report_dir(out: Path) -> Path:
+def report_dir(out: Path, files: Iterable[str] = ()) -> Path:
     """The report's directory ``out``, made; SetupError naming it when something else stands
-    there (a file, a link to nothing), which a report cannot be written into."""
+    there (a file, a link to nothing), which a report cannot be written into, or naming one of
+    the ``files`` (names or glob patterns) the report writes in it when something else than a
+    file stands there (:func:`~simoun_agent.run.rundir.check_output_files`)."""
     problem = broken_link(out)
     if problem is None and present(out) and not out.is_dir():
         problem = "it is a file, not a directory"
@@ -1030,6 +1079,7 @@ def report_dir(out: Path) -> Path:
             f"{out} is where the report is written, but {problem}; move it aside (mv {out} "
             f"{out}.old) and run the command again"
         )
+    check_output_files(output_files(out, files))
     out.mkdir(parents=True, exist_ok=True)
     return out
 

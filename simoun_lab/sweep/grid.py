@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from simoun_agent.config import SetupError, TrainConfig, resolve
+from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
@@ -424,6 +424,11 @@ class SweepSpec:
 
     @classmethod
     def load(cls, sweep_dir: Path) -> SweepSpec:
+        """The sweep saved in ``sweep_dir`` (its directory, or its ``sweep.json`` itself);
+        SetupError when there is none, or when the file is damaged."""
+        sweep_dir = Path(sweep_dir)
+        if sweep_dir.name == SWEEP_FILE and not sweep_dir.is_dir():
+            sweep_dir = sweep_dir.parent  # the file itself: read it, not sweep.json/sweep.json
         path = sweep_dir / SWEEP_FILE
         if not present(path):
             raise SetupError(
@@ -483,9 +488,53 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     return None
 
 
+RESUMED_AS_GIVEN = ("run_dir", "torch_threads", "total_env_steps", "progress")
+"""The keys a started trial's config.json may hold apart from the sweep's: the sweep directory
+moved, ``--cpus-per-trial`` and ``--total-env-steps`` given with ``--resume``, and the progress
+bar, none of which changes what the trial learns."""
+
+
+def config_differences(trial: Trial) -> dict[str, tuple[Any, Any]]:
+    """Each key the started trial's config.json (read whole by :func:`trial_problem`) records
+    with another value than the sweep gives the trial (its base, preset and grid, resolved):
+    key -> (saved, given by the sweep); :data:`RESUMED_AS_GIVEN` and keys a run of an older
+    version did not save are left out. A resumed trial goes on with its saved config, so such
+    a key means ``sweep.json`` was changed after the trial started, or, for a key the sweep
+    leaves to its default, that this version's default differs."""
+    path = Path(trial.run_dir) / CONFIG_NAME
+    if not present(path):
+        return {}
+    saved = flatten(read_json_object(path))
+    wanted = flatten(to_dict(resolve(trial.preset, trial.overrides)))
+    return {
+        key: (_plain(saved[key]), _plain(value))
+        for key, value in wanted.items()
+        if key in saved and key not in RESUMED_AS_GIVEN and _plain(saved[key]) != _plain(value)
+    }
+
+
+def differences_refusal(trial: Trial, sweep_dir: Path, differences: dict) -> SetupError:
+    """The refusal of a trial whose config.json differs from the sweep (:func:`config_differences`),
+    with the causes its keys allow and the fixes."""
+    values = "; ".join(
+        f"{key} {show(saved)} where the sweep gives {show(given)}"
+        for key, (saved, given) in differences.items()
+    )
+    defaults = any(key not in trial.overrides for key in differences)
+    cause = " or this version of simoun gives a default another value" if defaults else ""
+    version = ", resume with the version of simoun that started the sweep" if defaults else ""
+    return SetupError(
+        f"trial {trial.name} was trained with {values} ({Path(trial.run_dir, CONFIG_NAME)}), and "
+        f"a resumed trial keeps its own config: {Path(sweep_dir, SWEEP_FILE)} was changed after "
+        f"the trial started,{cause}. Restore {SWEEP_FILE} as it was (the values the trial was "
+        f"trained with){version}, or start a new sweep in a new --sweep-dir"
+    )
+
+
 def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
     """SetupError naming the first trial whose run directory is not its own
-    (:func:`trial_problem`), before the sweep counts it as finished or goes on from it."""
+    (:func:`trial_problem`), or whose config.json differs from what ``sweep.json`` gives it
+    (:func:`config_differences`), before the sweep counts it as finished or goes on from it."""
     for trial in spec.trials(sweep_dir):
         problem = trial_problem(trial, spec.grid)
         if problem and not problem.startswith(CONFIG_NAME):
@@ -503,6 +552,9 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
                 f"restore {CONFIG_NAME} from a copy, or move the run directory aside (mv "
                 f"{run_dir} {run_dir}.aside) so that the trial trains anew"
             )
+        differences = config_differences(trial)
+        if differences:
+            raise differences_refusal(trial, sweep_dir, differences)
 
 
 def check_runnable(

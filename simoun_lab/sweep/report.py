@@ -61,7 +61,7 @@ from simoun_agent.run.kept import (
     read_text,
 )
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
-from simoun_agent.run.logger import read_csv
+from simoun_agent.run.logger import log_values
 from simoun_agent.run.rundir import make_output_dir
 from simoun_lab import stats
 from simoun_lab.sweep.grid import (
@@ -81,6 +81,17 @@ CURVES_STEPS_PNG = "curves_env_steps.png"
 CURVES_TIME_PNG = "curves_wall_time.png"
 IQM_STEPS_PNG = "iqm_env_steps.png"
 PROFILE_PNG = "performance_profile.png"
+REPORT_FILES = (
+    REPORT_MD,
+    REPORT_CSV,
+    AGGREGATE_CSV,
+    IMPROVEMENT_CSV,
+    CURVES_STEPS_PNG,
+    CURVES_TIME_PNG,
+    IQM_STEPS_PNG,
+    PROFILE_PNG,
+)
+"""The files :func:`write_report` writes."""
 ERROR_FILE = "error.txt"
 """Written by a failed sweep trial into its run directory (:mod:`simoun_lab.sweep.trainable`)."""
 
@@ -238,7 +249,7 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     if not path.is_file() and not path.is_symlink():
         return {key: np.zeros(0) for key in CURVE_COLUMNS}
     try:
-        rows = read_csv(path)
+        rows = log_values(path, columns=())  # the missing columns are named below, all at once
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
     except (OSError, ValueError, TypeError, csv.Error) as err:
@@ -1131,7 +1142,7 @@ def write_report(
     root = Path(root)
     out = Path(out) if out is not None else default_out(root)
     comparison = compare_runs(root, budget)
-    make_output_dir(out, "--out")
+    make_output_dir(out, "--out", REPORT_FILES)
     groups = comparison.groups
     rows = [group.row() for group in groups]
     scores = variant_scores(groups)
@@ -1169,6 +1180,4 @@ def write_report(
         out / PROFILE_PNG,
         steps=True,
     )
-    names = (REPORT_MD, REPORT_CSV, AGGREGATE_CSV, IMPROVEMENT_CSV)
-    names += (CURVES_STEPS_PNG, CURVES_TIME_PNG, IQM_STEPS_PNG, PROFILE_PNG)
-    return [out / name for name in names]
+    return [out / name for name in REPORT_FILES]
