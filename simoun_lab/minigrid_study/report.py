@@ -33,6 +33,7 @@ from simoun_agent.run.kept import (
     read_csv_rows,
     read_json_object,
 )
+from simoun_agent.run.rundir import check_output_files, output_files
 from simoun_lab import stats
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
 from simoun_lab.minigrid_study.spec import Run, StudySpec, spec_from_dict
@@ -506,8 +507,10 @@ def plot_training(records: Records, out: Path) -> list[str]:
 
 def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
-    out = report_dir(archive / "report", (REPORT, "*_success.png", "*_intrinsic.png"))
+    files = (REPORT, "*_success.png", "*_intrinsic.png")
+    check_output_files(output_files(archive / "report", files))  # made once the runs read well
     records = Records(spec, archive)
+    out = report_dir(archive / "report", files)
     total = len(spec.runs())
     lines = [
         "# MiniGrid PPO study: does an intrinsic reward help PPO from pixels?",
