@@ -1,0 +1,3 @@
+"""The ninth reliability trial's cases: api (see reliability_trial.py)."""
+
+CASES: list[dict] = []
