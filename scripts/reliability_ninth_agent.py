@@ -177,7 +177,7 @@ RUNS = [
     ("train", [*RESUME, "--set", "torch_threads=0"], "torch_threads"),
     ("train", [*RESUME, "--checkpoint-every", "1e3"], "--checkpoint-every"),
     ("train", ["--resume", "{run}/checkpoint.pt/", "--total-env-steps", "60"],
-     ("checkpoint.pt", "--resume")),
+     ("checkpoint.pt", "--resume"), True),
 ]  # fmt: skip
 EVALS = [
     # train's flags given to simoun-eval
