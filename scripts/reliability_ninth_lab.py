@@ -51,6 +51,14 @@ RESUME = ["--resume", "--sweep-dir", "sw"]
 MGT_RUN = "mgt/MiniGrid-DoorKey-6x6-v0/ppo/s100"
 
 
+def bare(flag: str, *extra: str) -> list[str]:
+    """The tiny sweep's flags (40 env steps) with ``extra``, less the base ``flag`` and its value:
+    the key a case gives in --grid (or --envs) is not given as a base flag too."""
+    flags = sweep_tiny(*SHORT, *extra)
+    at = flags.index(flag)
+    return flags[:at] + flags[at + 2 :]
+
+
 def gpu_spec(*lines: str) -> str:
     """The DMC study's spec with ``lines`` added after its [resources] table's last line."""
     old = "max_concurrent_trials = 2   # two runs at a time on a 2-core machine"
@@ -65,13 +73,14 @@ FLAGS = [
     ("sweep", sweep_tiny("--total-env-steps", "5", "--action-repeat", "8"),
      ("--total-env-steps", "action_repeat", "action-repeat")),
     ("sweep", sweep_tiny(*SHORT, "--grid", "action_repeat=1,100"), ("action_repeat", "--grid")),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "total_env_steps=0,40"), "total_env_steps"),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "image_size=8,32"), "image_size"),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "agent.replay_capacity=1,1000"), "replay_capacity"),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "eval_every=0,20"), "eval_every"),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "agent.batch_size=0,8"), "batch_size"),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "warmup_agent_steps=10,100000"), "warmup", True),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "checkpoint_every=20,40"), "", True),
+    ("sweep", bare("--total-env-steps", "--grid", "total_env_steps=0,40"), "total_env_steps"),
+    ("sweep", bare("--image-size", "--grid", "image_size=8,32"), "image_size"),
+    ("sweep", sweep_tiny(*SHORT, "--grid", "replay_capacity=1,1000"), "replay_capacity"),
+    ("sweep", bare("--eval-every", "--grid", "eval_every=0,20"), "eval_every"),
+    ("sweep", bare("--agent.batch-size", "--grid", "agent.batch_size=0,8"), "batch_size"),
+    ("sweep", bare("--warmup-agent-steps", "--grid", "warmup_agent_steps=10,100000"), "warmup",
+     True),
+    ("sweep", bare("--checkpoint-every", "--grid", "checkpoint_every=20,40"), "", True),
     ("sweep", sweep_tiny(*SHORT, "--set", "agent.recipe=drq", "--grid", "agent.lr=1e-3,3e-4"),
      "", True),
     # --gpus-per-trial against --device
@@ -79,7 +88,7 @@ FLAGS = [
      ("--gpus-per-trial", "cuda")),
     ("sweep", sweep_tiny(*SHORT, "--device", "mps", "--gpus-per-trial", "1"),
      ("--gpus-per-trial", "mps")),
-    ("sweep", sweep_tiny(*SHORT, "--grid", "device=cpu,cuda", "--gpus-per-trial", "1"),
+    ("sweep", bare("--device", "--grid", "device=cpu,cuda", "--gpus-per-trial", "1"),
      ("--gpus-per-trial", "device")),
     ("sweep", sweep_tiny(*SHORT, "--device", "cpu", "--gpus-per-trial", "0"), "", True),
     ("sweep", sweep_tiny(*SHORT, "--device", "cuda:0", "--gpus-per-trial", "1"),
@@ -100,7 +109,8 @@ FLAGS = [
     ("sweep", sweep_tiny(*SHORT, "--grid", "agent.recipe=['simoun','drq']"),
      ("--grid", "agent.recipe")),
     ("sweep", sweep_tiny(*SHORT, "--grid", "agent.lr=1e-3, 3e-4"), ("--grid", "agent.lr"), True),
-    ("sweep", sweep_tiny(*SHORT, "--grid", 'env_kwargs={"max_episode_steps": 10}'),
+    ("sweep", sweep_tiny(*SHORT, "--grid",
+                        'env_kwargs={"max_episode_steps": 10, "disable_env_checker": true}'),
      ("env_kwargs", "--grid")),
     ("sweep", sweep_tiny(*SHORT, "--grid", "preset=cpu,highway-cpu"), ("preset", "--preset")),
     ("sweep", sweep_tiny(*SHORT, "--grid", "agent.recipe=SIMOUN,drq"), "SIMOUN"),
@@ -108,9 +118,9 @@ FLAGS = [
     ("sweep", sweep_tiny(*SHORT, "--seeds", "[0,1,2]"), "--seeds"),
     ("sweep", sweep_tiny(*SHORT, "--seeds", "0,1,1"), "--seeds"),
     ("sweep", sweep_tiny(*SHORT, "--seeds", "0-1", "--seed", "3"), "--seed", True),
-    ("sweep", sweep_tiny(*SHORT, "--envs", "[Pendulum-v1, simoun/PointReach-v0]"), "--envs"),
-    ("sweep", sweep_tiny(*SHORT, "--envs", "Pendulum-v1,Pendulum-v1"), ("--envs", "Pendulum")),
-    ("sweep", sweep_tiny(*SHORT, "--envs", "CartPole-v1"), ("CartPole", "--envs")),
+    ("sweep", bare("--env", "--envs", "[Pendulum-v1, simoun/PointReach-v0]"), "--envs"),
+    ("sweep", bare("--env", "--envs", "Pendulum-v1,Pendulum-v1"), ("--envs", "Pendulum")),
+    ("sweep", bare("--env", "--envs", "CartPole-v1"), ("CartPole", "--envs")),
     ("sweep", sweep_tiny(*SHORT, "--verbose", "-1"), "--verbose"),
     ("sweep", sweep_tiny(*SHORT, "--grid", "cameras=1,0"), "cameras"),
     # simoun-study: a study's record given as its spec, another study's archive
@@ -170,13 +180,17 @@ FLAGS = [
      False, (ARCH,)),
     ("minigrid", ["report", "--archive", "mgt", "--spec", "arch/study.json"], "study.json", False,
      (MGT, ARCH)),
-    ("minigrid", ["select", "--archive", "mgt", "--spec", "mgt/selection.json"],
-     ("selection.json", "--spec"), False, (MGT,)),
+    ("minigrid", ["select", "--archive", "mgt", "--spec", "ez/selection.json"],
+     ("selection.json", "--spec"), False, (MGT, EZ)),
     ("minigrid", ["run", "--archive", "mgt", "--work-dir", ""], "--work-dir", False, (MGT,)),
     ("minigrid", ["run", "--archive", "mgt", "--work-dir", "wd", "--spec", "mgt/spec.json"], "",
      True, (MGT,)),
-    ("minigrid", small_probe("--probes", "rnd", "--settings.n-envs", "0"), "n-envs"),
-    ("minigrid", small_probe("--probes", "rnd", "--settings.n-steps", "0"), "n-steps"),
+    ("minigrid", probe("--probes", "rnd", "--settings.steps", "512", "--settings.n-envs", "0",
+                       "--settings.n-steps", "32", "--settings.env-id", "MiniGrid-Empty-5x5-v0"),
+     "n-envs"),
+    ("minigrid", probe("--probes", "rnd", "--settings.steps", "512", "--settings.n-envs", "2",
+                       "--settings.n-steps", "0", "--settings.env-id", "MiniGrid-Empty-5x5-v0"),
+     "n-steps"),
     ("minigrid", ["select", "--archive", "mgt", "--concurrent", "2"], "--concurrent", False,
      (MGT,)),
     ("minigrid", probe("--probes", "rnd", "--settings.steps", "512", "--settings.n-envs", "2",
