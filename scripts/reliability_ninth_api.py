@@ -10,8 +10,8 @@ contradicts a field; ``Recipe.values_for``) and presets that fit or not the env 
 the agent's ``update_window`` given numpy arrays, floats and targets of the wrong shape, ``cpu()``
 and ``cuda()``, states edited or given as a path, copies of an agent, updates from replays of
 another frame count or with no transition; replays loaded from a glob pattern and added to after
-an episode ended; the RND and curiosity models' ``update``, ``pending``, pickling, an unbatched
-triplet, another model's state and ``FeatureSource``; ``make_encoder``; Gymnasium's
+an episode ended; the RND and curiosity models' ``update`` with nothing watched, pickling, an
+unbatched triplet, another model's state and ``FeatureSource``; ``make_encoder``; Gymnasium's
 TimeAwareObservation, FlattenObservation, RescaleAction and the vector DictInfoToList with the
 wrappers, actions given as torch tensors, lists, arrays or NaN, an env rendering
 ``rgb_array_list``, ResidualMotion over SimounObservation; the PettingZoo wrapper given an
