@@ -8,6 +8,7 @@ agent computes the motion channels itself, so the wrapper's are switched off).
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import functools
 import importlib
@@ -16,6 +17,7 @@ import inspect
 import json
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -127,7 +129,7 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
             f"id (e.g. {several[0]}): train one run per env, or sweep them with simoun-sweep "
             f"--envs {','.join(several)}"
         )
-    matches = difflib.get_close_matches(env_id, list(gym.registry), n=5, cutoff=0.6)
+    matches = close_env_ids(f"{module}:{env_id}" if module else env_id)
     hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
     if module is not None:
         raise SetupError(
@@ -140,6 +142,45 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
         "MODULE:ID (e.g. minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
         "on import."
     )
+
+
+def close_env_ids(typed: str, n: int = 5) -> list[str]:
+    """Registered ids close to ``typed`` (``--env`` as given), those that differ from it only by
+    case, separators (``:`` for ``/``, ``-`` for ``_``) or a missing version first
+    (``dm_control/cartpole-swingup-v0`` for ``dm_control:cartpole-swingup-v0`` or
+    ``cartpole-swingup``), then those difflib finds. Every suite that is installed is
+    imported first, so that its ids can be offered."""
+    for suite, _ in _SUITES.values():
+        with contextlib.suppress(ImportError):
+            importlib.import_module(suite)
+    ids = list(gym.registry)
+    spelled = [i for i in ids if _spelling(i) == _spelling(typed)]
+    names = _names(typed)
+    unversioned = sorted((i for i in ids if _names(i) & names), key=_plain_newest_first)
+    close = difflib.get_close_matches(typed, ids, n=n, cutoff=0.6)
+    return list(dict.fromkeys(spelled + unversioned + close))[:n]
+
+
+def _spelling(env_id: str) -> str:
+    """``env_id`` without case or separators: ``dmcontrolcartpoleswingupv0``."""
+    return re.sub(r"[-_:/\s]", "", env_id.lower())
+
+
+def _plain_newest_first(env_id: str) -> tuple[int, str, int]:
+    """Sort key: ids without a namespace first, then by name, the newest version first."""
+    version = re.search(r"-v(\d+)$", env_id)
+    return env_id.count("/"), _unversioned(env_id), -int(version.group(1)) if version else 0
+
+
+def _unversioned(env_id: str) -> str:
+    return re.sub(r"-v\d+$", "", env_id)
+
+
+def _names(env_id: str) -> set[str]:
+    """The spellings of ``env_id`` without its version: whole, and its name after a namespace
+    or module (``cartpoleswingup`` of ``dm_control:cartpole-swingup-v0``)."""
+    bare = _unversioned(env_id)
+    return {_spelling(bare), _spelling(re.split(r"[:/]", bare)[-1])}
 
 
 def env_keywords(env_id: str) -> tuple[list[str], bool]:
