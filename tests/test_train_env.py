@@ -544,3 +544,21 @@ def test_an_env_kwarg_that_takes_a_json_object_refuses_anything_else(env, given,
     with pytest.raises(SetupError) as error:
         check_env_kwargs(env, given)
     assert str(error.value).startswith(f"--env-kwargs: {said}")
+
+
+@pytest.mark.parametrize(
+    ("typed", "module", "first"),
+    [
+        ("cartpole-swingup-v0", "dm_control", "dm_control/cartpole-swingup-v0"),  # MODULE:ID
+        ("dm_control/ball-in-cup-catch-v0", None, "dm_control/ball_in_cup-catch-v0"),
+        ("DM_Control/Cartpole-Swingup-v0", None, "dm_control/cartpole-swingup-v0"),
+        ("highway_fast-v0", None, "highway-fast-v0"),
+        ("cartpole-swingup", None, "dm_control/cartpole-swingup-v0"),  # no version
+        ("cartpole", None, "CartPole-v1"),  # the newest version of the id without a namespace
+    ],
+)
+def test_an_env_id_spelt_another_way_is_offered_first(typed, module, first):
+    with pytest.raises(SetupError) as error:
+        ensure_registered(typed, module)
+    assert f"did you mean {first}" in str(error.value)
+    assert "no registered id is close" not in str(error.value)
