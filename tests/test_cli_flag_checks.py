@@ -322,10 +322,48 @@ def test_a_stray_argument_is_refused_naming_it(main, argv, said, capsys):
         (sweep_cli.main, ["--resume", "seed=3"], "write --set seed=3 or --seed 3"),
         (eval_cli.main, ["RUN", "--no-video", "episodes=3"], "a KEY=VALUE setting is not given "
          "bare: write --episodes 3"),
+        (train_cli.main, ["--", "agent.lr=1e-3"], "unexpected argument 'agent.lr=1e-3': "
+         "simoun-train takes no positional argument (every value goes with its --flag); a "
+         "KEY=VALUE setting is not given bare: write --set agent.lr=1e-3 or --agent.lr 1e-3"),
+        (train_cli.main, ["--no-video", "--", "foo"], "unexpected argument 'foo': simoun-train "
+         "takes no positional argument (every value goes with its --flag); `simoun-train "
+         "--help` lists its flags"),
+        (eval_cli.main, ["RUN", "episodes=1", "--no-video"], "'episodes=1' is not a RUN (no such "
+         "file or directory) but a KEY=VALUE setting, which simoun-eval does not take bare: it "
+         "takes options as flags; write --episodes 1"),
+        (eval_cli.main, ["episodes=1", "RUN", "--distraction", "train"], "'episodes=1' is not a "
+         "RUN"),
+        (report_cli.main, ["format=md"], "'format=md' is not a DIR (no such file or directory) "
+         "but a KEY=VALUE setting"),
     ],
 )  # fmt: skip
 def test_a_bare_key_value_setting_is_answered_with_the_forms_that_take_it(main, argv, said, capsys):
     assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--no-video", "preset=cpu"], "write --preset cpu; got 'preset=cpu'"),
+        (["preset=cpu"], "write --preset cpu"),
+        (["--no-video", "resume=runs/a"], "write --resume runs/a; got"),
+        (["--no-video", "overwrite=true"], "write --overwrite; got"),
+        (["--no-video", "overwrite=false"], "write nothing: leave --overwrite out; got"),
+        (["version=1"], "write --version"),
+        (["--no-video", "help=1"], "write --help; got"),
+    ],
+)  # fmt: skip
+def test_a_bare_setting_of_a_command_flag_is_answered_with_the_flag_alone(argv, said, capsys):
+    message = refused(capsys, train_cli.main, argv)
+    assert said in message
+    assert "--set" not in message  # --set refuses these keys
+
+
+def test_a_run_directory_named_like_a_setting_is_still_a_run(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "episodes=1").mkdir()
+    message = refused(capsys, eval_cli.main, ["episodes=1", "--no-video"])
+    assert "KEY=VALUE" not in message and "episodes=1" in message
 
 
 @pytest.mark.parametrize(

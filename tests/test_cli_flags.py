@@ -111,6 +111,10 @@ def test_set_preset_of_no_preset_says_so_with_the_presets():
         ("overwrite=true", "overwrite is not a config key but the flag --overwrite; give "
          "--overwrite instead"),
         ("overwrite=false", "the flag --overwrite; leave --overwrite out"),
+        ("version=1", "--set version=1: version is not a config key but the flag --version, "
+         "which prints the installed version; give --version alone"),
+        ("help=true", "--set help=true: help is not a config key but the flag --help, which "
+         "lists every flag and config key; give --help alone"),
     ],
 )  # fmt: skip
 def test_set_of_a_command_flag_points_at_the_flag(pair, said):

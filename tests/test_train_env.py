@@ -302,15 +302,11 @@ def test_a_highway_task_without_continuous_actions_is_named_in_one_sentence_with
 
 
 def test_an_env_kwarg_the_env_fails_on_inside_its_code_is_named_by_its_key():
-    highway = {"config": {"action": {"type": "ContinuousAction"}, "vehicles_density": "high"}}
+    highway = {"config": {"action": {"type": "ContinuousAction"}, "initial_lane_id": 5}}
     with pytest.raises(SetupError) as error:
         check_task(env_config("highway-fast-v0", highway))
-    assert 'cannot use config.vehicles_density="high" (making it failed: ' in str(error.value)
+    assert "cannot use config.initial_lane_id=5 (making it failed: " in str(error.value)
     assert str(error.value).endswith("Fix or drop that key")
-    # a misspelled action type: only dropping the dict that holds it makes the env work
-    typo = {"config": {"action": {"type": "ContinousAction"}}}
-    with pytest.raises(SetupError, match=r'cannot use config.action=\{"type": "ContinousAction"\}'):
-        check_task(env_config("highway-fast-v0", typo))
     with pytest.raises(SetupError, match=r'cannot use task_kwargs.random="x"'):
         check_task(env_config("dm_control/cartpole-swingup-v0", {"task_kwargs": {"random": "x"}}))
 
@@ -449,3 +445,120 @@ def test_an_env_that_renders_no_frame_is_refused_at_set_up_naming_the_key():
     with pytest.raises(SetupError, match=r"--env-kwargs .* gives no frames to learn from"):
         make_env(zero_width)
     assert check_task(env_config(dmc, {"render_kwargs": {"width": 48, "height": 40}})) == 1000
+
+
+@pytest.mark.parametrize(
+    ("given", "said"),
+    [
+        ({"lane_count": 4}, "config.lane_count is not a setting of highway-fast-v0's config, and "
+         "highway-env would ignore it; did you mean config.lanes_count? Fix the key or drop it"),
+        ({"lanes_count": True}, "config.lanes_count=true does not fit highway-fast-v0: "
+         "config.lanes_count must be a whole number >= 1 (its default is 3); e.g. "
+         "'{\"config\": {\"lanes_count\": 3}}', or drop config.lanes_count"),
+        ({"offroad_terminal": "yes"}, "config.offroad_terminal=\"yes\" does not fit "
+         "highway-fast-v0: config.offroad_terminal must be true or false (its default is false)"),
+        ({"offroad_terminal": 1}, "config.offroad_terminal=1 does not fit"),
+        ({"collision_reward": "-1"}, "config.collision_reward=\"-1\" does not fit "
+         "highway-fast-v0: config.collision_reward must be a number"),
+        ({"collision_reward": [1]}, "config.collision_reward=[1] does not fit"),
+        ({"vehicles_count": None}, "config.vehicles_count=null does not fit"),
+        ({"reward_speed_range": 20}, "config.reward_speed_range=20 does not fit highway-fast-v0: "
+         "config.reward_speed_range must be a list of 2 numbers (its default is [20, 30])"),
+        ({"other_vehicles_type": 3}, "config.other_vehicles_type=3 does not fit"),
+        ({"controlled_vehicles": 2}, "config.controlled_vehicles=2 must be 1 for "
+         "highway-fast-v0: the agent drives one vehicle"),
+        ({"reward_speed_range": [30, 20]}, "config.reward_speed_range=[30, 20] (speeds mapped "
+         "onto the high-speed reward, [slowest, fastest] in m/s) must have its low end first "
+         "and below its high end; e.g. '{\"config\": {\"reward_speed_range\": [20, 30]}}'"),
+        ({"reward_speed_range": [20, 20]}, "config.reward_speed_range=[20, 20] (speeds mapped "
+         "onto the high-speed reward, [slowest, fastest] in m/s) has equal ends"),
+        ({"action": {"type": "ContinousAction"}}, "config.action.type=\"ContinousAction\" is "
+         "not an action type of highway-env; did you mean 'ContinuousAction'?"),
+        ({"action": {"type": "ContinuousAction", "acceleraton_range": [-5, 5]}},
+         "config.action.acceleraton_range is not a setting of highway-env's ContinuousAction, "
+         "which would ignore it; did you mean config.action.acceleration_range?"),
+        ({"action": {"type": "ContinuousAction", "lateral": "no"}},
+         "config.action.lateral=\"no\" does not fit highway-fast-v0: config.action.lateral "
+         "must be true or false"),
+        ({"action": {"type": "ContinuousAction", "speed_range": [30, 0]}},
+         "config.action.speed_range=[30, 0] (speeds the vehicle may reach, [lowest, highest] in "
+         "m/s) must have its low end first"),
+        ({"action": {"type": "ContinuousAction", "steering_range": [0.5, 0.5]}},
+         "config.action.steering_range=[0.5, 0.5] has equal ends, so that axis of the agent's "
+         "action would have no effect"),
+        ({"action": {"type": "ContinuousAction", "steering_range": 0.5}},
+         "config.action.steering_range=0.5 must be a list of 2 numbers [low, high]"),
+    ],
+)  # fmt: skip
+def test_a_highway_config_key_or_value_that_changes_the_task_is_refused(given, said):
+    kwargs = {"config": {**HIGHWAY_CONTINUOUS, **given}}
+    with pytest.raises(SetupError) as error:
+        check_env_kwargs("highway-fast-v0", kwargs)
+    assert str(error.value).startswith(f"--env-kwargs: {said}")
+
+
+def test_highway_config_values_of_the_defaults_kind_are_taken():
+    kept = {
+        "lanes_count": 2,
+        "duration": 20.5,  # a float where the default is an int: both are numbers
+        "collision_reward": -1.5,
+        "offroad_terminal": True,
+        "controlled_vehicles": 1,
+        "initial_lane_id": 1,  # a None default takes any value
+        "reward_speed_range": [10.5, 20],
+    }
+    assert check_env_kwargs("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **kept}}) is None
+    # swapped acceleration or steering ends only flip the sign of an action axis: same task
+    flipped = {"type": "ContinuousAction", "acceleration_range": [5, -5], "clip": False}
+    assert check_env_kwargs("highway-fast-v0", {"config": {"action": flipped}}) is None
+    # racetrack's own default action holds a key its action class ignores: copying it is fine
+    ensure_registered("racetrack-v0")
+    own = {"type": "ContinuousAction", "lateral": True, "target_speeds": [0, 5, 10]}
+    assert check_env_kwargs("racetrack-v0", {"config": {"action": own}}) is None
+
+
+@pytest.mark.parametrize(
+    ("env", "given", "said"),
+    [
+        ("highway-fast-v0", {"config": "highway.json"}, "config must be a JSON object of "
+         "highway-env settings for highway-fast-v0, got \"highway.json\"; e.g. "
+         "'{\"config\": {\"lanes_count\": 3}}' (a file's settings go in as its contents, not "
+         "its name), or drop config"),
+        ("highway-fast-v0", {"config": [1]}, "config must be a JSON object of highway-env "
+         "settings for highway-fast-v0, got [1]"),
+        ("dm_control/cartpole-swingup-v0", {"render_kwargs": "x"}, "render_kwargs must be a "
+         "JSON object of settings for dm_control/cartpole-swingup-v0, got \"x\"; e.g. "
+         "'{\"render_kwargs\": {\"width\": 84, \"height\": 84, \"camera_id\": 0}}'"),
+        ("dm_control/cartpole-swingup-v0", {"task_kwargs": [1]}, "task_kwargs must be a JSON "
+         "object"),
+        ("dm_control/cartpole-swingup-v0", {"environment_kwargs": 3}, "environment_kwargs must "
+         "be a JSON object"),
+        ("dm_control/cartpole-swingup-v0", {"visualize_reward": "no"}, "visualize_reward='no' "
+         "does not fit dm_control/cartpole-swingup-v0: its 'visualize_reward' is true or false"),
+        ("Reacher-v5", {"default_camera_config": "camera.json"}, "default_camera_config must be "
+         "a JSON object of settings for Reacher-v5"),
+    ],
+)  # fmt: skip
+def test_an_env_kwarg_that_takes_a_json_object_refuses_anything_else(env, given, said):
+    ensure_registered(env)
+    with pytest.raises(SetupError) as error:
+        check_env_kwargs(env, given)
+    assert str(error.value).startswith(f"--env-kwargs: {said}")
+
+
+@pytest.mark.parametrize(
+    ("typed", "module", "first"),
+    [
+        ("cartpole-swingup-v0", "dm_control", "dm_control/cartpole-swingup-v0"),  # MODULE:ID
+        ("dm_control/ball-in-cup-catch-v0", None, "dm_control/ball_in_cup-catch-v0"),
+        ("DM_Control/Cartpole-Swingup-v0", None, "dm_control/cartpole-swingup-v0"),
+        ("highway_fast-v0", None, "highway-fast-v0"),
+        ("cartpole-swingup", None, "dm_control/cartpole-swingup-v0"),  # no version
+        ("cartpole", None, "CartPole-v1"),  # the newest version of the id without a namespace
+    ],
+)
+def test_an_env_id_spelt_another_way_is_offered_first(typed, module, first):
+    with pytest.raises(SetupError) as error:
+        ensure_registered(typed, module)
+    assert f"did you mean {first}" in str(error.value)
+    assert "no registered id is close" not in str(error.value)

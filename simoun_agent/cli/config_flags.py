@@ -149,6 +149,14 @@ def own_flags(command: Any, argv: Sequence[str]) -> dict[str, tuple[str, Flag]]:
     }
 
 
+COMMAND_ONLY_FLAGS = {
+    "help": "lists every flag and config key",
+    "version": "prints the installed version",
+}
+"""flags every command takes that are no field of its dataclass, by the key ``--set`` would
+give them, with what each does"""
+
+
 def check_set_key(
     key: str, value: str, pair: str, own: dict[str, tuple[str, Flag]] | None = None
 ) -> None:
@@ -165,6 +173,11 @@ def check_set_key(
         )
     if key == "preset":
         raise SetupError(set_preset_problem(value))
+    if key in COMMAND_ONLY_FLAGS:
+        raise SetupError(
+            f"--set {pair}: {key} is not a config key but the flag --{key}, which "
+            f"{COMMAND_ONLY_FLAGS[key]}; give --{key} alone"
+        )
     if own and key in own:
         name, flag = own[key]
         fix = f"give {name} {value} instead"

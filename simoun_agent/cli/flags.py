@@ -41,6 +41,7 @@ import unicodedata
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
 from typing import Annotated, Any, NoReturn, TypeVar
 
 import tyro
@@ -365,10 +366,17 @@ def setting_forms(word: str, flags: dict[str, Flag]) -> str:
     if match is None:
         return ""
     key, value = match.groups()
+    name = "--" + key.replace("_", "-")
+    flag = flags.get(name)
+    if key in ("help", "version"):
+        return name
+    if flag is not None and not flag.config:  # the command's own flag: --set refuses it
+        if flag.switch is None:
+            return f"{name} {value}"
+        return f"nothing: leave {name} out" if value.lower() in FALSE_WORDS else name
     forms = [f"--set {key}={value}"] if "--set" in flags else []
-    flag = "--" + key.replace("_", "-")
-    if flag in flags:
-        forms.append(f"{flag} {value}")
+    if flag is not None:
+        forms.append(f"{name} {value}")
     return " or ".join(forms)
 
 
@@ -455,6 +463,11 @@ class Given:
     positional: PositionalArg | None = None
     """the positional argument the value fills (None: an option's, or a stray word)"""
 
+    @property
+    def unplaced(self) -> bool:
+        """a word that no option and no positional argument takes"""
+        return self.flag is None and self.positional is None
+
 
 def given_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> Iterator[Given]:
     """The values of ``argv`` in order, each with its option or positional argument: an option
@@ -525,17 +538,35 @@ def refuse_stray_arguments(
             else slot.metavar
             for slot in slots
         )
+    after_dashes = argv[argv.index("--") + 1 :] if "--" in argv and not slots else []
+    stray = [value.value for value in given_values(argv, flags, command) if value.unplaced]
+    for word in stray + after_dashes:
+        forms = setting_forms(word, flags)
+        hint = (
+            f"; a KEY=VALUE setting is not given bare: write {forms}"
+            if forms
+            else f"; `{prog}{sub} --help` lists its flags"
+        )
+        raise ValueError(f"unexpected argument {word!r}: {prog}{sub} takes {takes}{hint}")
     for value in given_values(argv, flags, command):
-        if value.flag is None and value.positional is None:
-            forms = setting_forms(value.value, flags)
-            hint = (
-                f"; a KEY=VALUE setting is not given bare: write {forms}"
-                if forms
-                else f"; `{prog}{sub} --help` lists its flags"
-            )
-            raise ValueError(
-                f"unexpected argument {value.value!r}: {prog}{sub} takes {takes}{hint}"
-            )
+        if value.positional is not None and value.positional.path:
+            refuse_setting_as_path(value.value, value.positional, flags, f"{prog}{sub}")
+
+
+def refuse_setting_as_path(
+    word: str, slot: PositionalArg, flags: dict[str, Flag], prog: str
+) -> None:
+    """Raise ValueError for a ``KEY=VALUE`` word (``episodes=1``) given where a path goes and
+    naming nothing on disk: it was meant as a setting, and the command would read it as one
+    more path (a second run, say)."""
+    if SETTING_WORD.fullmatch(word) is None or Path(word).exists():
+        return
+    forms = setting_forms(word, flags)
+    fix = f"write {forms}" if forms else f"`{prog} --help` lists its flags"
+    raise ValueError(
+        f"{word!r} is not a {slot.metavar} (no such file or directory) but a KEY=VALUE setting, "
+        f"which {prog} does not take bare: it takes options as flags; {fix}"
+    )
 
 
 def refuse_switch_values(

@@ -1,8 +1,11 @@
-"""The numeric keys of a highway-env task's ``config`` that some values turn into another task, or
-none: a simulation that never advances, a road without lanes, an episode over before it starts.
-highway-env takes such values without a word (``"simulation_frequency": 0`` runs no simulation
-step, so every episode returns the same), so they are refused before the env is made, naming
-``config.KEY`` and a value that works.
+"""The keys and values of a highway-env task's ``config`` that turn it into another task, or
+none: a key the task does not have (highway-env ignores it, so a misspelt ``lane_count`` leaves
+the default), a value of another kind than the default's (``"offroad_terminal": "no"`` is taken
+by its truth value), a second driven vehicle (the agent drives one; the other gets no driver), a
+range whose ends are swapped (the high-speed reward then pays for driving slowly), a simulation
+that never advances, a road without lanes, an episode over before it starts. highway-env takes
+such values without a word, so they are refused before the env is made, naming ``config.KEY``
+and a value that works.
 
 Example:
     >>> check_highway_config("highway-fast-v0", {"lanes_count": 2}, {"lanes_count": 3})
@@ -15,6 +18,8 @@ Example:
 
 from __future__ import annotations
 
+import difflib
+import inspect
 import json
 import math
 from dataclasses import dataclass
@@ -52,7 +57,6 @@ HIGHWAY_LIMITS = {
     "duration": Limit("episode length in seconds", 0, open_low=True),
     "lanes_count": Limit("number of lanes", 1, whole=True),
     "vehicles_count": Limit("number of other vehicles", 0, whole=True),
-    "controlled_vehicles": Limit("number of vehicles the agent drives", 1, whole=True),
     "initial_vehicle_count": Limit("number of vehicles at the start", 0, whole=True),
     "other_vehicles": Limit("number of other vehicles", 0, whole=True),
     "vehicles_density": Limit("traffic density", 0, open_low=True),
@@ -61,29 +65,230 @@ HIGHWAY_LIMITS = {
     "scaling": Limit("pixels per metre of the env's own viewer", 0, open_low=True),
 }
 """What each numeric key of a highway-env ``config`` (in any task that has it) must be for the
-task to be one: frequencies, durations, densities and the speed limit above 0, counts of lanes
-and of driven vehicles at least 1, counts of other vehicles at least 0, a probability in [0, 1].
-The screen size is left out: simoun's cameras set it for every view."""
+task to be one: frequencies, durations, densities and the speed limit above 0, a count of lanes
+at least 1, counts of other vehicles at least 0, a probability in [0, 1]. The screen size is left
+out: simoun's cameras set it for every view. ``controlled_vehicles`` must be 1 (see
+:func:`_check_driven`)."""
+
+ORDERED_RANGES = {
+    "reward_speed_range": "speeds mapped onto the high-speed reward, [slowest, fastest] in m/s",
+    "speed_range": "speeds the vehicle may reach, [lowest, highest] in m/s",
+}
+"""``[low, high]`` keys (of ``config`` or of ``config.action``) whose order makes the task:
+highway-env maps a speed through ``reward_speed_range`` with a linear map, so swapped ends pay
+the high-speed reward for driving slowly, and takes ``speed_range`` as (MIN_SPEED, MAX_SPEED)."""
+
+SIGNED_RANGES = ("acceleration_range", "steering_range")
+"""``[low, high]`` keys of ``config.action`` whose swapped ends only flip the sign of one axis of
+the agent's action (highway-env maps [-1, 1] onto them linearly): the task is the same, with the
+axis read the other way, so the order is free; equal ends leave the axis no effect and are
+refused."""
 
 
 def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
-    """SetupError for a key of ``given`` (the ``config`` of ``--env-kwargs``) that
-    :data:`HIGHWAY_LIMITS` refuses, or for a policy frequency above the simulation frequency;
-    ``defaults`` is the task's ``default_config()``, whose keys are the task's. Values that
-    are not numbers are left to the kind check (a string for a number)."""
+    """SetupError for a key of ``given`` (the ``config`` of ``--env-kwargs``) that the task's
+    ``defaults`` (its ``default_config()``) lack, a value of another kind than the default's,
+    a value :data:`HIGHWAY_LIMITS` refuses, a ``controlled_vehicles`` other than 1, a range in
+    the wrong order, an unknown action type or key, or a policy frequency above the simulation
+    frequency."""
     if not isinstance(given, dict) or not isinstance(defaults, dict):
         return
     for key, value in given.items():
+        _check_known(env_id, key, defaults)
+        _check_kind(env_id, f"config.{key}", value, defaults[key])
         limit = HIGHWAY_LIMITS.get(key)
-        if limit is None or key not in defaults or not _is_number(value):
-            continue
-        if not limit.ok(value):
+        if limit is not None and not limit.ok(value):
             raise SetupError(
                 f"--env-kwargs: config.{key}={json.dumps(value)} ({env_id}'s {limit.meaning}) "
                 f"must be {limit.need()}; e.g. {_example(key, defaults[key])} (its "
                 f"default), or drop config.{key}"
             )
+        _check_range(f"config.{key}", value)
+    _check_driven(env_id, given)
+    _check_action(env_id, given.get("action"), defaults.get("action"))
     _check_frequencies(env_id, given, defaults)
+
+
+def _check_known(env_id: str, key: str, defaults: dict) -> None:
+    """SetupError for a key that is not one of the task's: highway-env would ignore it."""
+    if key in defaults:
+        return
+    close = difflib.get_close_matches(key, list(defaults), n=1)
+    hint = f"did you mean config.{close[0]}?" if close else f"its keys are {', '.join(defaults)}."
+    raise SetupError(
+        f"--env-kwargs: config.{key} is not a setting of {env_id}'s config, and highway-env "
+        f"would ignore it; {hint} Fix the key or drop it"
+    )
+
+
+def _kind(value: object) -> str | None:
+    """The JSON kind of a default value, in words; None where any value may go (a None
+    default: highway-env reads None there as "choose for me")."""
+    if value is None:
+        return None
+    if isinstance(value, bool):
+        return "true or false"
+    if _is_number(value):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)} values"
+    if isinstance(value, dict):
+        return "a JSON object"
+    return None
+
+
+def _fits(value: object, default: object) -> bool:
+    if isinstance(default, bool):
+        return isinstance(value, bool)
+    if _is_number(default):
+        return _is_number(value)
+    if isinstance(default, str):
+        return isinstance(value, str)
+    if isinstance(default, (list, tuple)):
+        return (
+            isinstance(value, list)
+            and len(value) == len(default)
+            and all(_fits(item, expected) for item, expected in zip(value, default, strict=True))
+        )
+    if isinstance(default, dict):
+        return isinstance(value, dict)
+    return True
+
+
+def _check_kind(env_id: str, name: str, value: object, default: object) -> None:
+    """SetupError for a value of another kind than the default's: a switch given ``"yes"`` (any
+    non-empty string switches it on, ``"no"`` too), a count given ``true`` (read as 1), a list
+    where a number goes; ``null`` is refused where the default is not, as highway-env takes it
+    as the value itself rather than as its default."""
+    kind = _kind(default)
+    if kind is None or _fits(value, default):
+        return
+    key = name.split(".")[-1]
+    limit = HIGHWAY_LIMITS.get(key) if name.count(".") == 1 else None
+    need = limit.need() if limit is not None else kind
+    if isinstance(default, (list, tuple)) and all(_is_number(item) for item in default):
+        need = f"a list of {len(default)} numbers"
+    raise SetupError(
+        f"--env-kwargs: {name}={json.dumps(value)} does not fit {env_id}: {name} must be "
+        f"{need} (its default is {json.dumps(_plain(default))}); e.g. "
+        f"'{json.dumps(nested(name, _plain(default)))}', or drop {name}"
+    )
+
+
+def _check_range(name: str, value: object) -> None:
+    """SetupError for a ``[low, high]`` range in the wrong order (:data:`ORDERED_RANGES`, and
+    any other ``*_range`` key but :data:`SIGNED_RANGES`) or, for a signed one, with equal
+    ends."""
+    key = name.split(".")[-1]
+    if not key.endswith("_range") or not _is_pair(value):
+        return
+    low, high = value
+    if key in SIGNED_RANGES:
+        if low != high:
+            return
+        raise SetupError(
+            f"--env-kwargs: {name}={json.dumps(value)} has equal ends, so that axis of the "
+            f"agent's action would have no effect; give two different ends, e.g. "
+            f"'{json.dumps(nested(name, [-abs(low) or -1, abs(low) or 1]))}', or drop {name}"
+        )
+    if low < high:
+        return
+    meaning = ORDERED_RANGES.get(key, "range [low, high]")
+    raise SetupError(
+        f"--env-kwargs: {name}={json.dumps(value)} ({meaning}) must have its low end first and "
+        f"below its high end; e.g. '{json.dumps(nested(name, sorted(value)))}', or drop {name}"
+        if low != high
+        else f"--env-kwargs: {name}={json.dumps(value)} ({meaning}) has equal ends; give a low "
+        f"end below the high end, or drop {name}"
+    )
+
+
+def _check_driven(env_id: str, given: dict) -> None:
+    """SetupError for a ``controlled_vehicles`` other than 1: the agent drives one vehicle, and
+    highway-env gives the others no driver (they go straight at their first speed)."""
+    if "controlled_vehicles" not in given or given["controlled_vehicles"] == 1:
+        return
+    raise SetupError(
+        f"--env-kwargs: config.controlled_vehicles={json.dumps(given['controlled_vehicles'])} "
+        f"must be 1 for {env_id}: the agent drives one vehicle, and highway-env would give "
+        "any other no driver at all (it goes straight at its first speed); give "
+        '\'{"config": {"controlled_vehicles": 1}}\', or drop config.controlled_vehicles'
+    )
+
+
+ACTION_TYPES = ("ContinuousAction", "DiscreteAction", "DiscreteMetaAction", "MultiAgentAction")
+"""the action types highway-env's ``action_factory`` makes (``config.action.type``)"""
+
+
+def _check_action(env_id: str, action: object, default: object) -> None:
+    """SetupError for ``config.action`` with an unknown type, a key its action class does not
+    take (it takes ``**kwargs`` and ignores them), a value of another kind than the class's
+    default, or a range in the wrong order. Keys of the task's own default action are taken,
+    as highway-env writes some there that the class ignores."""
+    if not isinstance(action, dict) or "type" not in action:
+        return
+    kind = action["type"]
+    if kind not in ACTION_TYPES:
+        close = difflib.get_close_matches(str(kind), ACTION_TYPES, n=1)
+        hint = f"did you mean {close[0]!r}? The" if close else "the"
+        raise SetupError(
+            f"--env-kwargs: config.action.type={json.dumps(kind)} is not an action type of "
+            f"highway-env; {hint} types are {', '.join(ACTION_TYPES)}, and the agent drives "
+            'with \'{"config": {"action": {"type": "ContinuousAction"}}}\''
+        )
+    parameters = _action_parameters(kind)
+    known = {"type", *parameters, *(default if isinstance(default, dict) else {})}
+    for key, value in action.items():
+        if key not in known:
+            close = difflib.get_close_matches(key, sorted(known), n=1)
+            hint = (
+                f"did you mean config.action.{close[0]}?"
+                if close
+                else f"its keys are {', '.join(sorted(known))}."
+            )
+            raise SetupError(
+                f"--env-kwargs: config.action.{key} is not a setting of highway-env's {kind}, "
+                f"which would ignore it; {hint} Fix the key or drop it"
+            )
+        _check_kind(env_id, f"config.action.{key}", value, parameters.get(key))
+        if key.endswith("_range") and value is not None and not _is_pair(value):
+            example = json.dumps(nested(f"config.action.{key}", [-1, 1]))
+            raise SetupError(
+                f"--env-kwargs: config.action.{key}={json.dumps(value)} must be a list of 2 "
+                f"numbers [low, high]; e.g. '{example}', or drop config.action.{key}"
+            )
+        _check_range(f"config.action.{key}", value)
+
+
+def _action_parameters(kind: str) -> dict[str, Any]:
+    """The named parameters of highway-env's action class ``kind`` and their defaults."""
+    from highway_env.envs.common import action
+
+    parameters = inspect.signature(getattr(action, kind)).parameters.values()
+    return {
+        p.name: None if p.default is p.empty else p.default
+        for p in parameters
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name not in ("self", "env")
+    }
+
+
+def _is_pair(value: object) -> bool:
+    return isinstance(value, list) and len(value) == 2 and all(map(_is_number, value))
+
+
+def _plain(value: object) -> object:
+    """A default as JSON writes it (highway-env keeps some as numpy floats or tuples)."""
+    if isinstance(value, (list, tuple)):
+        return [_plain(item) for item in value]
+    return float(value) if isinstance(value, float) else value
+
+
+def nested(name: str, value: object) -> dict:
+    """``"config.lanes_count", 4`` -> ``{"config": {"lanes_count": 4}}``."""
+    head, _, rest = name.partition(".")
+    return {head: nested(rest, value) if rest else value}
 
 
 def _check_frequencies(env_id: str, given: dict, defaults: dict) -> None:

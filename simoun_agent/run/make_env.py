@@ -8,6 +8,7 @@ agent computes the motion channels itself, so the wrapper's are switched off).
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import functools
 import importlib
@@ -16,6 +17,7 @@ import inspect
 import json
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -28,7 +30,7 @@ from gymnasium.wrappers import RescaleAction
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
-from simoun_agent.run.highway_config import check_highway_config
+from simoun_agent.run.highway_config import check_highway_config, nested
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import check_render, image_layout
 
@@ -127,7 +129,7 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
             f"id (e.g. {several[0]}): train one run per env, or sweep them with simoun-sweep "
             f"--envs {','.join(several)}"
         )
-    matches = difflib.get_close_matches(env_id, list(gym.registry), n=5, cutoff=0.6)
+    matches = close_env_ids(f"{module}:{env_id}" if module else env_id)
     hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
     if module is not None:
         raise SetupError(
@@ -140,6 +142,45 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
         "MODULE:ID (e.g. minigrid:MiniGrid-DoorKey-6x6-v0) for an id that a package registers "
         "on import."
     )
+
+
+def close_env_ids(typed: str, n: int = 5) -> list[str]:
+    """Registered ids close to ``typed`` (``--env`` as given), those that differ from it only by
+    case, separators (``:`` for ``/``, ``-`` for ``_``) or a missing version first
+    (``dm_control/cartpole-swingup-v0`` for ``dm_control:cartpole-swingup-v0`` or
+    ``cartpole-swingup``), then those difflib finds. Every suite that is installed is
+    imported first, so that its ids can be offered."""
+    for suite, _ in _SUITES.values():
+        with contextlib.suppress(ImportError):
+            importlib.import_module(suite)
+    ids = list(gym.registry)
+    spelled = [i for i in ids if _spelling(i) == _spelling(typed)]
+    names = _names(typed)
+    unversioned = sorted((i for i in ids if _names(i) & names), key=_plain_newest_first)
+    close = difflib.get_close_matches(typed, ids, n=n, cutoff=0.6)
+    return list(dict.fromkeys(spelled + unversioned + close))[:n]
+
+
+def _spelling(env_id: str) -> str:
+    """``env_id`` without case or separators: ``dmcontrolcartpoleswingupv0``."""
+    return re.sub(r"[-_:/\s]", "", env_id.lower())
+
+
+def _plain_newest_first(env_id: str) -> tuple[int, str, int]:
+    """Sort key: ids without a namespace first, then by name, the newest version first."""
+    version = re.search(r"-v(\d+)$", env_id)
+    return env_id.count("/"), _unversioned(env_id), -int(version.group(1)) if version else 0
+
+
+def _unversioned(env_id: str) -> str:
+    return re.sub(r"-v\d+$", "", env_id)
+
+
+def _names(env_id: str) -> set[str]:
+    """The spellings of ``env_id`` without its version: whole, and its name after a namespace
+    or module (``cartpoleswingup`` of ``dm_control:cartpole-swingup-v0``)."""
+    bare = _unversioned(env_id)
+    return {_spelling(bare), _spelling(re.split(r"[:/]", bare)[-1])}
 
 
 def env_keywords(env_id: str) -> tuple[list[str], bool]:
@@ -284,29 +325,73 @@ def _is_number(value: object) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
+DMC_OBJECT_KWARGS = {
+    "render_kwargs": {"width": 84, "height": 84, "camera_id": 0},
+    "task_kwargs": {"time_limit": 10},
+    "environment_kwargs": {"flat_observation": True},
+}
+"""keywords of shimmy's dm_control envs that take a JSON object (their default is None, or they
+come through ``**kwargs``), each with an example"""
+
+
 def _check_value_kinds(env_id: str, kwargs: dict) -> None:
-    """SetupError for a string given where the creator's default is a number, or a number where
-    it is a string: the env would take it and fail later, mid-run, on arithmetic; for a
-    highway-env config value that breaks the task (:func:`check_highway_config`); and for a
-    negative count (:func:`_check_counts`)."""
+    """SetupError for a value of another kind than the creator's default (a string where a
+    number goes, a number where a string goes, anything but true or false for a switch,
+    anything but a JSON object where one goes): the env would take it and fail later, mid-run,
+    or read it another way; for a highway-env config value that breaks the task
+    (:func:`check_highway_config`); and for a negative count (:func:`_check_counts`)."""
     defaults = _creator_defaults(env_id)
+    for key, value in kwargs.items():
+        if value is not None:  # many creators take None for "their own default"
+            _check_object(env_id, key, value, defaults.get(key))
+            _check_scalar_kind(env_id, key, value, defaults.get(key))
     if is_highway(env_id):
         check_highway_config(env_id, kwargs.get("config"), defaults.get("config"))
     _check_counts(env_id, kwargs, defaults)
-    for key, value in kwargs.items():
-        default = defaults.get(key)
-        if value is None:  # many creators take None for "their own default"
-            continue
-        if _is_number(default) and not _is_number(value):
-            kind = "a number"
-        elif isinstance(default, str) and not isinstance(value, str):
-            kind = "a string"
-        else:
-            continue
-        raise SetupError(
-            f"--env-kwargs: {key}={value!r} does not fit {env_id}: its {key!r} is {kind} "
-            f"(default {default!r}); e.g. '{json.dumps({key: default})}', or drop it"
-        )
+
+
+def _check_scalar_kind(env_id: str, key: str, value: object, default: object) -> None:
+    if isinstance(default, bool) and not isinstance(value, bool):
+        kind = "true or false"
+    elif _is_number(default) and not _is_number(value):
+        kind = "a number"
+    elif isinstance(default, str) and not isinstance(value, str):
+        kind = "a string"
+    else:
+        return
+    raise SetupError(
+        f"--env-kwargs: {key}={value!r} does not fit {env_id}: its {key!r} is {kind} "
+        f"(default {default!r}); e.g. '{json.dumps({key: default})}', or drop it"
+    )
+
+
+def _check_object(env_id: str, key: str, value: object, default: object) -> None:
+    """SetupError for a keyword that takes a JSON object (highway-env's ``config``, dm_control's
+    ``render_kwargs``) given something else, such as a file name."""
+    if env_id.startswith("dm_control/") and key in DMC_OBJECT_KWARGS:
+        example = DMC_OBJECT_KWARGS[key]
+    elif isinstance(default, dict):
+        example = _object_example(default)
+    else:
+        return
+    if isinstance(value, dict):
+        return
+    what = "highway-env settings" if key == "config" and is_highway(env_id) else "settings"
+    file = (
+        " (a file's settings go in as its contents, not its name)" if isinstance(value, str) else ""
+    )
+    raise SetupError(
+        f"--env-kwargs: {key} must be a JSON object of {what} for {env_id}, got "
+        f"{json.dumps(value)}; "
+        f"e.g. '{json.dumps({key: example})}'{file}, or drop {key}"
+    )
+
+
+def _object_example(default: dict) -> dict:
+    """One plain setting of ``default`` as an example of the object (``{"lanes_count": 3}``)."""
+    plain = [key for key, value in default.items() if _is_number(value)]
+    preferred = "lanes_count" if "lanes_count" in plain else (plain or [None])[0]
+    return {} if preferred is None else {preferred: default[preferred]}
 
 
 def _check_counts(env_id: str, kwargs: dict, defaults: dict, prefix: str = "") -> None:
@@ -321,7 +406,7 @@ def _check_counts(env_id: str, kwargs: dict, defaults: dict, prefix: str = "") -
         if isinstance(value, dict) and isinstance(default, dict):
             _check_counts(env_id, value, default, f"{name}.")
         elif _is_count(default) and _is_number(value) and value < 0:
-            example = json.dumps(_nested(name, default))
+            example = json.dumps(nested(name, default))
             raise SetupError(
                 f"--env-kwargs: {name}={value!r} is negative, and {env_id}'s {name} is a count "
                 f"(default {default!r}); give a whole number of at least 0, e.g. "
@@ -331,12 +416,6 @@ def _check_counts(env_id: str, kwargs: dict, defaults: dict, prefix: str = "") -
 
 def _is_count(default: object) -> bool:
     return isinstance(default, int) and not isinstance(default, bool) and default >= 1
-
-
-def _nested(name: str, value: object) -> dict:
-    """``"config.lanes_count", 4`` -> ``{"config": {"lanes_count": 4}}``."""
-    head, _, rest = name.partition(".")
-    return {head: _nested(rest, value) if rest else value}
 
 
 def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
