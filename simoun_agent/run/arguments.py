@@ -108,4 +108,3 @@ def asked_signal(callback: TrainCallback, run: Run) -> int | None:
         f"{asked!r:.60}; it must return a signal number to stop the run as that signal would "
         "(e.g. signal.SIGTERM) or None to go on"
     )
-
