@@ -283,9 +283,9 @@ def refuse_held_here(run_dir: Path) -> None:
     held = _held.get((run_dir / LOCK_NAME).resolve())
     if held is not None and not held.closed:
         raise SetupError(
-            f"the run directory {run_dir} is in use by a run created in this process (create_run or "
-            "resume_run returned it, and it holds the directory until train(run) ends); train that "
-            "run, close it with run.close(), or pass another run_dir"
+            f"the run directory {run_dir} is in use by a run created in this process "
+            "(create_run or resume_run returned it, and it holds the directory until train(run) "
+            "ends); train that run, close it with run.close(), or pass another run_dir"
         )
 
 
