@@ -65,15 +65,15 @@ def unchanged(frames: torch.Tensor) -> torch.Tensor:
 
 
 def same_device(asked: object, device: torch.device) -> bool:
-    """Whether ``asked`` (what ``to()`` was given) names ``device``; ``"cuda"`` names the
-    current GPU, as torch reads it."""
+    """Whether ``asked`` (what ``to()`` was given) names ``device``; a device without an index
+    is the current GPU (``"cuda"``) or the one of its kind (``"cpu"`` is ``"cpu:0"``)."""
     try:
         wanted = torch.device(asked)
     except (RuntimeError, TypeError):
         return False
     if wanted.type != device.type:
         return False
-    index = torch.cuda.current_device() if wanted.type == "cuda" else None
+    index = torch.cuda.current_device() if wanted.type == "cuda" else 0
     return (wanted.index if wanted.index is not None else index) == (
         device.index if device.index is not None else index
     )

@@ -244,9 +244,9 @@ def pixel_env(
             )
             raise ValueError(
                 f"{owner} needs pixels: the env has no image observations (observation space "
-                f"{env.observation_space}), and its render_mode is {changer.render_mode!r}, "
-                f"which gives no single frame to take: {name}{made} turned the render mode "
-                f"'rgb_array' into it. Create the env with render_mode='rgb_array', e.g. "
+                f"{env.observation_space}), and {name} turned the render mode 'rgb_array' into "
+                f"{changer.render_mode!r}{made}, which gives no single frame to take. Create the "
+                f"env with render_mode='rgb_array', e.g. "
                 f"gym.make(env_id, render_mode='rgb_array'); to keep {name}, put {owner} under "
                 f"it: {name}({owner}(env, ...))."
             )
