@@ -64,6 +64,52 @@ def unchanged(frames: torch.Tensor) -> torch.Tensor:
     return frames
 
 
+def same_device(asked: object, device: torch.device) -> bool:
+    """Whether ``asked`` (what ``to()`` was given) names ``device``; a device without an index
+    is the current GPU (``"cuda"``) or the one of its kind (``"cpu"`` is ``"cpu:0"``)."""
+    try:
+        wanted = torch.device(asked)
+    except (RuntimeError, TypeError):
+        return False
+    if wanted.type != device.type:
+        return False
+    index = torch.cuda.current_device() if wanted.type == "cuda" else 0
+    return (wanted.index if wanted.index is not None else index) == (
+        device.index if device.index is not None else index
+    )
+
+
+def check_tensor(value: object, name: str, kind: str, shape: str) -> None:
+    """A TypeError naming ``update_window``'s argument ``name`` unless ``value`` is a torch
+    tensor of ``kind`` (``"uint8"`` or ``"float"``); ``shape`` is the one it must have."""
+    if not isinstance(value, torch.Tensor):
+        raise TypeError(
+            f"update_window({name}=...) must be a torch tensor, {kind} {shape}, got "
+            f"{type(value).__name__}; convert it with torch.as_tensor(value, device=agent.device)"
+            ", or use agent.update(replay, step), which samples and converts the batch"
+        )
+    ok = value.dtype == torch.uint8 if kind == "uint8" else value.dtype.is_floating_point
+    if not ok:
+        raise TypeError(
+            f"update_window({name}=...) must be {kind} {shape}, got {value.dtype}; "
+            + (
+                "pass the frames as stored, 0..255 (they are divided by 255 inside)"
+                if kind == "uint8"
+                else f"convert it with {name}.float()"
+            )
+        )
+
+
+def check_shape(value: torch.Tensor, name: str, shape: tuple, what: str) -> None:
+    """A ValueError naming ``update_window``'s argument ``name`` unless ``value`` has ``shape``
+    (``what`` says what it holds)."""
+    if tuple(value.shape) != tuple(shape):
+        raise ValueError(
+            f"update_window({name}=...) must have shape {tuple(shape)} ({what}), got "
+            f"{tuple(value.shape)}; pass FrameReplay.sample's batch, or reshape it"
+        )
+
+
 def check_config_in_use(config: AgentConfig) -> None:
     """Check ``config`` again where it is used: a dataclass takes any value assigned after it
     was built (``config.lr = -1``), which would otherwise fail inside torch naming no field."""
@@ -314,6 +360,14 @@ class SimounAgent:
                 f"create the replay with FrameReplay(capacity, {self.frame_shape}, "
                 f"{self.action_dim})"
             )
+        frames = getattr(replay, "num_frames", None)
+        if frames != cfg.num_frames:
+            raise ValueError(
+                f"replay has num_frames={frames!r}, but this agent stacks "
+                f"AgentConfig.num_frames={cfg.num_frames} frames per observation; create the "
+                f"replay with FrameReplay(capacity, {self.frame_shape}, {self.action_dim}, "
+                f"num_frames={cfg.num_frames})"
+            )
         batch = replay.sample(cfg.batch_size, cfg.n_step, cfg.discount)
 
         def put(name: str) -> torch.Tensor:
@@ -368,6 +422,7 @@ class SimounAgent:
         """
         cfg = self.config
         self.env_step = step = self._check_step(step, "update_window")
+        self.check_batch(window, action, reward, discount, bootstrap, return_mask)
         steps = 1 if return_mask is None else return_mask.shape[1]
         self.check_window(window, steps)
         bootstrap_obs, n_return = bootstrap if bootstrap is not None else (None, reward)
@@ -386,6 +441,58 @@ class SimounAgent:
             metrics.update(self.update_contrastive(views))
         self.num_updates += 1
         return metrics
+
+    def check_batch(
+        self,
+        window: object,
+        action: object,
+        reward: object,
+        discount: object,
+        bootstrap: object,
+        return_mask: object,
+    ) -> None:
+        """TypeError or ValueError naming the argument of :meth:`update_window` that is not the
+        tensor it takes (type, dtype, shape against this agent's and the window's batch size):
+        without this a wrong one fails deep in a layer, or broadcasts silently (a ``(B, 1)``
+        reward against ``(B,)`` values)."""
+        frames = ", ".join(map(str, self.frame_shape))
+        check_tensor(window, "window", "uint8", f"(B, {self.config.num_frames + 1}, {frames})")
+        if window.dim() != 5 or tuple(window.shape[2:]) != self.frame_shape:
+            raise ValueError(
+                f"update_window(window=...) must be uint8 (B, frames, {frames}) for this agent's "
+                f"frames {self.frame_shape}, got {tuple(window.shape)}; pass FrameReplay.sample's "
+                "'window' (channel-first, as SimounObservation gives them)"
+            )
+        size = window.shape[0]
+        check_tensor(action, "action", "float", f"({size}, {self.action_dim})")
+        what = f"the window holds {size} samples"
+        check_shape(
+            action, "action", (size, self.action_dim), f"{what}, actions of {self.action_dim}"
+        )
+        for name, value in (("reward", reward), ("discount", discount)):
+            check_tensor(value, name, "float", f"({size},)")
+            check_shape(value, name, (size,), f"one value per sample: {what}")
+        if bootstrap is not None:
+            if not (isinstance(bootstrap, tuple) and len(bootstrap) == 2):
+                raise TypeError(
+                    "update_window(bootstrap=...) must be a pair (bootstrap_obs, n_step_return) "
+                    f"or None, got {type(bootstrap).__name__}; pass (batch['bootstrap_obs'], "
+                    "batch['return']) of FrameReplay.sample"
+                )
+            obs, n_return = bootstrap
+            want = (size, self.config.num_frames, *self.frame_shape)
+            check_tensor(obs, "bootstrap[0]", "uint8", str(want))
+            check_shape(obs, "bootstrap[0]", want, f"the triplets to bootstrap from: {what}")
+            check_tensor(n_return, "bootstrap[1]", "float", f"({size},)")
+            check_shape(n_return, "bootstrap[1]", (size,), f"one n-step return per sample: {what}")
+        if return_mask is not None:
+            check_tensor(return_mask, "return_mask", "float", f"({size}, n)")
+            if return_mask.dim() != 2 or return_mask.shape[0] != size:
+                raise ValueError(
+                    f"update_window(return_mask=...) must be float ({size}, n), one row per "
+                    f"sample of the window, got {tuple(return_mask.shape)}; pass "
+                    "FrameReplay.sample's 'return_mask'"
+                )
 
     def check_window(self, window: torch.Tensor, steps: int) -> None:
         """ValueError unless ``window`` holds the frames of a triplet and ``steps`` more."""
@@ -780,9 +887,12 @@ class SimounAgent:
         return problems
 
     def to(self, device: str | torch.device) -> SimounAgent:
-        """Refused with a TypeError that says how to move an agent: its device is chosen when
-        it is built (its optimizers, generators and running maxima live there too), so
+        """The agent itself when it is on ``device`` already (as a torch module's ``to``);
+        otherwise refused with a TypeError that says how to move an agent: its device is chosen
+        when it is built (its optimizers, generators and running maxima live there too), so
         ``SimounAgent(..., device=device)`` and :meth:`load_state_dict` move it whole."""
+        if same_device(device, self.device):
+            return self
         raise TypeError(
             f"SimounAgent.to({device!r}): an agent's device is chosen when it is built, not "
             f"moved like a torch module (this one is on {self.device}). Build it there, "
@@ -791,11 +901,11 @@ class SimounAgent:
         )
 
     def cpu(self) -> SimounAgent:
-        """Refused as :meth:`to` is."""
+        """The agent itself on the CPU; elsewhere refused as :meth:`to` is."""
         return self.to("cpu")
 
     def cuda(self) -> SimounAgent:
-        """Refused as :meth:`to` is."""
+        """The agent itself on the GPU; elsewhere refused as :meth:`to` is."""
         return self.to("cuda")
 
     def load_state_dict(self, state: dict) -> None:

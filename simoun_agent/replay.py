@@ -15,7 +15,13 @@ from typing import IO
 import numpy as np
 
 from simoun_agent.run.kept import binary_problem
-from simoun_wrappers._checks import check_bool, check_positive_int, is_int, is_real
+from simoun_wrappers._checks import (
+    check_bool,
+    check_positive_int,
+    is_int,
+    is_real,
+    unexpanded_home,
+)
 
 _MAX_STEP = 255  # position in episode saturates here; only min(step, num_frames) is ever used
 
@@ -437,6 +443,9 @@ def _check_path_type(path: object, method: str) -> None:
             f"object, got {type(path).__name__} {path!r:.60}; e.g. "
             f"replay.{method}('replay.npz')"
         )
+    home = unexpanded_home(path)
+    if home is not None:
+        raise ValueError(f"FrameReplay.{method}(path={os.fspath(path)!r}): {home}")
 
 
 def _writable(path: str | os.PathLike) -> str | os.PathLike:

@@ -2,6 +2,7 @@
 
 import functools
 import inspect
+import os
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -250,3 +251,34 @@ def _bind_problem(func: Callable, args: tuple) -> tuple[str, str] | None:
     except TypeError as err:
         return str(signature), str(err)
     return None
+
+
+def unexpanded_home(path: Any) -> str | None:
+    """The fix for a ``path`` that starts with a ``~`` nobody expanded and names nothing as
+    written (Python, unlike a shell, reads ``'~/runs'`` as a folder called ``~``): the
+    sentence to add to the error; None for any other path."""
+    if not isinstance(path, (str, os.PathLike)):
+        return None
+    text = os.fspath(path)
+    if not isinstance(text, str) or not (text == "~" or text.startswith(("~/", "~" + os.sep))):
+        return None
+    if os.path.exists(text):
+        return None
+    return (
+        f"Python does not expand ~ in a path (only a shell does), so {text!r} names a folder "
+        f"called ~ here; pass os.path.expanduser({text!r}), which is {os.path.expanduser(text)!r}"
+    )
+
+
+def check_path(value: Any, name: str, example: str) -> None:
+    """A TypeError for a ``value`` of the argument ``name`` that is no path (a str or
+    os.PathLike), and a ValueError for one that starts with an unexpanded ``~``
+    (:func:`unexpanded_home`); ``example`` is a call that works."""
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(
+            f"{name} must be a path, a str or os.PathLike, got {type(value).__name__} "
+            f"{value!r:.60}; e.g. {example}"
+        )
+    home = unexpanded_home(value)
+    if home is not None:
+        raise ValueError(f"{name}={os.fspath(value)!r}: {home}")

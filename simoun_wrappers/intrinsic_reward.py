@@ -501,6 +501,35 @@ ONE_ENV = np.zeros(1, dtype=np.int64)
 """the sub-env index of a single env's transitions"""
 
 
+def check_dict_info(env: VectorEnv, owner: str) -> None:
+    """A TypeError when Gymnasium's ``DictInfoToList`` is under the vector reward ``owner``:
+    the reward reads and extends the vector env's info dict (``final_obs``,
+    ``reward_intrinsic``), which that wrapper turns into a list. It goes outside, as
+    Gymnasium's own vector wrappers that read the info require (``RecordEpisodeStatistics``)."""
+    layer: Any = env
+    while layer is not None:
+        if isinstance(layer, gym.wrappers.vector.DictInfoToList):
+            raise TypeError(dict_info_problem(owner))
+        layer = getattr(layer, "env", None)
+
+
+def check_info_is_dict(info: Any, owner: str) -> None:
+    """A TypeError when the vector env under ``owner`` gives an info that is not a dict."""
+    if not isinstance(info, dict):
+        raise TypeError(dict_info_problem(owner, type(info).__name__))
+
+
+def dict_info_problem(owner: str, got: str | None = None) -> str:
+    """Why ``owner`` refuses a list of infos (``got``: the type it got, when it got one)."""
+    given = f", got a {got}" if got else ""
+    return (
+        f"{owner} reads and extends the vector env's info dict{given}: Gymnasium's "
+        f"DictInfoToList under it turns the dict into a list of dicts. Put DictInfoToList "
+        f"outside, DictInfoToList({owner}(envs, ...)), as Gymnasium's RecordEpisodeStatistics "
+        "requires it too."
+    )
+
+
 class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordConstructorArgs):
     """``r_e + r_i`` for every sub-env of a vector env, in one batched signal call.
 
@@ -517,6 +546,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
     vector = True
 
     def _attach(self, env: VectorEnv) -> None:
+        check_dict_info(env, type(self).__name__)
         VectorWrapper.__init__(self, env)
         self._read = env_triplet_reader(env, type(self).__name__)
         self._autoreset_mode = env.metadata.get("autoreset_mode", AutoresetMode.NEXT_STEP)
@@ -531,6 +561,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
         mask = None if options is None else options.get("reset_mask")
         seed = check_vector_reset_seed(seed, type(self).__name__, self.num_envs)
         obs, info = self.env.reset(seed=seed, options=options)
+        check_info_is_dict(info, type(self).__name__)
         # a masked reset returns the other sub-envs' observations unchanged
         self._last_triplets = self._read(obs)
         # a sub-env left out of the mask that has just ended still autoresets on its next step
@@ -542,6 +573,7 @@ class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordC
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
         check_action(actions, self.action_space, type(self).__name__, vector=self.num_envs)
         obs, extrinsic, terminated, truncated, info = self.env.step(actions)
+        check_info_is_dict(info, type(self).__name__)
         triplets = self._read(obs)
         # The triplet that ends a SAME_STEP episode is in final_obs; obs already holds the reset.
         ended = np.logical_or(terminated, truncated)

@@ -237,11 +237,18 @@ def pixel_env(
         changer = render_mode_changer(env)
         if changer is not None:
             name = type(changer).__name__
+            made = (
+                f" (gym.make adds it for render_mode={changer.render_mode!r})"
+                if isinstance(changer, gym.wrappers.RenderCollection)
+                else ""
+            )
             raise ValueError(
                 f"{owner} needs pixels: the env has no image observations (observation space "
                 f"{env.observation_space}), and {name} turned the render mode 'rgb_array' into "
-                f"{changer.render_mode!r}, which gives no single frame to take. Put {owner} under "
-                f"{name}, {name}({owner}(env, ...)), or leave {name} out."
+                f"{changer.render_mode!r}{made}, which gives no single frame to take. Create the "
+                f"env with render_mode='rgb_array', e.g. "
+                f"gym.make(env_id, render_mode='rgb_array'); to keep {name}, put {owner} under "
+                f"it: {name}({owner}(env, ...))."
             )
         raise ValueError(
             f"{owner} needs pixels: the env has neither image observations "

@@ -194,6 +194,15 @@ class SimounParallelObservation(BaseParallelWrapper):
             check_action(action, self.env.action_space(agent), f"{owner}[{agent!r}]")
 
     def step(self, actions: dict[Any, Any]) -> tuple[dict[Any, Any], ...]:
+        if self._has_reset and not self.env.agents:
+            # PettingZoo's own order-enforcing wrapper checks this too, but only warns, and
+            # the parallel env then answers with empty dicts: a loop stepping a fixed count
+            # would collect nothing without a word
+            raise ResetNeeded(
+                "Cannot call SimounParallelObservation.step() after the episode ended: every "
+                "agent terminated or was truncated (env.agents is empty); call env.reset() "
+                "first, e.g. loop while env.agents."
+            )
         self._check_actions(actions)
         obs, rewards, terminations, truncations, infos = self.env.step(actions)
         stacked = self._stack(self._images(obs))

@@ -430,7 +430,9 @@ def test_an_online_model_config_changed_after_it_was_built_is_checked_again(
     assert said in str(error.value)
 
 
-@pytest.mark.parametrize("move", [lambda a: a.to("cpu"), lambda a: a.cpu(), lambda a: a.cuda()])
+@pytest.mark.parametrize(
+    "move", [lambda a: a.to("meta"), lambda a: a.to(torch.device("meta")), lambda a: a.cuda()]
+)
 def test_moving_an_agent_like_a_torch_module_says_how_to_move_it(move):
     agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
     with pytest.raises(TypeError) as error:
@@ -448,3 +450,77 @@ def test_an_agent_moves_by_a_new_agent_and_its_state_as_the_error_says():
     np.testing.assert_array_equal(
         agent.act(frames, deterministic=True), moved.act(frames, deterministic=True)
     )
+
+
+@pytest.mark.parametrize(
+    "move", [lambda a: a.cpu(), lambda a: a.to("cpu"), lambda a: a.to("cpu:0")]
+)
+def test_moving_an_agent_to_the_device_it_is_on_returns_it(move):
+    agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
+    assert move(agent) is agent
+
+
+def window_batch(size=8, frames=4, action_dim=1):
+    """What FrameReplay.sample gives update_window for a triplet agent of SIZE frames."""
+    return (
+        torch.zeros((size, frames, 3, SIZE, SIZE), dtype=torch.uint8),
+        torch.zeros(size, action_dim),
+        torch.zeros(size),
+        torch.ones(size),
+    )
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "said"),
+    [
+        (lambda b: (b[0].numpy(), *b[1:]), TypeError, "window=...) must be a torch tensor"),
+        (lambda b: (b[0].float(), *b[1:]), TypeError, "window=...) must be uint8"),
+        (
+            lambda b: (b[0], torch.zeros(8, 2), *b[2:]),
+            ValueError,
+            "action=...) must have shape (8, 1)",
+        ),
+        (
+            lambda b: (b[0], b[1], torch.zeros(8, 1), b[3]),
+            ValueError,
+            "reward=...) must have shape (8,)",
+        ),
+        (lambda b: (b[0][:4], *b[1:]), ValueError, "action=...) must have shape (4, 1)"),
+        (lambda b: (b[0], b[1].long(), *b[2:]), TypeError, "action=...) must be float"),
+        (
+            lambda b: (b[0].permute(0, 1, 3, 4, 2).contiguous(), *b[1:]),
+            ValueError,
+            "window=...) must be uint8 (B, frames, 3, 32, 32)",
+        ),
+    ],
+)
+def test_update_window_names_the_argument_its_shape_and_dtype(change, error, said):
+    agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
+    batch = window_batch()
+    agent.update_window(*batch, 0)
+    with pytest.raises(error) as raised:
+        agent.update_window(*change(batch), 0)
+    assert said in str(raised.value)
+
+
+def test_update_with_a_replay_of_another_frame_count_names_num_frames():
+    agent = SimounAgent((3, SIZE, SIZE), 1, small_agent_config(), device="cpu")
+    replay = FrameReplay(100, (3, SIZE, SIZE), 1, num_frames=2)
+    with pytest.raises(ValueError, match=r"replay has num_frames=2.*num_frames=3\)"):
+        agent.update(replay, 0)
+
+
+@pytest.mark.parametrize(
+    ("config", "shape", "error", "said"),
+    [
+        (AgentConfig(), (SIZE, SIZE, 3), ValueError, "looks channel-last"),
+        (AgentConfig(), (3, 8, 8), ValueError, "too small for the conv trunk"),
+        ({"encoder": "dual"}, (3, SIZE, SIZE), TypeError, "make_encoder(config=...) must be an"),
+    ],
+)
+def test_make_encoder_refuses_what_the_agent_refuses(config, shape, error, said):
+    from simoun_agent import make_encoder
+
+    with pytest.raises(error) as raised:
+        make_encoder(config, shape)
+    assert said in str(raised.value)

@@ -221,3 +221,13 @@ def test_one_step_sample_keeps_its_meaning():
     assert np.array_equal(batch["bootstrap_obs"], batch["next_obs"])
     terminal = batch["next_obs"][:, -1, 0, 0, 0] == 3  # the terminated episode's last frame
     assert np.array_equal(batch["discount"], np.where(terminal, 0.0, 1.0))
+
+
+@pytest.mark.parametrize("method", ["save", "load"])
+def test_a_path_with_an_unexpanded_home_is_named(method):
+    replay = FrameReplay(10, (3, 8, 8), 1)
+    call = replay.save if method == "save" else FrameReplay.load
+    with pytest.raises(
+        ValueError, match=rf"FrameReplay\.{method}\(path='~/no-such\.npz'\).*expanduser"
+    ):
+        call("~/no-such.npz")

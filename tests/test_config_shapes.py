@@ -15,7 +15,7 @@ from simoun_agent.config.shapes import (
     min_image_size,
 )
 from simoun_agent.models.actors import ACTORS
-from simoun_agent.models.encoder import ENCODERS, conv_trunk, make_encoder
+from simoun_agent.models.encoder import ENCODERS, conv_trunk
 
 REDUCTIONS = [(3, 3), (5, 2), (1, 1), (4, 4)]
 """(reduce_kernel, reduce_stride) of the interactive module: the default, and others."""
@@ -39,11 +39,15 @@ def _config(name: str, kernel: int, stride: int) -> AgentConfig:
 
 
 def _runs(config: AgentConfig, height: int, width: int) -> bool:
-    """Whether the torch encoder builds and encodes one observation of height x width."""
+    """Whether the torch encoder builds and encodes one observation of height x width: built
+    as make_encoder builds it, less make_encoder's own check of the frame (the closed form
+    under test)."""
     frames = torch.zeros(1, config.num_frames, 3, height, width, dtype=torch.uint8)
     try:
+        encoder = ENCODERS[config.encoder].build(config, (3, height, width))
+        encoder.pixel_offset = config.pixel_offset
         with torch.no_grad():
-            make_encoder(config, (3, height, width))(frames)
+            encoder(frames)
     except RuntimeError:
         return False
     return True

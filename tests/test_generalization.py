@@ -12,12 +12,15 @@ from simoun_agent.cli import train as train_cli
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.generalization import (
     DISTRACTIONS,
+    DistractionEvaluation,
     check_supported,
+    distraction_callbacks,
     distractor,
     make_distracted_env,
     parse_distractions,
 )
-from simoun_agent.generalization.evaluation import evaluate_runs
+from simoun_agent.generalization.evaluation import ModeResult, evaluate_runs
+from simoun_agent.generalization.report import REPORT_FILES, write_report
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 
@@ -201,8 +204,56 @@ def test_bad_eval_distraction_is_refused_before_training(tmp_path, capsys, flags
             TypeError,
             r"^evaluate_runs\(run_dirs=\.\.\.\) takes a list of run directories, got the one path",
         ),
+        (
+            lambda: evaluate_runs(["runs/a"], "train", 1),
+            TypeError,
+            r"^evaluate_runs\(modes=\.\.\.\) takes a list of mode names, got the str 'train'",
+        ),
+        (
+            lambda: evaluate_runs(["runs/a"], ["trian"], 1),
+            SetupError,
+            r"unknown mode 'trian'; did you mean 'train'\?",
+        ),
+        (
+            lambda: evaluate_runs(["runs/a"], ["train"], 1, progress=True),
+            TypeError,
+            r"^evaluate_runs\(progress=\.\.\.\) must be a callable",
+        ),
+        (
+            lambda: evaluate_runs(["~/simoun-no-such-run"], ["train"], 1),
+            ValueError,
+            r"os.path.expanduser\('~/simoun-no-such-run'\)",
+        ),
+        (
+            lambda: DistractionEvaluation("color_easy"),
+            TypeError,
+            r"^DistractionEvaluation\(modes=\.\.\.\) takes a list of mode names, got the str",
+        ),
+        (
+            lambda: DistractionEvaluation(["train"]),
+            SetupError,
+            r"^DistractionEvaluation\(modes=\.\.\.\): unknown mode 'train'",
+        ),
+        (
+            lambda: distraction_callbacks("dm_control/cartpole-swingup-v0"),
+            TypeError,
+            r"^distraction_callbacks\(config=\.\.\.\) takes the run's TrainConfig",
+        ),
+        (
+            lambda: write_report([], "out", "title"),
+            TypeError,
+            r"^write_report\(results=\.\.\.\) must be a non-empty list of ModeResult",
+        ),
     ],
 )
 def test_the_suites_functions_name_an_argument_of_the_wrong_type(call, error, said):
     with pytest.raises(error, match=said):
         call()
+
+
+def test_write_report_takes_a_str_folder_and_makes_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    results = [ModeResult("a", "dm_control/cartpole-swingup-v0", "train", 1.0, 0.5, 2, 0, 60)]
+    paths = write_report(results, "new/out", "cartpole under distraction")
+    assert sorted(path.name for path in paths.values()) == sorted(REPORT_FILES)
+    assert all((tmp_path / "new" / "out" / name).is_file() for name in REPORT_FILES)

@@ -414,3 +414,15 @@ def test_the_constant_bonus_takes_none_by_name_or_instance_and_re_makes_from_its
     again = gym.make(ConstantBonusReward(cartpole(), 0.1).spec)
     again.reset(seed=0)
     assert again.step(0)[4]["reward_intrinsic"] == pytest.approx(0.1)
+
+
+def test_dict_info_to_list_under_a_vector_reward_is_named_with_the_order_that_works():
+    listed = gym.wrappers.vector.DictInfoToList(vector(AutoresetMode.NEXT_STEP))
+    with pytest.raises(TypeError, match=r"DictInfoToList\(ConstantBonusVectorReward\(envs, "):
+        ConstantBonusVectorReward(listed, 0.1)
+    outside = gym.wrappers.vector.DictInfoToList(
+        ConstantBonusVectorReward(vector(AutoresetMode.NEXT_STEP), 0.1)
+    )
+    outside.reset(seed=0)
+    _, _, _, _, infos = outside.step(outside.action_space.sample())
+    assert isinstance(infos, list) and "reward_intrinsic" in infos[0]

@@ -495,3 +495,26 @@ def test_a_saved_config_lacking_a_key_takes_the_default_not_the_recipe_s_value()
     saved = to_dict(resolve("cpu", {"agent.recipe": "drqv2"}))
     del saved["agent"]["update_every_steps"]  # as if saved before the key existed
     assert from_dict(json.loads(json.dumps(saved))).agent.update_every_steps == 1
+
+
+@pytest.mark.parametrize(
+    "task",
+    ["cartpole-swingup", "cartpole_swingup", "dm_control/cartpole-swingup-v0", "Cartpole-Swingup"],
+)
+def test_values_for_matches_a_task_by_its_env_id_and_spellings(task):
+    assert RECIPES["drqv2"].values_for(task)["exploration_steps"] == 200_000
+
+
+@pytest.mark.parametrize("task", [None, "simoun/PointReach-v0", "cartpole-swingup_sparse"])
+def test_values_for_gives_the_base_values_on_any_other_env(task):
+    assert RECIPES["drqv2"].values_for(task) == RECIPES["drqv2"].values
+
+
+def test_values_for_names_a_task_one_typo_away():
+    with pytest.raises(ValueError, match=r"values_for\('cartpol-swingup'\).*'cartpole-swingup'"):
+        RECIPES["drqv2"].values_for("cartpol-swingup")
+
+
+def test_a_recipe_with_a_space_is_quoted_with_the_match():
+    with pytest.raises(ValueError, match=r"--agent\.recipe 'drq ' .*did you mean 'drq'\?"):
+        AgentConfig(recipe="drq ")

@@ -14,7 +14,7 @@ from simoun_agent.config import SetupError, resolve
 from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
-from simoun_agent.run.evaluate import evaluate
+from simoun_agent.run.evaluate import EvaluationStopped, RandomPolicy, evaluate
 from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME
 from simoun_agent.run.load import load_run
 from simoun_lab.cli import analyze as analyze_cli
@@ -145,6 +145,7 @@ def test_evaluate_takes_its_arguments_as_documented(loaded):
         ({"on_episode": lambda: None}, TypeError, r"on_episode\(index, episode_return\)"),
         ({"stop": True}, TypeError, r"^evaluate\(stop=\.\.\.\) must be a callable"),
         ({"stop": lambda now: now}, TypeError, r"signature \(now\) does not take"),
+        ({"stop": lambda: "no"}, TypeError, r"^evaluate\(stop=\.\.\.\) must return True \(stop\)"),
         ({"swap": True}, TypeError, r"^evaluate takes the agent first and the env second"),
         ({"env": "pendulum"}, TypeError, r"must give SimounObservation's frames .*run\.env"),
         ({"env": "agent"}, TypeError, r"^evaluate\(env=\.\.\.\) must be a Gymnasium env"),
@@ -161,3 +162,27 @@ def test_evaluate_refuses_a_wrong_argument_naming_it_before_any_episode(
         arguments["agent"], arguments["env"] = loaded.env, loaded.agent
     with pytest.raises(error, match=said):
         evaluate(**arguments)
+
+
+def test_evaluate_stopped_says_why(loaded):
+    with pytest.raises(EvaluationStopped, match=r"^stop\(\) returned True at step 0 of evaluation"):
+        evaluate(loaded.agent, loaded.env, 1, 0, stop=lambda: True)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "error", "said"),
+    [
+        ((gym.spaces.Box(-1, 1, (2,)), 0), TypeError, r"got the action space .* here 2$"),
+        ((2, -1), ValueError, r"^RandomPolicy\(seed=\.\.\.\) must be an int >= 0, got -1"),
+        ((2.5, 0), ValueError, r"^RandomPolicy\(action_dim=\.\.\.\) must be a positive int"),
+    ],
+)
+def test_random_policy_names_its_argument(arguments, error, said):
+    with pytest.raises(error, match=said):
+        RandomPolicy(*arguments)
+    assert RandomPolicy(2, 0).act(np.zeros(1)).shape == (2,)
+
+
+def test_load_run_of_an_unexpanded_home_says_python_does_not_expand_it():
+    with pytest.raises(SetupError, match=r"Python does not expand ~.*os.path.expanduser"):
+        load_run("~/simoun-no-such-run", device="cpu")

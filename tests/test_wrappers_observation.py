@@ -216,3 +216,11 @@ def test_a_wrapper_that_changed_the_render_mode_is_named_with_the_order_that_wor
     right.reset(seed=0)
     right.step(right.action_space.sample())
     assert len(right.render()) == 2
+
+
+def test_render_mode_rgb_array_list_names_the_render_mode_that_works():
+    with pytest.raises(ValueError) as error:
+        SimounObservation(gym.make("Pendulum-v1", render_mode="rgb_array_list"), size=16)
+    said = str(error.value)
+    assert "gym.make adds it for render_mode='rgb_array_list'" in said
+    assert "gym.make(env_id, render_mode='rgb_array')" in said

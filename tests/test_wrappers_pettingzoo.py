@@ -221,3 +221,23 @@ def test_a_render_sized_space_before_reset_names_reset():
         env.observation_space("piston_0")
     env.reset(seed=0)
     assert env.observation_space("piston_0")["frames"].shape[0] == 3
+
+
+def test_a_step_after_the_episode_ended_says_to_reset():
+    env = SimounParallelObservation(
+        pettingzoo.make(
+            "parallel",
+            "butterfly/pistonball-v6",
+            n_pistons=3,
+            max_cycles=2,
+            render_mode="rgb_array",
+        ),
+        size=16,
+    )
+    env.reset(seed=0)
+    while env.agents:
+        env.step({agent: env.action_space(agent).sample() for agent in env.agents})
+    with pytest.raises(gym.error.ResetNeeded, match=r"after the episode ended.*env\.reset\(\)"):
+        env.step({})
+    env.reset(seed=1)
+    assert env.agents

@@ -30,8 +30,12 @@ Example:
 
 from __future__ import annotations
 
+import difflib
+import re
 from dataclasses import dataclass, field
 from typing import Any
+
+from simoun_agent.config.envs import dmc_task, split_env_id
 
 
 @dataclass(frozen=True)
@@ -53,8 +57,47 @@ class Recipe:
     which a study's ``[diagnostics]`` lists it under; None for a method"""
 
     def values_for(self, task: str | None) -> dict[str, Any]:
-        """The recipe's values on ``task`` (a DMC task name, or None for any other env)."""
-        return {**self.values, **self.per_task.get(task, {})}
+        """The recipe's values on ``task``: a DMC task name (``cartpole-swingup``; its
+        ``cartpole_swingup`` spelling too), an env id (``dm_control/cartpole-swingup-v0``; any
+        other env's takes :attr:`values`), or None for any other env. A name close to a task of
+        :attr:`per_task` but none of them (a typo, which would drop the task's own values
+        silently) is refused with a ValueError naming it and the task meant."""
+        if task is None:
+            return dict(self.values)
+        if not isinstance(task, str):
+            raise TypeError(
+                f"Recipe.values_for(task=...) takes a DMC task name, an env id or None, got "
+                f"{type(task).__name__} {task!r:.60}; e.g. values_for('cartpole-swingup')"
+            )
+        if "/" in task or ":" in task:  # an env id
+            task = dmc_task(split_env_id(task)[1])
+            if task is None:
+                return dict(self.values)
+        return {**self.values, **self.per_task.get(self.task_key(task), {})}
+
+    def task_key(self, task: str) -> str:
+        """The key of :attr:`per_task` that the DMC task name ``task`` spells (case, ``_`` for
+        ``-`` and a ``-v0`` suffix aside), or ``task`` itself when it names none; a ValueError
+        for a name one typo away from a key (real DMC tasks are further from each other:
+        ``cartpole-swingup_sparse`` is 0.82 alike to ``cartpole-swingup``)."""
+        keys = {_spelling(key): key for key in self.per_task}
+        spelt = _spelling(task)
+        if spelt in keys:
+            return keys[spelt]
+        close = difflib.get_close_matches(spelt, list(keys), n=1, cutoff=0.85)
+        if close:
+            raise ValueError(
+                f"Recipe.values_for({task!r}): no DMC task of that name; did you mean "
+                f"{keys[close[0]]!r}? The recipe has values of its own for "
+                f"{', '.join(self.per_task)}; any other task takes its base values"
+            )
+        return task
+
+
+def _spelling(task: str) -> str:
+    """``task`` as compared with the keys of ``Recipe.per_task``: lower case, ``-`` for ``_``
+    (DrQ-v2's ``cartpole_swingup``), without a version suffix."""
+    return re.sub(r"-v\d+$", "", task.strip().lower().replace("_", "-"))
 
 
 NO_AUXILIARY = {

@@ -22,6 +22,7 @@ import difflib
 import json
 import math
 import numbers
+import shlex
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -241,6 +242,8 @@ def wrong_kind(value: Any, annotation: str) -> tuple[str, str]:
         return show(value), f", not a {type(value).__name__}"
     if getattr(value, "ndim", 0):
         return show(value), f", not a {type(value).__module__}.{type(value).__name__}"
+    if isinstance(value, str):  # quoted when a space or an empty value would not show
+        return shlex.quote(value), ""
     return show(value), ""
 
 
@@ -248,8 +251,9 @@ def fail(config: Any, prefix: str, name: str, problem: str) -> ValueError:
     """A ValueError for a cross-field problem of ``config``'s field ``name``, named as a flag and
     as the field: ``--flag value (Config.name): problem``."""
     value = getattr(config, name)
+    shown = shlex.quote(value) if isinstance(value, str) else show(value)
     return ValueError(
-        f"{flag_name(prefix, name)} {show(value)} ({type(config).__name__}.{name}): {problem}"
+        f"{flag_name(prefix, name)} {shown} ({type(config).__name__}.{name}): {problem}"
     )
 
 

@@ -159,16 +159,7 @@ class AgentSettings(EncoderSettings, ContrastiveSettings, Protocol):
 def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: AgentSettings) -> None:
     """What ``SimounAgent`` is built for: channel-first frames its encoder accepts, and at least
     one action dimension. Raises ValueError naming the argument and the fix."""
-    shape = tuple(frame_shape) if isinstance(frame_shape, Sequence) else (frame_shape,)
-    if hasattr(frame_shape, "tolist"):  # a numpy array of the three sizes
-        shape = tuple(frame_shape.tolist())
-    if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
-        raise ValueError(
-            f"frame_shape must be (C, H, W) positive ints, got {shape!r}; pass "
-            "env.observation_space['frames'].shape[1:] of a SimounObservation env"
-        )
-    check_channel_first(shape)
-    height, width = shape[1:]
+    check_frame_shape(frame_shape, agent)
     if isinstance(action_dim, spaces.Space) and not isinstance(action_dim, spaces.Box):
         raise ValueError(
             f"SimounAgent is a SAC agent for continuous actions (a 1-D Box), got the action space "
@@ -181,6 +172,22 @@ def check_agent_inputs(frame_shape: Sequence[int], action_dim: Any, agent: Agent
             f"action_dim must be an int >= 1, got {action_dim!r}; pass env.action_space.shape[0] "
             "of a continuous (Box) action space"
         )
+
+
+def check_frame_shape(frame_shape: Any, agent: AgentSettings) -> None:
+    """A ValueError naming ``frame_shape`` unless it is channel-first (C, H, W) positive ints
+    whose frames the encoder of ``agent`` (and its random convolution) accepts: what
+    ``SimounAgent`` and ``make_encoder`` are built for."""
+    shape = tuple(frame_shape) if isinstance(frame_shape, Sequence) else (frame_shape,)
+    if hasattr(frame_shape, "tolist"):  # a numpy array of the three sizes
+        shape = tuple(frame_shape.tolist())
+    if len(shape) != 3 or not all(is_int(v) and v > 0 for v in shape):
+        raise ValueError(
+            f"frame_shape must be (C, H, W) positive ints, got {shape!r}; pass "
+            "env.observation_space['frames'].shape[1:] of a SimounObservation env"
+        )
+    check_channel_first(shape)
+    height, width = shape[1:]
     if not frame_fits(agent, height, width):
         smallest = min_image_size(agent)
         reduce = conv_output_size(min(height, width))  # the widest reducing conv that fits

@@ -8,11 +8,18 @@ from pathlib import Path
 import gymnasium as gym
 
 from simoun_agent.config import TrainConfig
-from simoun_agent.generalization.suite import check_eval_distractions, make_distracted_env
+from simoun_agent.generalization.suite import (
+    DISTRACTIONS,
+    check_eval_distractions,
+    check_mode_list,
+    check_run_config,
+    make_distracted_env,
+)
 from simoun_agent.run.callback import TrainCallback
 from simoun_agent.run.evaluate import evaluate
 from simoun_agent.run.seeds import first_eval_seed
 from simoun_agent.run.state import Run
+from simoun_wrappers._checks import check_path
 
 
 class DistractionEvaluation(TrainCallback):
@@ -32,7 +39,10 @@ class DistractionEvaluation(TrainCallback):
     serves = ("eval_distraction",)
 
     def __init__(self, modes: Sequence[str], videos: str | Path | None = None) -> None:
-        self.modes = list(modes)
+        distracted = [name for name, entry in DISTRACTIONS.items() if entry is not None]
+        self.modes = check_mode_list(modes, "DistractionEvaluation(modes=...)", distracted)
+        if videos is not None:
+            check_path(videos, "DistractionEvaluation(videos=...)", "videos='dmcgb/videos'")
         self.videos = videos
         self._envs: dict[str, gym.Env] = {}
 
@@ -62,5 +72,6 @@ def distraction_callbacks(config: TrainConfig) -> list[TrainCallback]:
     """What a run of ``config`` passes to the loop for its ``eval_distraction`` modes: one
     :class:`DistractionEvaluation`, or nothing when it names none. Raises SetupError for a bad
     mode (:func:`~simoun_agent.generalization.suite.check_eval_distractions`)."""
+    check_run_config(config, "distraction_callbacks")
     modes = check_eval_distractions(config)
     return [DistractionEvaluation(modes)] if modes else []

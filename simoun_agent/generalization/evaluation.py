@@ -7,9 +7,20 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from simoun_agent.generalization.suite import check_supported, make_distracted_env
+from simoun_agent.generalization.suite import (
+    DISTRACTIONS,
+    check_mode_list,
+    check_supported,
+    make_distracted_env,
+)
 from simoun_agent.run.evaluate import evaluate
 from simoun_agent.run.load import load_run
+from simoun_wrappers._checks import (
+    check_callable,
+    check_nonnegative_int,
+    check_path,
+    check_positive_int,
+)
 
 
 @dataclass(frozen=True)
@@ -53,6 +64,27 @@ def evaluate_runs(
         raise TypeError(
             f"evaluate_runs(run_dirs=...) takes a list of run directories, got the one path "
             f"{str(run_dirs)!r}; e.g. run_dirs=[{str(run_dirs)!r}]"
+        )
+    if not isinstance(run_dirs, (list, tuple)) or not run_dirs:
+        raise TypeError(
+            f"evaluate_runs(run_dirs=...) takes a non-empty list of run directories, got "
+            f"{type(run_dirs).__name__} {run_dirs!r:.60}; e.g. run_dirs=['runs/my-run']"
+        )
+    for run_dir in run_dirs:
+        check_path(run_dir, "evaluate_runs(run_dirs=[...])", "run_dirs=['runs/my-run']")
+    modes = check_mode_list(modes, "evaluate_runs(modes=...)", list(DISTRACTIONS))
+    check_positive_int(episodes, "evaluate_runs(episodes=...)", "e.g. episodes=10")
+    if seed is not None:
+        check_nonnegative_int(seed, "evaluate_runs(seed=...)", "e.g. seed=0, or None")
+    if videos is not None:
+        check_path(videos, "evaluate_runs(videos=...)", "videos='dmcgb/videos'")
+    if progress is not None:
+        check_callable(
+            progress,
+            "evaluate_runs(progress=...)",
+            "progress(message) before each run and mode",
+            ("message",),
+            "pass a function of one str, e.g. progress=print, or None",
         )
     loaded = [load_run(run_dir, device) for run_dir in run_dirs]
     for run in loaded:

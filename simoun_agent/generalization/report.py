@@ -10,6 +10,8 @@ from pathlib import Path
 from simoun_agent import table
 from simoun_agent.generalization.evaluation import ModeResult
 from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.rundir import make_output_dir
+from simoun_wrappers._checks import check_path
 
 TABLE_MD = "generalization.md"
 TABLE_CSV = "generalization.csv"
@@ -80,10 +82,33 @@ def plot_bars(results: Sequence[ModeResult], path: Path, title: str) -> None:
 
 
 def write_report(results: Sequence[ModeResult], out: Path, title: str) -> dict[str, Path]:
-    """Write the Markdown table, the CSV and the bar chart into ``out``; returns their paths."""
+    """Write the Markdown table, the CSV and the bar chart into the folder ``out`` (a str or
+    os.PathLike, made when missing); returns their paths."""
+    check_report_arguments(results, out, title)
+    out = Path(out)
+    make_output_dir(out, "write_report(out=...)", REPORT_FILES)
     paths = {"table": out / TABLE_MD, "csv": out / TABLE_CSV, "chart": out / CHART_PNG}
     text = f"# {title}\n\n" + markdown_table(results)
     atomic_write(paths["table"], lambda tmp: tmp.write_text(text))
     write_csv(results, paths["csv"])
     plot_bars(results, paths["chart"], title)
     return paths
+
+
+def check_report_arguments(results: object, out: object, title: object) -> None:
+    """A TypeError naming :func:`write_report`'s argument that is not what it takes."""
+    if not (
+        isinstance(results, (list, tuple))
+        and results
+        and all(isinstance(result, ModeResult) for result in results)
+    ):
+        raise TypeError(
+            f"write_report(results=...) must be a non-empty list of ModeResult, got "
+            f"{type(results).__name__} {results!r:.60}; pass what evaluate_runs returns"
+        )
+    check_path(out, "write_report(out=...)", "write_report(results, 'runs/generalization', title)")
+    if not isinstance(title, str):
+        raise TypeError(
+            f"write_report(title=...) must be a str, got {type(title).__name__} {title!r:.60}; "
+            "e.g. title='walker-walk under distraction'"
+        )

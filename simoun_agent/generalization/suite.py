@@ -91,6 +91,26 @@ def _mode_texts(text: Any, argument: str) -> list[str]:
     return list(text)
 
 
+def check_mode_list(modes: Any, argument: str, allowed: Sequence[str]) -> list[str]:
+    """``modes``, a list (or tuple) of names from ``allowed``, as a list; a TypeError naming
+    ``argument`` for a str (which ``list()`` would read letter by letter) or another type, and
+    a SetupError for an unknown name, with the closest one."""
+    if isinstance(modes, str):
+        raise TypeError(
+            f"{argument} takes a list of mode names, got the str {modes!r}; pass it in a list, "
+            f"e.g. {argument.split('(')[0]}(..., [{modes!r}], ...)"
+        )
+    names = _mode_texts(modes, argument)
+    for name in names:
+        if name not in allowed:
+            close = difflib.get_close_matches(name, list(allowed), n=1, cutoff=0.5)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise SetupError(
+                f"{argument}: unknown mode {name!r}; {hint}choose from {', '.join(allowed)}"
+            )
+    return list(names)
+
+
 def check_run_config(config: Any, function: str) -> None:
     """A TypeError naming ``function``'s ``config`` when it is not a run's TrainConfig (an env
     id given in its place, say)."""

@@ -32,7 +32,13 @@ import torch
 from torch import nn
 
 from simoun_agent.config.agent import AgentConfig
-from simoun_agent.config.shapes import ENCODER_SHAPES, TRUNK, EncoderShape, conv_output_size
+from simoun_agent.config.shapes import (
+    ENCODER_SHAPES,
+    TRUNK,
+    EncoderShape,
+    check_frame_shape,
+    conv_output_size,
+)
 from simoun_agent.models.interaction import StructuralInteraction, StructureMasks, resized_linear
 
 
@@ -506,7 +512,18 @@ one in :data:`simoun_agent.config.shapes.ENCODER_SHAPES` (its paths and convs)."
 def make_encoder(config: AgentConfig, frame_shape: tuple[int, int, int]) -> PixelEncoder:
     """Build the encoder named by ``config.encoder`` (the variants of Fig. 6) from
     :data:`ENCODERS`, initialised by ``config.conv_init``, reading x / 255 - ``pixel_offset``, in
-    its conv memory format."""
+    its conv memory format.
+
+    A ``config`` that is no AgentConfig, or a ``frame_shape`` the encoder cannot take
+    (channel-last, too small for its conv trunk), is refused naming the argument, as
+    ``SimounAgent`` refuses them."""
+    if not isinstance(config, AgentConfig):
+        raise TypeError(
+            f"make_encoder(config=...) must be an AgentConfig, got {type(config).__name__} "
+            f"{config!r:.60}; e.g. make_encoder(AgentConfig(encoder='dual'), (3, 84, 84)), or "
+            "AgentConfig(**values) for a dict"
+        )
+    check_frame_shape(frame_shape, config)
     encoder = ENCODERS[config.encoder].build(config, tuple(frame_shape))
     encoder.apply(functools.partial(weight_init, conv=config.conv_init))
     encoder.pixel_offset = config.pixel_offset

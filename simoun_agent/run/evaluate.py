@@ -14,7 +14,13 @@ import torch
 
 from simoun_agent.config import SetupError
 from simoun_agent.run import driving_metrics
-from simoun_wrappers._checks import check_bool, check_callable, is_int
+from simoun_wrappers._checks import (
+    check_bool,
+    check_callable,
+    check_nonnegative_int,
+    check_positive_int,
+    is_int,
+)
 
 
 class EvaluationStopped(Exception):
@@ -75,8 +81,11 @@ def evaluate(
                 frames.append(obs["frames"][-1])
             total, length, done = 0.0, 0, False
             while not done:
-                if stop is not None and stop():
-                    raise EvaluationStopped
+                if stop is not None and asked_to_stop(stop):
+                    raise EvaluationStopped(
+                        f"stop() returned True at step {length} of evaluation episode {episode}: "
+                        "the evaluation was abandoned"
+                    )
                 action = agent.act(obs["frames"], deterministic=True)
                 obs, reward, terminated, truncated, info = env.step(action)
                 if not math.isfinite(reward):
@@ -173,6 +182,18 @@ def check_options(record: Any, on_episode: Any, stop: Any) -> None:
         )
 
 
+def asked_to_stop(stop: Callable[[], bool]) -> bool:
+    """What ``stop()`` answered, a bool; a TypeError for anything else (a truthy ``'no'``
+    would stop the evaluation)."""
+    answer = stop()
+    if not isinstance(answer, (bool, np.bool_)):
+        raise TypeError(
+            f"evaluate(stop=...) must return True (stop) or False (go on), got "
+            f"{type(answer).__name__} {answer!r:.60}; e.g. stop=threading.Event().is_set"
+        )
+    return bool(answer)
+
+
 class RandomPolicy:
     """Uniform actions in [-1, 1]^action_dim: the baseline a trained agent has to beat.
 
@@ -181,7 +202,21 @@ class RandomPolicy:
     """
 
     def __init__(self, action_dim: int, seed: int) -> None:
-        self.action_dim = action_dim
+        if isinstance(action_dim, gym.spaces.Box) and len(action_dim.shape) == 1:
+            raise TypeError(
+                f"RandomPolicy(action_dim=...) takes the number of action dimensions, got the "
+                f"action space {action_dim}; pass env.action_space.shape[0], here "
+                f"{action_dim.shape[0]}"
+            )
+        check_positive_int(
+            action_dim,
+            "RandomPolicy(action_dim=...)",
+            "pass the number of action dimensions, env.action_space.shape[0]",
+        )
+        check_nonnegative_int(
+            seed, "RandomPolicy(seed=...)", "e.g. seed=0 (the policy's own random stream)"
+        )
+        self.action_dim = int(action_dim)
         self._rng = np.random.default_rng(seed)
 
     def act(self, frames: np.ndarray, deterministic: bool = False) -> np.ndarray:

@@ -26,7 +26,7 @@ from simoun_agent.run.kept import Damaged, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
-from simoun_wrappers._checks import is_int
+from simoun_wrappers._checks import is_int, unexpanded_home
 
 
 @dataclass
@@ -90,6 +90,9 @@ def check_run_path(path: Any) -> None:
             f"load_run(path=...) must be a run directory or its checkpoint.pt, as a str or "
             f"os.PathLike, got {type(path).__name__} {path!r:.60}; e.g. load_run('runs/my-run')"
         )
+    home = unexpanded_home(path)
+    if home is not None:
+        raise SetupError(f"load_run(path={os.fspath(path)!r}): {home}")
 
 
 def machine_values(device: Any, torch_threads: Any) -> dict[str, Any]:

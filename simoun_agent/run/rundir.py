@@ -277,6 +277,18 @@ def require_checkpoint(run_dir: Path) -> None:
         )
 
 
+def refuse_held_here(run_dir: Path) -> None:
+    """A SetupError when a run this process created (or resumed) still holds ``run_dir``: a
+    second run there would take its directory from under it."""
+    held = _held.get((run_dir / LOCK_NAME).resolve())
+    if held is not None and not held.closed:
+        raise SetupError(
+            f"the run directory {run_dir} is in use by a run created in this process "
+            "(create_run or resume_run returned it, and it holds the directory until train(run) "
+            "ends); train that run, close it with run.close(), or pass another run_dir"
+        )
+
+
 def take_run_dir(run_dir: Path, *, resume: bool = False, overwrite: bool = False) -> IO[str]:
     """Lock ``run_dir`` and check that it suits the run: a new one (:func:`claim_new_run_dir`,
     ``overwrite`` clearing a run that crashed before its first checkpoint) or a resumed one
@@ -285,6 +297,7 @@ def take_run_dir(run_dir: Path, *, resume: bool = False, overwrite: bool = False
     Trainers call it once to fail fast, before building anything (closing what it returns),
     and again right before they write, keeping the lock until they are done.
     """
+    refuse_held_here(run_dir)
     handle = lock_run_dir(run_dir)
     try:
         if resume:

@@ -56,3 +56,13 @@ class Run:
     """set by the first stop signal or a callback's
     :meth:`~simoun_agent.run.callback.TrainCallback.stop_requested`; the
     loop and every evaluation poll ``run.stop.is_set()`` between steps"""
+
+    def close(self) -> None:
+        """Close the run's envs and let go of its directory (the lock), for a run that will not
+        be trained (:func:`~simoun_agent.run.train.train` lets go of it when it ends): another
+        run may then be created in the directory."""
+        if self.lock is not None:
+            self.lock.close()
+            self.lock = None
+        self.env.close()
+        self.eval_env.close()

@@ -30,13 +30,15 @@ rule of :data:`CHECKPOINT_TRIES` (exit 75).
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import json
 import math
 import random
 import signal
 import time
 import zipfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from pathlib import Path
@@ -48,9 +50,17 @@ import torch
 
 from simoun_agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
-from simoun_agent.config.envs import env_label
+from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, env_label
 from simoun_agent.config.train import RESUMABLE_FIELDS, check_train_config
 from simoun_agent.replay import FrameReplay
+from simoun_agent.run.arguments import (
+    asked_signal,
+    check_callbacks,
+    check_config_arg,
+    check_config_check,
+    check_metrics,
+    check_run_arg,
+)
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.callback import TrainCallback
 from simoun_agent.run.checkpoint import (
@@ -84,6 +94,7 @@ from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, tr
 from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.state import Counters, Run
 from simoun_agent.run.video import write_video
+from simoun_wrappers._checks import check_bool, check_path, is_int
 
 ConfigCheck = Callable[[TrainConfig], object]
 """A check of the optional parts on a run's config, run before any env is built; raises
@@ -129,10 +140,7 @@ def build(
     the agent and an empty replay; each random stream seeded from its child of the run's
     ``SeedSequence`` (:mod:`simoun_agent.run.seeds`). ``check(config)`` runs first, after
     the config's own rules (checked again: it may have been changed since it was built)."""
-    try:
-        check_train_config(config)
-    except ValueError as err:
-        raise SetupError(str(err)) from None
+    check_config_rules(config)
     seed = config.seed
     if config.torch_threads:
         torch.set_num_threads(config.torch_threads)
@@ -159,6 +167,15 @@ def build(
     return env, eval_env, agent, replay
 
 
+def check_config_rules(config: TrainConfig) -> None:
+    """The config's own rules (:func:`check_train_config`) as a SetupError: a field changed
+    after the config was built (``config.total_env_steps = 0``) is named as the field."""
+    try:
+        check_train_config(config)
+    except ValueError as err:
+        raise SetupError(str(err)) from None
+
+
 def create_run(
     config: TrainConfig, overwrite: bool = False, check: ConfigCheck | None = None
 ) -> Run:
@@ -167,9 +184,15 @@ def create_run(
     ``overwrite`` starts over in a directory whose run stopped before its first checkpoint;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built.
     """
+    check_config_arg(config, "create_run")
+    check_bool(overwrite, "create_run(overwrite=...)")
+    check_config_check(check, "create_run")
+    if config.run_dir:
+        check_path(config.run_dir, "TrainConfig.run_dir", "run_dir='runs/my-run'")
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
         take_run_dir(run_dir, overwrite=overwrite).close()
+    check_config_rules(config)
     check_budget(config)
     env, eval_env, agent, replay = build(config, check)
     try:
@@ -180,21 +203,45 @@ def create_run(
         raise
     make_output_dir(run_dir, "--run-dir")
     lock = take_run_dir(run_dir, overwrite=overwrite)
-    remove_leftovers(run_dir)
-    config.run_dir = str(run_dir)
-    write_config(run_dir, config)
     rng = np.random.default_rng(stream(config.seed, Stream.WARMUP_ACTIONS))
-    return Run(config, run_dir, env, eval_env, agent, replay, rng, Counters(), lock)
+    run = Run(config, run_dir, env, eval_env, agent, replay, rng, Counters(), lock)
+    with closed_on_error(run):
+        remove_leftovers(run_dir)
+        config.run_dir = str(run_dir)
+        write_config(run_dir, config)
+    return run
+
+
+@contextlib.contextmanager
+def closed_on_error(run: Run) -> Iterator[None]:
+    """Close ``run`` (its envs and its directory's lock) when its set-up fails after taking
+    the directory, so that a second try in this process is not refused as a live run's."""
+    try:
+        yield
+    except BaseException:
+        run.close()
+        raise
 
 
 def check_budget(config: TrainConfig) -> None:
     """SetupError when one agent decision (``action_repeat`` env steps) is longer than the
     whole run: the run would take that one decision, overrun ``total_env_steps`` and learn
     nothing."""
+    total = config.total_env_steps
+    if not (is_int(total) and total >= 1):  # the advice below needs a budget to divide
+        raise SetupError(
+            f"--total-env-steps {total!r} (TrainConfig.total_env_steps) must be an int >= 1, "
+            "the env steps the run trains for; e.g. --total-env-steps 100000"
+        )
     repeat = config.resolved_action_repeat()
     if repeat <= config.total_env_steps:
         return
-    given = "" if config.action_repeat is not None else ", the paper's value for this task"
+    if config.action_repeat is not None:
+        given = ""
+    elif dmc_task(config.env) in PAPER_ACTION_REPEAT:
+        given = ", the paper's value for this task"
+    else:
+        given = ", the default"
     raise SetupError(
         f"--action-repeat {repeat} (TrainConfig.action_repeat{given}) is longer than the whole "
         f"run (--total-env-steps {config.total_env_steps}, TrainConfig.total_env_steps): each "
@@ -262,6 +309,15 @@ def changes(saved: Any, key: str, value: Any, run_dir: Path) -> bool:
 def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
+    check_path(run_dir, "resume_run(run_dir=...)", "resume_run('runs/my-run', {})")
+    if not isinstance(overrides, dict):
+        raise TypeError(
+            f"resume_run(overrides=...) must be a dict of config keys, got "
+            f"{type(overrides).__name__} {overrides!r:.60}; e.g. {{'total_env_steps': 200000}}, "
+            "or {} to resume as saved"
+        )
+    check_config_check(check, "resume_run")
+    run_dir = Path(run_dir)
     config_path = run_dir / CONFIG_NAME
     if not run_dir.is_dir():
         why = "is a file, not a directory" if run_dir.exists() else "does not exist"
@@ -364,11 +420,13 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     rng.bit_generator.state = payload["state"]["trainer_rng"]
     counters = Counters(**payload["state"]["counters"])
     lock = take_run_dir(run_dir, resume=True)
-    remove_leftovers(run_dir, payload["replay_file"])
-    # trained further, the run is whole again only when it reaches its new end
-    (run_dir / SUMMARY_NAME).unlink(missing_ok=True)
-    write_config(run_dir, config)
-    return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
+    run = Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
+    with closed_on_error(run):
+        remove_leftovers(run_dir, payload["replay_file"])
+        # trained further, the run is whole again only when it reaches its new end
+        (run_dir / SUMMARY_NAME).unlink(missing_ok=True)
+        write_config(run_dir, config)
+    return run
 
 
 UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
@@ -468,7 +526,7 @@ class Trainer:
         """env step of the latest checkpoint on disk (None before the first)"""
         self.failed_checkpoints = 0
         """checkpoints in a row that did not fit (:data:`CHECKPOINT_TRIES`)"""
-        run.stop.sources = [lambda c=c: c.stop_requested(run) for c in self.callbacks]
+        run.stop.sources = [functools.partial(asked_signal, c, run) for c in self.callbacks]
 
     def evaluate(self, what: str = "an evaluation") -> dict[str, float]:
         """Evaluate the agent, let the callbacks see (and extend) the metrics, log them. A stop
@@ -498,6 +556,7 @@ class Trainer:
             ) from None
         for callback in self.callbacks:
             callback.on_evaluation(run, metrics)
+            check_metrics(metrics, callback)
         counters.wall_time_s = self.clock.total()
         metrics["wall_time_s"] = counters.wall_time_s
         self.logger.evaluation(counters.env_step, metrics)
@@ -717,6 +776,8 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     that a callback carries out (:attr:`TrainCallback.serves`, such as ``eval_distraction``,
     served by :func:`simoun_agent.generalization.distraction_callbacks`) is refused without one.
     """
+    check_run_arg(run, "train")
+    check_callbacks(callbacks, "train")
     check_served(run.config, callbacks)
     final = None
     # Entered after the envs were built, so a library that took the signals then (SDL) is found

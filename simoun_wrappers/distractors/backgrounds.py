@@ -9,6 +9,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from simoun_wrappers._checks import unexpanded_home
+
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".webm", ".gif")
 """File endings read as videos from a ``videos`` folder (DMC-GB ships mp4 files)."""
 
@@ -87,6 +89,9 @@ class VideoBackground:
                 f"{type(folder).__name__} {folder!r}; e.g. videos='davis/JPEGImages/480p', or "
                 f"videos=None for the procedural background."
             )
+        home = unexpanded_home(folder)
+        if home is not None:
+            raise ValueError(f"videos={os.fspath(folder)!r}: {home}")
         self.folder = Path(folder)
         if not self.folder.is_dir():
             raise ValueError(
