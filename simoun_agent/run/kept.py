@@ -290,3 +290,54 @@ def checkpoint_problem(path: Path) -> str | None:
     except OSError as err:
         return f"it cannot be read ({err.strerror})"
     return None if bad is None else f"its part {bad} does not match its checksum (overwritten)"
+
+
+RUN_LOG_COLUMNS = {
+    "eval.csv": (
+        "env_step",
+        "return_mean",
+        "return_std",
+        "return_min",
+        "return_max",
+        "length_mean",
+    ),
+    "train.csv": ("env_step", "episode", "return", "length", "env_steps_per_s"),
+}
+"""The columns every log of a simoun run holds, by file name: an evaluation's statistics, a
+training episode's own numbers (a resumed run's callbacks and test modes may add others)."""
+RUN_JSON_KEYS = {
+    "config.json": ("env", "seed", "agent"),
+    "summary.json": ("env_step", "final_eval"),
+}
+"""The keys every JSON record of a simoun run holds, by file name."""
+
+
+def kind_problem(name: str, found: Sequence[str]) -> str | None:
+    """What is wrong when ``found``, the header of the run's log ``name`` (eval.csv, train.csv)
+    or the keys of its record (config.json, summary.json), is not that file's: another of the
+    run's files copied over it (it holds that file's columns or keys, which are named), the two
+    logs mixed (the other's own columns beside its own), or one of its own columns or keys
+    missing; None when they are its own, or for a file of another name."""
+    kinds = RUN_LOG_COLUMNS if name in RUN_LOG_COLUMNS else RUN_JSON_KEYS
+    if name not in kinds:
+        return None
+    what = "columns" if kinds is RUN_LOG_COLUMNS else "keys"
+    own, present_ = kinds[name], set(found)
+    missing = [key for key in own if key not in present_]
+    for other, keys in kinds.items():
+        strays = [key for key in keys if key not in own and key in present_]
+        if other == name or not strays:
+            continue
+        shown = ", ".join(strays)
+        if missing:
+            return (
+                f"it holds {other}'s {what} ({shown}), not {name}'s (it has no "
+                f"{', '.join(missing)}): {other} was copied over it"
+            )
+        return (
+            f"it holds {other}'s {what} ({shown}) beside its own: the run's two files were "
+            "mixed into one"
+        )
+    if missing:
+        return f"it has no {', '.join(missing)} ({what} every {name} of a run holds)"
+    return None

@@ -22,7 +22,7 @@ from simoun_agent.agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.checkpoint import check_config, load_checkpoint
-from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.kept import Damaged, kind_problem, present, read_json_object
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
@@ -127,6 +127,8 @@ def check_config_file(payload: dict) -> None:
         return
     try:
         saved = read_json_object(path)
+        if problem := kind_problem(CONFIG_NAME, list(saved)):
+            raise Damaged(problem)
     except Damaged as err:
         raise SetupError(
             f"{path} is damaged: {err}. It should hold the config of the checkpoint beside it; "

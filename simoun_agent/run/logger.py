@@ -22,6 +22,7 @@ from simoun_agent.run.kept import (
     csv_lines,
     csv_number,
     header_problem,
+    kind_problem,
     read_csv_rows,
     step_count,
 )
@@ -77,8 +78,9 @@ class CsvLog:
 def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     """The columns and rows of a log written by :class:`CsvLog`, checked before a resumed run
     rewrites it; SetupError naming the file, the damage and the fix when it is empty, has no
-    ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
-    the user's file stays as it is."""
+    ``env_step`` header, has another file's header (:func:`~simoun_agent.run.kept.kind_problem`:
+    train.csv copied over eval.csv), or has a row that does not fit the header. Nothing is
+    changed then: the user's file stays as it is."""
     try:
         lines = csv_lines(path)
     except Damaged as err:
@@ -86,6 +88,9 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     if not lines or "env_step" not in lines[0]:
         problem = "it is empty" if not lines else header_problem(lines[0])
         raise damaged_log(path, problem or "its first line has no env_step column")
+    problem = kind_problem(path.name, lines[0])
+    if problem:
+        raise damaged_log(path, problem)
     columns, at = lines[0], lines[0].index("env_step")
     rows = []
     for number, values in enumerate(lines[1:], start=2):

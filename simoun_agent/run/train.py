@@ -66,7 +66,14 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EvaluationStopped, NonFiniteReward, evaluate, metrics_json
-from simoun_agent.run.kept import Damaged, binary_problem, broken_link, present, read_text
+from simoun_agent.run.kept import (
+    Damaged,
+    binary_problem,
+    broken_link,
+    kind_problem,
+    present,
+    read_text,
+)
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -287,6 +294,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         saved = json.loads(read_text(config_path))
     except (Damaged, json.JSONDecodeError) as err:
         raise damaged_config(config_path, str(err)) from None
+    if isinstance(saved, dict) and (problem := kind_problem(CONFIG_NAME, list(saved))):
+        raise damaged_config(config_path, problem)
     fixed = [key for key, value in overrides.items() if changes(saved, key, value, run_dir)]
     if fixed:
         raise SetupError(

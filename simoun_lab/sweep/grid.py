@@ -33,7 +33,13 @@ from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, folder_problem, present, read_json_object
+from simoun_agent.run.kept import (
+    Damaged,
+    folder_problem,
+    kind_problem,
+    present,
+    read_json_object,
+)
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_lab.sweep.saved import saved_problem
 
@@ -475,9 +481,12 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     if not present(path):
         return f"{CONFIG_NAME} is missing, though the run's other files are there"
     try:
-        saved = flatten(read_json_object(path))
+        record = read_json_object(path)
     except Damaged as err:
         return f"{CONFIG_NAME} is damaged: {err}"
+    if problem := kind_problem(CONFIG_NAME, list(record)):
+        return f"{CONFIG_NAME} is damaged: {problem}"
+    saved = flatten(record)
     for key in ("env", "seed", *grid):
         recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
         if key in saved and recorded != wanted:

@@ -56,6 +56,7 @@ from simoun_agent.run.kept import (
     STEP_LIMIT,
     Damaged,
     folder_problem,
+    kind_problem,
     present,
     read_json_object,
     read_text,
@@ -235,11 +236,15 @@ def config_paths(root: Path, damaged: list[str]) -> list[Path]:
 
 
 def read_json(path: Path) -> dict[str, Any]:
-    """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it."""
+    """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it (a run's
+    config.json or summary.json holding the other's keys included: :func:`kind_problem`)."""
     try:
-        return read_json_object(path)
+        data = read_json_object(path)
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
+    if not MINIGRID_RUN_KEYS <= data.keys() and (problem := kind_problem(path.name, list(data))):
+        raise DamagedRun(f"{path.name} is damaged: {problem}")
+    return data
 
 
 def read_curve(path: Path) -> dict[str, np.ndarray]:
@@ -256,6 +261,8 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
     if path.stat().st_size and not rows and "env_step" not in read_text(path):
         raise DamagedRun(f"{path.name} has no header line")
+    if rows and (problem := kind_problem(path.name, list(rows[0]))):
+        raise DamagedRun(f"{path.name} is damaged: {problem}")
     if rows and (missing := [key for key in CURVE_COLUMNS if key not in rows[0]]):
         raise DamagedRun(f"{path.name} has no column {', '.join(missing)}")
     curve = {key: np.array([row[key] for row in rows], dtype=float) for key in CURVE_COLUMNS}
