@@ -26,8 +26,9 @@ from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import atomic_write, dead_temporaries
-from simoun_agent.run.kept import binary_problem, broken_link
+from simoun_agent.run.kept import binary_problem, broken_link, packed_problem
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
+from simoun_agent.run.rundir import study_of
 from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
@@ -190,6 +191,8 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
                 f"{link} is damaged: {problem}. Restore the file it stands for from a copy "
                 f"(or point the link at it), or start a new run"
             )
+    if not path.exists() and (packed := packed_problem(path)):
+        raise SetupError(f"{packed} and run the command again")
     if not path.exists():
         raise SetupError(
             f"{path} does not exist; pass a run directory that simoun-train created, or its "
@@ -207,6 +210,15 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
         raise SetupError(
             f"{path} is not a file, so it holds no checkpoint; move it aside (mv {path} "
             f"{path}.damaged) and restore {CHECKPOINT_NAME} from a copy, or start a new run"
+        )
+    if packed := packed_problem(path):
+        raise SetupError(f"{packed} and run the command again")
+    if not path.is_file() and (study := study_of(path.parent)) is not None:
+        raise SetupError(
+            f"no checkpoint at {path}: {path.parent} is a run of the study in {study}, and a "
+            "study archive keeps no checkpoints (only the runs' logs and records). Pass the run "
+            "of the study directory, which keeps its checkpoint, or read this run's eval.csv "
+            "and summary.json"
         )
     if not path.is_file():
         raise SetupError(

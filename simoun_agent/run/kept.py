@@ -341,3 +341,24 @@ def kind_problem(name: str, found: Sequence[str]) -> str | None:
     if missing:
         return f"it has no {', '.join(missing)} ({what} every {name} of a run holds)"
     return None
+
+
+UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
+"""A compressed file's suffix -> the command that restores the file beside it."""
+
+
+def packed_problem(path: Path) -> str | None:
+    """What to say of the kept file ``path`` when it is missing but a compressed copy of it lies
+    beside it (``checkpoint.pt.gz``: packed by hand to save space), with the command that unpacks
+    it; None when ``path`` is there or no such copy is. A reader says this rather than that the
+    file was never written."""
+    if present(path):
+        return None
+    for suffix, command in UNPACK.items():
+        packed = path.with_name(path.name + suffix)
+        if present(packed):
+            return (
+                f"{path} is missing, but {packed.name} lies beside it (packed to save space): "
+                f"unpack it ({command} -k {packed})"
+            )
+    return None

@@ -88,9 +88,6 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     if not lines or "env_step" not in lines[0]:
         problem = "it is empty" if not lines else header_problem(lines[0])
         raise damaged_log(path, problem or "its first line has no env_step column")
-    problem = kind_problem(path.name, lines[0])
-    if problem:
-        raise damaged_log(path, problem)
     columns, at = lines[0], lines[0].index("env_step")
     rows = []
     for number, values in enumerate(lines[1:], start=2):
@@ -107,6 +104,9 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
                               "repeated)")  # fmt: skip
         # written back as the run writes it: a resumed log holds one spelling of its steps
         rows.append({**dict(zip(columns, values, strict=True)), "env_step": str(step)})
+    problem = kind_problem(path.name, columns)
+    if problem:
+        raise damaged_log(path, problem)
     return columns, rows
 
 

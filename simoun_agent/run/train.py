@@ -71,7 +71,7 @@ from simoun_agent.run.kept import (
     binary_problem,
     broken_link,
     kind_problem,
-    present,
+    packed_problem,
     read_text,
 )
 from simoun_agent.run.layout import (
@@ -276,6 +276,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"--resume {run_dir} {why}; pass the directory that simoun-train created (its "
             "path is printed as 'run directory: ...' when a run starts)"
         )
+    check_packed_files(run_dir)
     for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything is changed
         path = run_dir / name
         if path.exists() and not path.is_file():
@@ -380,25 +381,26 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     return Run(config, run_dir, env, eval_env, agent, replay, rng, counters, lock)
 
 
-UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
-"""A compressed file's suffix -> the command that restores the file beside it."""
-
-
 def missing_replay(path: Path) -> str:
     """The refusal for the checkpoint's replay missing at ``path``: where a compressed copy
     lies beside it (the replay packed by hand to save space), the command that unpacks it."""
-    copies = [path.with_name(path.name + suffix) for suffix in UNPACK]
-    packed = next((copy for copy in copies if present(copy)), None)
+    packed = packed_problem(path)
     if packed is not None:
-        return (
-            f"{path} (the replay of the checkpoint) is missing, but {packed.name} lies beside "
-            f"it: unpack it ({UNPACK[packed.suffix]} -k {packed}) and resume again; the run "
-            "reads the replay as it was saved"
-        )
+        return f"{packed} and resume again; the run reads the replay as it was saved"
     return (
         f"{path} (the replay of the checkpoint) is missing; the run cannot continue exactly. "
         "Restore it from a copy, or start a new run."
     )
+
+
+def check_packed_files(run_dir: Path) -> None:
+    """Refuse a resumed run whose config.json or a log is missing while a compressed copy lies
+    beside it: the run would go on with a new log from its checkpoint (the rows before lost for
+    good) or be taken for no run, where unpacking the file lets it resume whole."""
+    for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, CHECKPOINT_NAME):
+        packed = packed_problem(run_dir / name)
+        if packed is not None:
+            raise SetupError(f"{packed} and resume again. Nothing in the run was changed")
 
 
 def check_logs_reach(run_dir: Path, state: dict[str, Any]) -> None:

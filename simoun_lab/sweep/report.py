@@ -57,6 +57,7 @@ from simoun_agent.run.kept import (
     Damaged,
     folder_problem,
     kind_problem,
+    packed_problem,
     present,
     read_json_object,
     read_text,
@@ -214,7 +215,8 @@ def config_paths(root: Path, damaged: list[str]) -> list[Path]:
     """Every run's ``config.json`` under ``root`` (a link to nothing included: its run is named
     as damaged), Tune's records under ``tune/`` and hidden folders skipped. A link to a folder
     is followed (a run moved elsewhere and linked back is a run), each folder once; a link to a
-    folder it is in (a loop) is named in ``damaged``, not walked round."""
+    folder it is in (a loop), and a folder whose config.json lies packed beside its name
+    (``config.json.gz``), are named in ``damaged``, not walked round or passed over."""
     found: list[Path] = []
     seen = {os.path.realpath(root)}
     for top, folders, files in os.walk(root, followlinks=True):
@@ -232,6 +234,8 @@ def config_paths(root: Path, damaged: list[str]) -> list[Path]:
                 kept.append(name)
         folders[:] = kept
         found += [here / CONFIG_NAME] if CONFIG_NAME in files else []
+        if CONFIG_NAME not in files and (packed := packed_problem(here / CONFIG_NAME)):
+            damaged.append(f"{here.relative_to(root).as_posix()}: {packed}")
     return sorted(found)
 
 
@@ -251,6 +255,8 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
     """eval.csv's :data:`CURVE_COLUMNS`, or :class:`DamagedRun`: a file with a column
     missing, a value that is not a number, or a NaN or infinite return would otherwise blank
     or bend the statistics of its whole row."""
+    if packed := packed_problem(path):
+        raise DamagedRun(packed.replace(f"{path} is", f"{path.name} is", 1))
     if not path.is_file() and not path.is_symlink():
         return {key: np.zeros(0) for key in CURVE_COLUMNS}
     try:
