@@ -26,9 +26,9 @@ from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import atomic_write, dead_temporaries
-from simoun_agent.run.kept import binary_problem, broken_link, packed_problem
+from simoun_agent.run.kept import binary_problem, broken_link, packed_problem, present
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
-from simoun_agent.run.rundir import study_of
+from simoun_agent.run.rundir import folder_kind, study_of
 from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
@@ -199,6 +199,12 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
             f"{CHECKPOINT_NAME}"
         )
     if path.is_dir():
+        if not present(path / CHECKPOINT_NAME) and (kind := folder_kind(path)) is not None:
+            raise SetupError(
+                f"{path} is {kind}, not a run directory; pass the directory of one of its runs "
+                f"that holds {CHECKPOINT_NAME} (a study archive keeps none: pass the study "
+                "directory's run)"
+            )
         path = path / CHECKPOINT_NAME
     elif path.suffix != ".pt":
         # not a checkpoint's name: say so rather than call the file corrupt and advise deleting it

@@ -293,31 +293,29 @@ def checkpoint_problem(path: Path) -> str | None:
 
 
 RUN_LOG_COLUMNS = {
-    "eval.csv": (
-        "env_step",
-        "return_mean",
-        "return_std",
-        "return_min",
-        "return_max",
-        "length_mean",
-    ),
+    "eval.csv": ("env_step", "return_mean", "return_std", "return_min", "return_max",
+                 "length_mean"),
     "train.csv": ("env_step", "episode", "return", "length", "env_steps_per_s"),
-}
-"""The columns every log of a simoun run holds, by file name: an evaluation's statistics, a
-training episode's own numbers (a resumed run's callbacks and test modes may add others)."""
+}  # fmt: skip
+"""The columns a simoun run writes to each of its logs, by file name: an evaluation's
+statistics, a training episode's own numbers (callbacks and test modes may add others)."""
 RUN_JSON_KEYS = {
     "config.json": ("env", "seed", "agent"),
     "summary.json": ("env_step", "final_eval"),
 }
-"""The keys every JSON record of a simoun run holds, by file name."""
+"""The keys a simoun run writes to each of its JSON records, by file name."""
+REQUIRED = {"eval.csv": ("return_mean",), "train.csv": ("return",)}
+"""The columns every reader of a log reads besides env_step (the other columns of
+:data:`RUN_LOG_COLUMNS` are left out of an older or a trimmed copy)."""
 
 
 def kind_problem(name: str, found: Sequence[str]) -> str | None:
     """What is wrong when ``found``, the header of the run's log ``name`` (eval.csv, train.csv)
-    or the keys of its record (config.json, summary.json), is not that file's: another of the
-    run's files copied over it (it holds that file's columns or keys, which are named), the two
-    logs mixed (the other's own columns beside its own), or one of its own columns or keys
-    missing; None when they are its own, or for a file of another name."""
+    or the keys of its record (config.json, summary.json), holds another of the run's files'
+    own columns or keys (those the file ``name`` never holds): that file copied over it (the
+    ones it lacks of its own named too), or the two logs mixed into one; or, for a log, when a
+    column every reader of it reads is missing. None when they are its own, and for a file of
+    another name."""
     kinds = RUN_LOG_COLUMNS if name in RUN_LOG_COLUMNS else RUN_JSON_KEYS
     if name not in kinds:
         return None
@@ -328,18 +326,18 @@ def kind_problem(name: str, found: Sequence[str]) -> str | None:
         strays = [key for key in keys if key not in own and key in present_]
         if other == name or not strays:
             continue
-        shown = ", ".join(strays)
         if missing:
             return (
-                f"it holds {other}'s {what} ({shown}), not {name}'s (it has no "
+                f"it holds {other}'s {what} ({', '.join(strays)}), not {name}'s (it has no "
                 f"{', '.join(missing)}): {other} was copied over it"
             )
         return (
-            f"it holds {other}'s {what} ({shown}) beside its own: the run's two files were "
-            "mixed into one"
+            f"it holds {other}'s {what} ({', '.join(strays)}) beside its own: the run's two "
+            "files were mixed into one"
         )
-    if missing:
-        return f"it has no {', '.join(missing)} ({what} every {name} of a run holds)"
+    lacking = [key for key in REQUIRED.get(name, ()) if key not in present_]
+    if lacking:
+        return f"it has no {', '.join(lacking)} column, which every {name} of a run holds"
     return None
 
 
@@ -347,18 +345,18 @@ UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
 """A compressed file's suffix -> the command that restores the file beside it."""
 
 
-def packed_problem(path: Path) -> str | None:
+def packed_problem(path: Path, what: str = "") -> str | None:
     """What to say of the kept file ``path`` when it is missing but a compressed copy of it lies
     beside it (``checkpoint.pt.gz``: packed by hand to save space), with the command that unpacks
     it; None when ``path`` is there or no such copy is. A reader says this rather than that the
-    file was never written."""
+    file was never written. ``what``: what the file is, said after its path."""
     if present(path):
         return None
     for suffix, command in UNPACK.items():
         packed = path.with_name(path.name + suffix)
         if present(packed):
             return (
-                f"{path} is missing, but {packed.name} lies beside it (packed to save space): "
-                f"unpack it ({command} -k {packed})"
+                f"{path}{what} is missing, but {packed.name} lies beside it (packed to save "
+                f"space): unpack it ({command} -k {packed})"
             )
     return None

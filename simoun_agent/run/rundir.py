@@ -270,6 +270,29 @@ TRIAL_RECORD = "trial.json"
 """What a run trained by simoun-sweep or simoun-study keeps beside its config."""
 
 
+SWEEP_RECORD = "sweep.json"
+"""The record at the root of a simoun-sweep directory."""
+
+
+def folder_kind(path: Path) -> str | None:
+    """What the folder ``path`` is when another command keeps it and it is no run directory:
+    a study's (``study.json``) or a sweep's (``sweep.json``), with the command that reads it as
+    a whole; None for any other folder. Commands that take a run directory name it so, rather
+    than call it a run that stopped early."""
+    if (path / STUDY_RECORD).is_file():
+        return (
+            f"a simoun-study directory or archive (it holds {STUDY_RECORD}), which `simoun-study "
+            f"report SPEC --study-dir {path}` reports and `simoun-study run SPEC --study-dir DIR "
+            "--resume` resumes"
+        )
+    if (path / SWEEP_RECORD).is_file():
+        return (
+            f"a simoun-sweep directory (it holds {SWEEP_RECORD}), which `simoun-report {path}` "
+            f"reports and `simoun-sweep --resume --sweep-dir {path}` resumes"
+        )
+    return None
+
+
 def study_of(run_dir: Path) -> Path | None:
     """The study folder (a simoun-study directory or archive) the run directory ``run_dir``
     lies in: the nearest folder above it with a study.json, or, for an archive copied without

@@ -86,7 +86,7 @@ from simoun_agent.run.layout import (
 from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
-from simoun_agent.run.rundir import make_output_dir, take_run_dir
+from simoun_agent.run.rundir import folder_kind, make_output_dir, take_run_dir
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
 from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.state import Counters, Run
@@ -286,6 +286,11 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             raise damaged_log(path, problem)
         if problem:
             raise damaged_config(path, problem)
+    if not config_path.is_file() and (kind := folder_kind(run_dir)) is not None:
+        raise SetupError(
+            f"--resume {run_dir} is {kind}, not a run directory; pass the directory of one of "
+            "its runs that holds checkpoint.pt"
+        )
     if not config_path.is_file():
         raise SetupError(
             f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "
@@ -384,7 +389,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
 def missing_replay(path: Path) -> str:
     """The refusal for the checkpoint's replay missing at ``path``: where a compressed copy
     lies beside it (the replay packed by hand to save space), the command that unpacks it."""
-    packed = packed_problem(path)
+    packed = packed_problem(path, " (the replay of the checkpoint)")
     if packed is not None:
         return f"{packed} and resume again; the run reads the replay as it was saved"
     return (

@@ -41,6 +41,7 @@ from simoun_agent.run.kept import (
     read_json_object,
 )
 from simoun_agent.run.layout import CONFIG_NAME
+from simoun_agent.run.rundir import folder_kind
 from simoun_lab.sweep.saved import saved_problem
 
 SWEEP_FILE = "sweep.json"
@@ -436,6 +437,11 @@ class SweepSpec:
         if sweep_dir.name == SWEEP_FILE and not sweep_dir.is_dir():
             sweep_dir = sweep_dir.parent  # the file itself: read it, not sweep.json/sweep.json
         path = sweep_dir / SWEEP_FILE
+        if not present(path) and (kind := folder_kind(sweep_dir)) is not None:
+            raise SetupError(
+                f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing): it is {kind}; pass the "
+                "--sweep-dir of a sweep that simoun-sweep started"
+            )
         if not present(path):
             raise SetupError(
                 f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing); pass the --sweep-dir of "

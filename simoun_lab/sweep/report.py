@@ -64,7 +64,7 @@ from simoun_agent.run.kept import (
 )
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import log_values
-from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.rundir import STUDY_RECORD, make_output_dir
 from simoun_lab import stats
 from simoun_lab.sweep.grid import (
     BASE_VARIANT,
@@ -735,6 +735,7 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
             f"{root} is a file, not a directory; pass a sweep directory (simoun-sweep "
             "--sweep-dir) or the parent of run directories"
         )
+    refuse_study(root)
     damaged: list[str] = []
     records = sweep_trials_only(root, find_runs(root, damaged), damaged)
     if not records:
@@ -1130,6 +1131,20 @@ def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
 AGGREGATE_COLUMNS = ["variant", "tasks", "runs", "iqm", "iqm_low", "iqm_high", "mean", "mean_low"]
 AGGREGATE_COLUMNS += ["mean_high"]
 IMPROVEMENT_COLUMNS = ["x", "y", "tasks", "p", "low", "high"]
+
+
+def refuse_study(root: Path) -> None:
+    """SetupError for a simoun-study directory or archive given whole: its tuning variants and
+    its evaluation runs, of other budgets, would be compared side by side as one sweep, and the
+    report written among the study's records; ``simoun-study report`` is its report, and a
+    phase of it (``evaluation/``) is a comparison simoun-report makes."""
+    if (root / STUDY_RECORD).is_file():
+        raise SetupError(
+            f"{root} is a simoun-study directory or archive (it holds {STUDY_RECORD}), which "
+            f"simoun-report does not report whole; report it with `simoun-study report SPEC "
+            f"--study-dir {root}` (SPEC: the study's spec, e.g. docs/studies/dmc100k.toml), or "
+            f"compare the runs of one phase with `simoun-report {root / 'evaluation'} --out DIR`"
+        )
 
 
 def default_out(root: Path) -> Path:
