@@ -596,11 +596,18 @@ def config_removed(run_dir: Path) -> None:
     (run_dir / "config.json").unlink()
 
 
+def summary_over_config(run_dir: Path) -> None:
+    shutil.copyfile(run_dir / "summary.json", run_dir / "config.json")
+
+
 TRIAL_DAMAGES = [
     (another_env, "config.json records env Pendulum-v1, but the sweep's trial "
      f"{TRIAL.format(1)} has simoun/PointReach-v0: it is another run's config"),
     (another_seed, f"config.json records seed 2, but the sweep's trial {TRIAL.format(1)} has 1"),
     (config_removed, "config.json is missing, though the run's other files are there"),
+    (summary_over_config, "config.json is damaged: it holds summary.json's keys (env_step, "
+     "final_eval), not config.json's (it has no env, seed, agent): summary.json was copied over "
+     "it"),
 ]  # fmt: skip
 
 

@@ -72,6 +72,7 @@ from simoun_agent.run.kept import (
     broken_link,
     kind_problem,
     packed_problem,
+    present,
     read_text,
 )
 from simoun_agent.run.layout import (
@@ -86,7 +87,13 @@ from simoun_agent.run.layout import (
 from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
-from simoun_agent.run.rundir import folder_kind, make_output_dir, take_run_dir
+from simoun_agent.run.rundir import (
+    folder_kind,
+    make_output_dir,
+    study_of,
+    study_run_refusal,
+    take_run_dir,
+)
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
 from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.state import Counters, Run
@@ -277,6 +284,9 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             "path is printed as 'run directory: ...' when a run starts)"
         )
     check_packed_files(run_dir)
+    study = study_of(run_dir)
+    if study is not None and not present(run_dir / CHECKPOINT_NAME):  # nothing written there
+        raise study_run_refusal(run_dir, study)
     for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything is changed
         path = run_dir / name
         if path.exists() and not path.is_file():
