@@ -181,7 +181,9 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
     """Read a checkpoint written by :func:`save_checkpoint`.
 
     ``path`` is a run directory or a ``checkpoint.pt`` file. Raises ``SetupError`` naming the
-    problem and the fix for a missing, corrupt or foreign file.
+    problem and the fix for a missing, corrupt or foreign file: a missing one is told apart
+    from a packed copy beside it (``checkpoint.pt.gz``), a run of a study archive (which keeps
+    no checkpoints) and a study's or a sweep's folder given in place of a run directory.
     """
     path = Path(path)
     for link in (path, path / CHECKPOINT_NAME):
