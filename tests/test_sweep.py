@@ -624,6 +624,15 @@ def test_a_trial_run_that_is_not_the_trials_own_is_left_out_of_the_report(
     assert "## Damaged runs (not counted)" in table and f"- {TRIAL.format(1)}: {said}" in table
 
 
+def test_a_config_copied_over_a_trials_summary_is_named_on_resume(trained_sweep, tmp_path, capsys):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    shutil.copyfile(run_dir / "config.json", run_dir / "summary.json")
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"{run_dir / 'summary.json'} is damaged: it holds config.json's keys" in err
+    assert "already finished" not in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(("damage", "said"), TRIAL_DAMAGES)
 def test_a_trial_run_that_is_not_the_trials_own_is_refused_on_resume(
     trained_sweep, tmp_path, capsys, damage, said

@@ -40,7 +40,7 @@ from simoun_agent.run.kept import (
     present,
     read_json_object,
 )
-from simoun_agent.run.layout import CONFIG_NAME
+from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.rundir import folder_kind
 from simoun_lab.sweep.saved import saved_problem
 
@@ -570,6 +570,29 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
         differences = config_differences(trial)
         if differences:
             raise differences_refusal(trial, sweep_dir, differences)
+        problem = summary_kind_problem(trial)
+        if problem:
+            run_dir = trial.run_dir
+            raise SetupError(
+                f"trial {trial.name}: {Path(run_dir, SUMMARY_NAME)} is damaged: {problem}; "
+                f"restore {SUMMARY_NAME} from a copy, or move the run directory aside (mv "
+                f"{run_dir} {run_dir}.aside) so that the trial trains anew"
+            )
+
+
+def summary_kind_problem(trial: Trial) -> str | None:
+    """What is wrong with the trial's summary.json when it holds another file's keys
+    (:func:`~simoun_agent.run.kept.kind_problem`: config.json copied over it), which would
+    count the trial as finished; else None (a summary that cannot be read is the report's to
+    name, as it reads the run's result)."""
+    path = Path(trial.run_dir) / SUMMARY_NAME
+    if not path.is_file():
+        return None
+    try:
+        record = read_json_object(path)
+    except (Damaged, OSError):
+        return None
+    return kind_problem(SUMMARY_NAME, list(record))
 
 
 def check_runnable(
