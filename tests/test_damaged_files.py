@@ -433,3 +433,134 @@ def test_an_output_file_that_is_a_folder_is_refused_before_the_work(
     assert f"mv {out / name} {out / name}.aside" in err and "or pass another --out" in err
     assert "Traceback" not in err
     assert sorted(path.name for path in out.iterdir()) == [name]  # nothing written before
+
+
+@pytest.mark.parametrize(
+    ("source", "target", "problem"),
+    [
+        ("train.csv", "eval.csv", "it holds train.csv's columns (episode, return, length, "
+         "env_steps_per_s), not eval.csv's"),
+        ("eval.csv", "train.csv", "it holds eval.csv's columns (return_mean, return_std, "
+         "return_min, return_max, length_mean), not train.csv's"),
+        ("summary.json", "config.json", "it holds summary.json's keys (env_step, final_eval), "
+         "not config.json's"),
+    ],
+)  # fmt: skip
+def test_a_kept_file_copied_over_another_is_named_on_resume_and_left_as_it_was(
+    trained_run, source, target, problem, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    shutil.copyfile(run_dir / source, run_dir / target)
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{run_dir / target} is damaged: {problem}" in err
+    assert f"{source} was copied over it" in err
+
+
+def test_logs_mixed_into_one_are_named_by_resume_and_the_report(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    path = run_dir / "eval.csv"
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join([lines[0] + ",episode", *(line + ",3" for line in lines[1:])]))
+    mixed = "it holds train.csv's columns (episode) beside its own: the run's two files were mixed"
+    assert mixed in refusal("simoun-train", run_dir, capsys)
+    assert mixed in refusal("simoun-report", run_dir, capsys)
+
+
+@pytest.mark.parametrize("command", ["simoun-eval", "simoun-analyze"])
+def test_a_summary_copied_over_config_json_is_named_by_the_readers_of_a_checkpoint(
+    trained_run, command, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (run_dir / "summary.json").write_text('{"env_step": 60, "final_eval": {"return_mean": 1}}')
+    shutil.copyfile(run_dir / "summary.json", run_dir / "config.json")
+    err = refusal(command, run_dir, capsys)
+    assert f"{run_dir / 'config.json'} is damaged: it holds summary.json's keys" in err
+
+
+def packed(path, suffix=".gz"):
+    """``path`` packed in place (``gzip path``: only ``path.gz`` is left)."""
+    with path.open("rb") as source, gzip.open(f"{path}{suffix}", "wb") as target:
+        shutil.copyfileobj(source, target)
+    path.unlink()
+
+
+@pytest.mark.parametrize("command", ["simoun-train", "simoun-eval", "simoun-analyze"])
+@pytest.mark.parametrize("name", ["checkpoint.pt", "config.json"])
+def test_a_packed_checkpoint_or_config_is_named_with_the_command_that_unpacks_it(
+    trained_run, name, command, tmp_path, capsys
+):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    packed(run_dir / name)
+    err = refusal(command, run_dir, capsys)
+    assert f"{run_dir / name} is missing, but {name}.gz lies beside it" in err
+    assert f"gunzip -k {run_dir / name}.gz" in err
+    assert "stopped before its first checkpoint" not in err
+
+
+@pytest.mark.parametrize("name", ["eval.csv", "train.csv"])
+def test_a_packed_log_is_named_on_resume_not_started_anew(trained_run, name, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    packed(run_dir / name, ".xz")
+    err = refusal("simoun-train", run_dir, capsys)
+    assert f"{run_dir / name} is missing, but {name}.xz lies beside it" in err
+    assert f"unxz -k {run_dir / name}.xz" in err
+
+
+def test_a_packed_eval_csv_or_config_is_named_by_the_report(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    packed(run_dir / "eval.csv")
+    assert "eval.csv is missing, but eval.csv.gz lies beside it" in refusal(
+        "simoun-report", run_dir, capsys
+    )
+    (run_dir / "eval.csv.gz").unlink()
+    packed(run_dir / "config.json")
+    assert "config.json is missing, but config.json.gz lies beside it" in refusal(
+        "simoun-report", run_dir, capsys
+    )
+
+
+@pytest.mark.parametrize("columns", ["return_mean", b"return_mean", 3, ("return_mean", 3)])
+def test_read_csv_names_columns_that_are_no_list_of_names(trained_run, columns):
+    with pytest.raises(TypeError, match=re.escape("read_csv's columns must be a list or tuple")):
+        read_csv(trained_run / "eval.csv", columns=columns)
+    rows = read_csv(trained_run / "eval.csv", columns=["return_mean"])
+    assert rows[-1]["env_step"] == 60
+
+
+def study_run(tmp_path, trained_run, place):
+    """The trained run's files laid out as a study archive keeps a tuning run (no checkpoint),
+    under ``tmp_path / place``, with the archive's study.json."""
+    run_dir = tmp_path / place / "tuning/simoun/agent.n_step=1/point-reach/s1"
+    run_dir.mkdir(parents=True)
+    for name in ("config.json", "eval.csv", "train.csv"):
+        shutil.copyfile(trained_run / name, run_dir / name)
+    (run_dir / "trial.json").write_text("{}")
+    return run_dir
+
+
+@pytest.mark.parametrize("with_record", [True, False], ids=["study.json", "archive layout"])
+def test_resume_of_an_archived_study_run_never_advises_overwrite(
+    trained_run, with_record, tmp_path, capsys
+):
+    run_dir = study_run(tmp_path, trained_run, "arch")
+    if with_record:
+        (tmp_path / "arch/study.json").write_text("{}")
+    err = refusal("simoun-train", run_dir, capsys)
+    assert "--overwrite" not in err
+    assert f"{run_dir} is a run of the study in {tmp_path / 'arch'}" in err
+    assert "a study archive keeps no checkpoint.pt" in err and "a new --run-dir" in err
+    err = refusal("simoun-eval", run_dir, capsys)
+    assert "a study archive keeps no checkpoints" in err
+
+
+@pytest.mark.parametrize("command", ["simoun-train", "simoun-eval", "simoun-analyze"])
+@pytest.mark.parametrize("record", ["study.json", "sweep.json"])
+def test_a_study_or_sweep_folder_given_as_a_run_is_named(
+    trained_run, command, record, tmp_path, capsys
+):
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    (folder / record).write_text("{}")
+    err = refusal(command, folder, capsys)
+    assert f"{folder} is a simoun-{record.split('.')[0]} directory" in err
+    assert "not a run directory" in err

@@ -408,6 +408,18 @@ UPDATE_COSTS = {
         ({"ratio": {"drq": True}}, "its ratio.drq is true, which must be a positive number"),
         ({"ms_per_update": {"drq": -2.0, "simoun": 4.2}}, "its ms_per_update.drq is -2.0"),
         ({"ms_per_update": {"drq": 2.0}}, "ratio has simoun, which ms_per_update does not"),
+        (
+            {
+                "ratio": {"drq": 1.0, "simoun/agent.n_step=3": 2.1},
+                "ms_per_update": {"drq": 2.0, "simoun/agent.n_step=3": 4.2},
+            },
+            'its ratio has "simoun/agent.n_step=3", which is not a recipe (did you mean simoun? '
+            "rename the key to it): the file is keyed by recipe name (this study's: simoun, drq",
+        ),
+        (
+            {"ms_per_update": {"drq": 2.0, "simoun": 4.2, "curll": 3.0}},
+            'its ms_per_update has "curll", which is not a recipe (did you mean curl?',
+        ),
     ],
 )
 def test_an_update_cost_value_the_report_cannot_use_is_named_before_the_report(
@@ -726,3 +738,49 @@ def test_a_study_run_linked_to_its_own_folder_is_named_by_the_report(dmc_archive
     linked_to_its_folder(path)
     printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
     assert f"{path} (the directory of run {EVALUATION_RUN}) {LOOP}" in printed
+
+
+def test_a_study_archive_given_to_simoun_report_is_refused_naming_its_report(dmc_archive):
+    before = sorted(p.relative_to(dmc_archive) for p in dmc_archive.rglob("*"))
+    printed = refused(report_cli.main, str(dmc_archive))
+    assert f"{dmc_archive} is a simoun-study directory or archive (it holds study.json)" in printed
+    assert f"simoun-study report SPEC --study-dir {dmc_archive}" in printed
+    assert sorted(p.relative_to(dmc_archive) for p in dmc_archive.rglob("*")) == before
+    # a phase of it is a comparison simoun-report makes
+    status, printed = run_main(report_cli.main, str(dmc_archive / "evaluation"), "--out",
+                               str(dmc_archive.parent / "out"))  # fmt: skip
+    assert status == 0, printed[-3000:]
+
+
+def test_a_study_archive_given_as_a_sweep_is_named_with_the_study_command(dmc_archive):
+    with pytest.raises(SetupError, match=re.escape("it is a simoun-study directory or archive")):
+        SweepSpec.load(dmc_archive)
+
+
+def test_a_damaged_log_of_a_finished_minigrid_run_is_named_before_run_starts(
+    minigrid_archive, tmp_path, monkeypatch
+):
+    monkeypatch.setenv("RAY_ADDRESS", "no-ray-in-this-test")  # a run that got past the checks
+    path = minigrid_archive / MINIGRID_RUNS[1] / "eval.csv"
+    path.write_bytes(path.read_bytes() + bytes(512))
+    printed = refused(minigrid_cli.main, "run", "--archive", str(minigrid_archive), "--work-dir",
+                      str(tmp_path / "work"))  # fmt: skip
+    assert f"{path} is damaged: line " in printed and "holds a NUL byte" in printed
+    assert not (tmp_path / "work").exists() or not any((tmp_path / "work").iterdir())
+
+
+@pytest.mark.parametrize(
+    ("source", "target", "problem"),
+    [
+        ("train.csv", "eval.csv", "eval.csv is damaged: it holds train.csv's columns"),
+        ("summary.json", "config.json", "config.json is damaged: it holds summary.json's keys"),
+        ("config.json", "summary.json", "summary.json is damaged: it holds config.json's keys"),
+    ],
+)
+def test_a_file_of_a_finished_study_run_copied_over_another_is_named(
+    source, target, problem, dmc_archive
+):
+    run_dir = dmc_archive / TUNING_RUN
+    shutil.copyfile(run_dir / source, run_dir / target)
+    printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
+    assert f"{problem}" in printed and str(run_dir) in printed

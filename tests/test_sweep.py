@@ -596,11 +596,18 @@ def config_removed(run_dir: Path) -> None:
     (run_dir / "config.json").unlink()
 
 
+def summary_over_config(run_dir: Path) -> None:
+    shutil.copyfile(run_dir / "summary.json", run_dir / "config.json")
+
+
 TRIAL_DAMAGES = [
     (another_env, "config.json records env Pendulum-v1, but the sweep's trial "
      f"{TRIAL.format(1)} has simoun/PointReach-v0: it is another run's config"),
     (another_seed, f"config.json records seed 2, but the sweep's trial {TRIAL.format(1)} has 1"),
     (config_removed, "config.json is missing, though the run's other files are there"),
+    (summary_over_config, "config.json is damaged: it holds summary.json's keys (env_step, "
+     "final_eval), not config.json's (it has no env, seed, agent): summary.json was copied over "
+     "it"),
 ]  # fmt: skip
 
 
@@ -615,6 +622,15 @@ def test_a_trial_run_that_is_not_the_trials_own_is_left_out_of_the_report(
     assert (row["env"], row["n"]) == ("simoun-PointReach-v0", "1")
     table = (tmp_path / "out" / "report.md").read_text()
     assert "## Damaged runs (not counted)" in table and f"- {TRIAL.format(1)}: {said}" in table
+
+
+def test_a_config_copied_over_a_trials_summary_is_named_on_resume(trained_sweep, tmp_path, capsys):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    shutil.copyfile(run_dir / "config.json", run_dir / "summary.json")
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"{run_dir / 'summary.json'} is damaged: it holds config.json's keys" in err
+    assert "already finished" not in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(("damage", "said"), TRIAL_DAMAGES)

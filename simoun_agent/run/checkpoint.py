@@ -26,8 +26,9 @@ from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import atomic_write, dead_temporaries
-from simoun_agent.run.kept import binary_problem, broken_link
+from simoun_agent.run.kept import binary_problem, broken_link, packed_problem, present
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
+from simoun_agent.run.rundir import folder_kind, study_of
 from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
@@ -180,7 +181,9 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
     """Read a checkpoint written by :func:`save_checkpoint`.
 
     ``path`` is a run directory or a ``checkpoint.pt`` file. Raises ``SetupError`` naming the
-    problem and the fix for a missing, corrupt or foreign file.
+    problem and the fix for a missing, corrupt or foreign file: a missing one is told apart
+    from a packed copy beside it (``checkpoint.pt.gz``), a run of a study archive (which keeps
+    no checkpoints) and a study's or a sweep's folder given in place of a run directory.
     """
     path = Path(path)
     for link in (path, path / CHECKPOINT_NAME):
@@ -190,12 +193,20 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
                 f"{link} is damaged: {problem}. Restore the file it stands for from a copy "
                 f"(or point the link at it), or start a new run"
             )
+    if not path.exists() and (packed := packed_problem(path)):
+        raise SetupError(f"{packed} and run the command again")
     if not path.exists():
         raise SetupError(
             f"{path} does not exist; pass a run directory that simoun-train created, or its "
             f"{CHECKPOINT_NAME}"
         )
     if path.is_dir():
+        if not present(path / CHECKPOINT_NAME) and (kind := folder_kind(path)) is not None:
+            raise SetupError(
+                f"{path} is {kind}, not a run directory; pass the directory of one of its runs "
+                f"that holds {CHECKPOINT_NAME} (a study archive keeps none: pass the study "
+                "directory's run)"
+            )
         path = path / CHECKPOINT_NAME
     elif path.suffix != ".pt":
         # not a checkpoint's name: say so rather than call the file corrupt and advise deleting it
@@ -207,6 +218,15 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
         raise SetupError(
             f"{path} is not a file, so it holds no checkpoint; move it aside (mv {path} "
             f"{path}.damaged) and restore {CHECKPOINT_NAME} from a copy, or start a new run"
+        )
+    if packed := packed_problem(path):
+        raise SetupError(f"{packed} and run the command again")
+    if not path.is_file() and (study := study_of(path.parent)) is not None:
+        raise SetupError(
+            f"no checkpoint at {path}: {path.parent} is a run of the study in {study}, and a "
+            "study archive keeps no checkpoints (only the runs' logs and records). Pass the run "
+            "of the study directory, which keeps its checkpoint, or read this run's eval.csv "
+            "and summary.json"
         )
     if not path.is_file():
         raise SetupError(

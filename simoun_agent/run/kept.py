@@ -290,3 +290,73 @@ def checkpoint_problem(path: Path) -> str | None:
     except OSError as err:
         return f"it cannot be read ({err.strerror})"
     return None if bad is None else f"its part {bad} does not match its checksum (overwritten)"
+
+
+RUN_LOG_COLUMNS = {
+    "eval.csv": ("env_step", "return_mean", "return_std", "return_min", "return_max",
+                 "length_mean"),
+    "train.csv": ("env_step", "episode", "return", "length", "env_steps_per_s"),
+}  # fmt: skip
+"""The columns a simoun run writes to each of its logs, by file name: an evaluation's
+statistics, a training episode's own numbers (callbacks and test modes may add others)."""
+RUN_JSON_KEYS = {
+    "config.json": ("env", "seed", "agent"),
+    "summary.json": ("env_step", "final_eval"),
+}
+"""The keys a simoun run writes to each of its JSON records, by file name."""
+REQUIRED = {"eval.csv": ("return_mean",), "train.csv": ("return",)}
+"""The columns every reader of a log reads besides env_step (the other columns of
+:data:`RUN_LOG_COLUMNS` are left out of an older or a trimmed copy)."""
+
+
+def kind_problem(name: str, found: Sequence[str]) -> str | None:
+    """What is wrong when ``found``, the header of the run's log ``name`` (eval.csv, train.csv)
+    or the keys of its record (config.json, summary.json), holds another of the run's files'
+    own columns or keys (those the file ``name`` never holds): that file copied over it (the
+    ones it lacks of its own named too), or the two logs mixed into one; or, for a log, when a
+    column every reader of it reads is missing. None when they are its own, and for a file of
+    another name."""
+    kinds = RUN_LOG_COLUMNS if name in RUN_LOG_COLUMNS else RUN_JSON_KEYS
+    if name not in kinds:
+        return None
+    what = "columns" if kinds is RUN_LOG_COLUMNS else "keys"
+    own, present_ = kinds[name], set(found)
+    missing = [key for key in own if key not in present_]
+    for other, keys in kinds.items():
+        strays = [key for key in keys if key not in own and key in present_]
+        if other == name or not strays:
+            continue
+        if missing:
+            return (
+                f"it holds {other}'s {what} ({', '.join(strays)}), not {name}'s (it has no "
+                f"{', '.join(missing)}): {other} was copied over it"
+            )
+        return (
+            f"it holds {other}'s {what} ({', '.join(strays)}) beside its own: the run's two "
+            "files were mixed into one"
+        )
+    lacking = [key for key in REQUIRED.get(name, ()) if key not in present_]
+    if lacking:
+        return f"it has no {', '.join(lacking)} column, which every {name} of a run holds"
+    return None
+
+
+UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
+"""A compressed file's suffix -> the command that restores the file beside it."""
+
+
+def packed_problem(path: Path, what: str = "") -> str | None:
+    """What to say of the kept file ``path`` when it is missing but a compressed copy of it lies
+    beside it (``checkpoint.pt.gz``: packed by hand to save space), with the command that unpacks
+    it; None when ``path`` is there or no such copy is. A reader says this rather than that the
+    file was never written. ``what``: what the file is, said after its path."""
+    if present(path):
+        return None
+    for suffix, command in UNPACK.items():
+        packed = path.with_name(path.name + suffix)
+        if present(packed):
+            return (
+                f"{path}{what} is missing, but {packed.name} lies beside it (packed to save "
+                f"space): unpack it ({command} -k {packed})"
+            )
+    return None

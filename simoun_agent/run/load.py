@@ -22,7 +22,13 @@ from simoun_agent.agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.checkpoint import check_config, load_checkpoint
-from simoun_agent.run.kept import Damaged, present, read_json_object
+from simoun_agent.run.kept import (
+    Damaged,
+    kind_problem,
+    packed_problem,
+    present,
+    read_json_object,
+)
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
@@ -126,10 +132,16 @@ def check_config_file(payload: dict) -> None:
     A checkpoint without a ``config.json`` beside it (copied on its own) is read as it is."""
     run_dir = payload["replay_path"].parent
     path = run_dir / CONFIG_NAME
+    if packed := packed_problem(path):
+        raise SetupError(
+            f"{packed} and run the command again: it is checked against the checkpoint"
+        )
     if not present(path):
         return
     try:
         saved = read_json_object(path)
+        if problem := kind_problem(CONFIG_NAME, list(saved)):
+            raise Damaged(problem)
     except Damaged as err:
         raise SetupError(
             f"{path} is damaged: {err}. It should hold the config of the checkpoint beside it; "

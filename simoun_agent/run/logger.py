@@ -22,6 +22,7 @@ from simoun_agent.run.kept import (
     csv_lines,
     csv_number,
     header_problem,
+    kind_problem,
     read_csv_rows,
     step_count,
 )
@@ -77,8 +78,9 @@ class CsvLog:
 def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
     """The columns and rows of a log written by :class:`CsvLog`, checked before a resumed run
     rewrites it; SetupError naming the file, the damage and the fix when it is empty, has no
-    ``env_step`` header, or has a row that does not fit the header. Nothing is changed then:
-    the user's file stays as it is."""
+    ``env_step`` header, has another file's header (:func:`~simoun_agent.run.kept.kind_problem`:
+    train.csv copied over eval.csv), or has a row that does not fit the header. Nothing is
+    changed then: the user's file stays as it is."""
     try:
         lines = csv_lines(path)
     except Damaged as err:
@@ -102,6 +104,9 @@ def read_log(path: Path) -> tuple[list[str], list[dict[str, str]]]:
                               "repeated)")  # fmt: skip
         # written back as the run writes it: a resumed log holds one spelling of its steps
         rows.append({**dict(zip(columns, values, strict=True)), "env_step": str(step)})
+    problem = kind_problem(path.name, columns)
+    if problem:
+        raise damaged_log(path, problem)
     return columns, rows
 
 
@@ -120,17 +125,32 @@ def read_csv(
 ) -> list[dict[str, float]]:
     """Rows of a CSV written by :class:`CsvLog` (a str or a path), numbers as floats (NaN where
     empty); :class:`~simoun_agent.run.kept.Damaged` (a ValueError) naming the file for text no
-    run writes (:func:`log_values`); TypeError when ``path`` is neither a str nor a path. An
-    empty file has no rows."""
+    run writes (:func:`log_values`); TypeError when ``path`` is neither a str nor a path, or
+    ``columns`` (names the header must hold) not a list or tuple of str. An empty file has no
+    rows."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(
             f"read_csv's path must be a str or a pathlib.Path of a CSV log, not "
             f"{type(path).__name__}; pass read_csv('RUN_DIR/eval.csv')"
         )
+    check_columns(columns)
     try:
-        return log_values(Path(path), columns)
+        return log_values(Path(path), tuple(columns))
     except Damaged as err:
         raise Damaged(f"{path} cannot be read as a CSV log: {err}") from None
+
+
+def check_columns(columns: Any) -> None:
+    """TypeError naming read_csv's ``columns`` when it is not a list or tuple of column names:
+    a single str would be read as one name per character, and the file blamed for them."""
+    if isinstance(columns, (list, tuple)) and all(isinstance(name, str) for name in columns):
+        return
+    shown = f"{type(columns).__name__} {columns!r:.60}"
+    example = f"({columns!r},)" if isinstance(columns, str) else "('return_mean',)"
+    raise TypeError(
+        f"read_csv's columns must be a list or tuple of column names, not {shown}; pass "
+        f"columns={example}"
+    )
 
 
 def log_values(path: Path, columns: Sequence[str] = ("env_step",)) -> list[dict[str, float]]:

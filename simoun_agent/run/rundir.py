@@ -250,6 +250,8 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
             f"{run_dir} already holds a run with a checkpoint; continue it with --resume "
             f"{run_dir}, or pass another --run-dir (--overwrite never deletes a checkpoint)"
         )
+    if (study := study_of(run_dir)) is not None:
+        raise study_run_refusal(run_dir, study)
     if not overwrite:
         raise SetupError(
             f"{run_dir} holds a run that stopped before its first checkpoint, so there is "
@@ -258,6 +260,72 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
     for name in TRAINER_FILES:
         (run_dir / name).unlink(missing_ok=True)
     shutil.rmtree(run_dir / TENSORBOARD_DIR, ignore_errors=True)
+
+
+STUDY_RECORD = "study.json"
+"""The record at the root of a simoun-study directory and of its archive."""
+ARCHIVE_PHASES = ("tuning", "evaluation")
+"""The folders of a study's runs, in its directory and its archive."""
+TRIAL_RECORD = "trial.json"
+"""What a run trained by simoun-sweep or simoun-study keeps beside its config."""
+
+
+SWEEP_RECORD = "sweep.json"
+"""The record at the root of a simoun-sweep directory."""
+
+
+def folder_kind(path: Path) -> str | None:
+    """What the folder ``path`` is when another command keeps it and it is no run directory:
+    a study's (``study.json``) or a sweep's (``sweep.json``), with the command that reads it as
+    a whole; None for any other folder. Commands that take a run directory name it so, rather
+    than call it a run that stopped early."""
+    if (path / STUDY_RECORD).is_file():
+        return (
+            f"a simoun-study directory or archive (it holds {STUDY_RECORD}), which `simoun-study "
+            f"report SPEC --study-dir {path}` reports and `simoun-study run SPEC --study-dir DIR "
+            "--resume` resumes"
+        )
+    if (path / SWEEP_RECORD).is_file():
+        return (
+            f"a simoun-sweep directory (it holds {SWEEP_RECORD}), which `simoun-report {path}` "
+            f"reports and `simoun-sweep --resume --sweep-dir {path}` resumes"
+        )
+    return None
+
+
+def study_of(run_dir: Path) -> Path | None:
+    """The study folder (a simoun-study directory or archive) the run directory ``run_dir``
+    lies in: the nearest folder above it with a study.json, or, for an archive copied without
+    one, the folder above a tuning/ or evaluation/ folder when the run keeps a trial.json;
+    None for a run of no study."""
+    folder = Path(os.path.abspath(run_dir))
+    for above in folder.parents:
+        if (above / STUDY_RECORD).is_file():
+            return shown(above)
+    if (folder / TRIAL_RECORD).is_file():
+        for above in folder.parents:
+            if above.name in ARCHIVE_PHASES:
+                return shown(above.parent)
+    return None
+
+
+def shown(path: Path) -> Path:
+    """``path`` relative to the working directory when it lies in it, as a user types it."""
+    relative = os.path.relpath(path)
+    return Path(relative) if not relative.startswith("..") else path
+
+
+def study_run_refusal(run_dir: Path, study: Path) -> SetupError:
+    """The refusal of ``--resume`` (or a new run) in the run directory ``run_dir`` of the study
+    in ``study``: a study archive keeps no checkpoints, and the run there is the study's record,
+    so the way on is the study's own command or a new run elsewhere, never ``--overwrite``."""
+    return SetupError(
+        f"{run_dir} is a run of the study in {study} (its {STUDY_RECORD}), part of the study's "
+        f"record, which must not be overwritten; a study archive keeps no {CHECKPOINT_NAME}, so "
+        "there is nothing to resume there. Resume the study's own runs with `simoun-study run "
+        "SPEC --study-dir STUDY_DIR --resume`, or train this setting anew with the flags in "
+        f"{run_dir / CONFIG_NAME} and a new --run-dir outside {study}"
+    )
 
 
 def require_checkpoint(run_dir: Path) -> None:
@@ -270,6 +338,8 @@ def require_checkpoint(run_dir: Path) -> None:
             "from a copy (or point the link at it), or start a new run"
         )
     if (run_dir / TRAINER_FILES[0]).exists() and not (run_dir / CHECKPOINT_NAME).exists():
+        if (study := study_of(run_dir)) is not None:
+            raise study_run_refusal(run_dir, study)
         raise SetupError(
             f"{run_dir} has no {CHECKPOINT_NAME}: the run stopped before its first checkpoint, "
             "or the file was moved or deleted, so there is nothing to resume. Restore it from a "

@@ -76,7 +76,15 @@ from simoun_agent.run.checkpoint import (
 )
 from simoun_agent.run.env_runner import EnvRunner, make_runner
 from simoun_agent.run.evaluate import EvaluationStopped, NonFiniteReward, evaluate, metrics_json
-from simoun_agent.run.kept import Damaged, binary_problem, broken_link, present, read_text
+from simoun_agent.run.kept import (
+    Damaged,
+    binary_problem,
+    broken_link,
+    kind_problem,
+    packed_problem,
+    present,
+    read_text,
+)
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -89,7 +97,13 @@ from simoun_agent.run.layout import (
 from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
-from simoun_agent.run.rundir import make_output_dir, take_run_dir
+from simoun_agent.run.rundir import (
+    folder_kind,
+    make_output_dir,
+    study_of,
+    study_run_refusal,
+    take_run_dir,
+)
 from simoun_agent.run.seeds import Stream, first_eval_seed, int_seed, stream, train_episode_seed
 from simoun_agent.run.signals import Stopped, deferred_stop
 from simoun_agent.run.state import Counters, Run
@@ -325,6 +339,10 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             f"--resume {run_dir} {why}; pass the directory that simoun-train created (its "
             "path is printed as 'run directory: ...' when a run starts)"
         )
+    check_packed_files(run_dir)
+    study = study_of(run_dir)
+    if study is not None and not present(run_dir / CHECKPOINT_NAME):  # nothing written there
+        raise study_run_refusal(run_dir, study)
     for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, SUMMARY_NAME):  # before anything is changed
         path = run_dir / name
         if path.exists() and not path.is_file():
@@ -334,6 +352,11 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             raise damaged_log(path, problem)
         if problem:
             raise damaged_config(path, problem)
+    if not config_path.is_file() and (kind := folder_kind(run_dir)) is not None:
+        raise SetupError(
+            f"--resume {run_dir} is {kind}, not a run directory; pass the directory of one of "
+            "its runs that holds checkpoint.pt"
+        )
     if not config_path.is_file():
         raise SetupError(
             f"{run_dir} is not a simoun run directory (no {CONFIG_NAME}); pass the directory "
@@ -343,6 +366,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         saved = json.loads(read_text(config_path))
     except (Damaged, json.JSONDecodeError) as err:
         raise damaged_config(config_path, str(err)) from None
+    if isinstance(saved, dict) and (problem := kind_problem(CONFIG_NAME, list(saved))):
+        raise damaged_config(config_path, problem)
     fixed = [key for key, value in overrides.items() if changes(saved, key, value, run_dir)]
     if fixed:
         raise SetupError(
@@ -429,25 +454,26 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     return run
 
 
-UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
-"""A compressed file's suffix -> the command that restores the file beside it."""
-
-
 def missing_replay(path: Path) -> str:
     """The refusal for the checkpoint's replay missing at ``path``: where a compressed copy
     lies beside it (the replay packed by hand to save space), the command that unpacks it."""
-    copies = [path.with_name(path.name + suffix) for suffix in UNPACK]
-    packed = next((copy for copy in copies if present(copy)), None)
+    packed = packed_problem(path, " (the replay of the checkpoint)")
     if packed is not None:
-        return (
-            f"{path} (the replay of the checkpoint) is missing, but {packed.name} lies beside "
-            f"it: unpack it ({UNPACK[packed.suffix]} -k {packed}) and resume again; the run "
-            "reads the replay as it was saved"
-        )
+        return f"{packed} and resume again; the run reads the replay as it was saved"
     return (
         f"{path} (the replay of the checkpoint) is missing; the run cannot continue exactly. "
         "Restore it from a copy, or start a new run."
     )
+
+
+def check_packed_files(run_dir: Path) -> None:
+    """Refuse a resumed run whose config.json or a log is missing while a compressed copy lies
+    beside it: the run would go on with a new log from its checkpoint (the rows before lost for
+    good) or be taken for no run, where unpacking the file lets it resume whole."""
+    for name in (CONFIG_NAME, EVAL_CSV, TRAIN_CSV, CHECKPOINT_NAME):
+        packed = packed_problem(run_dir / name)
+        if packed is not None:
+            raise SetupError(f"{packed} and resume again. Nothing in the run was changed")
 
 
 def check_logs_reach(run_dir: Path, state: dict[str, Any]) -> None:

@@ -192,9 +192,13 @@ def describe_change(trained: dict[str, Any], wanted: dict[str, Any], key: str) -
 
 def read_finished(spec: StudySpec, archive: Path, run: Run) -> dict[str, Any]:
     """A finished run's checked ``summary.json``, its ``config.json`` checked against ``spec``
-    (SetupError naming a damaged file)."""
+    and its logs read as the report and the selection read them (SetupError naming a damaged
+    file): ``run``, ``report`` and ``select`` each check every finished run's files this way
+    before their work, so that a damaged log is named before hours of training, not after."""
     summary = read_summary(archive / run.name / SUMMARY, spec, run)
     check_config(archive / run.name / CONFIG, spec, run)
+    read_eval(archive / run.name / EVAL_CSV)
+    read_rows(archive / run.name / TRAIN_CSV, TRAIN_COLUMNS)
     return summary
 
 

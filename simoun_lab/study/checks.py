@@ -22,7 +22,13 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
-from simoun_agent.run.kept import Damaged, folder_problem, present, read_json_object
+from simoun_agent.run.kept import (
+    Damaged,
+    folder_problem,
+    kind_problem,
+    present,
+    read_json_object,
+)
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
@@ -243,9 +249,13 @@ def read_config(path: Path) -> dict[str, Any]:
     """A finished run's saved ``config.json``; SetupError naming the file, what is wrong and the
     fix when it is damaged: the run cannot be checked against the fixed spec without it."""
     try:
-        return read_json_object(path)
+        saved = read_json_object(path)
     except Damaged as err:
         problem = str(err)
+    else:
+        problem = kind_problem(path.name, list(saved))
+        if problem is None:
+            return saved
     run_dir = path.parent
     raise SetupError(
         f"{path} is damaged: {problem}. Restore it from a copy (the study directory and its "

@@ -14,7 +14,7 @@ from simoun_agent.config import SetupError, resolve, to_dict
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import present
+from simoun_agent.run.kept import packed_problem, present
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.logger import EVAL_CSV, read_csv
 from simoun_lab.study.plan import StudyRun, tuning_runs
@@ -80,6 +80,8 @@ def check_config(spec: StudySpec, study_dir: Path, run: StudyRun) -> None:
     as this run's)."""
     run_dir = Path(study_dir, run.name)
     path = run_dir / CONFIG_NAME
+    if packed := packed_problem(path):
+        raise damaged_run(run_dir, packed)
     if not present(path):
         raise damaged_run(run_dir, f"{CONFIG_NAME} is missing, but the run finished")
     try:

@@ -33,6 +33,7 @@ known maximum).
 from __future__ import annotations
 
 import csv
+import difflib
 import json
 import math
 from collections.abc import Callable, Iterable
@@ -759,6 +760,8 @@ def update_cost_problem(spec: StudySpec, costs: dict[str, Any]) -> str | None:
     for key in ("ratio", "ms_per_update"):
         if not isinstance(costs[key], dict):
             return f"its {key} is not an object"
+        if problem := unknown_recipe(key, costs[key], recipes):
+            return problem
         for recipe, value in costs[key].items():
             if not (is_real(value) and value > 0):
                 return (
@@ -768,6 +771,24 @@ def update_cost_problem(spec: StudySpec, costs: dict[str, Any]) -> str | None:
     untimed = [recipe for recipe in costs["ratio"] if recipe not in costs["ms_per_update"]]
     if untimed:
         return f"ratio has {', '.join(untimed)}, which ms_per_update does not"
+    return None
+
+
+def unknown_recipe(key: str, values: dict[str, Any], recipes: list[str]) -> str | None:
+    """What is wrong when ``values`` (the file's ``key``: ratio or ms_per_update) holds a name
+    that is no recipe (a run's folder, a misspelling), with the study's recipe it comes closest
+    to: left alone, its recipe would be reported as having no ratio. A recipe of simoun outside
+    this study (``recipe_update.py --ablations`` times more) is taken; the report leaves it out."""
+    for name in values:
+        if name in recipes or name in RECIPES:
+            continue
+        close = [recipe for recipe in recipes if name.split("/")[0] == recipe]
+        close = close or difflib.get_close_matches(name, recipes, n=1, cutoff=0.6)
+        guess = f" (did you mean {close[0]}? rename the key to it)" if close else ""
+        return (
+            f"its {key} has {json.dumps(name)}, which is not a recipe{guess}: the file is keyed "
+            f"by recipe name (this study's: {', '.join(recipes)}), not by a run's folder"
+        )
     return None
 
 

@@ -33,8 +33,15 @@ from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, folder_problem, present, read_json_object
-from simoun_agent.run.layout import CONFIG_NAME
+from simoun_agent.run.kept import (
+    Damaged,
+    folder_problem,
+    kind_problem,
+    present,
+    read_json_object,
+)
+from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
+from simoun_agent.run.rundir import folder_kind
 from simoun_lab.sweep.saved import saved_problem
 
 SWEEP_FILE = "sweep.json"
@@ -430,6 +437,11 @@ class SweepSpec:
         if sweep_dir.name == SWEEP_FILE and not sweep_dir.is_dir():
             sweep_dir = sweep_dir.parent  # the file itself: read it, not sweep.json/sweep.json
         path = sweep_dir / SWEEP_FILE
+        if not present(path) and (kind := folder_kind(sweep_dir)) is not None:
+            raise SetupError(
+                f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing): it is {kind}; pass the "
+                "--sweep-dir of a sweep that simoun-sweep started"
+            )
         if not present(path):
             raise SetupError(
                 f"{sweep_dir} holds no sweep ({SWEEP_FILE} is missing); pass the --sweep-dir of "
@@ -475,9 +487,12 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     if not present(path):
         return f"{CONFIG_NAME} is missing, though the run's other files are there"
     try:
-        saved = flatten(read_json_object(path))
+        record = read_json_object(path)
     except Damaged as err:
         return f"{CONFIG_NAME} is damaged: {err}"
+    if problem := kind_problem(CONFIG_NAME, list(record)):
+        return f"{CONFIG_NAME} is damaged: {problem}"
+    saved = flatten(record)
     for key in ("env", "seed", *grid):
         recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
         if key in saved and recorded != wanted:
@@ -555,6 +570,29 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
         differences = config_differences(trial)
         if differences:
             raise differences_refusal(trial, sweep_dir, differences)
+        problem = summary_kind_problem(trial)
+        if problem:
+            run_dir = trial.run_dir
+            raise SetupError(
+                f"trial {trial.name}: {Path(run_dir, SUMMARY_NAME)} is damaged: {problem}; "
+                f"restore {SUMMARY_NAME} from a copy, or move the run directory aside (mv "
+                f"{run_dir} {run_dir}.aside) so that the trial trains anew"
+            )
+
+
+def summary_kind_problem(trial: Trial) -> str | None:
+    """What is wrong with the trial's summary.json when it holds another file's keys
+    (:func:`~simoun_agent.run.kept.kind_problem`: config.json copied over it), which would
+    count the trial as finished; else None (a summary that cannot be read is the report's to
+    name, as it reads the run's result)."""
+    path = Path(trial.run_dir) / SUMMARY_NAME
+    if not path.is_file():
+        return None
+    try:
+        record = read_json_object(path)
+    except (Damaged, OSError):
+        return None
+    return kind_problem(SUMMARY_NAME, list(record))
 
 
 def check_runnable(

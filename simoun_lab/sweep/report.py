@@ -56,13 +56,15 @@ from simoun_agent.run.kept import (
     STEP_LIMIT,
     Damaged,
     folder_problem,
+    kind_problem,
+    packed_problem,
     present,
     read_json_object,
     read_text,
 )
 from simoun_agent.run.layout import CONFIG_NAME, EVAL_CSV, SUMMARY_NAME
 from simoun_agent.run.logger import log_values
-from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.rundir import STUDY_RECORD, make_output_dir
 from simoun_lab import stats
 from simoun_lab.sweep.grid import (
     BASE_VARIANT,
@@ -213,7 +215,8 @@ def config_paths(root: Path, damaged: list[str]) -> list[Path]:
     """Every run's ``config.json`` under ``root`` (a link to nothing included: its run is named
     as damaged), Tune's records under ``tune/`` and hidden folders skipped. A link to a folder
     is followed (a run moved elsewhere and linked back is a run), each folder once; a link to a
-    folder it is in (a loop) is named in ``damaged``, not walked round."""
+    folder it is in (a loop), and a folder whose config.json lies packed beside its name
+    (``config.json.gz``), are named in ``damaged``, not walked round or passed over."""
     found: list[Path] = []
     seen = {os.path.realpath(root)}
     for top, folders, files in os.walk(root, followlinks=True):
@@ -231,21 +234,29 @@ def config_paths(root: Path, damaged: list[str]) -> list[Path]:
                 kept.append(name)
         folders[:] = kept
         found += [here / CONFIG_NAME] if CONFIG_NAME in files else []
+        if CONFIG_NAME not in files and (packed := packed_problem(here / CONFIG_NAME)):
+            damaged.append(f"{here.relative_to(root).as_posix()}: {packed}")
     return sorted(found)
 
 
 def read_json(path: Path) -> dict[str, Any]:
-    """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it."""
+    """A JSON object from ``path``, or :class:`DamagedRun` saying what is wrong with it (a run's
+    config.json or summary.json holding the other's keys included: :func:`kind_problem`)."""
     try:
-        return read_json_object(path)
+        data = read_json_object(path)
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
+    if not MINIGRID_RUN_KEYS <= data.keys() and (problem := kind_problem(path.name, list(data))):
+        raise DamagedRun(f"{path.name} is damaged: {problem}")
+    return data
 
 
 def read_curve(path: Path) -> dict[str, np.ndarray]:
     """eval.csv's :data:`CURVE_COLUMNS`, or :class:`DamagedRun`: a file with a column
     missing, a value that is not a number, or a NaN or infinite return would otherwise blank
     or bend the statistics of its whole row."""
+    if packed := packed_problem(path):
+        raise DamagedRun(packed.replace(f"{path} is", f"{path.name} is", 1))
     if not path.is_file() and not path.is_symlink():
         return {key: np.zeros(0) for key in CURVE_COLUMNS}
     try:
@@ -256,6 +267,8 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
     if path.stat().st_size and not rows and "env_step" not in read_text(path):
         raise DamagedRun(f"{path.name} has no header line")
+    if rows and (problem := kind_problem(path.name, list(rows[0]))):
+        raise DamagedRun(f"{path.name} is damaged: {problem}")
     if rows and (missing := [key for key in CURVE_COLUMNS if key not in rows[0]]):
         raise DamagedRun(f"{path.name} has no column {', '.join(missing)}")
     curve = {key: np.array([row[key] for row in rows], dtype=float) for key in CURVE_COLUMNS}
@@ -722,6 +735,7 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
             f"{root} is a file, not a directory; pass a sweep directory (simoun-sweep "
             "--sweep-dir) or the parent of run directories"
         )
+    refuse_study(root)
     damaged: list[str] = []
     records = sweep_trials_only(root, find_runs(root, damaged), damaged)
     if not records:
@@ -1117,6 +1131,20 @@ def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
 AGGREGATE_COLUMNS = ["variant", "tasks", "runs", "iqm", "iqm_low", "iqm_high", "mean", "mean_low"]
 AGGREGATE_COLUMNS += ["mean_high"]
 IMPROVEMENT_COLUMNS = ["x", "y", "tasks", "p", "low", "high"]
+
+
+def refuse_study(root: Path) -> None:
+    """SetupError for a simoun-study directory or archive given whole: its tuning variants and
+    its evaluation runs, of other budgets, would be compared side by side as one sweep, and the
+    report written among the study's records; ``simoun-study report`` is its report, and a
+    phase of it (``evaluation/``) is a comparison simoun-report makes."""
+    if (root / STUDY_RECORD).is_file():
+        raise SetupError(
+            f"{root} is a simoun-study directory or archive (it holds {STUDY_RECORD}), which "
+            f"simoun-report does not report whole; report it with `simoun-study report SPEC "
+            f"--study-dir {root}` (SPEC: the study's spec, e.g. docs/studies/dmc100k.toml), or "
+            f"compare the runs of one phase with `simoun-report {root / 'evaluation'} --out DIR`"
+        )
 
 
 def default_out(root: Path) -> Path:
