@@ -504,6 +504,13 @@ class _Reader:
     ) -> None:
         """A key the study does not set, that exists, and that no recipe fixes (the grid's
         keys: :meth:`check_overrides`)."""
+        if key == "preset" and table == "[grid]":
+            raise self.fail(
+                where,
+                "the grid cannot vary the preset: the config key preset only labels a run, and "
+                "a preset's values are applied by preset in [base], one per study; to compare "
+                "presets, run one study per preset, each spec with its own preset in [base]",
+            )
         if key in STUDY_SETS:
             raise self.fail(where, f"the study sets {key} itself; give it as {STUDY_SETS[key]}")
         if key not in self.fields:
