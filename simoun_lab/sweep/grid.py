@@ -414,7 +414,8 @@ class SweepSpec:
             try:
                 resolve(trial.preset, trial.overrides)
             except SetupError as err:
-                raise SetupError(f"trial {trial.name} (from {source}): {err}") from None
+                note = grid_note(str(err), trial, self.grid) if source.startswith("--grid") else ""
+                raise SetupError(f"trial {trial.name} (from {source}): {err}{note}") from None
             if trial.run_dir in seen:
                 first = seen[trial.run_dir]
                 fix = "make their --grid values differ in letters or digits"
@@ -621,7 +622,9 @@ def check_runnable(
             check_decisions(config, made[env])  # the action repeat may differ by trial
             check_replay(config, made[env])
         except SetupError as err:
-            raise SetupError(f"trial {trial.name}: {err}") from None
+            raise SetupError(
+                f"trial {trial.name}: {err}{grid_note(str(err), trial, grid)}"
+            ) from None
         memory = {**asdict(config), "env": None, "seed": None, "run_dir": None}
         key = json.dumps(memory, sort_keys=True, default=str)
         if key not in measured:
@@ -629,10 +632,32 @@ def check_runnable(
             try:
                 warning = check_memory(config)
             except SetupError as err:
-                raise SetupError(f"trial {trial.name}: {err}") from None
+                note = grid_note(str(err), trial, grid)
+                raise SetupError(f"trial {trial.name}: {err}{note}") from None
             for said in (warning, budget_warning(config)):
                 if said:
+                    said += grid_note(said, trial, grid)
                     print(f"simoun-sweep: warning: trial {trial.name}: {said}", file=sys.stderr)
+
+
+def grid_note(said: str, trial: Trial, grid: dict[str, list[Any]]) -> str:
+    """For each ``grid`` key whose flag the message ``said`` about ``trial`` names (its fix
+    advises ``--action-repeat 40``), the note that the trial's value came from ``--grid`` and
+    that the fix goes there: the key's base flag is refused beside ``--grid``. Empty when the
+    message names no gridded key."""
+    notes = []
+    for key, values in grid.items():
+        flag = "--" + key.replace("_", "-")
+        if re.search(re.escape(flag) + r"(?![\w.-])", said) is None:
+            continue
+        value = show(trial.overrides[key])
+        given = f"{key}={','.join(show(v) for v in values)}"
+        notes.append(
+            f"{flag} {value} is this trial's value from --grid {given}: make the fix in "
+            f"--grid (leave {value} out of its values, or replace it by a value that works), "
+            f"not as a base {flag}, which --grid refuses beside it"
+        )
+    return "".join(f"; {note}" for note in notes)
 
 
 def check_trial_config(config: TrainConfig, grid: dict[str, list[Any]]) -> None:
