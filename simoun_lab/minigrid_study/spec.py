@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,9 +57,64 @@ class PPOSettings:
     clip_range: float = setting(0.2, real(0, open_low=True))
     """PPO's ratio clip (zoo: 0.2)"""
 
+    def __post_init__(self) -> None:
+        problem = minibatch_problem(self.n_envs, self.n_steps, self.batch_size)
+        if problem:
+            raise SetupError(problem)
+
     def kwargs(self) -> dict[str, Any]:
         """The settings as ``stable_baselines3.PPO`` keyword arguments (``n_envs`` left out)."""
         return {k: v for k, v in dataclasses.asdict(self).items() if k != "n_envs"}
+
+
+def minibatch_problem(n_envs: int, n_steps: int, batch_size: int) -> str | None:
+    """What SB3's PPO would refuse or quietly change in these settings, with the fix: a rollout
+    (``n_envs x n_steps`` transitions) or a mini-batch of one transition (each mini-batch's
+    advantages are normalized), a ``batch_size`` larger than the rollout (SB3 trains on the
+    whole rollout, while every run records ``batch_size``) or one that does not divide it
+    (each epoch ends on a truncated mini-batch); None when they fit."""
+    rollout = n_envs * n_steps
+    said = f"n_envs x n_steps = {n_envs} x {n_steps} = {rollout} transitions"
+    if rollout < 2:
+        return (
+            f"one rollout is {said}; SB3's PPO normalizes advantages over it and needs 2 or "
+            "more: raise n_steps (e.g. 128)"
+        )
+    if batch_size < 2:
+        return (
+            f"batch_size {batch_size}: SB3's PPO normalizes each mini-batch's advantages and "
+            f"needs mini-batches of 2 or more; set batch_size to a divisor of {rollout} "
+            f"({said}), e.g. {nearest_divisors(rollout, 64)[0]}"
+        )
+    if rollout % batch_size == 0:
+        return None
+    below, above = nearest_divisors(rollout, batch_size)
+    fit = batch_size // math.gcd(batch_size, n_envs)  # the fewest n_steps a batch divides
+    steps = fit * math.ceil(n_steps / fit)
+    if batch_size > rollout:
+        problem = (
+            f"batch_size {batch_size} is larger than one rollout ({said}): SB3 would train "
+            f"on mini-batches of {rollout} while every run records {batch_size}"
+        )
+    else:
+        problem = (
+            f"batch_size {batch_size} does not divide one rollout ({said}): each epoch "
+            f"would end on a truncated mini-batch of {rollout % batch_size} transitions"
+        )
+    choices = " or ".join(str(size) for size in dict.fromkeys((below, above)) if size > 1)
+    return (
+        f"{problem}; set batch_size to a divisor of {rollout} (e.g. {choices}), or n_steps "
+        f"to {steps} (a rollout of {n_envs * steps} transitions)"
+    )
+
+
+def nearest_divisors(number: int, near: int) -> tuple[int, int]:
+    """The divisors of ``number`` nearest ``near``, at most and at least it (``number`` when
+    ``near`` is larger)."""
+    divisors = [d for d in range(1, number + 1) if number % d == 0]
+    below = max((d for d in divisors if d <= near), default=1)
+    above = min((d for d in divisors if d >= near), default=number)
+    return below, above
 
 
 def is_minigrid_id(value: Any) -> bool:
@@ -217,7 +273,10 @@ def build(cls: type, values: dict[str, Any], where: str) -> Any:
             raise SetupError(
                 f"{where}: {name} is {json.dumps(values[name])}, which must be {rules[name].need}"
             )
-    return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
+    try:
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
+    except SetupError as err:  # a check of the values together: name the file too
+        raise SetupError(f"{where}: {err}") from None
 
 
 def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
