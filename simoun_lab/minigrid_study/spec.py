@@ -24,7 +24,8 @@ from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
 from simoun_agent.run.kept import Damaged, json_kind, json_problem, read_text
 from simoun_lab.minigrid_study.arms import ARMS, arm_settings
-from simoun_lab.study.record_file import record_not_spec
+from simoun_lab.study.given_path import blanks_note, shown
+from simoun_lab.study.record_file import record_not_spec, selection_not_spec
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -307,27 +308,29 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
     """The spec in the JSON file ``path``, or in the TOML file when it ends in ``.toml`` or is
     TOML and not JSON; errors name it as ``label`` (the flag or argument it was given by)."""
     is_toml = Path(path).suffix.lower() == ".toml"
+    as_toml = is_toml
     try:
         text = read_text(Path(path))
         values = toml_values(text, path, label) if is_toml else json_value(text)
     except FileNotFoundError:
-        raise SetupError(f"{label} {path}: no such file") from None
+        raise SetupError(f"{label} {shown(path)}: no such file{blanks_note(path)}") from None
     except Damaged as err:
         kind = "TOML" if is_toml else "JSON"
         raise SetupError(
-            f"{label} {path} cannot be read ({err}); pass a {kind} spec saved as UTF-8 text"
+            f"{label} {shown(path)} cannot be read ({err}); pass a {kind} spec saved as UTF-8 text"
         ) from None
     except json.JSONDecodeError as err:
         # a TOML spec under another name reads as TOML, as simoun-study reads it
-        values = toml_values(text, path, label, quiet=True)
+        values, as_toml = toml_values(text, path, label, quiet=True), True
         if not values:
             problem = json_problem(text, err)
-            raise SetupError(f"{label} {path} is not valid JSON: {problem}") from None
+            raise SetupError(f"{label} {shown(path)} is not valid JSON: {problem}") from None
     except ValueError as err:  # a key given twice
-        raise SetupError(f"{label} {path}: {err}") from None
-    record = record_not_spec(values, path, label)
-    if record is not None:
-        raise record
+        raise SetupError(f"{label} {shown(path)}: {err}") from None
+    for refusal in (record_not_spec, selection_not_spec):
+        refused = refusal(values, path, label)
+        if refused is not None:
+            raise refused
     if not isinstance(values, dict):
         raise SetupError(
             f"{label} {path} holds {json_kind(values)}, not the object of a study spec "
@@ -337,12 +340,33 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
         )
     sac = [key for key in SAC_SPEC_KEYS if key in values]
     if sac and "arms" not in values:
-        raise SetupError(
-            f"{label} {path} is a SAC study's spec (it has {sac[0]}), not a MiniGrid PPO spec; "
-            f"plan and run it with simoun-study (simoun-study plan {path}), or pass a MiniGrid "
-            "spec such as docs/studies/minigrid-v2/tuning/spec.json"
-        )
+        raise SetupError(sac_spec_problem(path, label, sac[0], as_toml))
     return spec_from_dict(values, str(path))
+
+
+def sac_spec_problem(path: Path, label: str, key: str, as_toml: bool) -> str:
+    """The refusal of a SAC study's spec (it has ``key``) given as a MiniGrid spec by ``label``
+    at ``path``, read as TOML when ``as_toml``: simoun-study takes a ``.toml`` file as a SAC
+    spec and a ``.json`` file as a MiniGrid one, so the fix is the name (a TOML spec saved as
+    ``.json``), the format (a SAC spec written as JSON), or the command (a ``.toml`` given to
+    the MiniGrid study's own command)."""
+    said = f"{label} {shown(path)} is a SAC study's spec (it has {key}), not a MiniGrid PPO spec"
+    example = "or pass a MiniGrid spec such as docs/studies/minigrid-v2/tuning/spec.json"
+    toml = Path(path).with_suffix(".toml")
+    if not as_toml:
+        return (
+            f"{said}, written as JSON: simoun-study reads a .json spec as a MiniGrid one and a "
+            f"SAC spec from TOML; write it as TOML in {shown(toml)} (docs/studies/dmc100k.toml "
+            f"shows the layout) and plan it with simoun-study plan {shown(toml)}, {example}"
+        )
+    if Path(path).suffix.lower() != ".toml":
+        return (
+            f"{said}: it is TOML saved under a {Path(path).suffix or 'bare'} name, and "
+            f"simoun-study reads a .json spec as a MiniGrid one; rename it to .toml (mv "
+            f"{shown(path)} {shown(toml)}) and plan it with simoun-study plan {shown(toml)}, "
+            f"{example}"
+        )
+    return f"{said}; plan and run it with simoun-study (simoun-study plan {shown(path)}), {example}"
 
 
 def toml_values(text: str, path: Path, label: str, quiet: bool = False) -> dict | None:
