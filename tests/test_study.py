@@ -331,6 +331,8 @@ BAD_SPECS = [
     ("agent.n_step = [1, 3]", 'agent.n_step = "three"',
      "give a non-empty list of values, e.g. agent.n_step = [1, ...]"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 1]", "a value is listed twice"),
+    ("agent.n_step = [1, 3]", 'agent.n_step = [1, 3]\npreset = ["cpu", "highway-cpu"]',
+     "[grid] preset: the grid cannot vary the preset: the config key preset only labels a run"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 0]", "agent.n_step = 0"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 3.5]", "cannot read agent.n_step='3.5'"),
     ("agent.n_step = [1, 3]", '# no grid values', "the grid is empty"),
