@@ -48,10 +48,15 @@ def selection_not_spec(values: Any, path: Path | str, label: str) -> SetupError 
     kinds = [kind for kind, keys in SELECTION_KEYS.items() if all(key in values for key in keys)]
     if not kinds or any(isinstance(values.get(key), list) for key in ("arms", "recipes")):
         return None  # a spec: its arms or recipes are a list
+    fix = f"pass {spec_beside(Path(path))}"
+    if label == "--spec" and kinds[0] == "SAC":  # the MiniGrid study's own command
+        fix = (
+            "leave --spec out to use the archive's spec.json, or pass a MiniGrid spec such as "
+            "docs/studies/minigrid-v2/tuning/spec.json"
+        )
     return SetupError(
         f"{label} {shown(path)} is the selection a {kinds[0]} study wrote (each "
-        f"{'recipe' if kinds[0] == 'SAC' else 'arm'}'s selected setting), not a study spec; "
-        f"pass {spec_beside(Path(path))}"
+        f"{'recipe' if kinds[0] == 'SAC' else 'arm'}'s selected setting), not a study spec; {fix}"
     )
 
 
