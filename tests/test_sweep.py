@@ -557,6 +557,8 @@ SWEEP_JSON_DAMAGES = [
     (lambda d: d.update(grid={"agent.lr": []}), "grid: agent.lr is [], not a non-empty list"),
     (lambda d: d.update(grid={"agent.lr": ["x"]}), 'grid: agent.lr is "x", which must be a number'),
     (lambda d: d.update(grid={"seed": [1, 2]}), "grid varies seed, which the sweep sets"),
+    (lambda d: d.update(grid={"preset": ["cpu", "highway-cpu"]}), "grid varies preset, which "
+     "only labels a run: a sweep has one preset"),
     (lambda d: d.update(grid=[]), "grid is [], not a JSON object"),
     (lambda d: d.update(preset="cpux"), "preset is \"cpux\", which is no preset (did you mean"),
     (lambda d: d["base"].update(nope=1), "base: 'nope' is no config key"),
