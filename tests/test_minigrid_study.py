@@ -604,3 +604,120 @@ def test_a_study_record_given_as_a_minigrid_spec_is_named_with_its_spec(tmp_path
     said = str(refused.value)
     assert f"--spec {record} is a study's record" in said and "not a study spec" in said
     assert "docs/studies/dmc100k.toml" in said and "unknown key" not in said
+
+
+def tree_bytes(root: Path) -> dict[str, bytes]:
+    """Every file under ``root`` by its path under it, with its bytes."""
+    return {
+        str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
+    }
+
+
+def test_a_minigrid_run_refuses_a_sac_archive_and_a_folder_inside_any_archive(tmp_path):
+    sac = Path(shutil.copytree("docs/studies/dmc100k", tmp_path / "arch"))
+    mgt = Path(shutil.copytree("docs/studies/minigrid-v2/tuning", tmp_path / "mgt"))
+    kept = {root: tree_bytes(root) for root in (sac, mgt)}
+    spec = str(mgt / "spec.json")
+    work = tmp_path / "s"
+    for resume in ([], ["--resume"]):
+        status, printed = simoun_study("run", spec, "--study-dir", str(work), "--archive",
+                                       str(sac), *resume)  # fmt: skip
+        assert status == 2 and "Traceback" not in printed
+        assert f"--archive {sac} holds a SAC study, 'dmc100k' ({sac / 'study.json'})" in printed
+        assert "drop --resume" not in printed
+    status, printed = simoun_study("run", spec, "--study-dir", str(sac))
+    assert status == 2 and f"--study-dir {sac} holds a SAC study, 'dmc100k'" in printed
+    for inside, owner in ((sac / "tuning", sac), (mgt / "MiniGrid-DoorKey-6x6-v0", mgt)):
+        status, printed = simoun_study("run", spec, "--study-dir", str(work), "--archive",
+                                       str(inside))  # fmt: skip
+        assert status == 2 and f"--archive {inside} lies inside {owner}, the archive of" in printed
+    status, printed = simoun_study("run", "docs/studies/dmc100k.toml", "--study-dir", str(work),
+                                   "--archive", str(sac / "tuning"))  # fmt: skip
+    assert status == 2 and f"lies inside {sac}, the archive of a SAC study" in printed
+    for args in (["run", "--archive", str(sac)], ["run", "--archive", str(sac / "tuning")],
+                 ["select", "--archive", str(sac / "tuning" / "drq")]):  # fmt: skip
+        status, printed = (
+            study(*args, "--work-dir", str(work)) if args[0] == "run" else study(*args)
+        )
+        assert status == 2 and "Traceback" not in printed
+        assert f"{sac}" in printed and "SAC study, 'dmc100k'" in printed
+    assert {root: tree_bytes(root) for root in (sac, mgt)} == kept
+    assert not work.exists() and not (sac / "spec.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("ppo", "said"),
+    [
+        ({"batch_size": 2048}, "ppo: batch_size 2048 is larger than one rollout (n_envs x "
+         "n_steps = 8 x 128 = 1024 transitions): SB3 would train on mini-batches of 1024 while "
+         "every run records 2048; set batch_size to a divisor of 1024 (e.g. 1024), or n_steps "
+         "to 256"),
+        ({"batch_size": 100}, "batch_size 100 does not divide one rollout (n_envs x n_steps = "
+         "8 x 128 = 1024 transitions): each epoch would end on a truncated mini-batch of 24 "
+         "transitions; set batch_size to a divisor of 1024 (e.g. 64 or 128), or n_steps to 150"),
+        ({"batch_size": 1}, "batch_size 1: SB3's PPO normalizes each mini-batch's advantages"),
+        ({"n_envs": 1, "n_steps": 1, "batch_size": 2}, "one rollout is n_envs x n_steps = 1 x 1"),
+    ],
+)  # fmt: skip
+def test_a_batch_size_sb3_would_truncate_or_refuse_is_refused_at_plan(ppo, said, tmp_path):
+    values = json.loads(Path("docs/studies/minigrid-v2/tuning/spec.json").read_text())
+    path = tmp_path / "spec.json"
+    path.write_text(json.dumps({**values, "ppo": {**values["ppo"], **ppo}}))
+    status, printed = simoun_study("plan", str(path))
+    assert status == 2 and said in printed and str(path) in printed, printed
+    assert "Traceback" not in printed
+    good = {**values["ppo"], "n_envs": 3, "n_steps": 100, "batch_size": 75}
+    assert spec_from_dict({**values, "ppo": good}, "x").ppo.batch_size == 75
+
+
+def test_a_file_that_is_no_minigrid_spec_is_named_with_a_fix_other_than_the_command(
+    tmp_path, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    docs = Path(__file__).resolve().parents[1] / "docs" / "studies"
+    shutil.copytree(docs / "dmc100k-drqv2-easy", "ez")
+    shutil.copy(docs / "dmc100k.toml", "spec.json")
+    Path("sac.json").write_text(json.dumps({"recipes": ["drq"], "grid": {}}))
+    mg = Path("mg")
+    mg.mkdir()
+    shutil.copy(docs / "minigrid-v2" / "tuning" / "spec.json", mg / "spec.json")
+    (mg / "selection.json").write_text(json.dumps({"arms": {}, "selected": {}}))
+    cases = {
+        "ez/selection.json": "is the selection a SAC study wrote (each recipe's selected "
+        "setting), not a study spec; pass the spec the study was run from, "
+        "docs/studies/dmc100k-drqv2-easy.toml (named in ez/study.json)",
+        "mg/selection.json": "is the selection a MiniGrid PPO study wrote (each arm's selected "
+        "setting), not a study spec; pass the spec the archive's runs were trained with, "
+        "mg/spec.json",
+        "spec.json": "it is TOML saved under a .json name, and simoun-study reads a .json spec "
+        "as a MiniGrid one; rename it to .toml (mv spec.json spec.toml) and plan it with "
+        "simoun-study plan spec.toml",
+        "sac.json": "written as JSON: simoun-study reads a .json spec as a MiniGrid one and a "
+        "SAC spec from TOML; write it as TOML in sac.toml",
+    }
+    for path, said in cases.items():
+        status, printed = simoun_study("plan", path)
+        assert status == 2 and said in printed, printed
+        assert f"simoun-study plan {path}" not in printed and "Traceback" not in printed
+        status, printed = study("select", "--archive", "mg", "--spec", path)
+        if path == "ez/selection.json":  # a SAC study's spec is no answer to the MiniGrid command
+            said = "selected setting), not a study spec; leave --spec out to use the archive's"
+        assert status == 2 and said in printed, printed
+
+
+def test_a_spec_path_with_a_trailing_blank_is_quoted_and_the_path_without_it_named(
+    tmp_path, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(Path(__file__).resolve().parents[1] / "docs/studies/dmc100k.toml", "dmc.toml")
+    Path("mg.json").write_text(json.dumps(TINY))
+    status, printed = simoun_study("plan", "dmc.toml ")
+    assert status == 2 and "cannot read the study spec 'dmc.toml ' (No such file" in printed
+    assert (
+        "'dmc.toml ' has a blank (a space or tab) at its start or end, and dmc.toml is" in printed
+    )
+    status, printed = simoun_study("plan", " mg.json")
+    assert status == 2 and "the study spec ' mg.json': no such file; ' mg.json' has a " in printed
+    status, printed = simoun_study("plan", "none.toml")
+    assert "cannot read the study spec none.toml (No such file" in printed
+    assert "has a blank" not in printed

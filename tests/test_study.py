@@ -331,6 +331,8 @@ BAD_SPECS = [
     ("agent.n_step = [1, 3]", 'agent.n_step = "three"',
      "give a non-empty list of values, e.g. agent.n_step = [1, ...]"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 1]", "a value is listed twice"),
+    ("agent.n_step = [1, 3]", 'agent.n_step = [1, 3]\npreset = ["cpu", "highway-cpu"]',
+     "[grid] preset: the grid cannot vary the preset: the config key preset only labels a run"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 0]", "agent.n_step = 0"),
     ("agent.n_step = [1, 3]", "agent.n_step = [1, 3.5]", "cannot read agent.n_step='3.5'"),
     ("agent.n_step = [1, 3]", '# no grid values', "the grid is empty"),
@@ -893,6 +895,39 @@ def test_a_study_is_refused_the_archive_of_a_minigrid_study(tmp_path):
     with pytest.raises(SetupError, match="holds runs of a MiniGrid PPO study"):
         open_study(spec_from(str(spec_path)), str(spec_path), options)
     assert not (archive / "study.json").exists()
+
+
+def test_a_study_is_refused_a_folder_inside_another_studys_archive(tmp_path, capsys):
+    archive = Path(shutil.copytree(DOCS / "dmc100k", tmp_path / "arch"))
+    mg = Path(shutil.copytree(DOCS / "minigrid-v2" / "tuning", tmp_path / "mg"))
+    kept = {p: p.read_bytes() for root in (archive, mg) for p in root.rglob("*") if p.is_file()}
+    spec_path = str(DOCS / "dmc100k.toml")
+    for inside, owner in ((archive / "tuning", archive), (mg / "MiniGrid-DoorKey-6x6-v0", mg)):
+        for flag in ("--archive", "--study-dir"):
+            study_dir = str(tmp_path / "s") if flag == "--archive" else str(inside)
+            argv = ["run", spec_path, "--study-dir", study_dir]
+            argv += ["--archive", str(inside)] if flag == "--archive" else []
+            with pytest.raises(SystemExit) as exit_info:
+                cli.main(argv)
+            assert exit_info.value.code == 2
+            err = capsys.readouterr().err
+            assert f"{flag} {inside} lies inside {owner}, the archive of a " in err, err
+        options = StudyOptions(study_dir=tmp_path / "s", archive=inside)
+        with pytest.raises(SetupError, match="lies inside"):
+            open_study(spec_from(spec_path), spec_path, options)
+    after = {p: p.read_bytes() for root in (archive, mg) for p in root.rglob("*") if p.is_file()}
+    assert after == kept and not (tmp_path / "s").exists()
+
+
+def test_plan_names_a_spec_path_with_a_trailing_blank(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write_spec(tmp_path / "tiny.toml")
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", "tiny.toml ", "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "cannot read the study spec 'tiny.toml ' (No such file or directory); " in err
+    assert "and tiny.toml is there: give the path without the blank" in err
 
 
 def test_plan_refuses_gpus_per_trial_for_runs_on_the_cpu(tmp_path, capsys):

@@ -337,6 +337,21 @@ def error_of(argv: list[str], capsys) -> str:
          "ends after 20 env steps"),
         (["--gpus-per-trial", "0.5"], "--gpus-per-trial 0.5 and --device cpu contradict each "
          "other: each trial would reserve 0.5 GPUs it never uses"),
+        # a preset only labels a run under --grid: its values come with --preset, one a sweep
+        (["--grid", "preset=cpu,highway-cpu"], "--grid preset=cpu,highway-cpu: --grid cannot "
+         "vary the preset: the config key preset only labels a run"),
+        (["--grid", "preset=cpu"], "run one sweep per preset, each with its own --preset and "
+         "--sweep-dir"),
+        # a text key reads a bracketed list as one value
+        (["--grid", "agent.recipe=['simoun','drq']"], "--grid \"agent.recipe=['simoun','drq']\": "
+         "--grid takes each value, comma-separated, not a list in brackets; write --grid "
+         "agent.recipe=simoun,drq"),
+        (["--grid", "agent.encoder=(stacked, single)"], "write --grid "
+         "agent.encoder=stacked,single"),
+        # a per-trial check of a --grid value sends the fix to --grid, not to the base flag
+        (["--grid", "action_repeat=1,100"], "or --total-env-steps many times 100; "
+         "--action-repeat 100 is this trial's value from --grid action_repeat=1,100: make the "
+         "fix in --grid (leave 100 out of its values"),
     ],
 )  # fmt: skip
 def test_bad_grid_input_fails_before_anything_runs(flags, message, tmp_path, capsys):
@@ -542,6 +557,8 @@ SWEEP_JSON_DAMAGES = [
     (lambda d: d.update(grid={"agent.lr": []}), "grid: agent.lr is [], not a non-empty list"),
     (lambda d: d.update(grid={"agent.lr": ["x"]}), 'grid: agent.lr is "x", which must be a number'),
     (lambda d: d.update(grid={"seed": [1, 2]}), "grid varies seed, which the sweep sets"),
+    (lambda d: d.update(grid={"preset": ["cpu", "highway-cpu"]}), "grid varies preset, which "
+     "only labels a run: a sweep has one preset"),
     (lambda d: d.update(grid=[]), "grid is [], not a JSON object"),
     (lambda d: d.update(preset="cpux"), "preset is \"cpux\", which is no preset (did you mean"),
     (lambda d: d["base"].update(nope=1), "base: 'nope' is no config key"),

@@ -41,6 +41,7 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     from simoun_lab.minigrid_study.runner import SPEC_FILE, load_saved_spec
     from simoun_lab.minigrid_study.spec import StudySpec, load_spec
     from simoun_lab.minigrid_study.study_command import refuse_sac_study
+    from simoun_lab.study.owner import check_not_inside_study
 
     if not archive.is_dir():
         where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
@@ -48,6 +49,7 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
         start = "; to start a new study, create the directory first" if new else ""
         raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
     refuse_sac_study(archive, "--archive")
+    check_not_inside_study(archive, "--archive")
     if spec is not None:
         given = load_spec(spec)
         if present(archive / SPEC_FILE):
@@ -161,6 +163,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             fail(PROG, err)
         return 0
     try:
+        if isinstance(args, Run):
+            from simoun_lab.minigrid_study.study_command import check_run_places
+
+            check_run_places({"--archive": args.archive, "--work-dir": args.work_dir})
         spec = spec_for(args.spec, args.archive, new=isinstance(args, Run))
         if isinstance(args, Run):
             from simoun_lab.minigrid_study.runner import run_study

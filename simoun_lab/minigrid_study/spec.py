@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,7 +24,8 @@ from simoun_agent.config.keys import json_value
 from simoun_agent.config.rules import Rule, integer, is_int, real, rules_of, setting, with_rule
 from simoun_agent.run.kept import Damaged, json_kind, json_problem, read_text
 from simoun_lab.minigrid_study.arms import ARMS, arm_settings
-from simoun_lab.study.record_file import record_not_spec
+from simoun_lab.study.given_path import blanks_note, shown
+from simoun_lab.study.record_file import record_not_spec, selection_not_spec
 
 __all__ = ["PPOSettings", "Run", "StudySpec", "Task", "load_spec", "spec_from_dict"]
 
@@ -56,9 +58,64 @@ class PPOSettings:
     clip_range: float = setting(0.2, real(0, open_low=True))
     """PPO's ratio clip (zoo: 0.2)"""
 
+    def __post_init__(self) -> None:
+        problem = minibatch_problem(self.n_envs, self.n_steps, self.batch_size)
+        if problem:
+            raise SetupError(problem)
+
     def kwargs(self) -> dict[str, Any]:
         """The settings as ``stable_baselines3.PPO`` keyword arguments (``n_envs`` left out)."""
         return {k: v for k, v in dataclasses.asdict(self).items() if k != "n_envs"}
+
+
+def minibatch_problem(n_envs: int, n_steps: int, batch_size: int) -> str | None:
+    """What SB3's PPO would refuse or quietly change in these settings, with the fix: a rollout
+    (``n_envs x n_steps`` transitions) or a mini-batch of one transition (each mini-batch's
+    advantages are normalized), a ``batch_size`` larger than the rollout (SB3 trains on the
+    whole rollout, while every run records ``batch_size``) or one that does not divide it
+    (each epoch ends on a truncated mini-batch); None when they fit."""
+    rollout = n_envs * n_steps
+    said = f"n_envs x n_steps = {n_envs} x {n_steps} = {rollout} transitions"
+    if rollout < 2:
+        return (
+            f"one rollout is {said}; SB3's PPO normalizes advantages over it and needs 2 or "
+            "more: raise n_steps (e.g. 128)"
+        )
+    if batch_size < 2:
+        return (
+            f"batch_size {batch_size}: SB3's PPO normalizes each mini-batch's advantages and "
+            f"needs mini-batches of 2 or more; set batch_size to a divisor of {rollout} "
+            f"({said}), e.g. {nearest_divisors(rollout, 64)[0]}"
+        )
+    if rollout % batch_size == 0:
+        return None
+    below, above = nearest_divisors(rollout, batch_size)
+    fit = batch_size // math.gcd(batch_size, n_envs)  # the fewest n_steps a batch divides
+    steps = fit * math.ceil(n_steps / fit)
+    if batch_size > rollout:
+        problem = (
+            f"batch_size {batch_size} is larger than one rollout ({said}): SB3 would train "
+            f"on mini-batches of {rollout} while every run records {batch_size}"
+        )
+    else:
+        problem = (
+            f"batch_size {batch_size} does not divide one rollout ({said}): each epoch "
+            f"would end on a truncated mini-batch of {rollout % batch_size} transitions"
+        )
+    choices = " or ".join(str(size) for size in dict.fromkeys((below, above)) if size > 1)
+    return (
+        f"{problem}; set batch_size to a divisor of {rollout} (e.g. {choices}), or n_steps "
+        f"to {steps} (a rollout of {n_envs * steps} transitions)"
+    )
+
+
+def nearest_divisors(number: int, near: int) -> tuple[int, int]:
+    """The divisors of ``number`` nearest ``near``, at most and at least it (``number`` when
+    ``near`` is larger)."""
+    divisors = [d for d in range(1, number + 1) if number % d == 0]
+    below = max((d for d in divisors if d <= near), default=1)
+    above = min((d for d in divisors if d >= near), default=number)
+    return below, above
 
 
 def is_minigrid_id(value: Any) -> bool:
@@ -217,7 +274,10 @@ def build(cls: type, values: dict[str, Any], where: str) -> Any:
             raise SetupError(
                 f"{where}: {name} is {json.dumps(values[name])}, which must be {rules[name].need}"
             )
-    return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
+    try:
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
+    except SetupError as err:  # a check of the values together: name the file too
+        raise SetupError(f"{where}: {err}") from None
 
 
 def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:
@@ -248,27 +308,29 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
     """The spec in the JSON file ``path``, or in the TOML file when it ends in ``.toml`` or is
     TOML and not JSON; errors name it as ``label`` (the flag or argument it was given by)."""
     is_toml = Path(path).suffix.lower() == ".toml"
+    as_toml = is_toml
     try:
         text = read_text(Path(path))
         values = toml_values(text, path, label) if is_toml else json_value(text)
     except FileNotFoundError:
-        raise SetupError(f"{label} {path}: no such file") from None
+        raise SetupError(f"{label} {shown(path)}: no such file{blanks_note(path)}") from None
     except Damaged as err:
         kind = "TOML" if is_toml else "JSON"
         raise SetupError(
-            f"{label} {path} cannot be read ({err}); pass a {kind} spec saved as UTF-8 text"
+            f"{label} {shown(path)} cannot be read ({err}); pass a {kind} spec saved as UTF-8 text"
         ) from None
     except json.JSONDecodeError as err:
         # a TOML spec under another name reads as TOML, as simoun-study reads it
-        values = toml_values(text, path, label, quiet=True)
+        values, as_toml = toml_values(text, path, label, quiet=True), True
         if not values:
             problem = json_problem(text, err)
-            raise SetupError(f"{label} {path} is not valid JSON: {problem}") from None
+            raise SetupError(f"{label} {shown(path)} is not valid JSON: {problem}") from None
     except ValueError as err:  # a key given twice
-        raise SetupError(f"{label} {path}: {err}") from None
-    record = record_not_spec(values, path, label)
-    if record is not None:
-        raise record
+        raise SetupError(f"{label} {shown(path)}: {err}") from None
+    for refusal in (record_not_spec, selection_not_spec):
+        refused = refusal(values, path, label)
+        if refused is not None:
+            raise refused
     if not isinstance(values, dict):
         raise SetupError(
             f"{label} {path} holds {json_kind(values)}, not the object of a study spec "
@@ -278,12 +340,33 @@ def load_spec(path: Path, label: str = "--spec") -> StudySpec:
         )
     sac = [key for key in SAC_SPEC_KEYS if key in values]
     if sac and "arms" not in values:
-        raise SetupError(
-            f"{label} {path} is a SAC study's spec (it has {sac[0]}), not a MiniGrid PPO spec; "
-            f"plan and run it with simoun-study (simoun-study plan {path}), or pass a MiniGrid "
-            "spec such as docs/studies/minigrid-v2/tuning/spec.json"
-        )
+        raise SetupError(sac_spec_problem(path, label, sac[0], as_toml))
     return spec_from_dict(values, str(path))
+
+
+def sac_spec_problem(path: Path, label: str, key: str, as_toml: bool) -> str:
+    """The refusal of a SAC study's spec (it has ``key``) given as a MiniGrid spec by ``label``
+    at ``path``, read as TOML when ``as_toml``: simoun-study takes a ``.toml`` file as a SAC
+    spec and a ``.json`` file as a MiniGrid one, so the fix is the name (a TOML spec saved as
+    ``.json``), the format (a SAC spec written as JSON), or the command (a ``.toml`` given to
+    the MiniGrid study's own command)."""
+    said = f"{label} {shown(path)} is a SAC study's spec (it has {key}), not a MiniGrid PPO spec"
+    example = "or pass a MiniGrid spec such as docs/studies/minigrid-v2/tuning/spec.json"
+    toml = Path(path).with_suffix(".toml")
+    if not as_toml:
+        return (
+            f"{said}, written as JSON: simoun-study reads a .json spec as a MiniGrid one and a "
+            f"SAC spec from TOML; write it as TOML in {shown(toml)} (docs/studies/dmc100k.toml "
+            f"shows the layout) and plan it with simoun-study plan {shown(toml)}, {example}"
+        )
+    if Path(path).suffix.lower() != ".toml":
+        return (
+            f"{said}: it is TOML saved under a {Path(path).suffix or 'bare'} name, and "
+            f"simoun-study reads a .json spec as a MiniGrid one; rename it to .toml (mv "
+            f"{shown(path)} {shown(toml)}) and plan it with simoun-study plan {shown(toml)}, "
+            f"{example}"
+        )
+    return f"{said}; plan and run it with simoun-study (simoun-study plan {shown(path)}), {example}"
 
 
 def toml_values(text: str, path: Path, label: str, quiet: bool = False) -> dict | None:

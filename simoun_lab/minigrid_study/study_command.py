@@ -18,9 +18,11 @@ import tomllib
 from simoun_agent.config import SetupError
 from simoun_agent.run.kept import Damaged, present, read_text
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec
+from simoun_lab.study.given_path import shown
+from simoun_lab.study.owner import check_not_inside_study, sac_study
 from simoun_lab.study.runner import PPO_SPEC_FILE, STUDY_FILE, StudyOptions
 
-__all__ = ["is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
+__all__ = ["check_run_places", "is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
 
 
 def _toml(path: Path) -> dict | None:
@@ -73,8 +75,9 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
             "--allow-other-commit is for SAC study specs; a MiniGrid PPO study goes on at any "
             "commit (each run records its own): drop the flag"
         )
-    runner = _runner()
     archive = options.archive if options.archive is not None else options.study_dir
+    check_run_places({"--study-dir": options.study_dir, "--archive": archive})
+    runner = _runner()
     started = present(archive / runner.SPEC_FILE)
     if started and not options.resume:
         raise SetupError(
@@ -97,6 +100,23 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
     )
     print(f"finished now: {len(outcome['finished'])}, failed: {outcome['failed']}")
     return 1 if outcome["failed"] else 0
+
+
+def check_run_places(places: dict[str, Path]) -> None:
+    """Refuse, by its flag, a directory of ``places`` where a MiniGrid study would run that
+    belongs to another study: a SAC study's directory or archive (its ``study.json``), or a
+    folder inside any study's archive (:func:`~simoun_lab.study.owner.check_not_inside_study`);
+    before anything is written into it."""
+    for flag, where in places.items():
+        study = sac_study(where)
+        if study is not None:
+            raise SetupError(
+                f"{flag} {shown(where)} holds {study}, not a MiniGrid PPO study: running this "
+                f"spec there would write its {PPO_SPEC_FILE} and runs into that study's; pass a "
+                f"new {flag} (or the one of this MiniGrid study), and continue that study with "
+                f"its own spec ({shown(where / STUDY_FILE)} names it)"
+            )
+        check_not_inside_study(where, flag)
 
 
 def refuse_sac_study(study_dir: Path, flag: str = "--study-dir") -> None:

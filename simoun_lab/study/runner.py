@@ -24,6 +24,7 @@ from simoun_lab.study.checks import check_fixed_spec, check_run_folder, check_st
 from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_lab.study.generalization import play_modes, playable, to_play
 from simoun_lab.study.options import StudyOptions
+from simoun_lab.study.owner import check_not_inside_study
 from simoun_lab.study.plan import (
     EVALUATION,
     TUNING,
@@ -213,6 +214,7 @@ def check_own_places(spec: StudySpec, spec_path: str, options: StudyOptions) -> 
     for where, flag in ((options.study_dir, "--study-dir"), (options.archive, "--archive")):
         if where is None:
             continue
+        check_not_inside_study(where, flag)
         if present(where / PPO_SPEC_FILE) and not present(where / STUDY_FILE):
             raise SetupError(
                 f"{flag} {where} holds runs of a MiniGrid PPO study ({where / PPO_SPEC_FILE}), "

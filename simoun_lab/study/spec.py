@@ -68,6 +68,7 @@ from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
+from simoun_lab.study.given_path import blanks_note, shown
 from simoun_lab.study.record_file import record_not_spec
 from simoun_lab.study.selection import SELECTION_RULES
 from simoun_lab.study.toml_lines import key_line
@@ -339,14 +340,14 @@ def spec_text(path: Path) -> str:
     try:
         return read_text(path)
     except OSError as err:
+        fix = blanks_note(path) or "; pass a TOML file, e.g. docs/studies/dmc100k.toml"
         raise SetupError(
-            f"cannot read the study spec {path} ({err.strerror}); pass a TOML file, "
-            "e.g. docs/studies/dmc100k.toml"
+            f"cannot read the study spec {shown(path)} ({err.strerror}){fix}"
         ) from None
     except Damaged as err:
         raise SetupError(
-            f"cannot read the study spec {path} ({err}); pass a TOML file saved as UTF-8 text, "
-            "e.g. docs/studies/dmc100k.toml"
+            f"cannot read the study spec {shown(path)} ({err}); pass a TOML file saved as UTF-8 "
+            "text, e.g. docs/studies/dmc100k.toml"
         ) from None
 
 
@@ -504,6 +505,13 @@ class _Reader:
     ) -> None:
         """A key the study does not set, that exists, and that no recipe fixes (the grid's
         keys: :meth:`check_overrides`)."""
+        if key == "preset" and table == "[grid]":
+            raise self.fail(
+                where,
+                "the grid cannot vary the preset: the config key preset only labels a run, and "
+                "a preset's values are applied by preset in [base], one per study; to compare "
+                "presets, run one study per preset, each spec with its own preset in [base]",
+            )
         if key in STUDY_SETS:
             raise self.fail(where, f"the study sets {key} itself; give it as {STUDY_SETS[key]}")
         if key not in self.fields:

@@ -143,14 +143,29 @@ def check_commas(flag: str, text: str, key: str = "", spaces: bool = True) -> No
 
 
 def check_key(key: str, flag: str) -> None:
-    """Raise SetupError for a key that is no config key (with the closest ones) or that the sweep
-    sets itself."""
+    """Raise SetupError for a key that is no config key (with the closest ones), that the sweep
+    sets itself, or that only labels a run (``preset``, :func:`preset_grid_problem`)."""
     if key in DEDICATED:
         raise SetupError(f"{flag} cannot set {key}: the sweep sets it; use {DEDICATED[key]}")
+    if key == "preset":
+        raise SetupError(preset_grid_problem(flag))
     known = config_fields()
     if key not in known:
         hint = close_key_here(key, DEDICATED, "the sweep")
         raise SetupError(f"{flag}: unknown config key {key!r}{hint}; {HELP_FIX}")
+
+
+def preset_grid_problem(flag: str) -> str:
+    """Why ``preset`` cannot be a grid key: the config key only names the preset a run started
+    from, and the preset's values (env, image size, budget) are applied by ``--preset`` to the
+    whole sweep, whose one base config its budget, resume and report rest on; each trial would
+    train the sweep's own preset under another name."""
+    return (
+        f"{flag}: --grid cannot vary the preset: the config key preset only labels a run, and a "
+        "preset's values are applied by --preset, one per sweep; to compare presets, run one "
+        "sweep per preset, each with its own --preset and --sweep-dir (e.g. --preset cpu "
+        "--sweep-dir sweeps/cpu)"
+    )
 
 
 def close_key_here(key: str, set_here: dict[str, str], setter: str) -> str:
@@ -190,6 +205,10 @@ def parse_grid(pairs: list[str]) -> dict[str, list[Any]]:
                 f"--grid {pair!r} has an empty value; give at least one, comma-separated, e.g. "
                 f"--grid {key}=V1,V2"
             )
+        listed = listed_values(text)
+        if listed is not None and text_valued(fields[key][0]):
+            # a text key reads "['simoun','drq']" as one value, refused later for a false reason
+            raise SetupError(list_form_problem(key, text, listed, "a list in brackets"))
         values = [grid_value(key, text, value, fields[key][0]) for value in texts]
         if len(set(map(show, values))) < len(values):
             raise SetupError(f"--grid {pair!r} repeats a value; list each value once")
@@ -211,10 +230,23 @@ def grid_value(key: str, text: str, value: str, kind: Any) -> Any:
                 f"{said}: {err}; --grid takes comma-separated values, e.g. --grid {key}=V1,V2"
             ) from None
         form = "a list in brackets" if text.strip()[:1] in "[(" else "a range"
-        raise SetupError(
-            f"{said}: --grid takes each value, comma-separated, not {form}; write "
-            f"--grid {key}={','.join(values)}"
-        ) from None
+        raise SetupError(list_form_problem(key, text, values, form)) from None
+
+
+def list_form_problem(key: str, text: str, values: list[str], form: str) -> str:
+    """The refusal of ``--grid key=text`` written as ``form`` (a bracketed list, a range) of
+    ``values``, with the comma-separated form --grid takes."""
+    return (
+        f"--grid {f'{key}={text}'!r}: --grid takes each value, comma-separated, not {form}; write "
+        f"--grid {key}={','.join(values)}"
+    )
+
+
+def text_valued(kind: Any) -> bool:
+    """Whether a config key of type ``kind`` holds text (``str``, ``str | None``): any value
+    reads as one, a bracketed list too."""
+    args = set(typing.get_args(kind)) or {kind}
+    return str in args and args <= {str, type(None)}
 
 
 def listed_values(text: str) -> list[str] | None:
@@ -389,7 +421,8 @@ class SweepSpec:
             try:
                 resolve(trial.preset, trial.overrides)
             except SetupError as err:
-                raise SetupError(f"trial {trial.name} (from {source}): {err}") from None
+                note = grid_note(str(err), trial, self.grid) if source.startswith("--grid") else ""
+                raise SetupError(f"trial {trial.name} (from {source}): {err}{note}") from None
             if trial.run_dir in seen:
                 first = seen[trial.run_dir]
                 fix = "make their --grid values differ in letters or digits"
@@ -627,7 +660,9 @@ def check_runnable(
             check_decisions(config, made[env])  # the action repeat may differ by trial
             check_replay(config, made[env])
         except SetupError as err:
-            raise SetupError(f"trial {trial.name}: {err}") from None
+            raise SetupError(
+                f"trial {trial.name}: {err}{grid_note(str(err), trial, grid)}"
+            ) from None
         memory = {**asdict(config), "env": None, "seed": None, "run_dir": None}
         key = json.dumps(memory, sort_keys=True, default=str)
         if key not in measured:
@@ -635,10 +670,32 @@ def check_runnable(
             try:
                 warning = check_memory(config)
             except SetupError as err:
-                raise SetupError(f"trial {trial.name}: {err}") from None
+                note = grid_note(str(err), trial, grid)
+                raise SetupError(f"trial {trial.name}: {err}{note}") from None
             for said in (warning, budget_warning(config)):
                 if said:
+                    said += grid_note(said, trial, grid)
                     print(f"simoun-sweep: warning: trial {trial.name}: {said}", file=sys.stderr)
+
+
+def grid_note(said: str, trial: Trial, grid: dict[str, list[Any]]) -> str:
+    """For each ``grid`` key whose flag the message ``said`` about ``trial`` names (its fix
+    advises ``--action-repeat 40``), the note that the trial's value came from ``--grid`` and
+    that the fix goes there: the key's base flag is refused beside ``--grid``. Empty when the
+    message names no gridded key."""
+    notes = []
+    for key, values in grid.items():
+        flag = "--" + key.replace("_", "-")
+        if re.search(re.escape(flag) + r"(?![\w.-])", said) is None:
+            continue
+        value = show(trial.overrides[key])
+        given = f"{key}={','.join(show(v) for v in values)}"
+        notes.append(
+            f"{flag} {value} is this trial's value from --grid {given}: make the fix in "
+            f"--grid (leave {value} out of its values, or replace it by a value that works), "
+            f"not as a base {flag}, which --grid refuses beside it"
+        )
+    return "".join(f"; {note}" for note in notes)
 
 
 def check_trial_config(config: TrainConfig, grid: dict[str, list[Any]]) -> None:

@@ -92,6 +92,8 @@ def grid_problem(grid: Any) -> str | None:
     for key, values in grid.items():
         if key in SET_BY_THE_SWEEP:
             return f"grid varies {key}, which the sweep sets for each trial"
+        if key == "preset":
+            return "grid varies preset, which only labels a run: a sweep has one preset"
         if problem := key_problem(key):
             return f"grid: {problem}"
         if not (isinstance(values, list) and values):
