@@ -338,7 +338,10 @@ DAMAGES = {
         "env_step,return_mean,wall_time_s\n0,nan,1\n",
         "eval.csv line 2 has an empty, NaN or infinite value",
     ),
-    "eval.csv   ": ("step,score\n0,1\n", "eval.csv has no column env_step, return_mean"),
+    "eval.csv   ": (
+        "step,score\n0,1\n",
+        "eval.csv is damaged: it has no return_mean column, which every eval.csv of a run holds",
+    ),
     "summary.json": ("{}", "summary.json has no finite final_eval.return_mean"),
 }
 """file (padded to be unique) -> what it is overwritten with, and what the report says"""
