@@ -30,6 +30,21 @@ import json
 import shutil
 from pathlib import Path
 
+from reliability_eighth_files import (  # the eighth trial's case helpers, shared
+    COSTS,
+    MG_REPORT,
+    MGT_RUN_ARGV,
+    MGT_SELECT,
+    STUDY_REPORT,
+    STUDY_RESUME,
+    add,
+    costs,
+    folder,
+    mgt_light,
+    on_run,
+    removed,
+    run_file,
+)
 from reliability_trial import (
     ARCH,
     DMC100K,
@@ -51,44 +66,6 @@ from reliability_trial import (
 )
 
 EVAL, RESUME, REPORT, MASKS = (FILE_COMMANDS[c] for c in ("eval", "train", "report", "analyze"))
-BIAS = ["bias", "{run}", "--pairs", "8", "--out", "b"]
-RUN_COMMANDS = {"eval": ("eval", EVAL), "train": ("train", RESUME), "report": ("report", REPORT),
-                "masks": ("analyze", MASKS), "bias": ("analyze", BIAS)}  # fmt: skip
-
-
-def on_run(commands: str, what: str, works, names, ok: bool = False) -> list[dict]:
-    """One case per command of ``commands`` (space-separated keys of :data:`RUN_COMMANDS`)."""
-    return [fifth("files", RUN_COMMANDS[key][0], RUN_COMMANDS[key][1], names, ok, works=works,
-                  what=what) for key in commands.split()]  # fmt: skip
-
-
-def run_file(name: str, how):
-    return spoil(f"run/{name}", how)
-
-
-def add(name: str, data: str | bytes = "kept by hand\n"):
-    """Work: a file ``name`` written (its folders made)."""
-
-    def work(here: Path) -> None:
-        (here / name).parent.mkdir(parents=True, exist_ok=True)
-        (here / name).write_bytes(data.encode() if isinstance(data, str) else data)
-
-    return work
-
-
-def folder(name: str):
-    """Work: a folder ``name`` (and its parents)."""
-    return lambda here: (here / name).mkdir(parents=True, exist_ok=True)
-
-
-def removed(name: str):
-    """Work: ``name`` (a file or a tree) deleted."""
-
-    def work(here: Path) -> None:
-        path = here / name
-        shutil.rmtree(path) if path.is_dir() else path.unlink()
-
-    return work
 
 
 def dangling(name: str):
@@ -314,20 +291,6 @@ SWEEP_CASES = [
      (SW, spoil(f"{SW_RUN}/eval.csv", zero_tail)), "eval.csv"),
 ]  # fmt: skip
 
-STUDY_REPORT = ["report", "dmc100k.toml", "--study-dir", "arch"]
-STUDY_RESUME = ["run", "dmc100k.toml", "--study-dir", "s", "--archive", "arch", "--resume",
-                "--allow-other-commit"]  # fmt: skip
-COSTS = "arch/update_cost.json"
-
-
-def costs(**change) -> str:
-    """An update_cost.json as benchmarks/recipe_update.py writes it, with ``change``."""
-    data = {"baseline": "drq", "ratio": {"simoun": 2.1, "drq": 1.0},
-            "ms_per_update": {"simoun": 21.0, "drq": 10.0}, "task": "cartpole-swingup",
-            "action_repeat": 8, "command": "python benchmarks/recipe_update.py", "commit": "abc",
-            "machine": "laptop"}  # fmt: skip
-    return json.dumps({**data, **change})
-
 
 def cost_file(**change):
     return add(COSTS, costs(**change))
@@ -373,17 +336,6 @@ STUDY_CASES = [
     (STUDY_REPORT, "the spec with CRLF line endings (edited on Windows)",
      (spoil("dmc100k.toml", CRLF),), "", True),
 ]  # fmt: skip
-
-MG_REPORT = ["report", "--archive", "mg"]
-MGT_SELECT = ["select", "--archive", "mgt"]
-MGT_RUN_ARGV = ["run", "--archive", "mgt", "--work-dir", "wd"]
-
-
-def mgt_light(here: Path) -> None:
-    """``mgt`` without its in-progress checkpoints (large), for the commands that do not read
-    them."""
-    shutil.copytree(STUDIES / "minigrid-v2/tuning", here / "mgt",
-                    ignore=shutil.ignore_patterns("checkpoint.pt"))  # fmt: skip
 
 
 MG_TASK = "mg/MiniGrid-DoorKey-6x6-v0"
