@@ -11,6 +11,7 @@ Python API and the files users keep, each classified by what the user is told.
     python scripts/reliability_trial.py --set seventh --timeout 90  # the seventh trial
     python scripts/reliability_trial.py --set eighth --timeout 90   # the eighth trial
     python scripts/reliability_trial.py --set ninth --timeout 90    # the ninth trial
+    python scripts/reliability_trial.py --set tenth --timeout 90    # the tenth trial
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
 it needs one) and is stopped after 20 s (``--timeout``; spec cases that import Ray want about 90 s
@@ -3401,7 +3402,7 @@ CASES = (
 
 AREAS = ("agent", "lab", "files", "api")
 """the areas of a trial kept as modules: ``reliability_<trial>_<area>.py`` in this directory"""
-MODULE_TRIALS = ("sixth", "seventh", "eighth", "ninth")
+MODULE_TRIALS = ("sixth", "seventh", "eighth", "ninth", "tenth")
 """the trials whose cases live in those modules, each with a list ``CASES`` made with this
 module's helpers (imported when the trial is selected: they import this module)"""
 

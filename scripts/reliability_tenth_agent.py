@@ -1,0 +1,3 @@
+"""The tenth reliability trial's cases: agent (see reliability_trial.py)."""
+
+CASES: list[dict] = []

@@ -1,0 +1,3 @@
+"""The tenth reliability trial's cases: api (see reliability_trial.py)."""
+
+CASES: list[dict] = []

@@ -1,0 +1,3 @@
+"""The tenth reliability trial's cases: lab (see reliability_trial.py)."""
+
+CASES: list[dict] = []
