@@ -96,7 +96,7 @@ FLAGS = [
     ("sweep", grid("agent.critic_augmentations=1,2"), ("critic_augmentations", "augmentation")),
     ("sweep", grid("agent.separate_trunks=false,true"), "separate_trunks"),
     ("sweep", grid("agent.encoder=single,stacked"), "", True),
-    ("sweep", grid("agent.encoder=single,dual-interactive"), "dual-interactive"),
+    ("sweep", grid("agent.encoder=dual_interactive,dual-interactive"), "dual-interactive"),
     ("sweep", grid("agent.conv_init=orthogonal,delta-orthogonal"), "delta-orthogonal"),
     ("sweep", grid("agent.target_augmentations=2,1"), ("target_augmentations", "augmentation")),
     ("sweep", grid("agent.pixel_offset=0,abc"), ("pixel_offset", "abc")),
@@ -141,7 +141,7 @@ FLAGS = [
     # --resume with flags that change the sweep
     ("sweep", [*RESUME, "--envs", "Pendulum-v1"], "--envs", False, (SW,)),
     ("sweep", [*RESUME, "--preset", "cpu"], "--preset", False, (SW,)),
-    ("sweep", [*RESUME, "--set", "agent.lr=1e-3"], "agent.lr", False, (SW,)),
+    ("sweep", [*RESUME, "--set", "agent.lr=3e-4"], "agent.lr", False, (SW,)),
     ("sweep", [*RESUME, "--env", "Pendulum-v1"], "--env", False, (SW,)),
     ("sweep", [*RESUME, "--agent.recipe", "drq"], "recipe", False, (SW,)),
     ("sweep", ["--sweep-dir", "sw", "--resume", "--total-env-steps", "40"], "", True, (SW,)),
