@@ -3,31 +3,31 @@
 The Python API on surfaces no earlier trial touched: the lab's statistics called from a notebook
 (``simoun_lab.stats``: scores given as lists, an array instead of a task dict, NaN runs, a
 confidence in percent or as text, no resamples or a fraction of one, a negative seed, a statistic
-given by name or of the wrong kind, tasks that differ, curves where final scores go and final
-scores where curves go, one threshold where a list goes, an env id and returns swapped, curves on
-different step grids, no tasks or a task with no runs, a function name misspelt) and the
-information-bias estimator (``information_bias``: factors capitalised, a threshold in percent,
-pairs stacked in one array, NaN activations, pairs of unequal length, conv maps, a list of pairs,
-an unknown factor); ``play_episode`` of a loaded run, its seed, its arguments swapped;
-Gymnasium's DelayObservation, TransformAction, NumpyToTorch and FilterObservation around and
-under the wrappers, the vector FlattenObservation, DtypeObservation and TransformReward;
-Stable-Baselines3's DummyVecEnv under the vector rewards and over the single ones,
-``check_sb3_policy`` given a PettingZoo env; other PettingZoo envs (cooperative pong,
-knights-archers-zombies whose agents leave mid-episode, discrete pistonball with frames of two
-sizes), unknown agents' spaces, a step with agents missing and a step after close; highway-env's
-rendered frames and its stacked grayscale observation; normalisations at their edges
-(``ReturnStd`` of gamma 0 and 1, ``Standardize``), a constant bonus normalised, a warmup written
-1e3, a novelty source of a torch model given numpy triplets, the model classes given where their
-instances go, a scale as text; vector resets with a seed per env, a vector step after close;
-agent configs in the forms of other libraries (a list of hidden sizes, a device, swapped log-std
-bounds, a pad without its augmentation, an even kernel, a negative curiosity scale or pad),
-a recipe's config copied through ``dataclasses.asdict``, ``resolve`` given nested or underscored
-keys and numpy seeds, env kwargs and a distraction mode as one string; the training loop driven
-from Python with hooks misspelt or named as other libraries name them, a hook returning a stop
-answer, the config given where a run goes, an env changed after ``resolve``, a dict assigned to
-``cfg.agent``, unknown env kwargs, a run dir as a Path, training in a thread; the agent's ``act``
-given a non-bool ``deterministic``; names imported from the wrong package; MiniGrid's actions
-under the constant bonus.
+given by name or of the wrong kind, tasks that differ, curves where final scores go and final scores
+where curves go, one threshold where a list goes, an env id and returns swapped, curves on different
+step grids, no tasks or a task with no runs, a function name misspelt) and the information-bias
+estimator (``information_bias``: factors capitalised, a threshold in percent, pairs stacked in one
+array, NaN activations, pairs of unequal length, conv maps, a list of pairs, an unknown factor);
+``play_episode`` of a loaded run, its seed, its arguments swapped; Gymnasium's DelayObservation,
+TransformAction, FilterObservation and a TransformObservation to torch tensors around and under the
+wrappers, the vector FlattenObservation, DtypeObservation and TransformReward; Stable-Baselines3's
+DummyVecEnv under the vector rewards and over the single ones, ``check_sb3_policy`` given a
+PettingZoo env; other PettingZoo envs (cooperative pong, knights-archers-zombies whose agents leave
+mid-episode, discrete pistonball with frames of two sizes), unknown agents' spaces, a step with
+agents missing and a step after close; highway-env's rendered frames and its stacked grayscale
+observation; normalisations at their edges (``ReturnStd`` of gamma 0 and 1, ``Standardize``), a
+constant bonus normalised, a warmup written 1e3, a novelty source of a torch model given numpy
+triplets, the model classes given where their instances go, a scale as text; vector resets with a
+seed per env or a float seed, a vector step after close; agent configs in the forms of other
+libraries (a list of hidden sizes, a device, swapped log-std bounds, a pad without its augmentation,
+an even kernel, a negative curiosity scale or pad), a recipe's config copied through
+``dataclasses.asdict``, ``resolve`` given nested or underscored keys and numpy seeds, env kwargs, a
+switch and a distraction mode as one string; the training loop driven from Python with hooks
+misspelt or named as other libraries name them, a hook returning a stop answer, the config given
+where a run goes, an env changed after ``resolve``, a dict assigned to ``cfg.agent``, unknown env
+kwargs, a run dir as a Path, training in a thread; the agent's ``act`` given a non-bool
+``deterministic``; names imported from the wrong package; MiniGrid's actions under the constant
+bonus.
 """
 
 from reliability_ninth_api import TRAIN, callback
@@ -70,6 +70,11 @@ PLAY = (
     "play_episode; r = load_run('../tiny', device='cpu'); "
 )
 TEN = "z = np.arange(8.0); "
+# observations made torch tensors, as Gymnasium's NumpyToTorch makes them (which needs
+# array_api_compat, an optional dependency of Gymnasium that is not installed here)
+TORCH = (
+    "import torch\ndef to_torch(o):\n    return {k: torch.from_numpy(v) for k, v in o.items()}\n"
+)
 
 # (code, the name the refusal must give, or "" for valid input[, valid: either])
 TENTH_CODES = [
@@ -123,11 +128,11 @@ TENTH_CODES = [
      f"{C}), 1), size=16); " + STEP, ""),
     (f"s = {S}; e = gym.wrappers.TransformAction(s, lambda a: np.clip(a, -2, 2), "
      "s.action_space); " + STEP, ""),
-    (f"import torch; e = w.ConstantBonusReward(gym.wrappers.NumpyToTorch({S}), 0.1); " + STEP,
-     ("NumpyToTorch", "tensor", "torch")),
-    (f"import torch; e = gym.wrappers.NumpyToTorch(w.ConstantBonusReward({S}, 0.1)); "
-     "e.reset(seed=0); o, *_ = e.step(torch.zeros(1)); assert isinstance(o['frames'], "
-     "torch.Tensor)", ""),
+    (TORCH + f"s = {S}; e = w.ConstantBonusReward(gym.wrappers.TransformObservation(s, to_torch, "
+     "s.observation_space), 0.1); " + STEP, ("TransformObservation", "tensor", "torch")),
+    (TORCH + f"s = w.ConstantBonusReward({S}, 0.1); e = gym.wrappers.TransformObservation(s, "
+     "to_torch, s.observation_space); e.reset(seed=0); o, *_ = e.step(np.zeros(1, np.float32)); "
+     "assert isinstance(o['frames'], torch.Tensor)", ""),
     (f"w.ConstantBonusReward(gym.wrappers.FilterObservation({S}, ['motion']), 0.1)", "frames"),
     (NOV + f"w.RNDVectorReward(gym.wrappers.vector.FlattenObservation({PEND}), nov)",
      ("frames", "FlattenObservation")),
@@ -199,7 +204,7 @@ TENTH_CODES = [
     (CONF + "AgentConfig(curiosity_scale=-0.2)", "curiosity_scale"),
     (CONF + "import dataclasses; c = AgentConfig(**dataclasses.asdict(AgentConfig("
      "recipe='drqv2'))); assert c.actor == 'deterministic', c.actor", ""),
-    (CONF + "resolve(None, {'agent': {'lr': 1e-3}})", ("agent.lr",), True),
+    (CONF + "resolve(None, {'agent': {'lr': 1e-3}})", ("agent.lr", "agent."), True),
     (CONF + "resolve(None, {'agent_lr': 1e-3})", "agent.lr"),
     (CONF + "c = resolve(None, {'seed': np.int64(3)}); assert c.seed == 3", ""),
     (CONF + "TrainConfig(env_kwargs='max_episode_steps=50')", "env_kwargs"),
