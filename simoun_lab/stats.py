@@ -2,7 +2,10 @@
 the edge of the statistical precipice", the ``rliable`` package) define them, in numpy only.
 
 Scores are given per task as ``{task: array of runs}`` (one score per seed), normalized by the
-task's maximum return (:func:`normalize`). Tasks may have different numbers of runs.
+task's maximum return (:func:`normalize`). Tasks may have different numbers of runs. Every
+function checks its arguments: a task with no runs, a NaN or infinite score, learning curves
+``(runs, steps)`` where final scores go (or the reverse) and a non-integer ``reps`` or ``seed``
+are refused with a ValueError or TypeError that names the argument and a fix.
 
 - :func:`iqm` / :func:`aggregate_iqm`: the interquartile mean, the 25 % trimmed mean over all
   runs (of all tasks): robust to one outlying seed, less noisy than the median.
@@ -43,12 +46,201 @@ whose return depends on its configured duration; PointReach; Pendulum) have no k
 return and keep their raw returns (:func:`normalize` divides by 1)."""
 
 
+def _kind(value: object) -> str:
+    """How a refused value is shown: its type, and its shape when it is an array."""
+    if isinstance(value, np.ndarray):
+        return f"a numpy array of shape {value.shape}"
+    return f"{type(value).__name__} {value!r}"[:120]
+
+
+def _numbers(values: object, where: str) -> np.ndarray:
+    """``values`` as a float array; a TypeError naming ``where`` when they are not numbers."""
+    if isinstance(values, Mapping | str | bytes):
+        raise TypeError(f"{where} must be an array of numbers, got {_kind(values)}")
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise TypeError(
+            f"{where} must be an array of numbers, got {_kind(values)} ({error})"
+        ) from None
+    return array
+
+
+def _finite(
+    array: np.ndarray,
+    where: str,
+    fix: str,
+    why: str = "every run needs a finite score (a NaN is often a run that did not finish)",
+) -> None:
+    """Refuse NaN and infinite values: a NaN sorts last and compares as a loss, so it would
+    pass for a real score; ``fix`` says how to leave such values out."""
+    bad = ~np.isfinite(array)
+    if bad.any():
+        first = tuple(int(i) for i in np.argwhere(bad)[0])
+        index = first[0] if len(first) == 1 else first
+        raise ValueError(
+            f"{where} has {int(bad.sum())} NaN or infinite value(s) ({array[first]} at index "
+            f"{index}): {why}; leave them out, e.g. {fix}"
+        )
+
+
+_SHAPES = {
+    1: "a 1-D array of final scores, one per run",
+    2: "a 2-D array of learning curves (runs, steps), on one step grid",
+    None: "an array with one entry per run on axis 0",
+}
+
+
+def _shape_hint(ndim: int | None, got: int, function: str, argument: str) -> str:
+    """The fix for a task whose array has ``got`` dimensions where ``ndim`` go."""
+    if ndim == 1 and got == 2:
+        return (
+            "this looks like learning curves (runs, steps); pass each run's final score, e.g. "
+            f"{{task: np.asarray(c)[:, -1] for task, c in {argument}.items()}}, or use "
+            "iqm_over_steps for the curves"
+        )
+    if ndim == 2 and got == 1:
+        return (
+            f"this looks like final scores (one per run); {function} takes each run's curve "
+            "over the evaluation steps, e.g. {task: np.stack(curves_of_its_runs)}; for final "
+            "scores use aggregate_iqm(scores)"
+        )
+    if got == 0:
+        return "e.g. {task: [score]} for a task with one run"
+    if ndim == 1:
+        return "e.g. {task: np.ravel(runs)} when every entry is one run's score"
+    return f"{function} takes one curve per run, e.g. {{task: np.stack(curves_of_its_runs)}}"
+
+
+def _task_runs(
+    runs: object, task: str, ndim: int | None, function: str, argument: str
+) -> np.ndarray:
+    """One task's runs, checked: numbers, of the shape ``function`` takes, at least one run,
+    all finite."""
+    where = f"{function}: {argument}[{task!r}]"
+    array = _numbers(runs, where)
+    if (ndim is None and array.ndim == 0) or (ndim is not None and array.ndim != ndim):
+        raise ValueError(
+            f"{where} must be {_SHAPES[ndim]}, got shape {array.shape}; "
+            f"{_shape_hint(ndim, array.ndim, function, argument)}"
+        )
+    if array.size == 0:
+        raise ValueError(
+            f"{where} has no {'runs' if len(array) == 0 else 'steps'} (shape {array.shape}): "
+            "every task needs at least one finished run; leave the task out, e.g. "
+            f"{{task: r for task, r in {argument}.items() if np.size(r)}}"
+        )
+    keep = "np.isfinite(r)" if array.ndim == 1 else "np.isfinite(r).all(axis=1)"
+    fix = f"{{task: np.asarray(r)[{keep}] for task, r in {argument}.items()}}"
+    if array.ndim > 2:
+        fix = f"runs without NaN only in {argument}[{task!r}]"
+    _finite(array, where, fix)
+    return array
+
+
+def _scores(
+    scores: object, function: str, argument: str = "scores", ndim: int | None = 1
+) -> dict[str, np.ndarray]:
+    """``scores`` checked and as float arrays: a non-empty mapping task -> runs, each task's
+    runs of ``ndim`` dimensions (1: final scores, 2: curves, None: any, runs on axis 0)."""
+    example = "{'cheetah-run': np.array([0.71, 0.65, 0.8])}"
+    if ndim == 2:
+        example = "{'cheetah-run': np.array([[0.1, 0.5, 0.7], [0.2, 0.4, 0.65]])}"
+    if not isinstance(scores, Mapping):
+        raise TypeError(
+            f"{function}: {argument} must be a dict task -> {_SHAPES[ndim]}, got "
+            f"{_kind(scores)}; e.g. {function}({example})"
+        )
+    if not scores:
+        raise ValueError(
+            f"{function}: {argument} has no tasks; give at least one task with its runs, e.g. "
+            f"{function}({example})"
+        )
+    return {task: _task_runs(runs, task, ndim, function, argument) for task, runs in scores.items()}
+
+
+def _count(value: object, name: str, low: int, high: int | None, example: str) -> int:
+    """An integer argument in [low, high]; bool and float (even 2000.0) are refused."""
+    span = f">= {low}" if high is None else f"in [{low}, {high}]"
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise TypeError(f"{name} must be an int {span}, got {_kind(value)}; e.g. {example}")
+    if value < low or (high is not None and value > high):
+        raise ValueError(f"{name} must be an int {span}, got {value}; e.g. {example}")
+    return int(value)
+
+
+def _resampling(reps: object, seed: object) -> tuple[int, int]:
+    """The bootstrap's ``reps`` (resamples) and ``seed`` (numpy RandomState's range)."""
+    return (
+        _count(reps, "reps (the number of bootstrap resamples)", 1, None, "reps=2000"),
+        _count(seed, "seed", 0, 2**32 - 1, "seed=0"),
+    )
+
+
+def _confidence(confidence: object) -> float:
+    """The interval's confidence level, a fraction in (0, 1)."""
+    if isinstance(confidence, bool) or not isinstance(confidence, int | float | np.number):
+        raise TypeError(
+            f"confidence must be a number in (0, 1), got {_kind(confidence)}; e.g. "
+            "confidence=0.95 for a 95 % interval"
+        )
+    if not 0 < confidence < 1:
+        percent = (
+            f" ({confidence} looks like a percent: confidence={confidence / 100:g})"
+            if 1 < confidence < 100
+            else ""
+        )
+        raise ValueError(
+            f"confidence must lie in (0, 1), got {confidence}{percent}; e.g. confidence=0.95 "
+            "for a 95 % interval"
+        )
+    return float(confidence)
+
+
+def _statistic(statistic: object, scores: dict[str, np.ndarray]) -> np.ndarray:
+    """``statistic(scores)`` as an array, with a TypeError naming ``statistic`` when it is not
+    a function of the scores mapping that returns numbers."""
+    example = "e.g. statistic=stats.aggregate_iqm or lambda s: stats.performance_profile(s, taus)"
+    if not callable(statistic):
+        named = f" (for {statistic!r} pass the function stats.aggregate_{statistic})" * (
+            statistic in ("iqm", "mean")
+        )
+        raise TypeError(
+            f"statistic must be a function of the scores dict task -> runs, got "
+            f"{_kind(statistic)}{named}; {example}"
+        )
+    try:
+        return np.asarray(statistic(scores), dtype=float)
+    except (TypeError, AttributeError, IndexError) as error:
+        name = getattr(statistic, "__name__", type(statistic).__name__)
+        raise TypeError(
+            f"statistic must be a function of the scores dict task -> runs returning numbers, "
+            f"but statistic(scores) ({name}) raised {type(error).__name__}: {error}; {example}"
+        ) from None
+
+
+def _one_number(point: np.ndarray, function: str) -> float:
+    """A statistic's value where an interval of one number is asked for."""
+    if point.size != 1:
+        raise ValueError(
+            f"{function} takes a statistic that returns one number, but statistic(scores) "
+            f"returned shape {point.shape}; for a curve or a profile use "
+            "stratified_bootstrap_band(scores, statistic)"
+        )
+    return float(point.item())
+
+
 def max_return(env_id: str) -> float | None:
     """The maximum return that :data:`NORMALIZERS` knows for ``env_id``, or None.
 
     >>> max_return("dm_control/cartpole-swingup-v0"), max_return("Pendulum-v1")
     (1000.0, None)
     """
+    if not isinstance(env_id, str):
+        raise TypeError(
+            f"env_id must be a Gymnasium env id (a str), got {_kind(env_id)}; e.g. "
+            "'dm_control/cheetah-run-v0'"
+        )
     for prefix, maximum in NORMALIZERS.items():
         if env_id.startswith(prefix):
             return maximum
@@ -62,7 +254,13 @@ def normalize(env_id: str, returns: np.ndarray) -> np.ndarray:
     >>> normalize("dm_control/walker-walk-v0", np.array([500.0, 1000.0]))
     array([0.5, 1. ])
     """
-    return np.asarray(returns, dtype=float) / (max_return(env_id) or 1.0)
+    if isinstance(returns, str) and not isinstance(env_id, str):
+        raise TypeError(
+            f"normalize takes (env_id, returns), got the returns first: env_id={_kind(env_id)}, "
+            f"returns={returns!r}; e.g. normalize({returns!r}, returns)"
+        )
+    maximum = max_return(env_id) or 1.0
+    return _numbers(returns, "normalize: returns") / maximum
 
 
 def _trimmed_mean(values: np.ndarray) -> np.ndarray:
@@ -81,27 +279,44 @@ def iqm(scores: np.ndarray) -> float:
     >>> iqm(np.array([[1.0, 100.0], [2.0, 3.0]]))  # 4 values: 1 and 100 cut
     2.5
     """
-    values = np.asarray(scores, dtype=float).ravel()
+    if isinstance(scores, Mapping):
+        raise TypeError(
+            "iqm takes an array of scores (runs, or a runs x tasks matrix), got a dict; for a "
+            "dict task -> runs use aggregate_iqm(scores)"
+        )
+    values = _numbers(scores, "iqm: scores").ravel()
     if values.size == 0:
         raise ValueError("iqm of no scores: give at least one run")
+    _finite(values, "iqm: scores", "np.asarray(scores)[np.isfinite(scores)]")
     return float(_trimmed_mean(values))
 
 
 def aggregate_iqm(scores: Scores) -> float:
     """IQM over all runs of all tasks (rliable's ``aggregate_iqm`` of its runs x tasks matrix;
     with unequal run counts a task with more runs weighs more)."""
-    return iqm(np.concatenate([np.ravel(runs) for runs in scores.values()]))
+    runs = _scores(scores, "aggregate_iqm")
+    return float(_trimmed_mean(np.concatenate(list(runs.values()))))
 
 
 def aggregate_mean(scores: Scores) -> float:
     """Mean over tasks of the mean over each task's runs (rliable's ``aggregate_mean``)."""
-    return float(np.mean([np.mean(runs) for runs in scores.values()]))
+    return float(np.mean([runs.mean() for runs in _scores(scores, "aggregate_mean").values()]))
 
 
 def iqm_over_steps(scores: Scores) -> np.ndarray:
     """IQM over all runs of all tasks at each evaluation step: scores are ``(runs, steps)``
     per task, on one step grid; returns ``(steps,)`` (rliable's sample-efficiency curve)."""
-    return _trimmed_mean(np.concatenate([np.atleast_2d(runs) for runs in scores.values()]))
+    curves = _scores(scores, "iqm_over_steps", ndim=2)
+    steps = {task: runs.shape[1] for task, runs in curves.items()}
+    if len(set(steps.values())) > 1:
+        shortest = min(steps.values())
+        raise ValueError(
+            f"iqm_over_steps needs every task's curves on one step grid, got steps per task "
+            f"{steps}; evaluate the tasks at the same steps, or cut the curves to a common grid, "
+            f"e.g. {{task: np.asarray(curves)[:, :{shortest}] for task, curves in "
+            "scores.items()} when the tasks share their first steps"
+        )
+    return _trimmed_mean(np.concatenate(list(curves.values())))
 
 
 def _draw_indices(
@@ -131,11 +346,6 @@ def _take(scores: Scores, indices: np.ndarray) -> dict[str, np.ndarray]:
     }
 
 
-def _check(scores: Scores, name: str) -> None:
-    if not scores or any(len(runs) == 0 for runs in scores.values()):
-        raise ValueError(f"{name}: every task needs at least one run (got {dict(scores)})")
-
-
 def bootstrap_replicates(
     scores: Scores,
     statistic: Callable[[Scores], float | np.ndarray],
@@ -144,10 +354,12 @@ def bootstrap_replicates(
 ) -> np.ndarray:
     """``statistic`` of ``reps`` stratified resamples of ``scores`` (runs drawn with replacement
     within each task, each task keeping its number of runs): ``(reps, *statistic's shape)``."""
-    _check(scores, "bootstrap")
+    runs = _scores(scores, "bootstrap_replicates", ndim=None)
+    reps, seed = _resampling(reps, seed)
+    _statistic(statistic, runs)
     rng = np.random.RandomState(seed)
-    (draws,) = _draw_indices(rng, [[len(runs) for runs in scores.values()]], reps)
-    return np.array([statistic(_take(scores, indices)) for indices in draws])
+    (draws,) = _draw_indices(rng, [[len(task) for task in runs.values()]], reps)
+    return np.array([statistic(_take(runs, indices)) for indices in draws])
 
 
 def percentile_interval(
@@ -155,8 +367,7 @@ def percentile_interval(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The percentile bootstrap interval of ``replicates`` along axis 0: the (1 - c) / 2 and
     (1 + c) / 2 quantiles (linear interpolation, as rliable through ``arch``)."""
-    if not 0 < confidence < 1:
-        raise ValueError(f"confidence must lie in (0, 1), got {confidence}")
+    confidence = _confidence(confidence)
     alpha = (1.0 - confidence) / 2
     low, high = np.percentile(replicates, [100 * alpha, 100 * (1.0 - alpha)], axis=0)
     return low, high
@@ -176,8 +387,11 @@ def stratified_bootstrap_ci(
     >>> point, low <= point <= high
     (4.5, True)
     """
-    low, high = percentile_interval(bootstrap_replicates(scores, statistic, reps, seed), confidence)
-    return float(statistic(scores)), float(low), float(high)
+    runs = _scores(scores, "stratified_bootstrap_ci", ndim=None)
+    confidence = _confidence(confidence)
+    point = _one_number(_statistic(statistic, runs), "stratified_bootstrap_ci")
+    low, high = percentile_interval(bootstrap_replicates(runs, statistic, reps, seed), confidence)
+    return point, float(np.ravel(low)[0]), float(np.ravel(high)[0])
 
 
 def stratified_bootstrap_band(
@@ -190,19 +404,24 @@ def stratified_bootstrap_band(
     """:func:`stratified_bootstrap_ci` of a vector statistic (a curve over steps, a profile
     over thresholds): point, low and high arrays. Whole runs are resampled, so a resampled
     curve is the curve of one run (rliable resamples each step on its own)."""
-    replicates = bootstrap_replicates(scores, statistic, reps, seed)
-    low, high = percentile_interval(replicates, confidence)
-    return np.asarray(statistic(scores), dtype=float), low, high
+    runs = _scores(scores, "stratified_bootstrap_band", ndim=None)
+    confidence = _confidence(confidence)
+    point = _statistic(statistic, runs)
+    low, high = percentile_interval(bootstrap_replicates(runs, statistic, reps, seed), confidence)
+    return point, low, high
 
 
-def _same_tasks(x: Scores, y: Scores) -> None:
-    if set(x) != set(y):
+def _same_tasks(
+    x: Scores, y: Scores, function: str
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """``x`` and ``y`` checked as final scores of the same tasks, ``y`` in ``x``'s task order."""
+    runs_x, runs_y = _scores(x, function, "x"), _scores(y, function, "y")
+    if set(runs_x) != set(runs_y):
         raise ValueError(
-            "probability of improvement needs the same tasks for both: "
-            f"{sorted(set(x) ^ set(y))} only in one; pass the tasks both have"
+            f"{function} needs the same tasks for both: "
+            f"{sorted(set(runs_x) ^ set(runs_y))} only in one; pass the tasks both have"
         )
-    _check(x, "probability of improvement")
-    _check(y, "probability of improvement")
+    return runs_x, {task: runs_y[task] for task in runs_x}
 
 
 def _improvement(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -218,8 +437,8 @@ def probability_of_improvement(x: Scores, y: Scores) -> float:
     counting one half (Mann-Whitney U / (n m)), averaged over the tasks (rliable's
     ``probability_of_improvement``). ``x`` and ``y`` must have the same tasks; their run counts
     may differ."""
-    _same_tasks(x, y)
-    return float(np.mean([_improvement(np.ravel(x[task]), np.ravel(y[task])) for task in x]))
+    runs_x, runs_y = _same_tasks(x, y, "probability_of_improvement")
+    return float(np.mean([_improvement(runs_x[task], runs_y[task]) for task in runs_x]))
 
 
 def probability_of_improvement_ci(
@@ -232,14 +451,15 @@ def probability_of_improvement_ci(
     """(point, low, high): :func:`probability_of_improvement` and its percentile interval, the
     runs of X and of Y resampled independently within each task (rliable's
     ``StratifiedIndependentBootstrap``; each resample draws X's indices, then Y's)."""
-    _same_tasks(x, y)
-    y = {task: y[task] for task in x}
+    x, y = _same_tasks(x, y, "probability_of_improvement_ci")
+    reps, seed = _resampling(reps, seed)
+    confidence = _confidence(confidence)
     rng = np.random.RandomState(seed)
     counts = [[len(runs) for runs in x.values()], [len(runs) for runs in y.values()]]
     draws_x, draws_y = _draw_indices(rng, counts, reps)
     per_task = []
     for column, task in enumerate(x):
-        runs_x, runs_y = np.ravel(x[task]), np.ravel(y[task])
+        runs_x, runs_y = x[task], y[task]
         resampled_x = runs_x[draws_x[:, : len(runs_x), column]]
         resampled_y = runs_y[draws_y[:, : len(runs_y), column]]
         per_task.append(_improvement(resampled_x, resampled_y))
@@ -263,8 +483,11 @@ def difference_ci(
     >>> difference_ci({"t": np.array([3.0, 3.0])}, {"t": np.array([1.0, 1.0])})
     (2.0, 2.0, 2.0)
     """
-    _same_tasks(x, y)
-    y = {task: y[task] for task in x}
+    x, y = _same_tasks(x, y, "difference_ci")
+    reps, seed = _resampling(reps, seed)
+    confidence = _confidence(confidence)
+    point_x = _one_number(_statistic(statistic, x), "difference_ci")
+    point_y = _one_number(_statistic(statistic, y), "difference_ci")
     rng = np.random.RandomState(seed)
     counts = [[len(runs) for runs in x.values()], [len(runs) for runs in y.values()]]
     draws_x, draws_y = _draw_indices(rng, counts, reps)
@@ -275,7 +498,7 @@ def difference_ci(
         ]
     )
     low, high = percentile_interval(replicates, confidence)
-    return float(statistic(x) - statistic(y)), float(low), float(high)
+    return point_x - point_y, float(np.ravel(low)[0]), float(np.ravel(high)[0])
 
 
 def performance_profile(scores: Scores, taus: np.ndarray) -> np.ndarray:
@@ -285,6 +508,20 @@ def performance_profile(scores: Scores, taus: np.ndarray) -> np.ndarray:
     >>> performance_profile({"a": np.array([0.2, 0.6]), "b": np.array([0.9])}, np.array([0.5]))
     array([0.66666667])
     """
-    _check(scores, "performance profile")
-    values = np.concatenate([np.ravel(runs) for runs in scores.values()])
-    return (values[:, None] > np.asarray(taus, dtype=float)[None, :]).mean(axis=0)
+    values = np.concatenate(list(_scores(scores, "performance_profile").values()))
+    return (values[:, None] > _thresholds(taus)[None, :]).mean(axis=0)
+
+
+def _thresholds(taus: object) -> np.ndarray:
+    """The profile's thresholds: a non-empty 1-D array of finite numbers."""
+    thresholds = _numbers(taus, "performance_profile: taus")
+    if thresholds.ndim != 1 or thresholds.size == 0:
+        one = f"np.array([{thresholds.item():g}])" if thresholds.size == 1 else "np.array([0.5])"
+        raise ValueError(
+            f"performance_profile: taus must be a 1-D array of thresholds, got shape "
+            f"{thresholds.shape}; e.g. taus={one} for one threshold, or np.linspace(0, 1, 21)"
+        )
+    _finite(
+        thresholds, "performance_profile: taus", "taus[np.isfinite(taus)]", "a threshold is a score"
+    )
+    return thresholds

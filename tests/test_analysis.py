@@ -293,3 +293,41 @@ def test_model_recolouring_of_a_non_mujoco_run_says_what_still_works(runs, tmp_p
     assert "not a dm_control task" in err and "--recolour conv" in err
     assert "simoun-analyze masks" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("change", "error", "message"),
+    [
+        (lambda p: [p["dynamic"], p["static"]], TypeError, r"dict factor -> \(z_a, z_b\)"),
+        (lambda p: {**p, "motion": p["static"]}, ValueError, r"unknown \['motion'\]"),
+        (
+            lambda p: {k.title(): v for k, v in p.items()},
+            ValueError,
+            r"missing \['dynamic', 'static'\], unknown \['Static', 'Dynamic'\]",
+        ),
+        (lambda p: {**p, "static": p["static"] * 2}, ValueError, r"two arrays.*length 4"),
+        (lambda p: {**p, "dynamic": p["dynamic"][0]}, ValueError, r"two arrays \(z_a, z_b\)"),
+        (
+            lambda p: {**p, "static": (p["static"][0], np.where(p["static"][1] > 3, np.nan, 0))},
+            ValueError,
+            r"pairs\['static'\]\[1\] has \d+ NaN or infinite activation",
+        ),
+    ],
+)
+def test_estimator_refuses_pairs_it_cannot_use(change, error, message):
+    with pytest.raises(error, match=message):
+        information_bias(change(synthetic_pairs(n=20)))
+
+
+@pytest.mark.parametrize(
+    ("threshold", "error", "message"),
+    [
+        (50, ValueError, r"threshold must lie in \(0, 1\).*50 looks like a percent: threshold=0.5"),
+        (1.0, ValueError, r"threshold must lie in \(0, 1\)"),
+        (0, ValueError, r"threshold must lie in \(0, 1\)"),
+        ("0.5", TypeError, r"threshold must be a number"),
+    ],
+)
+def test_estimator_refuses_a_threshold_outside_0_1(threshold, error, message):
+    with pytest.raises(error, match=message):
+        information_bias(synthetic_pairs(n=20), threshold=threshold)

@@ -147,3 +147,130 @@ def test_normalize_divides_dm_control_returns_by_1000_and_leaves_others():
     )
     np.testing.assert_array_equal(stats.normalize("simoun/PointReach-v0", returns), returns)
     assert stats.max_return("simoun/PointReach-v0") is None
+
+
+CURVES = np.array([[0.1, 0.5, 0.7], [0.2, 0.4, 0.6]])
+"""Two runs' learning curves over three evaluation steps."""
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "message"),
+    [
+        (lambda: stats.aggregate_iqm(np.array([0.7, 0.65])), TypeError, r"scores must be a dict"),
+        (lambda: stats.aggregate_mean([0.7]), TypeError, r"aggregate_mean\(\{'cheetah-run'"),
+        (lambda: stats.aggregate_iqm({}), ValueError, r"scores has no tasks"),
+        (lambda: stats.aggregate_mean({"t": []}), ValueError, r"\['t'\] has no runs"),
+        (lambda: stats.aggregate_iqm({"t": 0.5}), ValueError, r"\{task: \[score\]\}"),
+        (lambda: stats.aggregate_iqm({"t": ["a"]}), TypeError, r"\['t'\] must be an array of n"),
+        (lambda: stats.aggregate_iqm({"t": CURVES}), ValueError, r"\[:, -1\]"),
+        (
+            lambda: stats.probability_of_improvement({"t": CURVES}, {"t": [1.0, 2.0]}),
+            ValueError,
+            r"x\['t'\] must be a 1-D array.*looks like learning curves",
+        ),
+        (
+            lambda: stats.probability_of_improvement({"t": [1.0]}, {"t": CURVES}),
+            ValueError,
+            r"y\['t'\] must be a 1-D array",
+        ),
+        (
+            lambda: stats.iqm_over_steps({"t": [1.0, 2.0, 3.0]}),
+            ValueError,
+            r"must be a 2-D array of learning curves.*looks like final scores",
+        ),
+        (
+            lambda: stats.iqm_over_steps({"a": CURVES, "b": CURVES[:, :2]}),
+            ValueError,
+            r"one step grid.*\{'a': 3, 'b': 2\}.*\[:, :2\]",
+        ),
+        (
+            lambda: stats.performance_profile({"t": [0.2, 0.6]}, 0.5),
+            ValueError,
+            r"taus must be a 1-D array.*taus=np.array\(\[0.5\]\)",
+        ),
+        (
+            lambda: stats.normalize(np.array([500.0]), "dm_control/cheetah-run-v0"),
+            TypeError,
+            r"normalize\('dm_control/cheetah-run-v0', returns\)",
+        ),
+        (lambda: stats.normalize("Pendulum-v1", "500"), TypeError, r"returns must be an array"),
+        (lambda: stats.iqm({"t": [1.0]}), TypeError, r"use aggregate_iqm\(scores\)"),
+    ],
+)
+def test_scores_of_the_wrong_kind_are_refused_naming_the_argument(call, error, message):
+    with pytest.raises(error, match=message):
+        call()
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: stats.iqm([0.7, float("nan"), 0.72, 0.8]),
+        lambda: stats.aggregate_iqm({"t": [0.7, float("inf")]}),
+        lambda: stats.aggregate_mean({"t": [float("nan")]}),
+        lambda: stats.probability_of_improvement({"t": [1.0, float("nan")]}, {"t": [0.5, 0.6]}),
+        lambda: stats.iqm_over_steps({"t": np.where(CURVES > 0.6, np.nan, CURVES)}),
+        lambda: stats.stratified_bootstrap_ci({"t": [1.0, float("nan")]}, stats.aggregate_iqm),
+    ],
+)
+def test_non_finite_scores_are_refused(call):
+    """A NaN sorts last (the IQM trims it as the best run) and compares as a loss: refused."""
+    with pytest.raises(ValueError, match=r"NaN or infinite value.*np.isfinite"):
+        call()
+
+
+SCORES = {"t": np.arange(8.0)}
+
+
+@pytest.mark.parametrize(
+    ("arguments", "error", "message"),
+    [
+        (
+            {"reps": 0},
+            ValueError,
+            r"reps \(the number of bootstrap resamples\) must be an int >= 1",
+        ),
+        ({"reps": 2.5}, TypeError, r"reps .* must be an int >= 1, got float 2.5; e.g. reps=2000"),
+        ({"seed": -1}, ValueError, r"seed must be an int in \[0, 4294967295\].*seed=0"),
+        ({"seed": "0"}, TypeError, r"seed must be an int"),
+        ({"confidence": "95%"}, TypeError, r"confidence must be a number in \(0, 1\)"),
+        ({"confidence": 95}, ValueError, r"looks like a percent: confidence=0.95"),
+        ({"statistic": "iqm"}, TypeError, r"statistic must be a function.*stats.aggregate_iqm"),
+        ({"statistic": stats.iqm}, TypeError, r"statistic\(scores\) \(iqm\).*aggregate_iqm"),
+        ({"statistic": stats.iqm_over_steps}, ValueError, r"iqm_over_steps: scores\['t'\]"),
+        (
+            {"statistic": lambda s: stats.performance_profile(s, np.array([1.0, 2.0]))},
+            ValueError,
+            r"returns one number.*stratified_bootstrap_band",
+        ),
+    ],
+)
+def test_bootstrap_arguments_are_checked(arguments, error, message):
+    arguments = {"statistic": stats.aggregate_iqm, **arguments}
+    with pytest.raises(error, match=message):
+        stats.stratified_bootstrap_ci(SCORES, **arguments)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: stats.probability_of_improvement_ci(SCORES, SCORES, reps=0),
+        lambda: stats.difference_ci(SCORES, SCORES, reps=1.0),
+        lambda: stats.bootstrap_replicates(SCORES, stats.aggregate_iqm, reps=-3),
+        lambda: stats.stratified_bootstrap_band(SCORES, stats.aggregate_iqm, reps=True),
+    ],
+)
+def test_every_resampling_function_checks_reps(call):
+    with pytest.raises((TypeError, ValueError), match=r"reps .* must be an int >= 1"):
+        call()
+
+
+def test_valid_scores_in_other_forms_still_work():
+    """Lists, numpy integers and a task of one run stay accepted."""
+    assert stats.aggregate_iqm({"t": [1, 2, 3, 4]}) == 2.5
+    assert stats.aggregate_mean({"a": [1.0], "b": (3.0, 5.0)}) == 2.5
+    assert stats.stratified_bootstrap_ci({"t": [0.3]}, stats.aggregate_iqm, reps=np.int64(10))[
+        0
+    ] == pytest.approx(0.3)
+    np.testing.assert_allclose(stats.iqm_over_steps({"t": CURVES.tolist()}), [0.15, 0.45, 0.65])
+    assert stats.performance_profile({"t": [0.2, 0.6]}, [0.5]).tolist() == [0.5]

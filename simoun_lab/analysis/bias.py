@@ -9,7 +9,9 @@ run's own environment is in :mod:`simoun_lab.analysis.pairs`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -80,9 +82,8 @@ def information_bias(
         >>> information_bias({"dynamic": copy, "static": noise}).categories
         {'static': 0, 'dynamic': 1, 'joint': 0, 'residual': 0}
     """
-    missing = [factor for factor in FACTORS if factor not in pairs]
-    if missing:
-        raise ValueError(f"information_bias needs pairs for {FACTORS}, missing {missing}")
+    _check_factors(pairs)
+    _check_threshold(threshold)
     shapes = {
         factor: (np.shape(pairs[factor][0]), np.shape(pairs[factor][1])) for factor in FACTORS
     }
@@ -93,9 +94,7 @@ def information_bias(
                 f"pairs[{factor!r}] must be two arrays of the same shape (N, D) with N >= 2 and "
                 f"one D for every factor, got {shape_a} and {shape_b}"
             )
-    z = {
-        factor: tuple(np.asarray(side, np.float64) for side in pairs[factor]) for factor in FACTORS
-    }
+    z = {factor: _activations(factor, pairs[factor]) for factor in FACTORS}
     everything = np.concatenate([side for factor in FACTORS for side in z[factor]])
     total_var = float(everything.var(axis=0).sum())
     unit_scores, layer_scores = {}, {}
@@ -123,3 +122,86 @@ def information_bias(
         "residual": int(np.sum(~static & ~dynamic)),
     }
     return BiasEstimate(unit_scores, layer_scores, factor_units, categories, units)
+
+
+EXAMPLE = "information_bias({'dynamic': (z_a, z_b), 'static': (z_c, z_d)}), each z an (N, D) array"
+"""The form of ``pairs``, shown when it is refused."""
+
+
+def _check_factors(pairs: object) -> None:
+    """``pairs`` is a mapping with exactly the factors of :data:`FACTORS`, each a pair."""
+    if not isinstance(pairs, Mapping):
+        raise TypeError(
+            f"information_bias takes pairs as a dict factor -> (z_a, z_b), keyed by {FACTORS}, "
+            f"got {type(pairs).__name__}; e.g. {EXAMPLE}"
+        )
+    missing = [factor for factor in FACTORS if factor not in pairs]
+    unknown = [factor for factor in pairs if factor not in FACTORS]
+    if missing or unknown:
+        found = [f"missing {missing}"] * bool(missing) + [f"unknown {unknown}"] * bool(unknown)
+        raise ValueError(
+            f"information_bias needs pairs for exactly {FACTORS}, got {', '.join(found)}: the "
+            f"estimator knows these two factors only (lowercase); e.g. {EXAMPLE}"
+        )
+    for factor in FACTORS:
+        _check_pair(factor, pairs[factor])
+
+
+def _check_pair(factor: str, pair: Any) -> None:
+    """``pairs[factor]`` holds two sides, each the activations on one input of every pair."""
+    try:
+        size = None if isinstance(pair, str | bytes | Mapping) else len(pair)
+    except TypeError:
+        size = None
+    if size != 2:
+        length = "" if size is None else f" of length {size}"
+        raise ValueError(
+            f"pairs[{factor!r}] must be two arrays (z_a, z_b), the layer's activations on the "
+            f"first and the second input of each pair, got {type(pair).__name__}{length}; "
+            f"e.g. {EXAMPLE}"
+        )
+
+
+def _check_threshold(threshold: object) -> None:
+    """The category threshold is a fraction in (0, 1), as the per-unit scores are."""
+    if isinstance(threshold, bool) or not isinstance(threshold, int | float | np.number):
+        raise TypeError(
+            f"threshold must be a number in (0, 1), got {type(threshold).__name__} "
+            f"{threshold!r}; e.g. threshold={THRESHOLD} (the paper's)"
+        )
+    if not 0 < threshold < 1:
+        percent = (
+            f" ({threshold} looks like a percent: threshold={threshold / 100:g})"
+            if 1 < threshold <= 100
+            else ""
+        )
+        raise ValueError(
+            f"threshold must lie in (0, 1): the per-unit scores are correlations, at most 1, "
+            f"got {threshold}{percent}; e.g. threshold={THRESHOLD} (the paper's)"
+        )
+
+
+def _activations(factor: str, pair: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, ...]:
+    """The two sides of ``pair`` as float arrays of finite numbers."""
+    sides = []
+    for side, values in enumerate(pair):
+        where = f"pairs[{factor!r}][{side}]"
+        try:
+            array = np.asarray(values, np.float64)
+        except (TypeError, ValueError) as error:
+            raise TypeError(
+                f"{where} must be an (N, D) array of activations, got "
+                f"{type(values).__name__} ({error})"
+            ) from None
+        bad = ~np.isfinite(array)
+        if bad.any():
+            row, unit = (int(i) for i in np.argwhere(bad)[0][:2])
+            raise ValueError(
+                f"{where} has {int(bad.sum())} NaN or infinite activation(s) "
+                f"({array[row, unit]} at row {row}, unit {unit}): every score needs finite "
+                "activations; check the layer, or leave out the pairs with one, e.g. "
+                "keep = np.isfinite(z_a).all(1) & np.isfinite(z_b).all(1), then "
+                "(z_a[keep], z_b[keep])"
+            )
+        sides.append(array)
+    return tuple(sides)
