@@ -270,15 +270,19 @@ def unexpanded_home(path: Any) -> str | None:
     )
 
 
-def check_path(value: Any, name: str, example: str) -> None:
-    """A TypeError for a ``value`` of the argument ``name`` that is no path (a str or
-    os.PathLike), and a ValueError for one that starts with an unexpanded ``~``
-    (:func:`unexpanded_home`); ``example`` is a call that works."""
+def check_path(value: Any, name: str, example: str, what: str = "a path") -> None:
+    """The one check of a path argument of the Python API: a TypeError for a ``value`` of the
+    argument ``name`` that is no path (a str or os.PathLike), and a ValueError for one that
+    starts with an unexpanded ``~`` (:func:`unexpanded_home`); ``example`` is a call that
+    works, ``what`` what the path names. (The command lines refuse such a path as they read
+    their flags, with the flag's name.)"""
     if not isinstance(value, (str, os.PathLike)):
         raise TypeError(
-            f"{name} must be a path, a str or os.PathLike, got {type(value).__name__} "
+            f"{name} must be {what}, as a str or os.PathLike, got {type(value).__name__} "
             f"{value!r:.60}; e.g. {example}"
         )
     home = unexpanded_home(value)
-    if home is not None:
-        raise ValueError(f"{name}={os.fspath(value)!r}: {home}")
+    if home is not None:  # the call as written: load_run(path='~/runs'), not path=...)='~/runs'
+        given = repr(os.fspath(value))
+        call = name.replace("...", given) if "..." in name else f"{name}={given}"
+        raise ValueError(f"{call}: {home}")

@@ -9,6 +9,7 @@ stacked above deep-copy the spec, which keeps its class, so the check holds over
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 from typing import Any
@@ -62,6 +63,9 @@ class CheckedSpec(EnvSpec):
         ]
         if unwritable:
             raise TypeError(_unwritable(unwritable))
+        made_with = [(key, value) for key, value in self.kwargs.items() if not _writable(value)]
+        if made_with:
+            raise TypeError(_unwritable_make(made_with, "num_envs" in self.kwargs))
         return super().to_json()
 
     def __eq__(self, other: object) -> bool:
@@ -92,6 +96,17 @@ class CheckedSpecWrapper:
         return checked_spec(super().spec)  # type: ignore[misc]
 
 
+class CheckedVectorSpecWrapper:
+    """Mixin for a ``VectorWrapper``: its ``spec`` is a :class:`CheckedSpec` copy of the vector
+    env's (Gymnasium records no vector wrapper in the spec, and hands out the vector env's own
+    spec, whose class is left as it is)."""
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        spec = super().spec  # type: ignore[misc]
+        return None if spec is None else checked_spec(copy.copy(spec))
+
+
 def _writable(value: Any) -> bool:
     try:
         json.dumps(value)
@@ -105,9 +120,7 @@ def _unwritable(arguments: list[tuple[str, str, Any]]) -> str:
 
     named, advice = [], []
     for name, key, value in arguments:
-        held = SharedSource.unwrap(value)  # the spec holds the user's model in a SharedSource
-        shown = repr(held) if len(repr(held)) <= 80 else f"a {type(held).__name__}"
-        named.append(f"{name}'s {key}={shown}")
+        named.append(f"{name}'s {key}={_shown(value)}")
         form = _JSON_FORMS.get(key)
         advice.append(
             f"to write the spec, {form}"
@@ -119,4 +132,34 @@ def _unwritable(arguments: list[tuple[str, str, Any]]) -> str:
         f"and dicts only. For {key if len(arguments) == 1 else 'these'}: {'; '.join(advice)}. "
         f"In this process, gym.make(env.spec) (no JSON) re-makes the env, keeping them as they "
         f"are."
+    )
+
+
+def _shown(value: Any) -> str:
+    """``value`` as a message shows it: its repr, or its type when the repr is long."""
+    held = SharedSource.unwrap(value)  # the spec holds the user's model in a SharedSource
+    if len(repr(held)) <= 80:
+        return repr(held)
+    if isinstance(held, (list, tuple)):  # make_vec's wrappers: name each item's kind
+        return f"[{', '.join(_shown(item) for item in held)}]"
+    return f"a {type(held).__name__}"
+
+
+def _unwritable_make(arguments: list[tuple[str, Any]], vector: bool) -> str:
+    """The error for the ``(key, value)`` arguments of ``gym.make`` (``gym.make_vec`` when
+    ``vector``) recorded in the spec that JSON cannot hold."""
+    maker = "gym.make_vec" if vector else "gym.make"
+    named = "; ".join(f"{maker}'s {key}={_shown(value)}" for key, value in arguments)
+    advice = [
+        "make the vector env without wrappers= to write its spec, and wrap the sub-envs again "
+        "where the spec is read (a function cannot be written as JSON)"
+        if key == "wrappers" and vector
+        else f"pass {key} as a plain value to {maker}"
+        for key, _ in arguments
+    ]
+    return (
+        f"env.spec.to_json() cannot write {named}: JSON holds names, numbers, lists and dicts "
+        f"only, and the spec records the arguments the env was made with. To write the spec, "
+        f"{'; '.join(advice)}. In this process, {maker}(env.spec) (no JSON) re-makes the env, "
+        "keeping them as they are."
     )

@@ -34,7 +34,7 @@ from simoun_wrappers._checks import (
     keyword_reset,
     plain,
 )
-from simoun_wrappers._spec import CheckedSpecWrapper, SharedSource
+from simoun_wrappers._spec import CheckedSpecWrapper, CheckedVectorSpecWrapper, SharedSource
 from simoun_wrappers.frames import check_single_env
 from simoun_wrappers.intrinsic_normalization import (
     Normalization,
@@ -530,7 +530,9 @@ def dict_info_problem(owner: str, got: str | None = None) -> str:
     )
 
 
-class IntrinsicVectorReward(IntrinsicMechanism, VectorWrapper, gym.utils.RecordConstructorArgs):
+class IntrinsicVectorReward(
+    IntrinsicMechanism, CheckedVectorSpecWrapper, VectorWrapper, gym.utils.RecordConstructorArgs
+):
     """``r_e + r_i`` for every sub-env of a vector env, in one batched signal call.
 
     One signal (one source, one normalization) serves all sub-envs, and the triplets of all

@@ -522,6 +522,24 @@ def test_a_damaged_file_of_a_finished_run_is_named_not_counted(
     assert not (v1_copy / "report").exists() and not (v1_copy / "selection.md").exists()
 
 
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("", "it is empty"),
+        ("garbage", "it is not JSON"),
+        ('{"run": "MiniGrid-DoorKey-6x6-v0/rnd/s0", "env_st', "it is not JSON"),
+        ("[1, 2]", "it holds an array, not a JSON object"),
+    ],
+)
+def test_run_over_an_archive_names_an_unreadable_summary_before_it_counts(text, said, v1_copy):
+    path = v1_copy / V1_RUNS[2] / "summary.json"
+    path.write_text(text)
+    status, printed = study("run", "--archive", str(v1_copy))
+    assert status == 2 and "Traceback" not in printed, printed[-2000:]
+    assert f"{path} is damaged: {said}" in printed
+    assert "runs finished in" not in printed  # refused before any run is skipped or trained
+
+
 def test_a_finished_run_without_its_train_csv_is_named_by_the_report(v1_copy):
     path = v1_copy / V1_RUNS[1] / "train.csv"
     path.unlink()

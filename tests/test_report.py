@@ -184,8 +184,35 @@ def test_equal_budget_cuts_every_run_at_it_and_counts_unfinished_runs_that_reach
     )
     assert int(rows["agent.lr=0.0003"]["n"]) == 1  # b-s1 never trained: short of the budget
     assert "b-s1" in (out / report.REPORT_MD).read_text().split("short of the budget")[1]
-    with pytest.raises(SystemExit):
-        report_cli.main([str(runs_dir), "--at-step", "0"])
+
+
+def test_at_step_0_compares_the_evaluations_before_training(runs_dir, tmp_path, capsys):
+    out = tmp_path / "at-0"
+    assert report_cli.main([str(runs_dir), "--at-step", "0", "--out", str(out)]) == 0
+    rows = {row["variant"]: row for row in rows_of(out)}
+    at_0 = [
+        next(r for r in read_csv(runs_dir / name / "eval.csv") if r["env_step"] == 0)
+        for name in ("a-s0", "a-s1")
+    ]
+    a = rows["agent.lr=0.001"]
+    assert int(a["n"]) == 2
+    assert float(a["final_return_mean"]) == pytest.approx(np.mean([r["return_mean"] for r in at_0]))
+    assert "an equal budget of 0 env steps" in (out / report.REPORT_MD).read_text()
+
+
+@pytest.mark.parametrize(
+    ("flags", "said"),
+    [
+        (["--at-step", "-1"], "--at-step -1: give a number of env steps >= 0, e.g. --at-step"),
+        (["--at-wall-time", "0"], "--at-wall-time 0: give a positive finite number of seconds"),
+        (["--at-wall-time", "nan"], "--at-wall-time nan: give a positive finite number"),
+    ],
+)
+def test_a_budget_below_its_range_is_refused_naming_the_flag(flags, said, runs_dir, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        report_cli.main([str(runs_dir), *flags])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2 and said in err and "Traceback" not in err
 
 
 def test_a_dict_valued_key_stays_one_value_so_it_can_name_a_variant():

@@ -104,6 +104,7 @@ def loaded(gpu_run):
     ("arguments", "error", "said"),
     [
         ({"path": None}, TypeError, r"^load_run\(path=\.\.\.\) must be a run directory or its "),
+        ({"path": b"runs/a"}, TypeError, r"checkpoint\.pt, as a str or os\.PathLike, got bytes"),
         ({"device": "gpu"}, SetupError, r"^load_run\(device='gpu'\): device type 'gpu' is not "),
         ({"device": 0}, TypeError, r"^load_run\(device=\.\.\.\) must be a str, a torch.device"),
         ({"torch_threads": 0}, SetupError, r"^load_run\(torch_threads=\.\.\.\) must be an int"),
@@ -184,5 +185,8 @@ def test_random_policy_names_its_argument(arguments, error, said):
 
 
 def test_load_run_of_an_unexpanded_home_says_python_does_not_expand_it():
-    with pytest.raises(SetupError, match=r"Python does not expand ~.*os.path.expanduser"):
+    # the Python API's path check (check_path): a ValueError, as every path argument gives
+    with pytest.raises(ValueError, match=r"Python does not expand ~.*os.path.expanduser") as err:
         load_run("~/simoun-no-such-run", device="cpu")
+    assert type(err.value) is ValueError
+    assert str(err.value).startswith("load_run(path='~/simoun-no-such-run'): ")

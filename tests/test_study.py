@@ -770,6 +770,30 @@ def test_a_finished_run_whose_config_is_damaged_or_another_runs_is_named_by_the_
     assert f"mv {dmc_archive / run} {dmc_archive / run}.damaged" in err
 
 
+@pytest.mark.parametrize(
+    ("run", "text", "said"),
+    [
+        (DMC_TUNING_RUN, "", "it is empty"),
+        (DMC_TUNING_RUN, '{"env_step": 100000, "final_', "it is not JSON"),
+        (DMC_EVALUATION_RUN, "garbage", "it is not JSON"),
+        (DMC_EVALUATION_RUN, "[]", "it holds an array, not a JSON object"),
+    ],
+)
+def test_a_finished_runs_unreadable_summary_is_named_on_resume_before_it_counts(
+    run, text, said, dmc_archive, tmp_path, capsys
+):
+    path = dmc_archive / run / "summary.json"
+    path.write_text(text)
+    argv = ["run", "docs/studies/dmc100k.toml", "--study-dir", str(tmp_path / "s")]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main([*argv, "--archive", str(dmc_archive), "--resume", "--allow-other-commit"])
+    err = capsys.readouterr().err
+    assert exit_info.value.code == 2 and "Traceback" not in err
+    assert f"{path} (the mark that run {run} finished) is damaged: {said}" in err
+    assert f"mv {dmc_archive / run} {dmc_archive / run}.damaged" in err
+    assert not (tmp_path / "s" / run).exists()  # nothing restored from the archive
+
+
 def test_a_report_directory_that_is_a_file_is_named(dmc_archive, capsys):
     shutil.rmtree(dmc_archive / "report")
     (dmc_archive / "report").write_text("notes\n")

@@ -34,7 +34,7 @@ from simoun_lab.sweep.grid import (
     split_values,
 )
 from simoun_lab.sweep.launch import gpus_per_trial
-from simoun_lab.sweep.trainable import finished
+from simoun_lab.sweep.trainable import finished, open_run
 
 TINY = override(
     tiny_flags(total_env_steps=60),
@@ -648,6 +648,50 @@ def test_a_config_copied_over_a_trials_summary_is_named_on_resume(trained_sweep,
     err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
     assert f"{run_dir / 'summary.json'} is damaged: it holds config.json's keys" in err
     assert "already finished" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("", "it is empty"),
+        ("garbage\n", "it is not JSON"),
+        ('{"env_step": 40, "final_e', "it is not JSON"),
+        ("[40]", "it holds an array, not a JSON object"),
+        ('{"env_step": "40", "final_eval": {"return_mean": 1.0}}', 'its env_step is "40"'),
+        ('{"env_step": 40, "final_eval": null}', "it has no finite final_eval.return_mean"),
+    ],
+)
+def test_an_unreadable_trial_summary_is_refused_on_resume_not_counted_finished(
+    trained_sweep, tmp_path, capsys, text, said
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    (run_dir / "summary.json").write_text(text)
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(1)}: {run_dir / 'summary.json'} is damaged: {said}" in err
+    assert f"remove it (rm {run_dir / 'summary.json'}) so that the resume writes" in err
+    assert f"move the run directory aside (mv {run_dir} {run_dir}.aside)" in err
+    assert "Traceback" not in err and "already finished" not in capsys.readouterr().out
+
+
+def test_a_trial_whose_damaged_summary_was_removed_gets_its_end_written_again(
+    trained_sweep, tmp_path
+):
+    """The first fix of the refusal above: the trial (as a resumed sweep trains it) writes its
+    summary.json again from its checkpoint, its eval.csv as it was."""
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    spec = SweepSpec.load(sweep_dir)
+    trial = spec.trials(sweep_dir)[0]
+    run_dir = Path(trial.run_dir)
+    kept = json.loads((run_dir / "summary.json").read_text())
+    evaluations = (run_dir / "eval.csv").read_text()
+    (run_dir / "summary.json").unlink()
+    assert not finished(trial)
+    run = open_run(trial)
+    train.train(run)
+    train.release(run)
+    assert json.loads((run_dir / "summary.json").read_text())["final_eval"] == kept["final_eval"]
+    assert (run_dir / "eval.csv").read_text() == evaluations and finished(trial)
 
 
 @pytest.mark.parametrize(("damage", "said"), TRIAL_DAMAGES)

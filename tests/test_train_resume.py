@@ -186,6 +186,27 @@ def test_a_missing_checkpoint_is_named_with_both_fixes(finished_run, tmp_path):
     assert "Restore it from a copy" in str(refusal.value)
 
 
+@pytest.mark.parametrize("text", ["", "garbage", '{"env_step": 40, "final_', "[40]"])
+def test_a_finished_runs_unreadable_summary_is_named_and_its_fix_rewrites_it(
+    finished_run, tmp_path, text
+):
+    run_dir = tmp_path / "run"
+    shutil.copytree(finished_run, run_dir)
+    path = run_dir / "summary.json"
+    path.write_text(text)
+    with pytest.raises(SetupError, match=r"summary\.json is damaged: .*cannot say whether") as err:
+        train.resume_run(run_dir, {"total_env_steps": 40})
+    assert f"rm {path}" in str(err.value)
+    path.unlink()  # the fix the message gives: the run's end is written again, nothing trained
+    run = train.resume_run(run_dir, {"total_env_steps": 40})
+    train.train(run)
+    summary = json.loads(path.read_text())
+    assert summary["env_step"] == 40
+    kept = json.loads((finished_run / "summary.json").read_text())
+    assert summary["final_eval"] == kept["final_eval"]
+    assert (run_dir / "eval.csv").read_text() == (finished_run / "eval.csv").read_text()
+
+
 def test_a_config_json_that_lost_a_section_is_named_not_blamed_on_overrides(finished_run, tmp_path):
     run_dir = tmp_path / "run"
     shutil.copytree(finished_run, run_dir)

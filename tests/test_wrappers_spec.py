@@ -2,6 +2,8 @@
 
 import inspect
 import json
+import pickle
+from functools import partial
 
 import gymnasium as gym
 import numpy as np
@@ -15,12 +17,14 @@ from simoun_wrappers import (
     ColorShift,
     ConsistencyCuriosityReward,
     ConstantBonusReward,
+    ConstantBonusVectorReward,
     FrameTriplet,
     MovingBackground,
     MultiCamera,
     RandomConvolution,
     ResidualMotion,
     RNDReward,
+    RNDVectorReward,
     SimounObservation,
 )
 from simoun_wrappers.intrinsic_normalization import ReturnStd
@@ -218,6 +222,51 @@ def test_to_json_names_the_argument_json_cannot_hold(build, words):
         assert word in str(refused.value)
     # in the same process the spec still re-makes the env
     gym.make(env.spec).reset(seed=0)
+
+
+def _pixel_vector() -> gym.vector.VectorEnv:
+    return gym.make_vec(
+        "CartPole-v1",
+        num_envs=2,
+        vectorization_mode="sync",
+        render_mode="rgb_array",
+        wrappers=[partial(SimounObservation, size=16)],
+    )
+
+
+@pytest.mark.parametrize(
+    "build",
+    [
+        lambda: ConstantBonusVectorReward(_pixel_vector(), 0.1),
+        lambda: RNDVectorReward(_pixel_vector(), _novelty, normalization=ReturnStd()),
+    ],
+)
+def test_a_vector_wrappers_to_json_names_the_make_vec_argument_json_cannot_hold(build):
+    envs = build()
+    with pytest.raises(TypeError) as refused:
+        envs.spec.to_json()
+    said = str(refused.value)
+    assert "gym.make_vec's wrappers=[a partial]" in said
+    assert "make the vector env without wrappers= to write its spec" in said
+    # the vector env's own spec keeps its class; the spec still pickles and re-makes the env
+    assert type(envs.env.spec) is EnvSpec and envs.spec == envs.env.spec
+    pickled = pickle.loads(pickle.dumps(envs.spec))  # a new partial, equal in all else
+    assert type(pickled) is type(envs.spec) and pickled.kwargs["num_envs"] == 2
+    remade = gym.make_vec(envs.spec)
+    assert remade.single_observation_space == envs.single_observation_space
+    remade.close()
+    envs.close()
+
+
+def test_to_json_names_a_gym_make_argument_json_cannot_hold():
+    made = gym.make("CartPole-v1", render_mode="rgb_array", sutton_barto_reward=np.True_)
+    env = ConstantBonusReward(SimounObservation(made, size=16), 0.1)
+    with pytest.raises(TypeError) as refused:
+        env.spec.to_json()
+    said = str(refused.value)
+    assert "gym.make's sutton_barto_reward=np.True_" in said
+    assert "pass sutton_barto_reward as a plain value to gym.make" in said
+    assert pickle.loads(pickle.dumps(env.spec)) == env.spec
 
 
 def test_a_checked_spec_equals_the_gymnasium_spec_it_writes():

@@ -341,6 +341,36 @@ def kind_problem(name: str, found: Sequence[str]) -> str | None:
     return None
 
 
+def finite_number(value: Any) -> bool:
+    """Whether ``value`` is a finite JSON number (true/false are not numbers)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def summary_problem(path: Path) -> str | None:
+    """What is wrong with a run's ``summary.json``, the mark that the run finished, when a
+    resume cannot rely on it: it cannot be read (:func:`read_json_object`), holds another file's
+    keys (:func:`kind_problem`), or has no env_step >= 0 or no finite final_eval.return_mean,
+    which every reader of a finished run reads. None when there is no summary.json (the run is
+    not finished) or it is sound."""
+    if not path.is_file():
+        return None
+    try:
+        summary = read_json_object(path)
+    except Damaged as err:
+        return str(err)
+    problem = kind_problem(path.name, list(summary))
+    if problem:
+        return problem
+    step = summary.get("env_step")
+    if not (finite_number(step) and step >= 0):
+        return f"its env_step is {json.dumps(step)}, not a number >= 0"
+    final = summary.get("final_eval")
+    value = final.get("return_mean") if isinstance(final, dict) else None
+    if not finite_number(value):
+        return f"it has no finite final_eval.return_mean ({json.dumps(value)})"
+    return None
+
+
 UNPACK = {".gz": "gunzip", ".bz2": "bunzip2", ".xz": "unxz", ".zst": "unzstd"}
 """A compressed file's suffix -> the command that restores the file beside it."""
 

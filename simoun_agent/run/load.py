@@ -32,7 +32,10 @@ from simoun_agent.run.kept import (
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.make_env import make_env
 from simoun_agent.run.seeds import first_eval_seed
-from simoun_wrappers._checks import is_int, unexpanded_home
+from simoun_wrappers._checks import check_path, is_int
+
+RUN_PATH = "a run directory or its checkpoint.pt"
+"""What load_run's ``path`` names."""
 
 
 @dataclass
@@ -61,13 +64,15 @@ def load_run(
     device: str | torch.device | None = None,
     torch_threads: int | None = None,
 ) -> LoadedRun:
-    """Rebuild the run of ``path`` (its directory or checkpoint.pt); SetupError when it cannot.
+    """Rebuild the run of ``path`` (its directory or checkpoint.pt); SetupError when it cannot
+    (TypeError or ValueError for a ``path`` that is no path or starts with an unexpanded ``~``:
+    :func:`~simoun_wrappers._checks.check_path`).
 
     ``device`` (a str or torch.device) and ``torch_threads`` (None: the run's own) apply before
     the config's checks; a value of theirs that this machine cannot use is refused naming the
     argument (the saved files are not at fault).
     """
-    check_run_path(path)
+    check_path(path, "load_run(path=...)", "load_run('runs/my-run')", RUN_PATH)
     machine = machine_values(device, torch_threads)
     payload = load_checkpoint(Path(path))
     check_config_file(payload)
@@ -87,18 +92,6 @@ def load_run(
     agent.load_state_dict(payload["agent"])
     run_dir = payload["replay_path"].parent
     return LoadedRun(run_dir, config, env, agent, int(payload["state"]["env_step"]))
-
-
-def check_run_path(path: Any) -> None:
-    """A TypeError naming ``path`` when it is no path at all (pathlib's names no argument)."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(
-            f"load_run(path=...) must be a run directory or its checkpoint.pt, as a str or "
-            f"os.PathLike, got {type(path).__name__} {path!r:.60}; e.g. load_run('runs/my-run')"
-        )
-    home = unexpanded_home(path)
-    if home is not None:
-        raise SetupError(f"load_run(path={os.fspath(path)!r}): {home}")
 
 
 def machine_values(device: Any, torch_threads: Any) -> dict[str, Any]:

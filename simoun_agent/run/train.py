@@ -84,6 +84,7 @@ from simoun_agent.run.kept import (
     packed_problem,
     present,
     read_text,
+    summary_problem,
 )
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
@@ -399,6 +400,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     done = payload["state"]["env_step"]
     check_logs_reach(run_dir, payload["state"])
     finished = (run_dir / SUMMARY_NAME).exists()
+    if finished and config.total_env_steps == done:
+        check_end_mark(run_dir / SUMMARY_NAME)
     # At its last step without summary.json, a run stopped in its final evaluation or video.
     if config.total_env_steps < done or (config.total_env_steps == done and finished):
         is_finished = " and is finished" if finished else ""
@@ -452,6 +455,18 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         (run_dir / SUMMARY_NAME).unlink(missing_ok=True)
         write_config(run_dir, config)
     return run
+
+
+def check_end_mark(path: Path) -> None:
+    """SetupError for a run's damaged ``summary.json`` (:func:`summary_problem`), the mark that
+    the run ended, when a resume would rely on it to call the run finished."""
+    problem = summary_problem(path)
+    if problem:
+        raise SetupError(
+            f"{path} is damaged: {problem}, so it cannot say whether the run ended. Remove it "
+            f"(rm {path}) and resume again: the run's end is written again from its checkpoint "
+            "and last evaluation, without training; or restore the file from a copy"
+        )
 
 
 def missing_replay(path: Path) -> str:

@@ -56,18 +56,34 @@ class ReportCommand:
     that stopped earlier are listed as short)"""
 
 
+def budget_of(args: ReportCommand) -> tuple[str, float] | None:
+    """The equal budget ``--at-step`` or ``--at-wall-time`` asks for (None: compare the runs at
+    their ends); exits naming the flag when its value is no budget."""
+    if args.at_step is not None:
+        # step 0 is a budget too: the evaluation of the untrained agent, which every run logs
+        if args.at_step < 0:
+            fail(
+                PROG,
+                f"--at-step {args.at_step}: give a number of env steps >= 0, e.g. --at-step "
+                "100000 (or 0, the evaluation before any training)",
+            )
+        return ("env_step", args.at_step)
+    if args.at_wall_time is not None:
+        if not (math.isfinite(args.at_wall_time) and args.at_wall_time > 0):
+            fail(
+                PROG,
+                f"--at-wall-time {args.at_wall_time:g}: give a positive finite number of "
+                "seconds, e.g. --at-wall-time 3600",
+            )
+        return ("wall_time_s", args.at_wall_time)
+    return None
+
+
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""
     args = parse(ReportCommand, argv, PROG, DESCRIPTION)
-    budget = None
-    if args.at_step is not None:
-        budget = ("env_step", args.at_step)
-    elif args.at_wall_time is not None:
-        budget = ("wall_time_s", args.at_wall_time)
-    if budget is not None and not (math.isfinite(budget[1]) and budget[1] > 0):
-        flag = "--at-step" if budget[0] == "env_step" else "--at-wall-time"
-        fail(PROG, f"{flag} {budget[1]:g}: give a positive finite number, e.g. {flag} 100000")
+    budget = budget_of(args)
     try:
         written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
     except SetupError as err:

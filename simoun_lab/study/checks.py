@@ -28,6 +28,7 @@ from simoun_agent.run.kept import (
     kind_problem,
     present,
     read_json_object,
+    summary_problem,
 )
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
@@ -233,6 +234,28 @@ def check_run_folder(where: Path, name: str) -> None:
             f"{path} (the directory of run {name}) is damaged: {problem}. Restore the run from a "
             f"copy (the study directory and its archive each keep one), or move it aside (mv "
             f"{path} {path}.damaged) and resume the study, which trains that run again"
+        )
+
+
+def check_summary(name: str, places: list[Path]) -> None:
+    """SetupError naming the run ``name``'s ``summary.json`` in one of ``places`` (the study
+    directory, the archive) when it cannot be relied on
+    (:func:`~simoun_agent.run.kept.summary_problem`): the run would be counted as finished and
+    skipped, its damage found only when its result is read."""
+    for where in places:
+        path = where / name / SUMMARY_NAME
+        problem = summary_problem(path)
+        if problem is None:
+            continue
+        moves = " and ".join(
+            f"mv {run_dir} {run_dir}.damaged"
+            for run_dir in (place / name for place in places)
+            if present(run_dir)
+        )
+        raise SetupError(
+            f"{path} (the mark that run {name} finished) is damaged: {problem}. Restore it from "
+            f"a copy (the study directory and its archive each keep one), or move the run aside "
+            f"({moves}) and resume the study: the run is then trained again"
         )
 
 

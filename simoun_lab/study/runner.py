@@ -20,7 +20,12 @@ from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect
 from simoun_lab.study import archive as archiving
 from simoun_lab.study.archive import GENERALIZATION_CSV
-from simoun_lab.study.checks import check_fixed_spec, check_run_folder, check_study
+from simoun_lab.study.checks import (
+    check_fixed_spec,
+    check_run_folder,
+    check_study,
+    check_summary,
+)
 from simoun_lab.study.choice import SELECTION_FILE, Choice, choose, save_choices
 from simoun_lab.study.generalization import play_modes, playable, to_play
 from simoun_lab.study.options import StudyOptions
@@ -361,10 +366,11 @@ class Phases:
 
     def run(self, phase: str, runs: list[StudyRun]) -> dict[str, list]:
         """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
+        places = [where for where in (self.study_dir, self.archive) if where is not None]
         for run in runs:  # before anything is restored or trained: a damaged run is named
-            for where in (self.study_dir, self.archive):
-                if where is not None:
-                    check_run_folder(where, run.name)
+            for where in places:
+                check_run_folder(where, run.name)
+            check_summary(run.name, places)
         restored = self.restore(runs)
         todo = [run for run in runs if not run.finished(self.study_dir)]
         stop_file = str(self.study_dir / STOP_FILE)

@@ -39,8 +39,9 @@ from simoun_agent.run.kept import (
     kind_problem,
     present,
     read_json_object,
+    summary_problem,
 )
-from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
+from simoun_agent.run.layout import CHECKPOINT_NAME, CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.rundir import folder_kind
 from simoun_lab.sweep.saved import saved_problem
 
@@ -582,7 +583,9 @@ def differences_refusal(trial: Trial, sweep_dir: Path, differences: dict) -> Set
 def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
     """SetupError naming the first trial whose run directory is not its own
     (:func:`trial_problem`), or whose config.json differs from what ``sweep.json`` gives it
-    (:func:`config_differences`), before the sweep counts it as finished or goes on from it."""
+    (:func:`config_differences`), or whose summary.json cannot be relied on
+    (:func:`~simoun_agent.run.kept.summary_problem`), before the sweep counts it as finished or
+    goes on from it."""
     for trial in spec.trials(sweep_dir):
         problem = trial_problem(trial, spec.grid)
         if problem and not problem.startswith(CONFIG_NAME):
@@ -603,29 +606,26 @@ def check_trial_dirs(spec: SweepSpec, sweep_dir: Path) -> None:
         differences = config_differences(trial)
         if differences:
             raise differences_refusal(trial, sweep_dir, differences)
-        problem = summary_kind_problem(trial)
-        if problem:
-            run_dir = trial.run_dir
-            raise SetupError(
-                f"trial {trial.name}: {Path(run_dir, SUMMARY_NAME)} is damaged: {problem}; "
-                f"restore {SUMMARY_NAME} from a copy, or move the run directory aside (mv "
-                f"{run_dir} {run_dir}.aside) so that the trial trains anew"
-            )
+        problem = summary_problem(Path(trial.run_dir) / SUMMARY_NAME)
+        if problem:  # else the trial would count as finished, its result left to the report
+            raise damaged_summary(trial, problem)
 
 
-def summary_kind_problem(trial: Trial) -> str | None:
-    """What is wrong with the trial's summary.json when it holds another file's keys
-    (:func:`~simoun_agent.run.kept.kind_problem`: config.json copied over it), which would
-    count the trial as finished; else None (a summary that cannot be read is the report's to
-    name, as it reads the run's result)."""
-    path = Path(trial.run_dir) / SUMMARY_NAME
-    if not path.is_file():
-        return None
-    try:
-        record = read_json_object(path)
-    except (Damaged, OSError):
-        return None
-    return kind_problem(SUMMARY_NAME, list(record))
+def damaged_summary(trial: Trial, problem: str) -> SetupError:
+    """The refusal of a trial whose summary.json says ``problem``: with its checkpoint kept,
+    removing the file lets the resume write the trial's end again without training."""
+    run_dir, path = trial.run_dir, Path(trial.run_dir, SUMMARY_NAME)
+    rewrite = (
+        f"remove it (rm {path}) so that the resume writes the trial's end again from its "
+        "checkpoint, without training, "
+        if Path(run_dir, CHECKPOINT_NAME).is_file()
+        else ""
+    )
+    return SetupError(
+        f"trial {trial.name}: {path} is damaged: {problem}; {rewrite}restore {SUMMARY_NAME} from "
+        f"a copy, or move the run directory aside (mv {run_dir} {run_dir}.aside) so that the "
+        "trial trains anew"
+    )
 
 
 def check_runnable(

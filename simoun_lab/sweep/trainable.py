@@ -100,7 +100,7 @@ def finished(trial: Trial) -> bool:
     except (Damaged, OSError):
         done = None
     if not is_real(done):
-        return True  # damaged: the report names it; training cannot tell how far the run got
+        return True  # damaged: check_trial_dirs refuses it before a sweep starts or resumes
     return done >= trial_budget(trial)
 
 

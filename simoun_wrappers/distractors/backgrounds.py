@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from pathlib import Path
 
 import cv2
 import numpy as np
 
-from simoun_wrappers._checks import unexpanded_home
+from simoun_wrappers._checks import check_path
 
 VIDEO_SUFFIXES = (".mp4", ".avi", ".mov", ".mkv", ".webm", ".gif")
 """File endings read as videos from a ``videos`` folder (DMC-GB ships mp4 files)."""
@@ -83,15 +82,12 @@ class VideoBackground:
     """
 
     def __init__(self, folder: str | Path) -> None:
-        if not isinstance(folder, (str, os.PathLike)):
-            raise TypeError(
-                f"videos must be a folder path (str or Path) or None, got "
-                f"{type(folder).__name__} {folder!r}; e.g. videos='davis/JPEGImages/480p', or "
-                f"videos=None for the procedural background."
-            )
-        home = unexpanded_home(folder)
-        if home is not None:
-            raise ValueError(f"videos={os.fspath(folder)!r}: {home}")
+        check_path(
+            folder,
+            "videos",
+            "videos='davis/JPEGImages/480p'",
+            "a folder path or None (the procedural background)",
+        )
         self.folder = Path(folder)
         if not self.folder.is_dir():
             raise ValueError(
