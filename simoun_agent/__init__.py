@@ -11,6 +11,7 @@ from typing import Any
 import simoun_wrappers  # noqa: F401  (headless rendering defaults)
 from simoun_agent import moved
 from simoun_agent.config import AgentConfig
+from simoun_wrappers._homes import missing_name
 
 moved.install()  # the lab's former names (simoun_agent.study, ...) for one release
 
@@ -31,7 +32,7 @@ def __getattr__(name: str) -> Any:
     if name == "encoders":
         return importlib.import_module("simoun_agent.models.encoder")
     if name not in _LAZY:
-        raise AttributeError(f"module 'simoun_agent' has no attribute {name!r}")
+        raise missing_name(__name__, name)
     return getattr(importlib.import_module(_LAZY[name]), name)
 
 

@@ -7,3 +7,9 @@ compare recipes under one protocol (:mod:`simoun_lab.study`), the MiniGrid PPO s
 the commands are :mod:`simoun_lab.cli`. The lab imports the product; the product never imports
 the lab.
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

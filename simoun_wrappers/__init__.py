@@ -5,6 +5,7 @@ Importing the package sets headless rendering defaults when there is no display 
 """
 
 from simoun_wrappers import _headless  # noqa: F401  (must run before dm_control/pygame load)
+from simoun_wrappers._homes import missing_name
 from simoun_wrappers.action_repeat import ActionRepeat
 from simoun_wrappers.augment import RandomConvolution, random_conv
 from simoun_wrappers.cameras import MultiCamera
@@ -41,3 +42,7 @@ __all__ = [
     "random_conv",
     "residual_motion",
 ]
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

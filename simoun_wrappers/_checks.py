@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
-from gymnasium.error import ResetNeeded
+from gymnasium.error import ClosedEnvironmentError, ResetNeeded
 
 
 def is_int(value: Any) -> bool:
@@ -68,6 +68,22 @@ def refuse_step_before_reset(has_reset: bool, owner: str) -> None:
         raise ResetNeeded(
             f"Cannot call {owner}.step() before reset(); call env.reset(seed=...) first to start "
             f"a seeded episode."
+        )
+
+
+class ClosedEnvError(ClosedEnvironmentError, ValueError):
+    """A reset or step after ``close()``: Gymnasium's ClosedEnvironmentError, and a ValueError
+    as Python's closed files give (and as a closed dm_control task is refused)."""
+
+
+def refuse_after_close(closed: bool, owner: str, call: str) -> None:
+    """A :class:`ClosedEnvError` when ``owner`` was closed and is asked to ``call`` (reset or
+    step): under it a closed env fails inside its renderer (pygame, MuJoCo) with an error that
+    names nothing, or steps on as if it were open."""
+    if closed:
+        raise ClosedEnvError(
+            f"Cannot call {owner}.{call}() after close(): close() released the env and its "
+            f"renderer. Make the env anew and wrap it again, and call close() only when done."
         )
 
 

@@ -223,7 +223,9 @@ class FeatureSource(Protocol):
     """Anything that maps a batch of frame triplets to Simoun's motion and appearance features.
 
     ``__call__(triplets)`` takes ``uint8 (B, 3, C, H, W)`` (frames t-2, t-1, t) and returns
-    ``(f_m, f_a)``: numpy float32 ``(B, D)`` and ``(B, 3, D)``. Implementations:
+    ``(f_m, f_a)``: numpy float32 ``(B, D)`` and ``(B, 3, D)``. The triplets are a numpy
+    array, never a torch tensor: a torch module goes behind a function that converts them to a
+    float tensor and its features back to numpy. Implementations:
     ``simoun_agent.curiosity_model.CuriosityModel`` (learns online) and
     ``simoun_agent.curiosity_model.AgentFeatures`` (a trained agent's encoder).
 

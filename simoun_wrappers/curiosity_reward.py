@@ -71,7 +71,7 @@ class ConsistencySignal(IntrinsicSignal):
     def _features(self, triplets: np.ndarray) -> tuple[Any, Any]:
         """The source's ``(f_m, f_a)``, or a clear error naming the source and what it must
         return (Python's own is "too many values to unpack")."""
-        returned = self.source(triplets)
+        returned = self.call_source(triplets)
         if isinstance(returned, (tuple, list)) and len(returned) == 2:
             return returned[0], returned[1]
         if isinstance(returned, (tuple, list)):

@@ -33,6 +33,7 @@ from simoun_wrappers._checks import (
     is_real,
     keyword_reset,
     plain,
+    refuse_after_close,
 )
 from simoun_wrappers._spec import CheckedSpecWrapper, CheckedVectorSpecWrapper, SharedSource
 from simoun_wrappers.frames import check_single_env
@@ -179,6 +180,8 @@ class IntrinsicSignal(ABC):
     def __init__(self, source: Any = None) -> None:
         self.source = SharedSource.unwrap(source)
         wanted = self.source_protocol
+        if wanted is not None and isinstance(self.source, type):
+            raise TypeError(class_for_instance(self.source, wanted))
         if wanted is not None and not isinstance(self.source, wanted.protocol):
             raise TypeError(
                 f"{wanted.argument} must be a {wanted.protocol.__name__} ({wanted.expects}), got "
@@ -197,6 +200,15 @@ class IntrinsicSignal(ABC):
     def raw(self, triplets: np.ndarray) -> np.ndarray:
         """``(B,)`` float64 raw values of the triplets ``uint8 (B, 3, C, H, W)``."""
 
+    def call_source(self, triplets: np.ndarray) -> Any:
+        """The source's answer for ``triplets``; an error raised inside the source (say a torch
+        module given the numpy triplets) is raised again naming the source and what it was
+        given, since the error alone names neither."""
+        try:
+            return self.source(triplets)
+        except Exception as err:
+            raise source_failure(err, self.source, self.source_protocol, triplets) from err
+
     def watch(self, *transitions: np.ndarray) -> None:
         """Hand a batch of ``transitions`` (``triplets, actions, next_triplets, terminated,
         truncated``, the source's ``watch`` arguments) to the source when it learns online."""
@@ -209,6 +221,49 @@ class IntrinsicSignal(ABC):
         close = getattr(self.source, "close", None)
         if close is not None:
             close()
+
+
+def class_for_instance(source: type, wanted: SourceProtocol) -> str:
+    """Why a source given as a class is refused (a class is callable with one argument, so the
+    protocol alone would take it and fail at the first step): build it, with ``for_env`` when
+    the class has one."""
+    name = source.__name__
+    build = (
+        f"{wanted.argument}={name}.for_env(env), which sizes the model for the env's frames"
+        if callable(getattr(source, "for_env", None))
+        else f"an instance, {wanted.argument}={name}(...)"
+    )
+    return (
+        f"{wanted.argument} must be a {wanted.protocol.__name__} instance ({wanted.expects}), got "
+        f"the class {name} itself; pass {build}."
+    )
+
+
+def source_failure(
+    err: Exception, source: Any, wanted: SourceProtocol | None, triplets: np.ndarray
+) -> Exception:
+    """``err``, raised inside ``source`` on ``triplets``, as an error of the same kind that
+    names the source, what it was given (numpy uint8 triplets, not torch tensors) and how a
+    torch module is called on them."""
+    argument = wanted.argument if wanted is not None else "source"
+    qualname = getattr(source, "__qualname__", None)
+    named = f"function {qualname}" if isinstance(qualname, str) else type(source).__name__
+    torch_call = (
+        f"e.g. {argument}=lambda t: net(torch.as_tensor(t).float().flatten(1)).squeeze(-1)"
+        ".detach().numpy()"
+        if argument == "novelty"
+        else "torch.as_tensor(triplets).float(), and give back numpy arrays"
+    )
+    message = (
+        f"The {argument}= source {named} raised {type(err).__name__}: {err} -- when given the "
+        f"triplets, a numpy uint8 array of shape {triplets.shape} (B, 3, C, H, W), as every "
+        f"source is. A torch module needs them as a float tensor, {torch_call}"
+        + (f"; or use {wanted.example}." if wanted is not None else ".")
+    )
+    try:
+        return type(err)(message)
+    except Exception:  # an error class whose constructor takes other arguments
+        return RuntimeError(message)
 
 
 class ConstantSignal(IntrinsicSignal):
@@ -258,6 +313,37 @@ def check_extrinsic(extrinsic: np.ndarray) -> None:
         )
 
 
+def is_sb3_vec_env(env: Any) -> bool:
+    """Whether ``env`` is a Stable-Baselines3 VecEnv (DummyVecEnv, SubprocVecEnv, a
+    VecEnvWrapper), told by its module: SB3 is not imported for the check."""
+    return any(
+        klass.__module__.startswith("stable_baselines3.") and klass.__name__ == "VecEnv"
+        for klass in type(env).__mro__
+    )
+
+
+def not_a_vector_env(env: Any, owner: str) -> str:
+    """Why the vector reward ``owner`` refuses ``env``, with the fix that works for it: an SB3
+    VecEnv is a vector env to its user but not a Gymnasium one, and takes the single-env reward
+    inside each of its envs."""
+    single = owner.replace("VectorReward", "Reward")
+    if is_sb3_vec_env(env):
+        kind = type(env).__name__
+        return (
+            f"{owner} wraps a Gymnasium vector env (gymnasium.vector.VectorEnv), got "
+            f"Stable-Baselines3's {kind}, which is not one (SB3's VecEnvs have their own step "
+            f"API). Put the single-env {single} inside {kind}'s env function instead: "
+            f"{kind}([lambda: {single}(SimounObservation(gym.make(env_id, "
+            f"render_mode='rgb_array'), fold_frames=True), ...)])."
+        )
+    return (
+        f"{owner} wraps a Gymnasium vector env (gymnasium.vector.VectorEnv), got "
+        f"{type(env).__name__} {env!r:.60}; use {single}(env, ...) on a single env, or "
+        f"gym.make_vec(env_id, num_envs, wrappers=[lambda e: SimounObservation(e, ...)]) for a "
+        f"vector env."
+    )
+
+
 class IntrinsicMechanism(ABC):
     """What the two wrappers share: the signal, its normalization and weight, and scoring.
 
@@ -297,10 +383,7 @@ class IntrinsicMechanism(ABC):
             check_single_env(env, name)
         if isinstance(env, VectorEnv) != self.vector:
             if self.vector:
-                raise TypeError(
-                    f"{name} wraps a vector env, got {env}; use "
-                    f"{name.replace('VectorReward', 'Reward')}(env, ...) on a single env."
-                )
+                raise TypeError(not_a_vector_env(env, name))
             raise TypeError(
                 f"{name} wraps a single env, got the vector env {env}; use "
                 f"{name.replace('Reward', 'VectorReward')}(envs, ...) on the vector env, or put "
@@ -327,6 +410,7 @@ class IntrinsicMechanism(ABC):
         claim_normalization(self.normalization, self)
         self.scored = 0
         """transitions scored so far: the step t of the weight and the warm-up's clock"""
+        self._closed = False
         self._attach(env)
 
     @abstractmethod
@@ -439,6 +523,7 @@ class IntrinsicMechanism(ABC):
     def close(self) -> None:
         """Close the env, then the source (stops a model's update thread; a model shared with
         other envs starts a new one when they step again)."""
+        self._closed = True
         try:
             super().close()
         finally:
@@ -470,12 +555,14 @@ class IntrinsicReward(
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        refuse_after_close(self._closed, type(self).__name__, "reset")
         seed = check_reset_seed(seed, type(self).__name__)
         obs, info = self.env.reset(seed=seed, options=options)
         self._last_triplet = self._read(obs)
         return obs, info
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        refuse_after_close(self._closed, type(self).__name__, "step")
         if self._last_triplet is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
         check_action(action, self.action_space, type(self).__name__)
@@ -560,6 +647,7 @@ class IntrinsicVectorReward(
         self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         # read before the reset: Gymnasium's vector envs pop "reset_mask" from the options
+        refuse_after_close(self._closed, type(self).__name__, "reset")
         mask = None if options is None else options.get("reset_mask")
         seed = check_vector_reset_seed(seed, type(self).__name__, self.num_envs)
         obs, info = self.env.reset(seed=seed, options=options)
@@ -571,6 +659,7 @@ class IntrinsicVectorReward(
         return obs, info
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
+        refuse_after_close(self._closed, type(self).__name__, "step")
         if self._last_triplets is None:
             raise gym.error.ResetNeeded(f"Call reset() before step() on {type(self).__name__}.")
         check_action(actions, self.action_space, type(self).__name__, vector=self.num_envs)

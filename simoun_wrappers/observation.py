@@ -21,11 +21,13 @@ from simoun_wrappers._checks import (
     is_int,
     keyword_reset,
     plain,
+    refuse_after_close,
     refuse_step_before_reset,
 )
-from simoun_wrappers.frames import check_single_env, frame_stack_in
 
 # LUMA, frame_shape and to_frame (the per-frame step) are importable from this module too.
+from simoun_wrappers.distractors._dm_control import is_closed_dm_control
+from simoun_wrappers.frames import check_single_env, frame_stack_in
 from simoun_wrappers.stack import LUMA as LUMA
 from simoun_wrappers.stack import FrameStack, StreamTriplet
 from simoun_wrappers.stack import frame_shape as frame_shape
@@ -374,20 +376,33 @@ class ChainWrapper(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self._has_reset = False
         """whether the user reset this wrapper: reading pixels from render() resets the env
         while the chain is built"""
+        self._closed = False
 
     @keyword_reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
+        self._refuse_closed("reset")
         seed = check_reset_seed(seed, type(self).__name__)
         result = self.env.reset(seed=seed, options=options)
         self._has_reset = True
         return result
 
     def step(self, action: Any) -> tuple[Any, Any, bool, bool, dict[str, Any]]:
+        self._refuse_closed("step")
         check_action(action, self.action_space, type(self).__name__)
         refuse_step_before_reset(self._has_reset, type(self).__name__)
         return self.env.step(action)
+
+    def _refuse_closed(self, call: str) -> None:
+        # a closed dm_control task is named by the distractor or camera over it, with the id
+        # to make it anew: that refusal comes from the call itself
+        if not is_closed_dm_control(self._source_env):
+            refuse_after_close(self._closed, type(self).__name__, call)
+
+    def close(self) -> None:
+        self._closed = True
+        super().close()
 
     def __reduce__(self) -> tuple:
         """Pickled as its arguments around the pickled source env, since gymnasium's wrappers in

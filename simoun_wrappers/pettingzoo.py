@@ -11,7 +11,7 @@ from gymnasium.error import ResetNeeded
 from pettingzoo.utils.env import AECEnv, ParallelEnv
 from pettingzoo.utils.wrappers import BaseParallelWrapper
 
-from simoun_wrappers._checks import check_action, check_reset_seed
+from simoun_wrappers._checks import check_action, check_reset_seed, refuse_after_close
 from simoun_wrappers.observation import check_stack_options, image_layout, parse_size
 from simoun_wrappers.stack import FrameStack
 
@@ -25,7 +25,9 @@ class SimounParallelObservation(BaseParallelWrapper):
     stacks it with reset padding, then adds motion or folds the stack. Agents that appear
     mid-episode start with a reset-padded stack, and an agent's stack starts anew after it
     terminates or truncates.
-    With ``source="render"`` (or ``"auto"`` when observations are not images) every agent
+    With ``source="render"`` (or ``"auto"`` when observations are not uint8 images and the env
+    renders ``rgb_array``, as ``SimounObservation`` decides: a float ``(H, W)`` table such as
+    knights_archers_zombies' vector observation is no image) every agent
     sees the env's global ``render()`` frame (then, with ``size=None``, ``observation_space``
     needs a render, so call ``reset()`` first). ``observation_space(agent)`` returns the same
     cached object on every call, as ``parallel_api_test`` requires.
@@ -92,13 +94,19 @@ class SimounParallelObservation(BaseParallelWrapper):
         self._stacks: dict[Any, FrameStack] = {}
         self._live: set[Any] = set()
         self._has_reset = False
+        self._closed = False
 
     def _pick_source(self, source: str) -> bool:
         agent = self.env.possible_agents[0]
-        layout = image_layout(self.env.observation_space(agent))
-        if source == "observation" or (source == "auto" and layout is not None):
-            space = self.env.observation_space(agent)
-            if layout is None or space.dtype != np.uint8:
+        space = self.env.observation_space(agent)
+        layout = image_layout(space)
+        is_uint8 = layout is not None and space.dtype == np.uint8
+        renders = getattr(self.env, "render_mode", None) == "rgb_array"
+        use_observation = source == "observation" or (
+            source == "auto" and layout is not None and (is_uint8 or not renders)
+        )
+        if use_observation:
+            if not is_uint8:
                 raise TypeError(
                     f"SimounParallelObservation expects each agent's observation to be an "
                     f"(H, W, C) or (H, W) uint8 image, got {space} for {agent!r}; convert it "
@@ -113,6 +121,15 @@ class SimounParallelObservation(BaseParallelWrapper):
                 f"agents (H, W, 3) uint8 image observations."
             )
         return True
+
+    def _check_open(self, call: str) -> None:
+        refuse_after_close(self._closed, "SimounParallelObservation", call)
+
+    def close(self) -> None:
+        """Close the env; a later reset or step is refused (PettingZoo's envs then fail inside
+        pygame)."""
+        self._closed = True
+        super().close()
 
     def _check_agent(self, agent: Any, call: str) -> None:
         """A ValueError naming the env's agents for an ``agent`` that is none of them."""
@@ -160,6 +177,7 @@ class SimounParallelObservation(BaseParallelWrapper):
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[Any, Any], dict[Any, dict[str, Any]]]:
+        self._check_open("reset")
         seed = check_reset_seed(seed, "SimounParallelObservation")
         obs, infos = self.env.reset(seed=seed, options=options)
         self._has_reset = True
@@ -194,6 +212,7 @@ class SimounParallelObservation(BaseParallelWrapper):
             check_action(action, self.env.action_space(agent), f"{owner}[{agent!r}]")
 
     def step(self, actions: dict[Any, Any]) -> tuple[dict[Any, Any], ...]:
+        self._check_open("step")
         if self._has_reset and not self.env.agents:
             # PettingZoo's own order-enforcing wrapper checks this too, but only warns, and
             # the parallel env then answers with empty dicts: a loop stepping a fixed count

@@ -34,9 +34,11 @@ class NoveltySource(Protocol):
 
     ``__call__(triplets)`` takes ``uint8 (B, 3, C, H, W)`` and returns ``(B,)`` non-negative
     floats, larger for less familiar observations (``simoun_agent.rnd_model.RNDModel``: the
-    predictor's squared error on the newest frame). Like a ``FeatureSource`` it may define
-    ``watch(triplets, actions, next_triplets, terminated, truncated)`` to learn online and
-    ``close()``.
+    predictor's squared error on the newest frame). The triplets are a numpy array, never a
+    torch tensor: a torch module goes behind a function that converts them, e.g. ``lambda t:
+    net(torch.as_tensor(t).float().flatten(1)).squeeze(-1).detach().numpy()``. Like a
+    ``FeatureSource`` it may define ``watch(triplets, actions, next_triplets, terminated,
+    truncated)`` to learn online and ``close()``.
     """
 
     def __call__(self, triplets: np.ndarray) -> np.ndarray: ...
@@ -56,7 +58,7 @@ class RNDSignal(IntrinsicSignal):
         super().__init__(novelty)
 
     def raw(self, triplets: np.ndarray) -> np.ndarray:
-        errors = self.source(triplets)
+        errors = self.call_source(triplets)
         errors = None if isinstance(errors, tuple) else np.asarray(errors, dtype=np.float64)
         if errors is None or errors.shape != (len(triplets),):
             shape = "a tuple" if errors is None else f"shape {errors.shape}"

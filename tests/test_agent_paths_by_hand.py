@@ -371,7 +371,7 @@ def test_zero_weight_terms_build_no_head_and_report_no_loss():
 
 
 def test_construction_reads_the_optimiser_settings_shift_pad_and_shapes_from_the_config():
-    config = small_config(lr=3e-4, alpha_lr=2e-4, alpha_beta=0.6, shift_pad=3)
+    config = small_config(lr=3e-4, alpha_lr=2e-4, alpha_beta=0.6, shift_pad=3, augmentation="shift")
     agent = SimounAgent(FRAME, ACTIONS, config, "cpu")
     assert [g["lr"] for g in agent.critic_optimizer.param_groups] == [3e-4]
     assert [g["lr"] for g in agent.actor_optimizer.param_groups] == [3e-4]

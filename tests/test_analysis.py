@@ -331,3 +331,27 @@ def test_estimator_refuses_pairs_it_cannot_use(change, error, message):
 def test_estimator_refuses_a_threshold_outside_0_1(threshold, error, message):
     with pytest.raises(error, match=message):
         information_bias(synthetic_pairs(n=20), threshold=threshold)
+
+
+def test_the_run_functions_check_their_arguments_and_name_a_swap():
+    import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
+    from simoun_agent import SimounAgent
+    from simoun_lab.analysis.runs import play_episode
+    from simoun_wrappers import SimounObservation
+
+    config = AgentConfig(num_filters=4, feature_dim=8, hidden_dim=16, aux_hidden_dim=16)
+    agent = SimounAgent((3, 32, 32), 2, config, device="cpu")
+    env = SimounObservation(gym.make("simoun/PointReach-v0", render_mode="rgb_array"), size=32)
+    with pytest.raises(TypeError, match="play_episode takes the agent first and the env second"):
+        play_episode(env, agent, 0)
+    with pytest.raises(ValueError, match=r"play_episode\(seed=\.\.\.\) must be an int >= 0"):
+        play_episode(agent, env, -1)
+    with pytest.raises(TypeError, match=r"layer_activations\(encoder=\.\.\.\).*agent\.encoder"):
+        layer_activations(agent, torch.zeros(1, 3, 3, 32, 32, dtype=torch.uint8))
+    with pytest.raises(TypeError, match=r"structure_masks\(encoder=\.\.\.\)"):
+        mask_pictures.structure_masks(np.zeros((1, 3, 3, 32, 32), np.uint8), agent.encoder)
+    with pytest.raises(
+        TypeError, match=r"replay_recoloured\(config=\.\.\.\) must be a TrainConfig"
+    ):
+        replay_recoloured(agent, 0, np.zeros((1, 1)), np.random.default_rng(0))
+    assert play_episode(agent, env, 0).length > 0

@@ -12,6 +12,7 @@ from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, Train
 from simoun_agent.config.keys import config_fields
 from simoun_agent.config.resolve import to_dict
 from simoun_agent.config.rules import Rule, check_fields, integer, rules_of, setting
+from simoun_agent.config.train import check_train_config
 
 BAD = {
     "env": "",
@@ -196,6 +197,10 @@ def test_agent_config_in_python_names_the_field_too():
             lambda: AgentConfig(augmentation="none", critic_augmentations=2),
             ["AgentConfig.augmentation='shift'", "AgentConfig.critic_augmentations=1"],
         ),
+        (
+            lambda: AgentConfig(shift_pad=4),
+            ["AgentConfig.shift_pad", "AgentConfig.augmentation='shift'", "shift_pad=None"],
+        ),
         (lambda: AgentConfig(num_frames=2), ["AgentConfig.num_frames=3"]),
         (
             lambda: AgentConfig(encoder="flare", curiosity=False, num_frames=1),
@@ -270,3 +275,47 @@ def test_a_name_field_refuses_a_wrong_type_naming_the_field_and_the_names(build,
         build()
     for word in words:
         assert word in str(refused.value)
+
+
+def test_shift_pad_is_taken_where_a_shift_reads_it():
+    assert AgentConfig(augmentation="shift", shift_pad=4).shift_pad == 4
+    assert AgentConfig(contrastive_view="shift", shift_pad=2).shift_pad == 2
+
+
+@pytest.mark.parametrize(
+    ("build", "said"),
+    [
+        (
+            lambda: AgentConfig(device="cuda"),
+            ["device is a setting of TrainConfig", "TrainConfig(device='cuda')", "--device"],
+        ),
+        (
+            lambda: TrainConfig(lr=1e-3),
+            ["lr is a setting of AgentConfig", "TrainConfig(agent=AgentConfig(lr=0.001))"],
+        ),
+        (
+            lambda: AgentConfig(bach_size=8),
+            ["unexpected keyword argument 'bach_size'", "batch_size"],
+        ),
+    ],
+)
+def test_a_keyword_of_the_other_config_class_names_where_it_lives(build, said):
+    with pytest.raises(TypeError) as raised:
+        build()
+    assert all(part in str(raised.value) for part in said), str(raised.value)
+
+
+def test_an_agent_set_as_a_dict_is_refused_with_the_agent_config_of_its_values():
+    config = TrainConfig()
+    config.agent = {"lr": 1e-3}
+    with pytest.raises(ValueError) as raised:
+        check_train_config(config)
+    said = str(raised.value)
+    assert "config.agent = AgentConfig(lr=0.001)" in said
+    assert "--agent.lr 0.001" in said
+    assert "--agent {" not in said and "recipe=None" not in said
+
+
+def test_a_run_dir_given_as_a_path_is_kept_as_a_str(tmp_path):
+    assert TrainConfig(run_dir=tmp_path / "r").run_dir == str(tmp_path / "r")
+    assert resolve(None, {"run_dir": tmp_path / "r"}).run_dir == str(tmp_path / "r")

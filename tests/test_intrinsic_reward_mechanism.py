@@ -9,7 +9,10 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 from simoun_wrappers import SimounObservation
-from simoun_wrappers.curiosity_reward import ConsistencyCuriosityReward
+from simoun_wrappers.curiosity_reward import (
+    ConsistencyCuriosityReward,
+    ConsistencyCuriosityVectorReward,
+)
 from simoun_wrappers.intrinsic_normalization import Normalization, Raw, ReturnStd
 from simoun_wrappers.intrinsic_reward import (
     ConstantBonusReward,
@@ -426,3 +429,92 @@ def test_dict_info_to_list_under_a_vector_reward_is_named_with_the_order_that_wo
     outside.reset(seed=0)
     _, _, _, _, infos = outside.step(outside.action_space.sample())
     assert isinstance(infos, list) and "reward_intrinsic" in infos[0]
+
+
+def every_intrinsic_wrapper():
+    """Each intrinsic wrapper class, single and vector, on Pendulum."""
+    vec = lambda: SyncVectorEnv([pendulum, pendulum])  # noqa: E731
+    return [
+        ConsistencyCuriosityReward(pendulum(), Features()),
+        ConsistencyCuriosityVectorReward(vec(), Features()),
+        RNDReward(pendulum(), Recorder()),
+        RNDVectorReward(vec(), Recorder()),
+        ConstantBonusReward(pendulum(), scale=0.1),
+        ConstantBonusVectorReward(vec(), scale=0.1),
+    ]
+
+
+@pytest.mark.parametrize("call", ["step", "reset"])
+def test_a_reset_or_step_after_close_is_refused_by_every_intrinsic_wrapper(call):
+    for env in every_intrinsic_wrapper():
+        env.reset(seed=0)
+        env.close()
+        name = type(env).__name__
+        with pytest.raises(ValueError, match=rf"Cannot call {name}\.{call}\(\) after close\(\)"):
+            env.step(env.action_space.sample()) if call == "step" else env.reset(seed=0)
+        with pytest.raises(gym.error.ClosedEnvironmentError):
+            env.step(env.action_space.sample())
+
+
+def test_a_stable_baselines3_vec_env_is_named_with_the_single_reward_inside_it():
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    for vector_reward, single in [
+        (ConstantBonusVectorReward, "ConstantBonusReward"),
+        (RNDVectorReward, "RNDReward"),
+    ]:
+        args = (0.1,) if vector_reward is ConstantBonusVectorReward else (Recorder(),)
+        with pytest.raises(TypeError) as raised:
+            vector_reward(DummyVecEnv([pendulum]), *args)
+        said = str(raised.value)
+        assert "Stable-Baselines3's DummyVecEnv, which is not one" in said
+        assert f"DummyVecEnv([lambda: {single}(SimounObservation(" in said
+    # the fix it gives works
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    fixed = DummyVecEnv(
+        [
+            lambda: ConstantBonusReward(
+                SimounObservation(
+                    gym.make("Pendulum-v1", render_mode="rgb_array"), size=16, fold_frames=True
+                ),
+                0.1,
+            )
+        ]
+    )
+    fixed.reset()
+    fixed.step(np.zeros((1, 1), np.float32))
+
+
+def test_a_source_class_is_refused_naming_for_env():
+    from simoun_agent.curiosity_model import CuriosityModel
+    from simoun_agent.rnd_model import RNDModel
+
+    with pytest.raises(TypeError, match=r"got the class RNDModel itself; pass novelty=RNDModel"):
+        RNDReward(pendulum(), RNDModel)
+    with pytest.raises(TypeError, match=r"features=CuriosityModel\.for_env\(env\)"):
+        ConsistencyCuriosityReward(pendulum(), CuriosityModel)
+    with pytest.raises(TypeError, match=r"got the class Recorder itself; pass an instance"):
+        RNDVectorReward(SyncVectorEnv([pendulum]), Recorder)
+
+
+def test_an_error_inside_a_source_names_the_source_and_the_numpy_triplets():
+    import torch
+
+    net = torch.nn.Sequential(torch.nn.Flatten(), torch.nn.LazyLinear(1))
+    env = RNDReward(pendulum(), lambda t: net(t).squeeze(-1), warmup=0)
+    env.reset(seed=0)
+    with pytest.raises(TypeError) as raised:
+        env.step(env.action_space.sample())
+    said = str(raised.value)
+    assert "The novelty= source function" in said
+    assert "a numpy uint8 array of shape (1, 3, 3, 16, 16) (B, 3, C, H, W)" in said
+    assert isinstance(raised.value.__cause__, TypeError)
+    # the call it suggests works
+    fixed = RNDReward(
+        pendulum(),
+        lambda t: net(torch.as_tensor(t).float().flatten(1)).squeeze(-1).detach().numpy() ** 2,
+        warmup=0,
+    )
+    fixed.reset(seed=0)
+    fixed.step(fixed.action_space.sample())

@@ -143,3 +143,65 @@ def test_a_run_dir_with_an_unexpanded_home_is_named():
     config = tiny_config("~/simoun-no-such-run")
     with pytest.raises(ValueError, match=r"os.path.expanduser\('~/simoun-no-such-run'\)"):
         train.create_run(config)
+
+
+class Misspelt(TrainCallback):
+    def on_evalution(self, run, metrics):
+        raise AssertionError("never called")
+
+
+class StableBaselinesStyle(TrainCallback):
+    def on_step(self, run):
+        raise AssertionError("never called")
+
+
+class OwnHook(TrainCallback):
+    def on_best(self, run):
+        raise AssertionError("never called")
+
+
+class Helper(TrainCallback):
+    """A helper method of its own is no hook and is allowed."""
+
+    def summarize(self, metrics):
+        return dict(metrics)
+
+
+@pytest.mark.parametrize(
+    ("callback", "said"),
+    [
+        (Misspelt(), "Misspelt defines on_evalution, which the loop never calls; did you mean "),
+        (StableBaselinesStyle(), "on_step is a hook of Stable-Baselines3's BaseCallback"),
+        (OwnHook(), "OwnHook defines on_best, which the loop never calls"),
+    ],
+)
+def test_a_method_named_like_a_hook_the_loop_never_calls_is_refused(live_run, callback, said):
+    with pytest.raises(TypeError) as raised:
+        train.train(live_run, [callback])
+    message = str(raised.value)
+    assert said in message
+    assert "on_start, on_evaluation, on_logged, on_end, stop_requested" in message
+
+
+class ReturnsTrue(TrainCallback):
+    def on_evaluation(self, run, metrics):
+        return True
+
+
+def test_a_hook_returning_a_value_is_refused_naming_stop_requested(tmp_path):
+    train.check_callbacks([Helper()], "train")
+    run = train.create_run(tiny_config(tmp_path / "r"))
+    with pytest.raises(TypeError) as raised:
+        train.train(run, [ReturnsTrue()])
+    said = str(raised.value)
+    assert "ReturnsTrue.on_evaluation returned bool True" in said
+    assert "stop_requested(run)" in said
+
+
+def test_a_run_dir_given_as_a_path_is_taken_and_kept_as_a_str(tmp_path):
+    config = tiny_config(tmp_path / "r")
+    config.run_dir = tmp_path / "p"
+    run = train.create_run(config)
+    run.close()
+    assert run.config.run_dir == str(tmp_path / "p")
+    assert (tmp_path / "p" / "config.json").is_file()

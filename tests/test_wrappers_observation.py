@@ -224,3 +224,16 @@ def test_render_mode_rgb_array_list_names_the_render_mode_that_works():
     said = str(error.value)
     assert "gym.make adds it for render_mode='rgb_array_list'" in said
     assert "gym.make(env_id, render_mode='rgb_array')" in said
+
+
+@pytest.mark.parametrize("call", ["step", "reset"])
+def test_a_reset_or_step_after_close_is_refused(call):
+    from simoun_wrappers import RandomConvolution
+
+    for make in (lambda e: SimounObservation(e, size=16), RandomConvolution):
+        env = make(gym.make("Pendulum-v1", render_mode="rgb_array"))
+        env.reset(seed=0)
+        env.close()
+        name = type(env).__name__
+        with pytest.raises(ValueError, match=rf"Cannot call {name}\.{call}\(\) after close\(\)"):
+            env.step(env.action_space.sample()) if call == "step" else env.reset(seed=0)

@@ -46,3 +46,35 @@ def test_values_the_user_set_win():
         [sys.executable, "-c", SHOW], env=env, capture_output=True, text=True, timeout=300
     )
     assert out.stdout.split() == ["osmesa", "x11", "0", "False"], out.stderr
+
+
+@pytest.mark.parametrize(
+    ("statement", "home"),
+    [
+        ("from simoun_wrappers import SimounParallelObservation", "simoun_wrappers.pettingzoo"),
+        ("from simoun_wrappers import ReturnStd", "simoun_wrappers.intrinsic_normalization"),
+        ("from simoun_wrappers import RNDModel", "simoun_agent.rnd_model"),
+        ("from simoun_lab import iqm", "simoun_lab.stats"),
+        ("from simoun_agent import load_run", "simoun_agent.run.load"),
+    ],
+)
+def test_a_name_of_a_submodule_imported_from_the_package_names_its_module(statement, home):
+    name = statement.split()[-1]
+    with pytest.raises(ImportError) as raised:
+        exec(statement, {})
+    assert f"from {home} import {name}" in str(raised.value)
+
+
+def test_the_package_lookup_keeps_hasattr_submodules_and_torch_free_imports():
+    check = (
+        "import sys, simoun_wrappers, simoun_lab\n"
+        "assert not hasattr(simoun_wrappers, 'nope') and not hasattr(simoun_lab, 'nope')\n"
+        "try:\n    from simoun_wrappers import RNDModel\nexcept ImportError:\n    pass\n"
+        "from simoun_wrappers import pettingzoo\n"
+        "from simoun_lab import stats\n"
+        "assert 'torch' not in sys.modules, 'torch imported'\n"
+        "import simoun_agent\nassert not hasattr(simoun_agent, 'nope')\n"
+        "from simoun_agent import run\n"
+    )
+    out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr

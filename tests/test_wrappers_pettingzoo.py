@@ -241,3 +241,34 @@ def test_a_step_after_the_episode_ended_says_to_reset():
         env.step({})
     env.reset(seed=1)
     assert env.agents
+
+
+def test_auto_renders_when_the_agents_see_float_vectors_not_images():
+    from pettingzoo.butterfly import knights_archers_zombies_v11
+
+    kaz = knights_archers_zombies_v11.parallel_env(render_mode="rgb_array", max_cycles=5)
+    env = SimounParallelObservation(kaz, size=16)
+    obs, _ = env.reset(seed=0)
+    while env.agents:
+        env.step({a: env.action_space(a).sample() for a in env.agents})
+    agent = env.possible_agents[0]
+    assert obs[agent]["frames"].shape == (3, 3, 16, 16)
+    assert env.observation_space(agent)["frames"].shape == (3, 3, 16, 16)
+    with pytest.raises(TypeError, match="uint8 image, got Box"):
+        SimounParallelObservation(
+            knights_archers_zombies_v11.parallel_env(render_mode="rgb_array"),
+            source="observation",
+        )
+
+
+@pytest.mark.parametrize("call", ["step", "reset"])
+def test_a_reset_or_step_after_close_is_refused(call):
+    pz = pettingzoo.make(
+        "parallel", "butterfly/pistonball-v6", n_pistons=3, render_mode="rgb_array"
+    )
+    env = SimounParallelObservation(pz, size=16)
+    env.reset(seed=0)
+    actions = {a: env.action_space(a).sample() for a in env.agents}
+    env.close()
+    with pytest.raises(ValueError, match=rf"SimounParallelObservation\.{call}\(\) after close"):
+        env.step(actions) if call == "step" else env.reset(seed=0)

@@ -10,6 +10,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from simoun_agent.config.keywords import refuse_unknown
 from simoun_agent.config.recipes import RECIPES
 from simoun_agent.config.rules import (
     Rule,
@@ -237,6 +238,7 @@ def with_recipe(generated_init: Callable[..., None]) -> Callable[..., None]:
 
     @functools.wraps(generated_init)
     def __init__(self: AgentConfig, *args: Any, **kwargs: Any) -> None:
+        refuse_train_keywords(kwargs)
         given = {*names[: len(args)], *kwargs}
         recipe = args[0] if args else kwargs.get("recipe")
         if isinstance(recipe, str) and recipe in RECIPES:
@@ -245,6 +247,24 @@ def with_recipe(generated_init: Callable[..., None]) -> Callable[..., None]:
         generated_init(self, *args, **kwargs)
 
     return __init__
+
+
+def refuse_train_keywords(kwargs: dict[str, Any]) -> None:
+    """A TypeError for a keyword of ``AgentConfig`` that is no field of it, naming
+    ``TrainConfig`` when the setting is that class's (``device``, ``seed``)."""
+    from simoun_agent.config.train import TrainConfig  # train.py imports this module
+
+    def where(name: str, value: Any) -> str:
+        flag = "--" + name.replace("_", "-")
+        extra = (
+            " (a loaded run or a bare agent takes it too: load_run(path, device=...), "
+            "SimounAgent(frame_shape, action_dim, config, device=...))"
+            if name == "device"
+            else ""
+        )
+        return f"set it there, TrainConfig({name}={value!r}), or {flag} on the command line{extra}"
+
+    refuse_unknown(AgentConfig, kwargs, TrainConfig, where)
 
 
 AgentConfig.__init__ = with_recipe(AgentConfig.__init__)  # type: ignore[method-assign]
@@ -271,6 +291,7 @@ def check_agent_config(config: Any) -> None:
                 f"'none' (every view would be the same); set "
                 f"{knob(config, AGENT, 'augmentation', 'shift')} or {knob(config, AGENT, name, 1)}",
             )
+    check_shift_settings(config)
     if config.separate_trunks:
         check_separate_trunks(config)
     motion_path = ENCODER_SHAPES[config.encoder].motion_path
@@ -300,6 +321,26 @@ def check_agent_config(config: Any) -> None:
             f"curiosity (Eq. 13) compares the motion and appearance paths, which encoder "
             f"{config.encoder!r} does not have; set {knob(config, AGENT, 'curiosity', False)} "
             "or use a dual encoder",
+        )
+
+
+def check_shift_settings(config: Any) -> None:
+    """``shift_pad`` only with a shift that reads it (the RL augmentation or CURL's contrastive
+    view), as more than one view is refused without an augmentation: set alone it would change
+    nothing, and a user expecting DrQ's pad-4 shift would train without one.
+    (``independent_next_shift`` stays allowed: the recipes carry it as how their method shifts
+    once a shift is asked for.)"""
+    shift = knob(config, AGENT, "augmentation", "shift")
+    contrastive_shift = config.contrastive_weight and config.contrastive_view == "shift"
+    if config.shift_pad is not None and config.augmentation != "shift" and not contrastive_shift:
+        raise fail(
+            config,
+            AGENT,
+            "shift_pad",
+            "is the padding of the shift augmentation, which this config does not use "
+            f"(augmentation is {config.augmentation!r} and the contrastive view is no shift), so "
+            f"it would change nothing; set {shift} to shift the frames, or "
+            f"{knob(config, AGENT, 'shift_pad', None)}",
         )
 
 

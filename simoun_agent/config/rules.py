@@ -22,6 +22,7 @@ import difflib
 import json
 import math
 import numbers
+import os
 import shlex
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -122,6 +123,22 @@ def did_you_mean_name(typed: Any, options: Sequence[str]) -> str:
 def text(optional: bool = False, fix: str = "") -> Rule:
     need = "a non-empty string" + (" or none" if optional else "")
     return Rule(need, lambda v: (optional and v is None) or (isinstance(v, str) and v != ""), fix)
+
+
+def path(optional: bool = False, fix: str = "") -> Rule:
+    """A file system path: a non-empty str or an ``os.PathLike`` (a ``pathlib.Path``, the usual
+    form in Python), or None when ``optional``. The config keeps it as a str (JSON)."""
+    need = "a path (a non-empty str or os.PathLike such as pathlib.Path)" + (
+        " or none" if optional else ""
+    )
+
+    def ok(value: Any) -> bool:
+        if optional and value is None:
+            return True
+        text = os.fspath(value) if isinstance(value, os.PathLike) else value
+        return isinstance(text, str) and text != ""
+
+    return Rule(need, ok, fix)
 
 
 def module_name(optional: bool = False, fix: str = "") -> Rule:

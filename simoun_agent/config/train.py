@@ -8,12 +8,16 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
+import os
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from simoun_agent.config.agent import AGENT, AgentConfig, check_agent_config
 from simoun_agent.config.device import device_problem
 from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, split_env_id
+from simoun_agent.config.keywords import refuse_unknown
 from simoun_agent.config.presets import PRESETS
 from simoun_agent.config.rules import (
     Rule,
@@ -26,7 +30,9 @@ from simoun_agent.config.rules import (
     knob,
     module_name,
     optional_name,
+    path,
     setting,
+    show,
     text,
     with_rule,
 )
@@ -170,7 +176,7 @@ class TrainConfig:
     env_process: bool = setting(False, boolean())
     """step the training environment in a background process while the agent updates (a
     second core works on physics and rendering; results are identical either way)"""
-    run_dir: str | None = setting(None, text(optional=True))
+    run_dir: str | None = setting(None, path(optional=True, fix="e.g. --run-dir runs/my-run"))
     """output directory; None: runs/<env>-<preset>-s<seed>-<date>"""
     progress: bool = setting(True, boolean())
     """true/false: a progress bar on a terminal (false, or no terminal: one line per
@@ -190,6 +196,8 @@ class TrainConfig:
                     f"{self.env_module!r}; give the module once"
                 )
             self.env, self.env_module = env_id, module
+        if isinstance(self.run_dir, os.PathLike):  # kept as a str: config.json is JSON
+            self.run_dir = os.fspath(self.run_dir)
         check_train_config(self)
 
     def resolved_action_repeat(self) -> int:
@@ -215,9 +223,59 @@ RESUMABLE_FIELDS = (
 resumes on a machine without one); every other field must match the saved config."""
 
 
+def refuse_agent_keywords(generated_init: Callable[..., None]) -> Callable[..., None]:
+    """``TrainConfig``'s ``__init__``, refusing a keyword that is no field of it and naming
+    ``AgentConfig`` when the setting is that class's (``lr``, ``batch_size``)."""
+
+    @functools.wraps(generated_init)
+    def __init__(self: TrainConfig, *args: Any, **kwargs: Any) -> None:
+        refuse_unknown(TrainConfig, kwargs, AgentConfig, on_the_agent)
+        generated_init(self, *args, **kwargs)
+
+    return __init__
+
+
+def on_the_agent(name: str, value: Any) -> str:
+    """Where an agent setting goes, in Python and on the command line."""
+    flag = "--agent." + name.replace("_", "-")
+    return (
+        f"set it on the agent, TrainConfig(agent=AgentConfig({name}={value!r})), or "
+        f"{flag} {show(value)} on the command line"
+    )
+
+
+TrainConfig.__init__ = refuse_agent_keywords(TrainConfig.__init__)  # type: ignore[method-assign]
+
+
+def check_agent_field(config: TrainConfig) -> None:
+    """A ValueError unless ``config.agent`` is an AgentConfig, with the fix in the form the user
+    is in: a dict set in Python becomes the ``AgentConfig(...)`` call of its values (there is no
+    ``--agent`` flag; its fields are ``--agent.NAME``)."""
+    agent = config.agent
+    if isinstance(agent, AgentConfig):
+        return
+    if isinstance(agent, Mapping) and agent and all(isinstance(key, str) for key in agent):
+        call = ", ".join(f"{key}={value!r}" for key, value in agent.items())
+        flags = " ".join(f"--agent.{key.replace('_', '-')} {show(v)}" for key, v in agent.items())
+        fix = (
+            f"in Python set config.agent = AgentConfig({call}) (from simoun_agent.config); on "
+            f"the command line {flags}"
+        )
+    else:
+        fix = (
+            "in Python set e.g. config.agent = AgentConfig(lr=1e-3) or AgentConfig(recipe='drq') "
+            "(from simoun_agent.config); on the command line --agent.NAME VALUE, e.g. "
+            "--agent.lr 0.001"
+        )
+    raise ValueError(
+        f"TrainConfig.agent must be an AgentConfig, got {type(agent).__name__} {agent!r:.60}; {fix}"
+    )
+
+
 def check_train_config(config: TrainConfig) -> None:
     """Every field of a ``TrainConfig`` and of its ``AgentConfig`` (checked again: either may
     have been changed since it was built), then the constraints between fields."""
+    check_agent_field(config)
     check_fields(config, "")
     if isinstance(config.agent, AgentConfig):
         check_agent_config(config.agent)

@@ -5,6 +5,7 @@ list goes fails far from the call with Python's message, or is taken silently.""
 
 from __future__ import annotations
 
+import difflib
 import signal
 from collections.abc import Mapping
 from typing import Any
@@ -71,6 +72,7 @@ def check_callbacks(callbacks: Any, function: str) -> None:
         )
     for index, callback in enumerate(callbacks):
         if isinstance(callback, TrainCallback):
+            check_hook_names(callback, function)
             continue
         if isinstance(callback, type) and issubclass(callback, TrainCallback):
             problem = f"the class {callback.__name__}, not an instance; pass {callback.__name__}()"
@@ -108,3 +110,66 @@ def asked_signal(callback: TrainCallback, run: Run) -> int | None:
         f"{asked!r:.60}; it must return a signal number to stop the run as that signal would "
         "(e.g. signal.SIGTERM) or None to go on"
     )
+
+
+HOOKS = ("on_start", "on_evaluation", "on_logged", "on_end", "stop_requested")
+"""The methods of TrainCallback the loop calls."""
+
+SB3_HOOKS = (
+    "on_step",
+    "_on_step",
+    "on_rollout_start",
+    "on_rollout_end",
+    "on_training_start",
+    "on_training_end",
+    "_on_rollout_start",
+    "_on_rollout_end",
+    "_on_training_start",
+    "_on_training_end",
+)
+"""Stable-Baselines3's BaseCallback hooks, which a callback written for SB3 defines."""
+
+
+def check_hook_names(callback: TrainCallback, function: str) -> None:
+    """A TypeError when ``callback``'s class defines a method the loop never calls but that
+    looks like a hook: a misspelt hook (``on_evalution``), Stable-Baselines3's ``on_step``, or
+    any other ``on_*`` name. The loop calls only :data:`HOOKS`; the method would be skipped
+    without a word."""
+    hooks = ", ".join(HOOKS)
+    for klass in type(callback).__mro__:
+        if klass is TrainCallback or not issubclass(klass, TrainCallback):
+            break
+        for name, value in vars(klass).items():
+            if not callable(value) or name in HOOKS or name.startswith("__"):
+                continue
+            close = difflib.get_close_matches(name, HOOKS, n=1, cutoff=0.8)
+            if name in SB3_HOOKS:
+                why = (
+                    f"{name} is a hook of Stable-Baselines3's BaseCallback, which this loop "
+                    "does not call; to act between steps override stop_requested(run) (polled "
+                    "between steps), or on_evaluation(run, metrics) at each evaluation."
+                )
+            elif close:
+                why = f"did you mean {close[0]}?"
+            elif name.startswith("on_"):
+                why = "it is no hook of TrainCallback."
+            else:
+                continue
+            raise TypeError(
+                f"{function}(callbacks=...): {klass.__name__} defines {name}, which the loop "
+                f"never calls; {why} The hooks are {hooks} "
+                "(simoun_agent.run.callback.TrainCallback)."
+            )
+
+
+def call_hook(callback: TrainCallback, hook: str, *args: Any) -> None:
+    """``callback.hook(*args)``, refusing a value returned: the loop ignores it, so a hook
+    returning True to stop the run (as some libraries' callbacks do) would go on silently."""
+    returned = getattr(callback, hook)(*args)
+    if returned is not None:
+        raise TypeError(
+            f"{type(callback).__name__}.{hook} returned {type(returned).__name__} "
+            f"{returned!r:.60}, but the loop ignores what {hook} returns (it must return None). "
+            "To stop the run, override stop_requested(run) to return a signal number, e.g. "
+            "return signal.SIGINT once your condition holds (it is polled between steps)."
+        )

@@ -115,29 +115,31 @@ def evaluate(
     return metrics, frames
 
 
-def check_players(agent: Any, env: Any) -> None:
+def check_players(agent: Any, env: Any, function: str = "evaluate", example: str = "") -> None:
     """A TypeError unless ``agent`` acts (``act(frames, deterministic=True)``) and ``env`` is
-    a Gymnasium env giving SimounObservation's frames; the two swapped are named as such."""
-    example = "e.g. evaluate(run.agent, run.env, episodes, run.first_seed)"
+    a Gymnasium env giving SimounObservation's frames; the two swapped are named as such.
+    ``function`` (taking the agent first, the env second) is named, with ``example``, a call
+    that works."""
+    example = example or f"e.g. {function}(run.agent, run.env, episodes, run.first_seed)"
     if isinstance(agent, gym.Env) and callable(getattr(env, "act", None)):
         raise TypeError(
-            f"evaluate takes the agent first and the env second, got the env "
+            f"{function} takes the agent first and the env second, got the env "
             f"{type(agent).__name__} as agent and the {type(env).__name__} as env; swap them, "
             f"{example}"
         )
     if not callable(getattr(agent, "act", None)):
         raise TypeError(
-            f"evaluate(agent=...) must have act(frames, deterministic) (a SimounAgent or a "
+            f"{function}(agent=...) must have act(frames, deterministic) (a SimounAgent or a "
             f"RandomPolicy), got {type(agent).__name__}; {example}"
         )
     if not isinstance(env, gym.Env):
         raise TypeError(
-            f"evaluate(env=...) must be a Gymnasium env, got {type(env).__name__}; {example}"
+            f"{function}(env=...) must be a Gymnasium env, got {type(env).__name__}; {example}"
         )
     space = env.observation_space
     if not (isinstance(space, gym.spaces.Dict) and "frames" in space.spaces):
         raise TypeError(
-            f"evaluate(env=...) must give SimounObservation's frames (a Dict observation with "
+            f"{function}(env=...) must give SimounObservation's frames (a Dict observation with "
             f"'frames'), but {env} gives {space}; pass the run's own env (run.env), or wrap it "
             "as the run did: simoun_wrappers.SimounObservation(env, size=...)"
         )

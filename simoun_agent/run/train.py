@@ -34,6 +34,7 @@ import contextlib
 import functools
 import json
 import math
+import os
 import random
 import signal
 import time
@@ -55,6 +56,7 @@ from simoun_agent.config.train import RESUMABLE_FIELDS, check_train_config
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.arguments import (
     asked_signal,
+    call_hook,
     check_callbacks,
     check_config_arg,
     check_config_check,
@@ -204,6 +206,7 @@ def create_run(
     check_config_check(check, "create_run")
     if config.run_dir:
         check_path(config.run_dir, "TrainConfig.run_dir", "run_dir='runs/my-run'")
+        config.run_dir = os.fspath(config.run_dir)  # a Path set after the config was built
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
         take_run_dir(run_dir, overwrite=overwrite).close()
@@ -596,7 +599,7 @@ class Trainer:
                 1,
             ) from None
         for callback in self.callbacks:
-            callback.on_evaluation(run, metrics)
+            call_hook(callback, "on_evaluation", run, metrics)
             check_metrics(metrics, callback)
         counters.wall_time_s = self.clock.total()
         metrics["wall_time_s"] = counters.wall_time_s
@@ -604,7 +607,7 @@ class Trainer:
         counters.eval_pending = False
         self.phase = self.step_phase()
         for callback in self.callbacks:
-            callback.on_logged(run, metrics)
+            call_hook(callback, "on_logged", run, metrics)
         self.progress.evaluated(counters.env_step, metrics)
         return metrics
 
@@ -826,7 +829,7 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
         trainer = Trainer(run, callbacks)
         try:
             for callback in trainer.callbacks:
-                callback.on_start(run)
+                call_hook(callback, "on_start", run)
             try:
                 trainer.loop()
                 if not run.stop.is_set():
@@ -868,7 +871,7 @@ def end_callbacks(
     error: BaseException | None = None
     for callback in callbacks:
         try:
-            callback.on_end(run, final)
+            call_hook(callback, "on_end", run, final)
         except BaseException as err:  # re-raised below, once every callback has closed
             error = error or err
     if error is not None:

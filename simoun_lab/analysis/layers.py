@@ -19,6 +19,7 @@ from simoun_agent.models.encoder import (
     SingleFrameEncoder,
     StackedEncoder,
 )
+from simoun_lab.analysis.runs import check_encoder
 
 PATH, MOTION, APPEARANCE, STATE = "path", "motion path", "appearance path", "fused state"
 """Layer names: the conv path of a single-path encoder, the two paths of a dual encoder, f_t."""
@@ -73,6 +74,7 @@ def layer_activations(
     encoder: PixelEncoder, observations: torch.Tensor, batch_size: int = 64
 ) -> dict[str, torch.Tensor]:
     """:func:`feature_layers` over many observations, in batches, without gradient, on CPU."""
+    check_encoder(encoder, "layer_activations")
     parts: dict[str, list[torch.Tensor]] = {}
     device = next(encoder.parameters()).device
     with torch.inference_mode():

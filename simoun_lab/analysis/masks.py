@@ -19,6 +19,7 @@ from simoun_agent.config import SetupError
 from simoun_agent.models.encoder import PixelEncoder
 from simoun_agent.models.interaction import StructureMasks
 from simoun_agent.run.atomic import atomic_write
+from simoun_lab.analysis.runs import check_encoder
 
 COLORMAP = "magma"
 """Perceptual colour map of the heat maps (uniform in lightness, readable in grey)."""
@@ -50,6 +51,7 @@ def structure_masks(
 ) -> StructureMasks:
     """Masks of uint8 observations ``(N, 3, C, H, W)``, on CPU (attention ``(N, hw, hw)``, masks
     ``(N, c, h, w)``)."""
+    check_encoder(encoder, "structure_masks")
     device = next(encoder.parameters()).device
     parts: list[StructureMasks] = []
     with torch.inference_mode():

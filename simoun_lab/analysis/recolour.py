@@ -13,7 +13,9 @@ import gymnasium as gym
 import numpy as np
 
 from simoun_agent.config import SetupError, TrainConfig
+from simoun_agent.run.arguments import check_config_arg
 from simoun_agent.run.make_env import make_env
+from simoun_wrappers._checks import is_int
 
 BLOCK = 3
 """Decisions per colour set: the triplets at t = 2, 5, 8, ... see one colour set each."""
@@ -82,6 +84,18 @@ def replay_recoloured(
     Returns the observations ``(T + 1, k, C, H, W)``, the rewards ``(T,)`` and the final
     physics state (to check against the original).
     """
+    check_config_arg(config, "replay_recoloured")
+    if not (is_int(seed) and seed >= 0):
+        raise TypeError(
+            f"replay_recoloured(seed=...) must be an int >= 0 (the episode's reset seed), got "
+            f"{type(seed).__name__} {seed!r:.60}; e.g. replay_recoloured(run.config, "
+            "episode.seed, episode.actions, np.random.default_rng(0))"
+        )
+    if not isinstance(rng, np.random.Generator):
+        raise TypeError(
+            f"replay_recoloured(rng=...) must be a numpy Generator, got {type(rng).__name__}; "
+            "e.g. np.random.default_rng(0)"
+        )
     twin = make_env(config)
     try:
         colours = ModelColours(twin, config.env)

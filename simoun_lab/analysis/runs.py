@@ -11,7 +11,10 @@ import torch
 
 from simoun_agent.agent import SimounAgent
 from simoun_agent.config import SetupError
+from simoun_agent.models.encoder import PixelEncoder
+from simoun_agent.run.evaluate import check_players
 from simoun_agent.run.rundir import make_output_dir
+from simoun_wrappers._checks import is_int
 
 
 @dataclass
@@ -35,6 +38,13 @@ class Episode:
 
 def play_episode(agent: SimounAgent, env: gym.Env, seed: int) -> Episode:
     """One episode from ``reset(seed=seed)`` with deterministic actions."""
+    example = "e.g. play_episode(run.agent, run.env, run.first_seed) for run = load_run(path)"
+    check_players(agent, env, "play_episode", example)
+    if not (is_int(seed) and seed >= 0):
+        raise (ValueError if is_int(seed) else TypeError)(
+            f"play_episode(seed=...) must be an int >= 0 (the episode's reset seed), got "
+            f"{type(seed).__name__} {seed!r:.60}; {example}"
+        )
     obs, _ = env.reset(seed=seed)
     observations, actions, rewards = [obs["frames"]], [], []
     done = False
@@ -63,3 +73,19 @@ def prepare_output(out: Path, names: list[str], overwrite: bool, flag: str = "--
             f"another {flag}"
         )
     make_output_dir(out, flag, names)
+
+
+def check_encoder(encoder: object, function: str) -> None:
+    """A TypeError naming ``function``'s ``encoder`` unless it is a PixelEncoder: an agent, or
+    the observations in its place, would fail inside torch."""
+    if isinstance(encoder, PixelEncoder):
+        return
+    hint = (
+        "pass its encoder, agent.encoder"
+        if isinstance(getattr(encoder, "encoder", None), PixelEncoder)
+        else "pass a run's encoder, load_run(path).agent.encoder"
+    )
+    raise TypeError(
+        f"{function}(encoder=...) must be a PixelEncoder, got {type(encoder).__name__}; {hint}, "
+        f"e.g. {function}(run.agent.encoder, observations)"
+    )

@@ -12,13 +12,18 @@ from simoun_wrappers._checks import check_reset_seed, is_int
 LEVELS = ("easy", "hard")
 
 
+def is_closed_dm_control(env: gym.Env) -> bool:
+    """Whether ``env`` is a dm_control task whose ``close()`` freed its physics (shimmy's
+    close() frees the physics but keeps it: its model is gone)."""
+    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
+    return physics is not None and not hasattr(physics, "model")
+
+
 def check_open(env: gym.Env, owner: str) -> None:
     """A ValueError (as Python's closed files give) naming ``close()`` when ``env`` is a
     dm_control task whose ``close()`` freed its physics. ``owner`` calls it before each reset,
     step and render: shimmy's own error then is an AttributeError deep in dm_control."""
-    physics = getattr(getattr(env.unwrapped, "_env", None), "physics", None)
-    if physics is not None and not hasattr(physics, "model"):
-        # shimmy's close() frees the physics but keeps it: its model is gone
+    if is_closed_dm_control(env):
         spec = env.unwrapped.spec
         env_id = spec.id if spec is not None else "dm_control/cartpole-swingup-v0"
         raise ValueError(
