@@ -3507,8 +3507,10 @@ def classify(case: dict, text: str, timed_out: bool) -> tuple[str, str]:
         inside = "/site-packages/" in rest.partition(":")[0]
         # an error class of the project's own counts as the refusal it derives from (Damaged is
         # a ValueError): the child lists the class and its bases
+        # an ImportError naming the module that holds a name is the packages' refusal of a name
+        # imported from the wrong one
         refusals = {"ValueError", "TypeError", "ResetNeeded", "SetupError", "FileNotFoundError",
-                    "InvalidAction", "Error"}  # fmt: skip
+                    "InvalidAction", "Error", "ImportError"}  # fmt: skip
         if inside or not {kind, *kinds.split()} & refusals:
             return "wrong", status
         if case["ok"]:  # valid input may be refused only where the case names what for
