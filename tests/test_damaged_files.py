@@ -7,6 +7,7 @@ import json
 import os
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 from test_train_resume import TINY
@@ -564,3 +565,27 @@ def test_a_study_or_sweep_folder_given_as_a_run_is_named(
     err = refusal(command, folder, capsys)
     assert f"{folder} is a simoun-{record.split('.')[0]} directory" in err
     assert "not a run directory" in err
+
+
+LFS = (
+    "version https://git-lfs.github.com/spec/v1\n"
+    "oid sha256:4d7a214614ab2935c943f9e0ff69d22eadbb8f32b1258daaa5e2ca24d17e2393\nsize 20864795\n"
+)
+"""A Git LFS pointer, what a clone made without git-lfs holds in place of each LFS file."""
+
+
+@pytest.mark.parametrize("name", ["eval.csv", "config.json", "checkpoint.pt"])
+def test_a_git_lfs_pointer_is_named_with_git_lfs_pull(name, trained_run, tmp_path, capsys):
+    run_dir = Path(shutil.copytree(trained_run, tmp_path / "run"))
+    (run_dir / name).write_text(LFS)
+    if name == "eval.csv":
+        with pytest.raises(DamagedRun) as info:
+            read_curve(run_dir / name)
+        said = str(info.value)
+    else:
+        with pytest.raises(SystemExit):
+            eval_cli.main([str(run_dir), "--episodes", "1", "--no-video"])
+        said = capsys.readouterr().err
+    assert f"{name} is damaged" in said or f"checkpoint {run_dir / name}" in said
+    assert "it is a Git LFS pointer, not the file itself" in said
+    assert "git lfs install && git lfs pull" in said and "cut short" not in said

@@ -559,7 +559,11 @@ def test_a_damaged_trial_record_is_named(tmp_path):
     ("damage", "said"),
     [
         (emptied, "failed"),
-        (utf16, "failed (error.txt is damaged: it is saved as UTF-16 text, not UTF-8)"),
+        (
+            utf16,
+            "failed (error.txt is damaged: it is saved as UTF-16 text, not UTF-8; convert it "
+            "(iconv -f UTF-16 -t UTF-8 {error} > {error}.utf8 && mv {error}.utf8 {error}))",
+        ),
         (a_directory, "failed (error.txt is damaged: it is a directory, not a regular file)"),
     ],
 )
@@ -571,6 +575,7 @@ def test_a_damaged_error_file_still_says_the_trial_failed(damage, said, tmp_path
     damage(error)
     status = launch.summarize({"failed": [trial_of(run_dir)]}, tmp_path / "sweep", [])
     assert status == 1
+    said = said.format(error=error)
     assert f"FAILED base/cheetah-run/s1: {said} (traceback: {error})" in capsys.readouterr().err
     shutil.copytree(DMC / "evaluation/drq/cheetah-run/s2", tmp_path / "sweep" / "finished")
     assert report_cli.main([str(tmp_path / "sweep"), "--out", str(tmp_path / "report")]) == 0
@@ -785,3 +790,22 @@ def test_a_file_of_a_finished_study_run_copied_over_another_is_named(
     shutil.copyfile(run_dir / source, run_dir / target)
     printed = refused(study_cli.main, "report", str(DMC_SPEC), "--study-dir", str(dmc_archive))
     assert f"{problem}" in printed and str(run_dir) in printed
+
+
+def test_every_kept_json_file_is_read_alike_in_utf16(tmp_path):
+    """One reader for every kept JSON file: a UTF-16 study record, MiniGrid spec, sweep.json or
+    update_cost.json is refused alike, with the command that converts it."""
+    from simoun_lab.study.owner import read_object
+
+    record = Path(shutil.copy(DMC / "study.json", tmp_path / "study.json"))
+    utf16(record)
+    with pytest.raises(Damaged, match="saved as UTF-16 text, not UTF-8; convert it") as info:
+        read_json_object(record)
+    assert f"iconv -f UTF-16 -t UTF-8 {record} > {record}.utf8 && mv {record}.utf8 {record}" in (
+        str(info.value)
+    )
+    assert read_object(record) is None  # the owner check reads it as every reader does
+    spec = Path(shutil.copy("docs/studies/minigrid/spec.json", tmp_path / "spec.json"))
+    utf16(spec)
+    with pytest.raises(SetupError, match="saved as UTF-16 text, not UTF-8; convert it"):
+        load_minigrid_spec(spec)

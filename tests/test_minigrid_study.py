@@ -607,7 +607,7 @@ def test_a_hand_edited_json_spec_is_told_where_and_why_it_is_not_json(edit, said
     path = tmp_path / "spec.json"
     path.write_text(text.replace(*edit))
     with pytest.raises(SetupError) as refused:
-        load_spec(path)
+        load_spec(path, "--spec")
     assert str(refused.value) == f"--spec {path} is not valid JSON: {said}"
     with pytest.raises(SetupError) as refused:
         load_ppo_spec(str(path))
@@ -739,3 +739,39 @@ def test_a_spec_path_with_a_trailing_blank_is_quoted_and_the_path_without_it_nam
     status, printed = simoun_study("plan", "none.toml")
     assert "cannot read the study spec none.toml (No such file" in printed
     assert "has a blank" not in printed
+
+
+def test_report_and_select_given_a_folder_of_an_archive_are_told_the_archive(tmp_path):
+    mgt = Path(shutil.copytree("docs/studies/minigrid-v2/tuning", tmp_path / "mgt"))
+    task = mgt / "MiniGrid-DoorKey-6x6-v0"
+    for command in ("report", "select"):
+        status, printed = study(command, "--archive", str(task))
+        assert status == 2 and "Traceback" not in printed
+        assert f"--archive {task} is a folder inside {mgt}, the archive of a MiniGrid" in printed
+        assert f"pass the archive (--archive {mgt})" in printed
+        assert "outside" not in printed  # run's advice, for a study written there
+    status, printed = simoun_study("report", str(mgt / "spec.json"), "--study-dir", str(task))
+    assert status == 2 and f"pass the archive (--study-dir {mgt})" in printed
+
+
+@pytest.mark.parametrize(
+    ("name", "unpack"), [("mgt.zip", "unzip {p} -d {d}"), ("mgt.tar.gz", "tar -xf {p} -C {d}")]
+)
+def test_an_archive_given_as_a_packed_file_is_told_to_unpack_it(name, unpack, tmp_path):
+    packed = tmp_path / name
+    packed.write_bytes(b"PK\x05\x06" + bytes(18))
+    for command in ("report", "select"):
+        status, printed = study(command, "--archive", str(packed))
+        assert status == 2 and "no such directory" not in printed
+        assert f"--archive {packed} is a file, not a study's archive" in printed
+        assert unpack.format(p=packed, d=tmp_path) in printed
+
+
+def test_load_spec_from_python_names_its_file_not_the_flag(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_text('{"tasks": [\n')
+    with pytest.raises(SetupError, match=r"^the spec file .*s\.json is not valid JSON") as info:
+        load_spec(path)
+    assert "--spec" not in str(info.value)
+    with pytest.raises(SetupError, match=r"^--spec .*s\.json is not valid JSON"):
+        load_spec(path, "--spec")

@@ -965,3 +965,23 @@ def test_plan_refuses_gpus_per_trial_for_runs_on_the_cpu(tmp_path, capsys):
     line = key_line(text, ("resources", "gpus_per_trial"))
     assert f"{path}:{line}: [resources] gpus_per_trial: gpus_per_trial = 1 and [base] " in err
     assert 'device = "cpu" contradict each other' in err and "set it to 0" in err
+
+
+def test_a_phase_report_folder_that_is_a_file_is_named_with_a_fix_the_command_has(
+    dmc_archive, capsys
+):
+    tuning = dmc_archive / "report" / "tuning"
+    shutil.rmtree(tuning)
+    tuning.write_text("notes\n")
+    err = report_refused(dmc_archive, capsys)
+    assert f"the output directory {tuning} is a file, not a directory" in err
+    assert f"move it aside (mv {tuning} {tuning}.aside) and run the command again" in err
+    assert "--out" not in err  # simoun-study report has no --out
+
+
+def test_a_study_directory_given_as_a_packed_file_is_told_to_unpack_it(tmp_path, capsys):
+    packed = tmp_path / "arch.tar.gz"
+    packed.write_bytes(b"\x1f\x8b\x08\x00")
+    err = report_refused(packed, capsys)
+    assert f"{packed} is a file, not a directory" in err and "no such directory" not in err
+    assert f"tar -xf {packed} -C {tmp_path}" in err

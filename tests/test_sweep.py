@@ -821,3 +821,33 @@ def test_auto_gpus_refuse_a_cuda_trial_on_a_cluster_without_gpus(ray_address):
     with pytest.raises(SetupError, match="the Ray cluster has no GPU"):
         gpus_per_trial(ray, "auto", "cuda")
     assert gpus_per_trial(ray, "auto", "mps") == gpus_per_trial(ray, "auto", None) == 0.0
+
+
+def test_a_finished_trial_whose_logs_cannot_be_read_is_named_before_the_sweep_goes_on(
+    trained_sweep, tmp_path, capsys
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(1)
+    (run_dir / "eval.csv").write_text(
+        "version https://git-lfs.github.com/spec/v1\noid sha256:4d7a\nsize 2086\n"
+    )
+    err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(1)} is finished, but its run {run_dir} cannot be read" in err
+    assert "eval.csv is damaged: it is a Git LFS pointer" in err and "git lfs pull" in err
+    assert f"mv {run_dir} {run_dir}.aside" in err
+    assert not (sweep_dir / "report").exists()
+
+
+def test_a_closing_report_that_cannot_be_written_is_named_and_fails_the_sweep(
+    trained_sweep, tmp_path, capsys
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    table = sweep_dir / "report.md"
+    table.unlink(missing_ok=True)
+    table.mkdir()  # where the report writes a file: only moving it aside frees the place
+    assert cli.main(["--resume", "--sweep-dir", str(sweep_dir)]) == 1
+    err = capsys.readouterr().err
+    assert f"report not written: cannot write {table} (it is a directory" in err
+    assert f"mv {table} {table}.aside) and run the command again" in err
+    assert "--out" not in err  # simoun-sweep has none
+    assert f"then write it with: simoun-report {sweep_dir}" in err

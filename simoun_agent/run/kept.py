@@ -28,6 +28,30 @@ STEP_LIMIT = 2**63
 
 _UTF16_MARKS = (b"\xff\xfe", b"\xfe\xff")
 
+LFS_POINTER = b"version https://git-lfs.github.com/spec/v1"
+"""The first line of a Git LFS pointer: what a clone made without git-lfs holds in place of each
+file the repository keeps in LFS."""
+
+
+def lfs_problem(path: Path, data: bytes) -> str | None:
+    """What is wrong with ``path`` when its bytes ``data`` (its start suffices) are a Git LFS
+    pointer, else None: the file itself was never fetched, and ``git lfs pull`` fetches it."""
+    if not data.startswith(LFS_POINTER):
+        return None
+    return (
+        "it is a Git LFS pointer, not the file itself (a clone made without git-lfs); fetch the "
+        f"file with `git lfs install && git lfs pull` in the clone that holds {path.name}"
+    )
+
+
+def encoding_problem(path: Path) -> str:
+    """What is wrong with ``path``, a UTF-16 text file (PowerShell's ``>`` and Notepad write
+    them), and the fix that keeps its content: every kept text file is read as UTF-8."""
+    return (
+        f"it is saved as UTF-16 text, not UTF-8; convert it (iconv -f UTF-16 -t UTF-8 {path} > "
+        f"{path}.utf8 && mv {path}.utf8 {path})"
+    )
+
 
 def json_problem(text: str, err: json.JSONDecodeError) -> str:
     """Where and why ``text`` is not JSON (``err``, json's error on it), in the words of a
@@ -108,14 +132,19 @@ def not_a_file(path: Path) -> str | None:
 def read_text(path: Path) -> str:
     """The UTF-8 text of ``path`` (a leading byte order mark dropped, as a spreadsheet writes
     it); :class:`Damaged` for a link to nothing, something that is not a regular file (checked
-    before it is opened), text in another encoding or NUL bytes, which no run writes. OSError
+    before it is opened), a Git LFS pointer (:func:`lfs_problem`), text in another encoding
+    (UTF-16 named with the command that converts it) or NUL bytes, which no run writes. Every
+    kept text file, JSON or CSV, is read here, so that each is refused or taken alike. OSError
     for a file that cannot be read."""
     problem = broken_link(path) or not_a_file(path)
     if problem:
         raise Damaged(problem)
     data = path.read_bytes()
+    problem = lfs_problem(path, data)
+    if problem:
+        raise Damaged(problem)
     if data.startswith(_UTF16_MARKS):
-        raise Damaged("it is saved as UTF-16 text, not UTF-8")
+        raise Damaged(encoding_problem(path))
     if b"\0" in data:
         line = data[: data.index(b"\0")].count(b"\n") + 1
         raise Damaged(f"line {line} holds a NUL byte (zero bytes from a disk or copy failure)")
@@ -260,13 +289,17 @@ def step_count(text: str) -> int:
 
 
 def binary_problem(path: Path) -> str:
-    """What is visibly wrong with a binary file that its reader refused: empty, or all zero
-    bytes (a disk that lost the data, a copy cut off); else that it cannot be read."""
+    """What is visibly wrong with a binary file that its reader refused: empty, a Git LFS
+    pointer (:func:`lfs_problem`), or all zero bytes (a disk that lost the data, a copy cut
+    off); else that it cannot be read."""
     try:
         size = path.stat().st_size
         if size == 0:
             return "it is empty"
         with path.open("rb") as f:
+            if problem := lfs_problem(path, f.read(len(LFS_POINTER))):
+                return problem
+            f.seek(0)
             while chunk := f.read(1 << 20):
                 if chunk.count(0) != len(chunk):
                     return f"it cannot be read ({size} bytes, cut short or overwritten)"
@@ -390,3 +423,14 @@ def packed_problem(path: Path, what: str = "") -> str | None:
                 f"space): unpack it ({command} -k {packed})"
             )
     return None
+
+
+def packed_folder_advice(path: Path) -> str:
+    """The advice for a file given where a folder is read (a run, a sweep, a study's archive):
+    the folder packed for sending (``mg.tar.gz``, ``runs.zip``), with the command that unpacks
+    it beside itself."""
+    if path.suffix.lower() == ".zip":
+        command = f"unzip {path} -d {path.parent}"
+    else:
+        command = f"tar -xf {path} -C {path.parent}"
+    return f"if it is the folder packed, unpack it first ({command}) and pass the folder it gives"

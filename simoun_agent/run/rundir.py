@@ -39,14 +39,26 @@ _held: dict[Path, IO[str]] = {}
 """The run-directory locks this process holds, by lock file"""
 
 
-def refuse_a_file(path: Path, flag: str) -> None:
+def refuse_a_file(path: Path, flag: str | None) -> None:
     """Raise SetupError naming ``flag`` when the output directory ``path`` is a file; creates
-    nothing, so a command can check before work whose failure must leave nothing behind."""
+    nothing, so a command can check before work whose failure must leave nothing behind.
+    ``flag`` None: a folder the command names itself (``DIR/report/tuning``), which no flag
+    moves; the fix is then to move the file aside."""
     if path.exists() and not path.is_dir():
-        raise SetupError(
-            f"the output directory {path} is a file, not a directory; pass a new or existing "
-            f"directory to {flag}"
+        fix = (
+            f"pass a new or existing directory to {flag}"
+            if flag
+            else f"move it aside (mv {path} {path}.aside) and run the command again"
         )
+        raise SetupError(f"the output directory {path} is a file, not a directory; {fix}")
+
+
+def writable_fix(flag: str | None) -> str:
+    """The fix for an output directory that cannot be written: another one by ``flag``, or,
+    for a folder the command names itself (``flag`` None), write access to it."""
+    if flag:
+        return f"pass a writable {flag}"
+    return "make it writable (or free space there) and run the command again"
 
 
 def check_output_files(paths: Iterable[Path], flag: str | None = None) -> None:
@@ -74,7 +86,7 @@ def output_files(directory: Path, names: Iterable[str]) -> list[Path]:
     return [path for name in names for path in sorted(directory.glob(name))]
 
 
-def check_output_dir(path: Path, flag: str, files: Iterable[str] = ()) -> None:
+def check_output_dir(path: Path, flag: str | None, files: Iterable[str] = ()) -> None:
     """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
     written: it is a file, a folder on its way is a file or a symbolic link that loops or leads
     nowhere, a name is too long, or the nearest folder of it that exists takes no new folder
@@ -82,7 +94,8 @@ def check_output_dir(path: Path, flag: str, files: Iterable[str] = ()) -> None:
     ``files`` (names or glob patterns) the command writes in it is something else than a file
     (:func:`check_output_files`). Leaves nothing behind (its probe folder is removed at once),
     so a command can check before the work whose set-up takes long (Ray) rather than fail
-    after it."""
+    after it. ``flag`` None: a folder the command names itself, which the fixes say how to
+    free rather than naming a flag the command does not have."""
     try:
         refuse_a_file(path, flag)
         reason = unwritable(path.absolute())
@@ -90,7 +103,7 @@ def check_output_dir(path: Path, flag: str, files: Iterable[str] = ()) -> None:
         reason = getattr(err, "strerror", None) or str(err)
     if reason:
         raise SetupError(
-            f"cannot write to the output directory {path} ({reason}); pass a writable {flag}"
+            f"cannot write to the output directory {path} ({reason}); {writable_fix(flag)}"
         )
     check_output_files(output_files(path, files), flag)
 
@@ -117,7 +130,7 @@ def unwritable(path: Path) -> str | None:
     return None
 
 
-def make_output_dir(path: Path, flag: str = "--out", files: Iterable[str] = ()) -> bool:
+def make_output_dir(path: Path, flag: str | None = "--out", files: Iterable[str] = ()) -> bool:
     """Create ``path`` (with its parents) and check that it can be written, and that none of
     ``files`` (names or glob patterns) the command writes in it is something else than a file
     (:func:`check_output_dir`). Returns True when it did not exist before, so a caller that
@@ -134,7 +147,7 @@ def make_output_dir(path: Path, flag: str = "--out", files: Iterable[str] = ()) 
         if created and path.is_dir() and not any(path.iterdir()):
             path.rmdir()
         raise SetupError(
-            f"cannot write to the output directory {path} ({err.strerror}); pass a writable {flag}"
+            f"cannot write to the output directory {path} ({err.strerror}); {writable_fix(flag)}"
         ) from None
     return created
 

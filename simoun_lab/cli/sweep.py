@@ -34,12 +34,15 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import flag_name
+from simoun_agent.run.kept import present
+from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import (
     SWEEP_FILE,
     SweepSpec,
+    Trial,
     check_devices,
     check_runnable,
     check_trial_dirs,
@@ -233,6 +236,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     todo = [trial for trial in spec.trials(sweep_dir) if not finished(trial)]
     done = len(spec.trials(sweep_dir)) - len(todo)
     try:
+        check_finished_trials([trial for trial in spec.trials(sweep_dir) if trial not in todo])
         check_runnable(todo, "--envs" if args.envs or len(spec.envs) > 1 else "--env", spec.grid)
     except SetupError as err:
         fail(PROG, err)
@@ -261,11 +265,37 @@ def main(argv: Sequence[str] | None = None) -> int:
                 ray.shutdown()
     else:
         outcome = {}
+    written, unwritten = closing_report(spec, sweep_dir)
+    return summarize(outcome, sweep_dir, written, bool(terminated), unwritten=unwritten)
+
+
+def check_finished_trials(trials: list[Trial]) -> None:
+    """SetupError naming the first of the finished ``trials`` whose files the report cannot
+    read (:func:`~simoun_lab.sweep.report.read_run`: an eval.csv that is a Git LFS pointer, a
+    summary.json cut short), before any trial trains: the sweep would count it finished and
+    end without its report."""
+    for trial in trials:
+        run_dir = Path(trial.run_dir)
+        try:
+            report.read_run(run_dir / CONFIG_NAME)
+        except report.DamagedRun as err:
+            raise SetupError(
+                f"trial {trial.name} is finished, but its run {run_dir} cannot be read: {err}; "
+                "restore the file from a copy, or move the run directory aside (mv "
+                f"{run_dir} {run_dir}.aside) so that the trial trains anew"
+            ) from None
+
+
+def closing_report(spec: SweepSpec, sweep_dir: Path) -> tuple[list[Path], str | None]:
+    """The report the sweep writes at its end (``SWEEP_DIR/report``): its files, and why it
+    could not be written (None when it was, or when no trial got as far as its config.json:
+    nothing to report, which the trials' own lines say)."""
+    if not any(present(Path(trial.run_dir) / CONFIG_NAME) for trial in spec.trials(sweep_dir)):
+        return [], None
     try:
-        written = report.write_report(sweep_dir)
-    except SetupError:  # no trial got as far as writing its config.json
-        written = []
-    return summarize(outcome, sweep_dir, written, bool(terminated))
+        return report.write_report(sweep_dir, flag=None), None
+    except SetupError as err:
+        return [], f"{err}; then write it with: simoun-report {sweep_dir}"
 
 
 if __name__ == "__main__":

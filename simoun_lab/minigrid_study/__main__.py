@@ -41,17 +41,14 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
     from simoun_lab.minigrid_study.runner import SPEC_FILE, load_saved_spec
     from simoun_lab.minigrid_study.spec import StudySpec, load_spec
     from simoun_lab.minigrid_study.study_command import refuse_sac_study
-    from simoun_lab.study.owner import check_not_inside_study
+    from simoun_lab.study.owner import check_not_inside_archive, check_not_inside_study
 
-    if not archive.is_dir():
-        where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
-        in_clone = " (run it from the root of a clone of simoun)" if archive == ARCHIVE else ""
-        start = "; to start a new study, create the directory first" if new else ""
-        raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
+    check_archive_folder(archive, new)
     refuse_sac_study(archive, "--archive")
-    check_not_inside_study(archive, "--archive")
+    # a run writes a study into --archive, report and select read one from it
+    (check_not_inside_study if new else check_not_inside_archive)(archive, "--archive")
     if spec is not None:
-        given = load_spec(spec)
+        given = load_spec(spec, "--spec")
         if present(archive / SPEC_FILE):
             check_archive_spec(given, spec, archive / SPEC_FILE)
         return given
@@ -63,6 +60,26 @@ def spec_for(spec: Path | None, archive: Path, new: bool = False) -> StudySpec:
         f"--archive {archive} holds no {SPEC_FILE}, so it is not a study's archive; pass the "
         "archive a run wrote, or --spec FILE for the spec its runs were trained with"
     )
+
+
+def check_archive_folder(archive: Path, new: bool) -> None:
+    """Refuse an ``archive`` that is no directory: not there (a mistyped ``--archive`` would
+    otherwise start the whole study, or report on nothing), or a file, such as the archive
+    packed for sending (``mg.tar.gz``), which must be unpacked first. ``new``: a ``run``, which
+    may start a study in a directory created for it."""
+    from simoun_agent.run.kept import packed_folder_advice
+
+    if archive.is_dir():
+        return
+    where = f"{archive.absolute()}" if archive == ARCHIVE else f"--archive {archive}"
+    if archive.exists():
+        raise SetupError(
+            f"{where} is a file, not a study's archive (a directory); "
+            f"{packed_folder_advice(archive)}"
+        )
+    in_clone = " (run it from the root of a clone of simoun)" if archive == ARCHIVE else ""
+    start = "; to start a new study, create the directory first" if new else ""
+    raise SetupError(f"no study archive at {where}: no such directory{in_clone}{start}")
 
 
 def check_archive_spec(spec: StudySpec, path: Path, saved: Path) -> None:

@@ -304,9 +304,10 @@ SAC_SPEC_KEYS = ("recipes", "tuning", "base", "grid")
 (nor a misspelling of one)."""
 
 
-def load_spec(path: Path, label: str = "--spec") -> StudySpec:
+def load_spec(path: Path, label: str = "the spec file") -> StudySpec:
     """The spec in the JSON file ``path``, or in the TOML file when it ends in ``.toml`` or is
-    TOML and not JSON; errors name it as ``label`` (the flag or argument it was given by)."""
+    TOML and not JSON; errors name it as ``label`` (the flag it was given by, ``--spec``; by
+    default as the file given to this function, since a caller in Python passed no flag)."""
     is_toml = Path(path).suffix.lower() == ".toml"
     as_toml = is_toml
     try:

@@ -16,10 +16,10 @@ from pathlib import Path
 import tomllib
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import Damaged, present, read_text
+from simoun_agent.run.kept import Damaged, packed_folder_advice, present, read_text
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 from simoun_lab.study.given_path import shown
-from simoun_lab.study.owner import check_not_inside_study, sac_study
+from simoun_lab.study.owner import check_not_inside_archive, check_not_inside_study, sac_study
 from simoun_lab.study.runner import PPO_SPEC_FILE, STUDY_FILE, StudyOptions
 
 __all__ = ["check_run_places", "is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
@@ -138,7 +138,13 @@ def report(spec: StudySpec, study_dir: Path) -> Path:
 
     runner = _runner()
     saved = study_dir / runner.SPEC_FILE
+    if present(study_dir) and not study_dir.is_dir():
+        raise SetupError(
+            f"--study-dir {study_dir} is a file, not a study's archive (a directory); "
+            f"{packed_folder_advice(study_dir)}"
+        )
     refuse_sac_study(study_dir)
+    check_not_inside_archive(study_dir, "--study-dir")
     if present(saved) and runner.load_saved_spec(saved) != spec:
         raise SetupError(
             f"--study-dir {study_dir} holds runs of another spec ({saved}); pass the spec it "

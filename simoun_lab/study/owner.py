@@ -7,12 +7,12 @@ its record and runs over that study's.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import Damaged, read_json_object
 from simoun_lab.study.given_path import shown
 from simoun_lab.study.record_file import RECORD_KEYS
 
@@ -29,12 +29,12 @@ the SAC study's phases, Ray Tune's records, the report."""
 
 
 def read_object(path: Path) -> dict[str, Any] | None:
-    """The JSON object in ``path``, None when it is not there or not one."""
+    """The JSON object in ``path``, read as every kept file is
+    (:func:`~simoun_agent.run.kept.read_json_object`); None when it is not there or not one."""
     try:
-        value = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        return read_json_object(path) if path.is_file() else None
+    except Damaged:
         return None
-    return value if isinstance(value, dict) else None
 
 
 def sac_study(where: Path) -> str | None:
@@ -79,6 +79,19 @@ def enclosing_study(path: Path) -> tuple[Path, str] | None:
         if study is not None:
             return given, study
     return None
+
+
+def check_not_inside_archive(path: Path, flag: str) -> None:
+    """Refuse ``flag``'s directory ``path``, given as a study's archive to read, when it is a
+    folder inside one (:func:`enclosing_study`): its archive is the one to pass."""
+    found = enclosing_study(path)
+    if found is None:
+        return
+    archive, study = found
+    raise SetupError(
+        f"{flag} {shown(path)} is a folder inside {shown(archive)}, the archive of {study}, not "
+        f"an archive itself; pass the archive ({flag} {shown(archive)})"
+    )
 
 
 def check_not_inside_study(path: Path, flag: str) -> None:

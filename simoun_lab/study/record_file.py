@@ -5,11 +5,11 @@ unknown keys.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.run.kept import Damaged, read_json_object
 from simoun_lab.study.given_path import shown
 
 RECORD_KEYS = ("spec_file", "spec_text", "spec", "parts")
@@ -65,8 +65,8 @@ def spec_beside(path: Path) -> str:
     study record names, or its MiniGrid ``spec.json``; else the spec file the study ran from."""
     record, saved = path.parent / "study.json", path.parent / "spec.json"
     try:
-        source = json.loads(record.read_text()).get("spec_file")
-    except (OSError, ValueError, AttributeError):
+        source = read_json_object(record).get("spec_file")
+    except (OSError, Damaged):
         source = None
     if isinstance(source, str) and source:
         return f"the spec the study was run from, {shown(source)} (named in {shown(record)})"

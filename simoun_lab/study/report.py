@@ -51,7 +51,7 @@ from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, broken_link, present, read_json_object
 from simoun_agent.run.layout import SUMMARY_NAME
-from simoun_agent.run.rundir import check_output_files, output_files
+from simoun_agent.run.rundir import check_output_dir, check_output_files, output_files
 from simoun_lab import stats
 from simoun_lab.study.checks import check_run_folder
 from simoun_lab.study.choice import SELECTION_FILE, Choice, check_config, read_finished
@@ -1055,9 +1055,15 @@ def write_study_report(
     for run in runs:  # before simoun-report of the phase, which would leave a damaged one out
         if present(Path(study_dir, run.name, SUMMARY_NAME)):
             check_config(spec, study_dir, run)
-    for phase in (TUNING, EVALUATION):
-        if any(run.finished(study_dir) for run in phase_runs(spec, phase, choices)):
-            sweep_report.write_report(study_dir / phase, out / phase)
+    phases = [
+        phase
+        for phase in (TUNING, EVALUATION)
+        if any(run.finished(study_dir) for run in phase_runs(spec, phase, choices))
+    ]
+    for phase in phases:  # both before either is written: a report is not left half new
+        check_output_dir(out / phase, None, sweep_report.REPORT_FILES)
+    for phase in phases:  # the study command has no --out: its report's folders are its own
+        sweep_report.write_report(study_dir / phase, out / phase, flag=None)
     results = [result for run in runs if (result := read_result(study_dir, run)) is not None]
     tuned = [r for run in tuning_runs(spec) if (r := read_result(study_dir, run)) is not None]
     missing = [run.name for run in runs if not run.finished(study_dir)]

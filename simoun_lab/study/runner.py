@@ -14,7 +14,13 @@ from typing import Any
 
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.run.atomic import atomic_write
-from simoun_agent.run.kept import Damaged, json_kind, present, read_json_object
+from simoun_agent.run.kept import (
+    Damaged,
+    json_kind,
+    packed_folder_advice,
+    present,
+    read_json_object,
+)
 from simoun_agent.run.layout import CHECKPOINT_NAME, SUMMARY_NAME
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect
@@ -77,7 +83,7 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
                 f"report {where / PPO_SPEC_FILE} --study-dir {where}), or pass the directory "
                 "of a SAC study"
             )
-    missing = "" if any(p.is_dir() for p in (study_dir, archive) if p) else " (no such directory)"
+    missing = missing_note([p for p in (study_dir, archive) if p is not None])
     if not resuming:
         raise SetupError(
             f"no study to report: {places} holds no {STUDY_FILE}{missing}; pass the "
@@ -87,6 +93,17 @@ def load_record(study_dir: Path, archive: Path | None, resuming: bool = True) ->
         f"no study to resume: {places} holds no {STUDY_FILE}{missing}; drop --resume to start "
         "the study, or pass the --study-dir (or --archive) of the study to continue"
     )
+
+
+def missing_note(places: list[Path]) -> str:
+    """Why ``places`` that hold no study record hold none, when no directory is among them: a
+    file there (a packed archive, with the command that unpacks it), else nothing at all."""
+    if any(place.is_dir() for place in places):
+        return ""
+    files = [place for place in places if place.exists()]
+    if files:
+        return f" ({files[0]} is a file, not a directory: {packed_folder_advice(files[0])})"
+    return " (no such directory)"
 
 
 PART_KEYS = ("commit", "dirty", "version")
@@ -430,13 +447,20 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
     finally:
         if phases.started:
             ray.shutdown()
-    written = []
+    written, unwritten = [], None
     if choices is not None:
-        write_study_report(spec, study_dir, record, choices)
-        written = [study_dir / REPORT_DIR / REPORT_MD]
-        if archive is not None:
-            archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
-    return launch.summarize(outcome, study_dir, written, bool(terminated), phases.resume)
+        try:
+            write_study_report(spec, study_dir, record, choices)
+        except SetupError as err:  # the runs are done: say so, and what keeps the report back
+            again = f"simoun-study report {spec_path} --study-dir {study_dir}"
+            unwritten = f"{err}; then write it with: {again}"
+        else:
+            written = [study_dir / REPORT_DIR / REPORT_MD]
+            if archive is not None:
+                archiving.archive_tree(study_dir / REPORT_DIR, archive / REPORT_DIR)
+    return launch.summarize(
+        outcome, study_dir, written, bool(terminated), phases.resume, unwritten=unwritten
+    )
 
 
 def report_study(spec: StudySpec, study_dir: Path) -> Path:

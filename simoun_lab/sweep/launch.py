@@ -96,9 +96,13 @@ def summarize(
     written: list[Path],
     terminated: bool = False,
     resume: str | None = None,
+    unwritten: str | None = None,
 ) -> int:
     """Say what happened to each trial and how to go on (``resume``: the command that continues,
-    by default simoun-sweep's); the exit status."""
+    by default simoun-sweep's); the exit status. ``unwritten``: why the closing report could not
+    be written (a damaged file it names, with the fix, and the command that writes the report
+    once it is fixed), said as an error: status 1 when nothing
+    else failed, since the report is the sweep's result."""
     resume = resume or f"simoun-sweep --resume --sweep-dir {sweep_dir}"
     for trial in outcome.get("failed", []):
         error = Path(trial.run_dir) / ERROR_FILE
@@ -106,6 +110,8 @@ def summarize(
         print(f"FAILED {trial.name}: {last} (traceback: {error})", file=sys.stderr)
     if written:
         print(f"report: {', '.join(map(str, written))}")
+    if unwritten:
+        print(f"report not written: {unwritten}", file=sys.stderr)
     if outcome.get("stopped"):
         print(
             f"stopped with {len(outcome['stopped'])} trials unfinished; continue with: {resume}",
@@ -119,4 +125,4 @@ def summarize(
             file=sys.stderr,
         )
         return 1
-    return 0
+    return 1 if unwritten else 0

@@ -1158,11 +1158,16 @@ def default_out(root: Path) -> Path:
 
 
 def write_report(
-    root: Path, out: Path | None = None, budget: tuple[str, float] | None = None
+    root: Path,
+    out: Path | None = None,
+    budget: tuple[str, float] | None = None,
+    flag: str | None = "--out",
 ) -> list[Path]:
     """Write the tables and figures of the runs under ``root`` into ``out`` (default:
     :func:`default_out`); returns the files written. Raises SetupError when ``root`` holds no
-    run or ``out`` cannot be written.
+    run or ``out`` cannot be written, its fix naming ``flag``, the option that gave ``out``
+    (None: a command that has none, such as the report a sweep or a study writes at its end,
+    whose fix is to move what stands there aside).
 
     ``budget`` = (``"env_step"`` or ``"wall_time_s"``, value) compares the runs at an equal
     budget instead of at their ends (:func:`at_budget`); the runs short of it are listed.
@@ -1170,7 +1175,7 @@ def write_report(
     root = Path(root)
     out = Path(out) if out is not None else default_out(root)
     comparison = compare_runs(root, budget)
-    make_output_dir(out, "--out", REPORT_FILES)
+    make_output_dir(out, flag, REPORT_FILES)
     groups = comparison.groups
     rows = [group.row() for group in groups]
     scores = variant_scores(groups)
