@@ -12,6 +12,7 @@ Python API and the files users keep, each classified by what the user is told.
     python scripts/reliability_trial.py --set eighth --timeout 90   # the eighth trial
     python scripts/reliability_trial.py --set ninth --timeout 90    # the ninth trial
     python scripts/reliability_trial.py --set tenth --timeout 90    # the tenth trial
+    python scripts/reliability_trial.py --set eleventh --timeout 90 # the eleventh trial
 
 Each case runs in a forked child in a directory of its own (a copy of a tiny trained run where
 it needs one) and is stopped after 20 s (``--timeout``; spec cases that import Ray want about 90 s
@@ -3402,7 +3403,7 @@ CASES = (
 
 AREAS = ("agent", "lab", "files", "api")
 """the areas of a trial kept as modules: ``reliability_<trial>_<area>.py`` in this directory"""
-MODULE_TRIALS = ("sixth", "seventh", "eighth", "ninth", "tenth")
+MODULE_TRIALS = ("sixth", "seventh", "eighth", "ninth", "tenth", "eleventh")
 """the trials whose cases live in those modules, each with a list ``CASES`` made with this
 module's helpers (imported when the trial is selected: they import this module)"""
 
