@@ -51,7 +51,7 @@ import torch
 
 from simoun_agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
-from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, env_label
+from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, env_label, split_env_id
 from simoun_agent.config.train import RESUMABLE_FIELDS, check_train_config
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.arguments import (
@@ -324,6 +324,32 @@ def changes(saved: Any, key: str, value: Any, run_dir: Path) -> bool:
     )
 
 
+def saved_spellings(saved: Any, overrides: dict[str, Any]) -> dict[str, Any]:
+    """``overrides`` less the values that are the ``saved`` run's own, spelled another way:
+    ``--env MODULE:ID`` of the run's ID (its module the run's ``env_module``, or one the run
+    did without), an ``--env-module`` equal to the run's, and an ``--action-repeat`` equal to
+    the one the run resolved (a dm_control task's paper value when it saved none)."""
+    if not isinstance(saved, dict):
+        return overrides
+    kept = dict(overrides)
+    env = kept.get("env")
+    if isinstance(env, str):
+        module, env_id = split_env_id(env)
+        if module and env_id == saved.get("env") and saved.get("env_module") in (None, module):
+            del kept["env"]
+    if "env_module" in kept and kept["env_module"] == saved.get("env_module"):
+        del kept["env_module"]
+    repeat = kept.get("action_repeat")
+    if (
+        repeat is not None
+        and saved.get("action_repeat") is None
+        and isinstance(saved.get("env"), str)
+    ):
+        if repeat == PAPER_ACTION_REPEAT.get(dmc_task(saved["env"]), 1):
+            del kept["action_repeat"]
+    return kept
+
+
 def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
@@ -372,6 +398,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         raise damaged_config(config_path, str(err)) from None
     if isinstance(saved, dict) and (problem := kind_problem(CONFIG_NAME, list(saved))):
         raise damaged_config(config_path, problem)
+    overrides = saved_spellings(saved, overrides)
     fixed = [key for key, value in overrides.items() if changes(saved, key, value, run_dir)]
     if fixed:
         raise SetupError(
