@@ -1,6 +1,7 @@
 """Environment construction, video, logs and driving measures of simoun-train."""
 
 import importlib.util
+import json
 
 import gymnasium as gym
 import imageio.v2 as imageio
@@ -562,3 +563,50 @@ def test_an_env_id_spelt_another_way_is_offered_first(typed, module, first):
         ensure_registered(typed, module)
     assert f"did you mean {first}" in str(error.value)
     assert "no registered id is close" not in str(error.value)
+
+
+def test_env_kwargs_merge_into_simouns_own_settings_key_by_key():
+    dmc = make_env(
+        env_config("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 1}})
+    )
+    try:  # the camera is the user's; the frame size stays the run's
+        assert dmc.unwrapped.render_kwargs == {"width": 32, "height": 32, "camera_id": 1}
+    finally:
+        dmc.close()
+    stack = {"observation": {"stack_size": 2}}
+    highway = make_env(env_config("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **stack}}))
+    try:  # simoun's dropped observation keeps its type, shape and weights under the user's stack
+        observation = highway.unwrapped.config["observation"]
+        assert observation["type"] == "GrayscaleObservation"
+        assert observation["stack_size"] == 2
+        assert observation["observation_shape"] == (8, 8)
+    finally:
+        highway.close()
+    # an observation of another type replaces simoun's whole: its settings are another class's
+    other = {"config": {**HIGHWAY_CONTINUOUS, "observation": {"type": "Kinematics"}}}
+    kinematics = make_env(env_config("highway-fast-v0", other))
+    try:
+        assert kinematics.unwrapped.config["observation"] == {"type": "Kinematics"}
+    finally:
+        kinematics.close()
+
+
+def test_a_preset_setting_another_highway_task_lacks_is_named_as_the_presets():
+    with pytest.raises(SetupError) as error:
+        check_task(resolve("highway", {"env": "merge-v0", "image_size": 32}))
+    message = str(error.value)
+    assert message.startswith("--preset highway sets config.lanes_count, ")
+    assert "for its own env highway-v0, and merge-v0's config has no such settings" in message
+    # merge-v0 has no continuous actions: no flags for it without the preset are offered
+    assert message.endswith("train the preset on highway-v0 (drop --env merge-v0)")
+    # a task that drives with continuous actions gets the flags that train it without the preset
+    with pytest.raises(SetupError) as error:
+        check_task(resolve("highway", {"env": "racetrack-v0", "image_size": 32}))
+    message = str(error.value)
+    flags = message.partition("--preset none ")[2]
+    assert flags.startswith("--env racetrack-v0 --env-kwargs '") and "--cameras 3" in flags
+    kwargs = json.loads(flags.split("'")[1])
+    fixed = resolve(
+        None, {"env": "racetrack-v0", "env_kwargs": kwargs, "action_repeat": 1, "image_size": 32}
+    )
+    check_task(fixed)  # made, reset and stepped: no refusal

@@ -30,6 +30,8 @@ from gymnasium.wrappers import RescaleAction
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
+from simoun_agent.config.presets import PRESETS, Preset
+from simoun_agent.config.resolve import merged
 from simoun_agent.run.highway_config import check_highway_config, nested
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import check_render, image_layout
@@ -285,6 +287,54 @@ def check_env_kwargs(env_id: str, kwargs: dict) -> None:
     _check_value_kinds(env_id, own)
 
 
+def check_preset_kwargs(config: TrainConfig) -> None:
+    """SetupError naming ``config``'s preset when a highway-env ``config`` key that the preset
+    sets (as the preset sets it) is not a setting of ``config.env``: the preset was written for
+    its own env, and the user never typed that key. The fix trains the preset's env, or the
+    user's env without the preset and with the preset's settings that env has."""
+    preset = PRESETS.get(config.preset) if isinstance(config.preset, str) else None
+    ours = preset.overrides.get("env_kwargs", {}).get("config") if preset else None
+    given = config.env_kwargs.get("config")
+    if not (isinstance(ours, dict) and isinstance(given, dict) and is_highway(config.env)):
+        return
+    task = _creator_defaults(config.env).get("config")
+    if not isinstance(task, dict):
+        return
+    alien = [key for key, value in ours.items() if key not in task and given.get(key) == value]
+    if not alien:
+        return
+    kept = {"config": {key: value for key, value in given.items() if key in task}}
+    own = preset.overrides["env"]
+    names = ", ".join(f"config.{key}" for key in alien)
+    plural = "s" if len(alien) > 1 else ""
+    raise SetupError(
+        f"--preset {config.preset} sets {names} for its own env {own}, and {config.env}'s config "
+        f"has no such setting{plural} (highway-env would ignore it); train the preset on {own} "
+        f"(drop --env {config.env}){_without_preset(config, preset, kept)}"
+    )
+
+
+def _without_preset(config: TrainConfig, preset: Preset, kept: dict) -> str:
+    """``, or train ENV without the preset: FLAGS``, the flags that set ``config.env`` as the
+    preset would with its env kwargs ``kept``, when the env is made, reset and stepped with
+    them; else empty (a task without continuous actions has no such flags)."""
+    try:
+        works = _works(replace(config, env_kwargs=kept), kept)
+    except AttributeError:  # a task whose reward reads its discrete actions' attributes
+        works = False
+    if not works:
+        return ""
+    flags = " ".join(
+        f"--{key.replace('_', '-')} {preset.overrides[key]}"
+        for key in ("action_repeat", "cameras")
+        if key in preset.overrides
+    )
+    return (
+        f", or train {config.env} without the preset, with the preset's settings it has: "
+        f"--preset none --env {config.env} --env-kwargs '{json.dumps(kept)}' {flags}"
+    )
+
+
 def _check_make_keywords(env_id: str, kwargs: dict) -> None:
     """SetupError for a value of a gymnasium.make keyword that make would misread."""
     if "max_episode_steps" in kwargs:
@@ -453,19 +503,38 @@ def _make_base(config: TrainConfig) -> gym.Env:
 
 
 def _make_kwargs(config: TrainConfig) -> dict:
-    """The keywords ``gym.make`` is given for ``config``: its ``--env-kwargs`` with dm_control's
-    render size and highway-env's dropped observation."""
-    kwargs = dict(config.env_kwargs)
+    """The keywords ``gym.make`` is given for ``config``: simoun's own settings (dm_control's
+    render size, highway-env's dropped observation) with its ``--env-kwargs`` merged over them
+    key by key, as ``--env-kwargs`` is merged over a preset's: a ``render_kwargs`` that names
+    only the camera keeps the run's frame size."""
+    own: dict = {}
     if config.env.startswith("dm_control/"):
-        render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
-        kwargs.setdefault("render_kwargs", render)
+        own["render_kwargs"] = {
+            "width": config.image_size,
+            "height": config.image_size,
+            "camera_id": 0,
+        }
     if is_highway(config.env):
-        kwargs["config"] = {"observation": HIGHWAY_DROPPED_OBSERVATION, **kwargs.get("config", {})}
-    return kwargs
+        own["config"] = {"observation": _dropped_observation(config.env_kwargs)}
+    return merged(own, config.env_kwargs)
+
+
+def _dropped_observation(env_kwargs: dict) -> dict:
+    """The highway-env observation simoun sets under ``env_kwargs``: its dropped one, which a
+    ``config.observation`` of another ``type`` replaces whole (the settings of one observation
+    class mean nothing to another), and one without a type or of the same type is merged into
+    key by key."""
+    given = env_kwargs.get("config", {})
+    observation = given.get("observation") if isinstance(given, dict) else None
+    own_type = HIGHWAY_DROPPED_OBSERVATION["type"]
+    if isinstance(observation, dict) and observation.get("type", own_type) != own_type:
+        return {}
+    return dict(HIGHWAY_DROPPED_OBSERVATION)
 
 
 def _make_rendering_env(config: TrainConfig) -> gym.Env:
     ensure_registered(config.env, config.env_module)
+    check_preset_kwargs(config)
     check_env_kwargs(config.env, config.env_kwargs)
     kwargs = _make_kwargs(config)
     try:
@@ -603,7 +672,7 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
 
 def _render_example(config: TrainConfig) -> str:
     """`` (e.g. '{"render_kwargs": ...}')``: the render settings of a dm_control task at the
-    run's image size, which simoun gives it when --env-kwargs names none; empty for others."""
+    run's image size, which simoun gives it under --env-kwargs; empty for others."""
     if not config.env.startswith("dm_control/"):
         return ""
     render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
