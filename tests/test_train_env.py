@@ -439,7 +439,7 @@ def test_an_env_that_renders_no_frame_is_refused_at_set_up_naming_the_key():
         check_task(zero_width)
     message = str(error.value)
     assert message.startswith('--env-kwargs {"render_kwargs": {"width": 0}}: ')
-    assert "returned an array of shape (240, 0, 3)" in message
+    assert "returned an array of shape (32, 0, 3)" in message  # the run's height kept
     assert "render_kwargs.width=0 is the value that spoils it" in message
     assert '\'{"render_kwargs": {"width": 32, "height": 32, "camera_id": 0}}\'' in message
     # built without the check (a sweep's trial, a resumed run), it is refused all the same
