@@ -16,8 +16,9 @@ import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 from flag_lists import SMALL_AGENT
 
-from simoun_agent.config import RECIPES, SetupError
+from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_lab.cli import study as cli
+from simoun_lab.study.checks import changes
 from simoun_lab.study.plan import evaluation_runs, tuning_runs
 from simoun_lab.study.provenance import code_version
 from simoun_lab.study.report import RunResult, cost_curves, mean_cpu, read_result
@@ -985,3 +986,10 @@ def test_a_study_directory_given_as_a_packed_file_is_told_to_unpack_it(tmp_path,
     err = report_refused(packed, capsys)
     assert f"{packed} is a file, not a directory" in err and "no such directory" not in err
     assert f"tar -xf {packed} -C {tmp_path}" in err
+
+
+def test_a_finished_runs_device_spelled_otherwise_is_no_change():
+    trained = to_dict(resolve(None, {"device": "cpu"}))
+    assert changes(trained, to_dict(resolve(None, {"device": "cpu:0"}))) == []
+    seeded = to_dict(resolve(None, {"device": "cpu", "seed": 7}))
+    assert changes(trained, seeded) == ["seed: 1 when it ran, 7 now"]

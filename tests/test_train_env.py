@@ -750,3 +750,29 @@ def test_every_spacing_length_count_duration_and_noise_of_every_highway_task_is_
     assert {"ego_spacing", "before_merge_length", "roundabout_radius", "state_noise"} <= checked
     with pytest.raises(SetupError, match=r"config.roundabout_radius=-20 .* must be a number > 0"):
         check_env_kwargs("roundabout-generic-v0", {"config": {"roundabout_radius": -20}})
+
+
+def test_env_kwargs_merge_into_simouns_own_settings_key_by_key():
+    dmc = make_env(
+        env_config("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 1}})
+    )
+    try:  # the camera is the user's; the frame size stays the run's
+        assert dmc.unwrapped.render_kwargs == {"width": 32, "height": 32, "camera_id": 1}
+    finally:
+        dmc.close()
+    stack = {"observation": {"stack_size": 2}}
+    highway = make_env(env_config("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **stack}}))
+    try:  # simoun's dropped observation keeps its type, shape and weights under the user's stack
+        observation = highway.unwrapped.config["observation"]
+        assert observation["type"] == "GrayscaleObservation"
+        assert observation["stack_size"] == 2
+        assert observation["observation_shape"] == (8, 8)
+    finally:
+        highway.close()
+    # an observation of another type replaces simoun's whole: its settings are another class's
+    other = {"config": {**HIGHWAY_CONTINUOUS, "observation": {"type": "Kinematics"}}}
+    kinematics = make_env(env_config("highway-fast-v0", other))
+    try:
+        assert kinematics.unwrapped.config["observation"] == {"type": "Kinematics"}
+    finally:
+        kinematics.close()

@@ -27,7 +27,7 @@ from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
-from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
 
 
@@ -190,7 +190,7 @@ def evaluate_distractions(args: EvalCommand) -> int:
     write the table, CSV and bar chart; bad input exits with status 2, without traceback."""
     if args.random_policy:
         fail(PROG, "--random-policy does not combine with --distraction")
-    from simoun_agent.generalization.evaluation import evaluate_runs
+    from simoun_agent.generalization.evaluation import load_runs, play_runs
     from simoun_agent.generalization.report import (
         REPORT_FILES,
         TABLE_CSV,
@@ -215,19 +215,20 @@ def evaluate_distractions(args: EvalCommand) -> int:
                 f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
                 "or --out DIR to write this one elsewhere"
             )
-        created = make_output_dir(out, files=REPORT_FILES)
+        check_output_dir(out, "--out", REPORT_FILES)
         with stop_at_once():
-            results = evaluate_runs(
-                run_dirs,
+            # every run and mode is refused or taken before the report directory is made
+            runs = load_runs(run_dirs, modes, device=args.device, videos=args.videos)
+            created = make_output_dir(out, files=REPORT_FILES)
+            results = play_runs(
+                runs,
                 modes,
                 args.episodes,
                 seed=args.seed,
-                device=args.device,
                 videos=args.videos,
                 progress=_status if args.progress else None,
             )
     except SetupError as err:
-        # a run or mode refused while loading: leave no empty report directory behind
         if created:
             shutil.rmtree(out, ignore_errors=True)
         fail(PROG, err)

@@ -30,6 +30,7 @@ from gymnasium.wrappers import RescaleAction
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
+from simoun_agent.config.resolve import merged
 from simoun_agent.run.env_kwargs_checks import check_class_paths, check_files, check_render_keys
 from simoun_agent.run.highway_config import check_highway_config, nested
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
@@ -452,15 +453,33 @@ def _make_base(config: TrainConfig) -> gym.Env:
 
 
 def _make_kwargs(config: TrainConfig) -> dict:
-    """The keywords ``gym.make`` is given for ``config``: its ``--env-kwargs`` with dm_control's
-    render size and highway-env's dropped observation."""
-    kwargs = dict(config.env_kwargs)
+    """The keywords ``gym.make`` is given for ``config``: simoun's own settings (dm_control's
+    render size, highway-env's dropped observation) with its ``--env-kwargs`` merged over them
+    key by key, as ``--env-kwargs`` is merged over a preset's: a ``render_kwargs`` that names
+    only the camera keeps the run's frame size."""
+    own: dict = {}
     if config.env.startswith("dm_control/"):
-        render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
-        kwargs.setdefault("render_kwargs", render)
+        own["render_kwargs"] = {
+            "width": config.image_size,
+            "height": config.image_size,
+            "camera_id": 0,
+        }
     if is_highway(config.env):
-        kwargs["config"] = {"observation": HIGHWAY_DROPPED_OBSERVATION, **kwargs.get("config", {})}
-    return kwargs
+        own["config"] = {"observation": _dropped_observation(config.env_kwargs)}
+    return merged(own, config.env_kwargs)
+
+
+def _dropped_observation(env_kwargs: dict) -> dict:
+    """The highway-env observation simoun sets under ``env_kwargs``: its dropped one, which a
+    ``config.observation`` of another ``type`` replaces whole (the settings of one observation
+    class mean nothing to another), and one without a type or of the same type is merged into
+    key by key."""
+    given = env_kwargs.get("config", {})
+    observation = given.get("observation") if isinstance(given, dict) else None
+    own_type = HIGHWAY_DROPPED_OBSERVATION["type"]
+    if isinstance(observation, dict) and observation.get("type", own_type) != own_type:
+        return {}
+    return dict(HIGHWAY_DROPPED_OBSERVATION)
 
 
 def _make_rendering_env(config: TrainConfig) -> gym.Env:
@@ -631,7 +650,7 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
 
 def _render_example(config: TrainConfig) -> str:
     """`` (e.g. '{"render_kwargs": ...}')``: the render settings of a dm_control task at the
-    run's image size, which simoun gives it when --env-kwargs names none; empty for others."""
+    run's image size, which simoun gives it under --env-kwargs; empty for others."""
     if not config.env.startswith("dm_control/"):
         return ""
     render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}

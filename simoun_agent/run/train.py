@@ -101,6 +101,7 @@ from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import (
+    check_run_dir,
     folder_kind,
     make_output_dir,
     study_of,
@@ -209,7 +210,7 @@ def create_run(
         config.run_dir = os.fspath(config.run_dir)  # a Path set after the config was built
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
-        take_run_dir(run_dir, overwrite=overwrite).close()
+        check_run_dir(run_dir, overwrite=overwrite)
     check_config_rules(config)
     check_budget(config)
     env, eval_env, agent, replay = build(config, check)
@@ -422,7 +423,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     except ValueError as err:
         raise SetupError(str(err)) from None
     config.run_dir = str(run_dir)
-    take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
+    check_run_dir(run_dir, resume=True)  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
     check_seed_scheme(payload, run_dir)
     check_config(payload, as_saved, run_dir, saved=config_path)

@@ -32,6 +32,7 @@ from simoun_agent.cli.config_flags import (
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
+from simoun_agent.config.device import same_setting
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import flag_name
 from simoun_agent.run.kept import present
@@ -187,7 +188,7 @@ def base_differences(base: dict[str, Any], saved: SweepSpec) -> list[str]:
         mine = plain(value)
         if key in saved.grid:
             theirs = f"{json.dumps(saved.grid[key])} (its --grid)"
-        elif plain(effective.get(key)) != mine:
+        elif not same_setting(key, plain(effective.get(key)), mine):
             theirs = json.dumps(plain(effective.get(key)))
         else:
             continue

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
+from simoun_agent.config.device import same_setting
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
@@ -529,7 +530,7 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     saved = flatten(record)
     for key in ("env", "seed", *grid):
         recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
-        if key in saved and recorded != wanted:
+        if key in saved and not same_setting(key, recorded, wanted):
             return (
                 f"{CONFIG_NAME} records {key} {show(recorded)}, but the sweep's trial "
                 f"{trial.name} has {show(wanted)}: it is another run's config"
@@ -558,7 +559,9 @@ def config_differences(trial: Trial) -> dict[str, tuple[Any, Any]]:
     return {
         key: (_plain(saved[key]), _plain(value))
         for key, value in wanted.items()
-        if key in saved and key not in RESUMED_AS_GIVEN and _plain(saved[key]) != _plain(value)
+        if key in saved
+        and key not in RESUMED_AS_GIVEN
+        and not same_setting(key, _plain(saved[key]), _plain(value))
     }
 
 
