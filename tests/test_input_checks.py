@@ -141,9 +141,9 @@ def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys
         (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
         (["--agent.encoder", "duall"], "must be a known name (did you mean 'dual'?)"),
         (["--video=maybe"], "--video is a switch: it takes true or false"),
-        (["--learning-rate", "1e-3"], "unknown flag --learning-rate (did you mean --agent.lr?)"),
+        (["--learning-rate", "1e-3"], "--learning-rate: simoun-train calls it --agent.lr"),
         (["--agent.gamma=0.9"], "unknown flag --agent.gamma (did you mean --agent.discount?)"),
-        (["--frame-skip", "4"], "unknown flag --frame-skip (did you mean --action-repeat?)"),
+        (["--frame-skip", "4"], "--frame-skip: simoun-train calls it --action-repeat"),
         (["--xyzzy"], "unknown flag --xyzzy; `simoun-train --help` lists every flag"),
     ],
 )

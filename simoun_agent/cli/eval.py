@@ -24,6 +24,7 @@ from tqdm import tqdm
 
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import POSITIONAL, RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
@@ -66,6 +67,27 @@ DESCRIPTION = """Evaluate a simoun-train checkpoint: deterministic episodes, met
 example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10"""
 
 
+OTHER_NAMES = RUN_CONFIG_NAMES | {
+    "run-dir": POSITIONAL,
+    "log-dir": POSITIONAL,
+    "logdir": POSITIONAL,
+    "load-path": POSITIONAL,
+    "model-path": POSITIONAL,
+    "trained-agent": POSITIONAL,
+    "n-eval-episodes": Meant(("--episodes",)),
+    "num-eval-episodes": Meant(("--episodes",)),
+    "render": Meant(("--video",)),
+    "distraction": Meant(note="comma-separate the modes, e.g. --distraction train,video_hard"),
+    "num-envs": Meant(note="simoun-eval plays its episodes one after another on one env"),
+    "deterministic": Meant(
+        note="simoun-eval always plays the agent's deterministic action; --random-policy plays "
+        "the random baseline"
+    ),
+}
+"""Other libraries' flags with what simoun-eval calls them, the run itself its positional RUN
+(:mod:`simoun_agent.cli.other_names`); a run config key's is named as the run's setting."""
+
+
 @dataclass
 class EvalCommand:
     """What ``simoun-eval`` is asked."""
@@ -105,7 +127,13 @@ class EvalCommand:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
     args = parse(
-        EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"), reads_runs=True
+        EvalCommand,
+        argv,
+        PROG,
+        DESCRIPTION,
+        switches=("--video", "--progress"),
+        reads_runs=True,
+        other_names=OTHER_NAMES,
     )
     if not args.checkpoint:  # tyro accepts no value for a variable number of them
         fail(PROG, "give the run to evaluate: a run directory or its checkpoint.pt")

@@ -12,6 +12,7 @@ with a checkpoint is never overwritten: it is resumed, or the user deletes it.
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import os
 import shutil
@@ -264,7 +265,8 @@ def refuse_live_lock(run_dir: Path) -> None:
     found without writing anything: a directory without a lock file has no live trainer."""
     path = run_dir / LOCK_NAME
     if not os.access(run_dir, os.W_OK | os.X_OK):
-        raise not_writable(run_dir, "Permission denied")
+        read_only = os.statvfs(run_dir).f_flag & os.ST_RDONLY
+        raise not_writable(run_dir, os.strerror(errno.EROFS if read_only else errno.EACCES))
     if not path.is_file():
         return
     try:
