@@ -322,6 +322,28 @@ BAD_SPECS = [
     ('recipes = ["simoun", "sac"]', 'recipes = ["sac", "sac"]', "'sac' is listed twice"),
     ('description = "a tiny study for tests"', 'selection = "best"',
      "unknown selection rule 'best'; choose one of auc, final"),
+    ('description = "a tiny study for tests"', 'selection = ["auc"]',
+     'selection: give one rule name (auc or final), not an array (["auc"]); e.g. selection = '
+     '"auc"'),
+    ('recipes = ["simoun", "sac"]', 'recipes = [["simoun"], "sac"]',
+     'recipes: give an array of recipe names (strings), not an array holding an array '
+     '(["simoun"]); e.g. recipes = ["simoun", "drq"]'),
+    ("eval_episodes = 1", 'eval_episodes = 1\npreset = ["cpu"]',
+     'highway-cpu), not an array (["cpu"]); e.g. preset = "cpu"'),
+    ("seeds = [101, 102]", 'seeds = [101, "102"]',
+     '[tuning] seeds: give seeds as an array of whole numbers or a range string ("1-5"), or a '
+     'table with one per task, not an array holding a string ("102")'),
+    ('seeds = "1-2"', 'seeds = { "simoun/PointReach-v0" = 2 }',
+     '[evaluation] seeds.simoun/PointReach-v0: give seeds as an array of whole numbers or a '
+     'range string ("1-5"), not an integer (2)'),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 2.0",
+     "[resources] max_concurrent_trials: give a whole number, not a float (2.0); e.g. "
+     "max_concurrent_trials = 2"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = [{ recipe = "simoun_no_aux" }]',
+     '[diagnostics] simoun: give an array of recipe names (strings), not an array holding a '
+     'table ({"recipe": "simoun_no_aux"})'),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["color_easy"]\nepisodes = "5"',
+     '[generalization] episodes: give a whole number, not a string ("5"); e.g. episodes = 10'),
     ("agent.n_step = [1, 3]", "agent.n_stepp = [1, 3]",
      "unknown config key 'agent.n_stepp' (did you mean agent.n_step?)"),
     ("agent.n_step = [1, 3]", "agent.n_step = 3",

@@ -71,6 +71,7 @@ from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.given_path import blanks_note, shown
 from simoun_lab.study.record_file import record_not_spec
 from simoun_lab.study.selection import SELECTION_RULES
+from simoun_lab.study.spec_kinds import kind_problem
 from simoun_lab.study.toml_lines import key_line
 from simoun_lab.sweep.grid import MAX_SEEDS, close_key_here, parse_seeds
 
@@ -363,6 +364,9 @@ class _Reader:
 
     def spec(self, data: dict[str, Any], name: str) -> StudySpec:
         self.check_keys(data, ())
+        wrong_kind = kind_problem(data)
+        if wrong_kind:
+            raise self.fail(*wrong_kind)
         missing = [key for key in REQUIRED if key not in data]
         if missing:
             raise SetupError(
