@@ -397,6 +397,14 @@ BAD_SPECS = [
      "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
      "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\nagent.n_step = 3\n\n[resources]',
+     "[tasks.\"simoun/PointReach-v0\"] agent.n_step: agent.n_step is set in [grid] too (line 20), "
+     "and the grid's values override [tasks.\"simoun/PointReach-v0\"]'s in every run of the task; "
+     "set it in one place only: in [grid] to tune it on every task, or in each task's table (and "
+     "drop it from [grid])", "agent.n_step = 3"),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\neval_episodes = 2\n\n[resources]',
+     "eval_episodes is set in [base] too (line 9), and [base]'s value is then used for no run of "
+     "this task; set it in one place only", "eval_episodes = 2"),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\nenv_steps = 40\n\n[resources]',
      "unknown config key 'env_steps' (the study sets total_env_steps itself: give it as "
      "env_steps in [tuning] and [evaluation])", "env_steps = 40"),
