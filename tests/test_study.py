@@ -226,6 +226,18 @@ def test_resume_from_another_commit_is_refused_unless_allowed(study, tmp_path, c
     assert len(parts) == 2 and parts[1]["allowed_other_commit"] is True
 
 
+def test_allow_other_commit_without_resume_is_refused_before_anything_is_made(tmp_path, capsys):
+    spec_path = write_spec(tmp_path / "tiny.toml")
+    argv = ["run", str(spec_path), "--study-dir", str(tmp_path / "s"), "--allow-other-commit"]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "--allow-other-commit works only with --resume" in err
+    assert "add --resume to continue the study in --study-dir, or drop --allow-other-commit" in err
+    assert not (tmp_path / "s").exists()
+
+
 def test_resume_with_another_spec_and_a_new_study_over_an_old_one_are_refused(study, capsys):
     spec_path, study_dir, _ = study
     (spec_path.parent / "changed").mkdir(exist_ok=True)
