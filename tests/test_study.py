@@ -321,6 +321,23 @@ def test_plan_without_a_probe_lists_the_runs_only(tmp_path, capsys):
     assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
     out = capsys.readouterr().out
     assert "runs: 8 tuning + 4 evaluation = 12" in out and "estimated" not in out
+    assert "note:" not in out
+
+
+def test_plan_notes_runs_that_evaluate_less_often_than_their_budget(tmp_path, capsys):
+    text = SPEC.replace("eval_every = 40", "eval_every = 100").replace(
+        "env_steps = 80\n\n[resources]", "env_steps = 120\n\n[resources]"
+    )
+    spec = write_spec(tmp_path / "tiny.toml", text)
+    assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "note: the tuning runs on simoun-PointReach-v0 evaluate every 100 env steps (eval_every "
+        "in [base]), more than their 80: each is evaluated only at step 0 and at the end; the "
+        "auc selection rule reads those two points; for a learning curve, give an eval_every "
+        "below 80"
+    ) in out
+    assert "the evaluation runs" not in out  # 120 env steps: evaluated at 100 too
 
 
 MAX = "max_concurrent_trials = 2\n"
