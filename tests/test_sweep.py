@@ -352,6 +352,14 @@ def error_of(argv: list[str], capsys) -> str:
         (["--grid", "agent.encoder=(stacked, single)"], "write --grid "
          "agent.encoder=stacked,single"),
         # a per-trial check of a --grid value sends the fix to --grid, not to the base flag
+        (["--grid", "env_module=nosuchmodule,none"], "trial env_module=nosuchmodule/"
+         "simoun-PointReach-v0/s1: --env-module 'nosuchmodule' is not installed, so the ids it "
+         "registers are unknown; pip install nosuchmodule (or the package that provides "
+         "nosuchmodule); --env-module nosuchmodule is this trial's value from --grid "
+         "env_module=nosuchmodule,none: make the fix in --grid"),
+        (["--grid", 'env_kwargs={"a":1},{}'], "simoun/PointReach-v0 takes no keyword 'a'; it "
+         'accepts: max_steps, size, step_size; --env-kwargs {"a":1} is this trial\'s value from '
+         "--grid"),
         (["--grid", "action_repeat=1,100"], "or --total-env-steps many times 100; "
          "--action-repeat 100 is this trial's value from --grid action_repeat=1,100: make the "
          "fix in --grid (leave 100 out of its values"),

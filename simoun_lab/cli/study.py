@@ -146,6 +146,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"report: {report_study(spec, args.study_dir)}")
             return 0
         options = absolute(args)
+        check_switches(options)
         check_outputs(options)  # before Ray, which takes seconds to import
         ray = load_ray()
         for flag, path in outputs(options).items():
@@ -169,6 +170,18 @@ def ppo_study(args: Plan | Run | Report) -> int:
     options = absolute(args)
     check_outputs(options)
     return study_command.run(spec, options)
+
+
+def check_switches(options: Run) -> None:
+    """Refuse a switch given without the flag it works with: it would be accepted and change
+    nothing."""
+    if options.allow_other_commit and not options.resume:
+        raise SetupError(
+            "--allow-other-commit works only with --resume: it lets a resumed study go on at "
+            "another commit than the one it started from, and a new study starts at this one "
+            "(and records it); add --resume to continue the study in --study-dir, or drop "
+            "--allow-other-commit to start one"
+        )
 
 
 def outputs(options: Run) -> dict[str, Path]:
