@@ -1,46 +1,51 @@
 """The eleventh reliability trial's cases: lab (see reliability_trial.py).
 
 The lab's command lines on surfaces the earlier trials left alone: simoun-sweep's --grid values
-written with a capital E, as none, on/off or true/false, in hex, with a trailing comma or the flag's
-own dashes, a top-level key under agent. or an agent key without its prefix, a per-trial zero or
-negative size (feature_dim, aux_hidden_dim, num_filters, actor_update_every, init_temperature,
-eval_episodes), values in the wrong units (a learning rate of 3, a pixel offset of 128), a grid key
-that a base flag (not --set) also gives; --seeds in exponent form, with leading zeros or as a
-hundred seeds; --envs naming a dm_control task without its version, mixing families with an action
-repeat or with --env-kwargs only one of them takes; --gpus-per-trial none, --verbose 1.0, a
---sweep-dir with a blank or that is a study's archive; --resume given the original command again, a
-saved value repeated or changed (--eval-every, --seeds, --cpus-per-trial, --image-size), flags that
-do not change the sweep (--verbose, --gpus-per-trial auto), --run-dir, --env-module, --overwrite, an
-exponent budget, and the sweep directory as ./sw, through .. or moved to another folder.
-simoun-study: plan given --probe-updates twice, with underscores or as -p, a relative path from the
-wrong folder, flags of run (--verbose, --num-cpus); run given plan's --probe-updates, an archive
-inside the study directory, a study directory inside the archive or in a MiniGrid archive, a blank
-in --study-dir, a MiniGrid spec with --num-cpus; report given run's flags or simoun-report's
+written with a capital E, as none, on/off or true/false, in hex, with a trailing comma or the
+flag's own dashes, a top-level key under agent. or an agent key without its prefix, a per-trial
+zero or negative size (feature_dim, aux_hidden_dim, num_filters, actor_update_every,
+init_temperature, eval_episodes), values in the wrong units (a learning rate of 3, a pixel offset
+of 128), a grid key that a base flag (not --set) also gives; --seeds in exponent form, with
+leading zeros or as a hundred seeds; --envs naming a dm_control task without its version, mixing
+families with an action repeat or with --env-kwargs only one of them takes; --gpus-per-trial
+none, --verbose 1.0, a --sweep-dir with a blank or that is a study's archive; --resume given the
+original command again or while a trial of the sweep still trains, a saved value repeated or
+changed (--eval-every, --seeds, --cpus-per-trial, --image-size), flags that do not change the
+sweep (--verbose, --gpus-per-trial auto), --run-dir, --env-module, --overwrite, an exponent
+budget, and the sweep directory as ./sw, through .. or moved to another folder. simoun-study:
+plan given --probe-updates twice, with underscores or as -p, a relative path from the wrong
+folder, flags of run (--verbose, --num-cpus); run given plan's --probe-updates, an archive inside
+the study directory, a study directory inside the archive or in a MiniGrid archive, a blank in
+--study-dir, a MiniGrid spec with --num-cpus; report given run's flags or simoun-report's
 --at-step, a path through .., the archive under another name, --study-dir twice, the archive's
 report folder. simoun-report with -o, --overwrite, a letter O in --at-step, --out twice or
-unwritable, a fractional wall time, a checkpoint file, sweep.json, the run's tb folder, --out inside
-the sweep. simoun-analyze masks with --steps or --query given twice, a query split by a semicolon or
-a blank, an MPS device, an empty --out, two runs; bias on a CUDA device, with a fractional seed, on
-a run given with and without a slash, on a study archive and on a MiniGrid PPO run. The MiniGrid
-study's run given --resume, --num-cpus, --allow-other-commit or another study's archive as
---work-dir; report given --at-step or a --spec with a trailing blank; select given --selection,
---archive twice or a copy of the archive's spec; probe a task id without its version, a seed of 1.5,
-negative steps, --settings.env-id twice, a step count with an underscore and --probes twice. The DMC
-study's TOML spec edited by hand in new ways: base keys the study owns (env) or too small
-(image_size 8), a repeated or misspelt grid value or key, grid_overrides without the agent. prefix,
-tuning seeds as a comma list, a misspelt [resources] key or a device there, eval_every in a phase
-table or with units, a selection rule in the evaluation table, a task table or tuning task without
-its dm_control/ prefix, per-task evaluation seeds as a number; the v2 spec's diagnostics with a
-method as an ablation or an ablation twice, a quoted generalization episode count; the highway spec
-with env_kwargs as a table, as JSON text or with a misspelt highway config key, and a task without
-its version or the slower highway-v0. The MiniGrid PPO JSON spec edited in new ways: tasks as an
-object, a task id without its version, repeated seeds, a task without steps, a misspelt or unknown
-normalization, arms spelt Arms, eval_every in place of evaluations; and valid edits (a second task,
-an entropy bonus)."""
+unwritable, a fractional wall time, a checkpoint file, sweep.json, the run's tb folder, --out
+inside the sweep, a sweep whose trial still trains. simoun-analyze masks with --steps or --query
+given twice, a query split by a semicolon or a blank, an MPS device, an empty --out, two runs;
+bias on a CUDA device, with a fractional seed, on a run given with and without a slash, on a
+study archive and on a MiniGrid PPO run. The MiniGrid study's run given --resume, --num-cpus,
+--allow-other-commit or another study's archive as --work-dir; report given --at-step or a --spec
+with a trailing blank; select given --selection, --archive twice or a copy of the archive's spec;
+probe a task id without its version, a seed of 1.5, negative steps, --settings.env-id twice, a
+step count with an underscore and --probes twice. The DMC study's TOML spec edited by hand in new
+ways: base keys the study owns (env) or too small (image_size 8), a repeated or misspelt grid
+value or key, grid_overrides without the agent. prefix, tuning seeds as a comma list, a misspelt
+[resources] key or a device there, eval_every in a phase table or with units, a selection rule in
+the evaluation table, a task table or tuning task without its dm_control/ prefix, per-task
+evaluation seeds as a number, a recipe or a misspelt env_kwargs key in a task's table; the v2
+spec's diagnostics with a method as an ablation, an ablation twice or spelt with hyphens, a tasks
+key in [generalization], a quoted generalization episode count; the highway spec with its preset
+spelt highway_cpu, env_kwargs as a table, as JSON text or with a misspelt highway config key, and
+a task without its version or the slower highway-v0. The MiniGrid PPO JSON spec edited in new
+ways: tasks as an object, a task id without its version, repeated seeds, a task without steps, a
+misspelt or unknown normalization, arms spelt Arms, eval_every in place of evaluations; and valid
+edits (a second task, an entropy bonus)."""
 
 from __future__ import annotations
 
+import fcntl
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -54,6 +59,7 @@ from reliability_trial import (
     MGT_SPEC,
     SPEC,
     SW,
+    SW_RUN,
     V2_SPEC,
     bias,
     fifth,
@@ -76,6 +82,20 @@ def moved_sweep(here: Path) -> None:
     """``sw`` moved to ``moved/sw2``, as a user tidying their sweeps does."""
     (here / "moved").mkdir()
     shutil.move(here / "sw", here / "moved/sw2")
+
+
+HELD = []  # lock files kept open for the life of the case
+
+
+def trial_in_use(here: Path) -> None:
+    """``sw``'s trial unfinished and still training: its lock held, as a trainer holds it, by
+    a sweep started earlier in another terminal."""
+    (here / SW_RUN / "summary.json").unlink()
+    handle = (here / SW_RUN / ".lock").open("a+")
+    fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    handle.write(f"{os.getpid()}\n")
+    handle.flush()
+    HELD.append(handle)
 
 
 def grid(*values: str) -> list[str]:
@@ -152,6 +172,7 @@ FLAGS = [
     ("sweep", ["--resume", "--sweep-dir", "./sw"], "", True, (SW,)),
     ("sweep", ["--resume", "--sweep-dir", "sw/base/.."], "", True, (SW,)),
     ("sweep", ["--resume", "--sweep-dir", "moved/sw2"], "", True, (SW, moved_sweep)),
+    ("sweep", RESUME, ("in use", "PID"), False, (SW, trial_in_use)),
     ("sweep", sweep_tiny(*SHORT, "--sweep-dir", "arch"), ("arch", "--sweep-dir"), False, (ARCH,)),
     # simoun-study
     ("study", ["plan", "spec.toml", "--probe-updates", "0", "--probe-updates", "5"],
@@ -192,6 +213,7 @@ FLAGS = [
     ("report", ["sw/sweep.json"], "sweep.json", False, (SW,)),
     ("report", ["{run}/tb"], ("tb", "no run")),
     ("report", ["sw", "--out", "sw/report"], "", True, (SW,)),
+    ("report", ["sw"], "", True, (SW, trial_in_use)),
     ("report", ["{run}", "--out", "/proc/r"], ("/proc/r", "--out")),
     ("report", ["{run}", "--out", "r", "--out", "s"], "--out"),
     ("report", ["{run}", "--overwrite"], "--overwrite"),
@@ -257,6 +279,8 @@ SPEC_EDITS = [
     ("env_steps = 50_000", "env_steps = 50_000\neval_every = 5_000", "eval_every"),
     ("env_steps = 100_000", 'env_steps = 100_000\nselection = "final"', "selection"),
     ("max_concurrent_trials = 2 ", 'max_concurrent_trials = 2\ndevice = "cpu" ', "device"),
+    ("action_repeat = 8", 'action_repeat = 8\nagent.recipe = "drq"', "recipe"),
+    ("action_repeat = 4", "action_repeat = 4\nenv_kwargs = { nope = 1 }", "nope"),
     ('grid_overrides = ["agent.n_step"]', 'grid_overrides = ["n_step"]', "n_step"),
     ("cpus_per_trial = 1 ", "cpu_per_trial = 1 ", "cpu_per_trial"),
     ('[tasks."dm_control/cartpole-swingup-v0"]', '[tasks."cartpole-swingup"]', "cartpole-swingup"),
@@ -276,6 +300,11 @@ DIAGNOSTICS = 'simoun = ["simoun_no_curiosity", "simoun_no_interaction", "simoun
 OTHER_EDITS = [
     (V2_SPEC, DIAGNOSTICS, 'simoun = ["sac"]', "sac"),
     (V2_SPEC, DIAGNOSTICS, 'simoun = ["simoun_no_aux", "simoun_no_aux"]', "simoun_no_aux"),
+    (V2_SPEC, DIAGNOSTICS, 'simoun = ["simoun-no-aux"]', "simoun-no-aux"),
+    (V2_SPEC, '"video_hard"]\nepisodes = 10',
+     '"video_hard"]\nepisodes = 10\ntasks = ["dm_control/cheetah-run-v0"]',
+     ("tasks", "generalization")),
+    (HIGHWAY_SPEC, 'preset = "highway-cpu"', 'preset = "highway_cpu"', "highway_cpu"),
     (V2_SPEC, '"video_hard"]\nepisodes = 10', '"video_hard"]\nepisodes = "10"', "episodes"),
     (HIGHWAY_SPEC, "video = false", "video = false\nenv_kwargs = { config = { duration = 40 } }",
      "env_kwargs", True),
