@@ -148,6 +148,9 @@ def file_size_limit(here: Path) -> None:
     node; a write past it fails as a full disk's does, with the signal ignored as a shell's
     ``trap '' XFSZ`` leaves it)."""
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    # the study report's provenance runs ``git status`` in the checkout running the trial,
+    # which would refresh its index under the limit and leave a stale index.lock there
+    os.environ["GIT_OPTIONAL_LOCKS"] = "0"
     resource.setrlimit(resource.RLIMIT_FSIZE, (10_000, 10_000))
 
 
