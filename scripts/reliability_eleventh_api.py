@@ -26,10 +26,11 @@ highway range as a Python tuple) next to typical valid ones; ``create_run``'s ``
 ``check`` of the wrong kinds; callbacks given as one object, a class, a function or a tuple;
 Gymnasium's vector RescaleAction and TransformObservation with the vector rewards, ``make_vec``
 with the wrapper classes themselves as ``wrappers`` or without a render mode, a normalisation by
-its class name; the PettingZoo wrapper with a three-number size, PettingZoo's seed test, its
-``observation_spaces`` dict, its agents' own images, pursuit's float (H, W, C) observations and
-actions of the wrong shape; names imported from the analysis package that live in its
-submodules, and a name spelt as other libraries spell it.
+its class name; the normalisations called with one argument, float sub-env indices or 0/1
+where the counted mask goes; the PettingZoo wrapper with a three-number size, PettingZoo's seed
+test, its ``observation_spaces`` dict, its agents' own images, pursuit's float (H, W, C)
+observations and actions of the wrong shape; names imported from the analysis package that live
+in its submodules, and a name spelt as other libraries spell it.
 """
 
 from reliability_ninth_api import TINY_CONFIG, TRAIN, callback
@@ -52,6 +53,7 @@ MASKS = LOADED + "from simoun_lab.analysis.masks import structure_masks; "
 PAIRS = "from simoun_lab.analysis.pairs import make_pairs; "
 SWEEP = "from simoun_lab.sweep.report import compare_runs, write_report; "
 PEND = vec("NEXT_STEP")
+NORM = "from simoun_wrappers.intrinsic_normalization import ReturnStd, RewardStd; "
 SPO = "from simoun_wrappers.pettingzoo import SimounParallelObservation as SPO; "
 PZ = (
     "import pettingzoo; " + SPO + "pz = pettingzoo.make('parallel', 'butterfly/pistonball-v6', "
@@ -206,6 +208,12 @@ ELEVENTH_CODES = [
     (f"v = w.ConstantBonusVectorReward(gym.wrappers.vector.TransformObservation({PEND}, "
      "lambda o: {'frames': o['frames'][:, -1]}), 0.1)", ("frames", "TransformObservation")),
     (NOV + f"w.RNDReward({S}, nov, normalization='ReturnStd')", "return_std"),
+    # the normalisations called directly, as their examples call them
+    (NORM + "RewardStd()(np.array([1.0, 3.0]))", ("extrinsic", "counted")),
+    (NORM + "ReturnStd()(np.array([1.0, 2.0]), np.zeros(2), np.array([0.0, 1.0]), "
+     "np.ones(2, bool))", "envs"),
+    (NORM + "RewardStd()(np.array([1.0, 3.0]), np.zeros(2), np.zeros(2, int), np.array([1, 1]))",
+     "counted"),
     ("gym.make_vec('Pendulum-v1', 2, vectorization_mode='sync', "
      "wrappers=[lambda e: w.SimounObservation(e, size=16)])", "render_mode"),
     ("v = w.ConstantBonusVectorReward(gym.make_vec('Pendulum-v1', 2, vectorization_mode='sync', "
