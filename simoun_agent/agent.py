@@ -15,6 +15,7 @@ import torch
 
 from simoun_agent.config import AgentConfig
 from simoun_agent.config.agent import check_agent_config
+from simoun_agent.config.device import device_key
 from simoun_agent.config.shapes import check_agent_inputs
 from simoun_agent.device import default_device
 from simoun_agent.losses import (
@@ -71,12 +72,7 @@ def same_device(asked: object, device: torch.device) -> bool:
         wanted = torch.device(asked)
     except (RuntimeError, TypeError):
         return False
-    if wanted.type != device.type:
-        return False
-    index = torch.cuda.current_device() if wanted.type == "cuda" else 0
-    return (wanted.index if wanted.index is not None else index) == (
-        device.index if device.index is not None else index
-    )
+    return device_key(str(wanted)) == device_key(str(device))
 
 
 def check_tensor(value: object, name: str, kind: str, shape: str) -> None:

@@ -13,6 +13,8 @@ import torch
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
+from simoun_agent.cli.command_flags import command_flags
+from simoun_agent.cli.other_names import RUN_CONFIG_NAMES
 from simoun_agent.run import driving_reference
 from simoun_lab.cli import analyze as analyze_cli
 from simoun_lab.cli import report as report_cli
@@ -37,7 +39,7 @@ def refused(capsys, main, argv) -> str:
 @pytest.mark.parametrize(
     ("main", "argv", "said"),
     [
-        (sweep_cli.main, ["--learning-rate", "3e-4"], "unknown flag --learning-rate (did you "
+        (sweep_cli.main, ["--learning-rat", "3e-4"], "unknown flag --learning-rat (did you "
          "mean --agent.lr?); `simoun-sweep --help` lists every flag"),
         (sweep_cli.main, ["--sweepdir", "x"], "(did you mean --sweep-dir?)"),
         (eval_cli.main, ["RUN", "--num-episodes", "3"], "unknown flag --num-episodes (did you "
@@ -56,7 +58,7 @@ def refused(capsys, main, argv) -> str:
          "--image-size?)"),
         (train_cli.main, ["--resolution", "64"], "unknown flag --resolution (did you mean "
          "--image-size?)"),
-        (train_cli.main, ["--frame-skip", "4"], "(did you mean --action-repeat?)"),
+        (train_cli.main, ["--frame-skip", "4"], "calls it --action-repeat"),
         (eval_cli.main, ["RUN", "--action-repeat", "2"], "--action-repeat is not a flag of "
          "simoun-eval: action_repeat is a setting of the run, saved in its config.json, and "
          "simoun-eval uses the run's own; it is chosen when the run is trained (simoun-train "
@@ -306,6 +308,113 @@ def test_a_switch_given_a_value_says_it_takes_none(main, argv, said, capsys):
 )  # fmt: skip
 def test_a_stray_argument_is_refused_naming_it(main, argv, said, capsys):
     assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (train_cli.main, ["--buffer-size", "100000"], "unknown flag --buffer-size: simoun-train "
+         "calls it --replay-capacity (transitions kept in the replay buffer)"),
+        (train_cli.main, ["--Buffer_Size", "100000"], "calls it --replay-capacity"),
+        (train_cli.main, ["--log-dir", "logs"], "simoun-train calls it --run-dir"),
+        (train_cli.main, ["--exp-name", "mine"], "simoun-train calls it --run-dir"),
+        (train_cli.main, ["--save-freq", "20"], "simoun-train calls it --checkpoint-every"),
+        (train_cli.main, ["--train-freq", "2"], "simoun-train calls it "
+         "--agent.update-every-steps (the agent's gradient step(s) come at every this-many-th "
+         "agent step once learning has started) or --updates-per-step (gradient updates per "
+         "agent decision once learning has started)"),
+        (train_cli.main, ["--num-envs", "4"], "unknown flag --num-envs: not supported here: a "
+         "run steps one environment (there are no vectorised envs); to train several runs at "
+         "once, simoun-sweep runs them as parallel trials"),
+        (train_cli.main, ["--seeds", "1"], "simoun-train calls it --seed (seed of every random "
+         "stream); a run has one seed; for several, simoun-sweep --seeds 1,2,3"),
+        (eval_cli.main, ["--run-dir", "runs/a", "--episodes", "1", "--no-video"], "unknown flag "
+         "--run-dir: RUN is a positional argument of simoun-eval, given without a flag: "
+         "simoun-eval runs/a --episodes 1 --no-video"),
+        (eval_cli.main, ["--checkpoint=runs/a/checkpoint.pt"], "given without a flag: "
+         "simoun-eval runs/a/checkpoint.pt"),
+        (eval_cli.main, ["RUN", "--buffer-size", "3"], "--buffer-size is not a flag of "
+         "simoun-eval: replay_capacity is a setting of the run"),
+        (eval_cli.main, ["RUN", "--deterministic"], "not supported here: simoun-eval always "
+         "plays the agent's deterministic action"),
+        (sweep_cli.main, ["--log-dir", "x"], "simoun-sweep calls it --sweep-dir"),
+        (study_cli.main, ["run", "--config", "s.toml", "--study-dir", "d"], "SPEC is a "
+         "positional argument of simoun-study run, given without a flag: simoun-study run "
+         "s.toml --study-dir d"),
+        (report_cli.main, ["--log-dir", "runs"], "DIR is a positional argument of "
+         "simoun-report, given without a flag: simoun-report runs"),
+        (analyze_cli.main, ["masks", "--run-dir", "r"], "given without a flag: simoun-analyze "
+         "masks r"),
+        (minigrid_cli.main, ["run", "--log-dir", "x"], f"{MINIGRID} run calls it --work-dir"),
+    ],
+)  # fmt: skip
+def test_another_librarys_flag_is_named_with_this_commands_own(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (train_cli.main, ["--no-curiosity"], "unknown flag --no-curiosity (did you mean "
+         "--agent.no-curiosity?)"),
+        (sweep_cli.main, ["--disable-video"], "(did you mean --no-video?)"),
+        (train_cli.main, ["--no-eval"], "unknown flag --no-eval; "),
+    ],
+)  # fmt: skip
+def test_a_negated_flag_is_offered_only_negations(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+def test_every_other_names_table_names_flags_of_its_command():
+    commands = [
+        (train_cli.TrainCommand, train_cli.OTHER_NAMES, [[]]),
+        (eval_cli.EvalCommand, eval_cli.OTHER_NAMES, [[]]),
+        (sweep_cli.SweepCommand, sweep_cli.OTHER_NAMES, [[]]),
+        (study_cli.Command, study_cli.OTHER_NAMES, [["plan"], ["run"], ["report"]]),
+        (minigrid_cli.Command, minigrid_cli.OTHER_NAMES, [["run"], ["report"], ["probe"]]),
+    ]
+    for command, table, argvs in commands:
+        known = {name for argv in argvs for name in command_flags(command, argv)}
+        for name, meant in table.items():
+            run_config = command is eval_cli.EvalCommand and name in RUN_CONFIG_NAMES
+            assert run_config or set(meant.flags) <= known, (name, meant.flags)
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (train_cli.main, ["--env-kwargs", '{"size": 32}', '{"max_steps": 5}'], "--env-kwargs "
+         """takes one value, so '{"max_steps": 5}' after '{"size": 32}' is left over: put every """
+         """key in one JSON object, e.g. --env-kwargs '{"size": 32, "max_steps": 5}'"""),
+        (train_cli.main, ["--seed", "1", "2", "3"], "--seed takes one value, so '2' after '1' "
+         "is left over: a run has one seed; for several, simoun-sweep --seeds 1,2,3 trains one "
+         "run per seed"),
+        (train_cli.main, ["--set", "agent.lr=1e-3", "agent.n_step=3"], "give --set once per "
+         "value, e.g. --set agent.lr=1e-3 --set agent.n_step=3"),
+        (train_cli.main, ["--env", "a", "b"], "--env takes one value, so 'b' after 'a' is left "
+         "over"),
+        (sweep_cli.main, ["--seeds", "1", "2", "3"], "--seeds takes one value, so '2' after '1' "
+         "is left over: list the seeds in one word, e.g. --seeds 1,2,3 or a range, --seeds 0-4"),
+        (sweep_cli.main, ["--seed", "1", "2"], "for several, list the seeds in one word"),
+        (eval_cli.main, ["RUN", "--distraction", "train", "video_hard"], "--distraction takes "
+         "one value, so 'video_hard' after 'train' is left over: comma-separate the modes"),
+        (eval_cli.main, ["RUN", "--episodes", "1", "2"], "--episodes takes one value"),
+        (report_cli.main, ["DIR", "--at-step", "1", "2"], "--at-step takes one value"),
+        (report_cli.main, ["DIR", "100"], "unexpected argument '100': simoun-report takes only "
+         "DIR; a number goes with the flag it is for, e.g. --at-step 100"),
+    ],
+)  # fmt: skip
+def test_a_second_value_is_named_with_the_flag_that_takes_one(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+def test_a_number_where_a_run_goes_is_named_as_a_flags_value(tmp_path, capsys):
+    said = refused(capsys, eval_cli.main, [str(tmp_path), "1", "--no-video"])
+    assert (
+        "'1' is not a RUN (no such file or directory) but a number, which simoun-eval does "
+        "not take bare: a number goes with the flag it is for, e.g. --episodes 1 (episodes to "
+        "play)" in said
+    )
 
 
 @pytest.mark.parametrize(

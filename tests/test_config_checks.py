@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from simoun_agent.config import PRESETS, RECIPES, AgentConfig, SetupError, TrainConfig, resolve
+from simoun_agent.config.device import device_keys, same_device, same_setting
 from simoun_agent.config.keys import config_fields
 from simoun_agent.config.resolve import to_dict
 from simoun_agent.config.rules import Rule, check_fields, integer, rules_of, setting
@@ -319,3 +320,16 @@ def test_an_agent_set_as_a_dict_is_refused_with_the_agent_config_of_its_values()
 def test_a_run_dir_given_as_a_path_is_kept_as_a_str(tmp_path):
     assert TrainConfig(run_dir=tmp_path / "r").run_dir == str(tmp_path / "r")
     assert resolve(None, {"run_dir": tmp_path / "r"}).run_dir == str(tmp_path / "r")
+
+
+def test_two_spellings_of_one_device_are_the_same_device():
+    current = torch.cuda.current_device() if torch.cuda.is_available() else 0
+    assert same_device("cpu:0", "cpu") and same_device("cpu", "cpu:0")
+    assert same_device("cuda", f"cuda:{current}") and same_device("mps:0", "mps")
+    assert not same_device("cpu", "cuda") and not same_device("cuda:0", "cuda:1")
+    assert same_device(None, None) and not same_device(None, "cpu")
+    assert same_setting("device", "cpu:0", "cpu") and not same_setting("seed", 1, 2)
+    assert device_keys({"base": {"device": "cpu:0"}, "device": "cuda"}) == {
+        "base": {"device": "cpu"},
+        "device": f"cuda:{current}",
+    }

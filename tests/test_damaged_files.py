@@ -589,3 +589,71 @@ def test_a_git_lfs_pointer_is_named_with_git_lfs_pull(name, trained_run, tmp_pat
     assert f"{name} is damaged" in said or f"checkpoint {run_dir / name}" in said
     assert "it is a Git LFS pointer, not the file itself" in said
     assert "git lfs install && git lfs pull" in said and "cut short" not in said
+
+
+def tree(folder):
+    """Every path under ``folder`` with its bytes (None for a directory)."""
+    return {
+        str(path.relative_to(folder)): None if path.is_dir() else path.read_bytes()
+        for path in sorted(folder.rglob("*"))
+    }
+
+
+def new_run_refusal(run_dir, capsys, *flags):
+    """What ``simoun-train`` says of a new run in ``run_dir``, asserting that it exits with
+    status 2 and writes nothing in the folder above ``run_dir`` (no lock file included)."""
+    folder = run_dir.parent
+    before = tree(folder)
+    given = {
+        key: value if isinstance(value, str) else json.dumps(value) for key, value in TINY.items()
+    }
+    argv = [x for key, value in given.items() for x in ("--set", f"{key}={value}")]
+    with pytest.raises(SystemExit) as stop:
+        train_cli.main([*argv, "--run-dir", str(run_dir), *flags])
+    assert stop.value.code == 2
+    assert tree(folder) == before
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize("overwrite", [[], ["--overwrite"]], ids=["", "--overwrite"])
+def test_a_new_run_refused_in_a_study_or_sweep_writes_nothing_there(
+    trained_run, overwrite, tmp_path, capsys
+):
+    archived = study_run(tmp_path, trained_run, "arch")
+    (tmp_path / "arch/study.json").write_text("{}")
+    err = new_run_refusal(archived, capsys, *overwrite)
+    assert f"{archived} is a run of the study in {tmp_path / 'arch'}" in err
+    for record in ("study.json", "sweep.json"):
+        folder = tmp_path / record.split(".")[0] / "folder"
+        folder.mkdir(parents=True)
+        (folder / record).write_text("{}")
+        err = new_run_refusal(folder, capsys, *overwrite)
+        assert f"--run-dir {folder} is a simoun-{record.split('.')[0]} directory" in err
+        assert "Pass a --run-dir outside it" in err
+    with_checkpoint = shutil.copytree(trained_run, tmp_path / "kept" / "run")
+    (with_checkpoint / ".lock").unlink(missing_ok=True)
+    err = new_run_refusal(with_checkpoint, capsys, *overwrite)
+    assert "already holds a run with a checkpoint" in err
+
+
+def test_a_refused_resume_writes_no_lock_in_the_run(trained_run, tmp_path, capsys):
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (run_dir / ".lock").unlink(missing_ok=True)
+    before = tree(run_dir)
+    with pytest.raises(SystemExit):
+        train_cli.main(["--resume", str(run_dir), "--total-env-steps", "20"])
+    assert "there is nothing to continue" in capsys.readouterr().err
+    assert tree(run_dir) == before
+
+
+def test_a_refused_distraction_evaluation_makes_no_report_directory(tmp_path, capsys):
+    out = tmp_path / "reports" / "dmcgb"
+    not_a_run = tmp_path / "empty"
+    not_a_run.mkdir()
+    with pytest.raises(SystemExit) as stop:
+        eval_cli.main([str(not_a_run), "--distraction", "train", "--out", str(out)])
+    assert stop.value.code == 2
+    assert "Traceback" not in capsys.readouterr().err
+    assert not (tmp_path / "reports").exists()

@@ -108,6 +108,13 @@ MINIGRID_SPEC = json.loads(Path("docs/studies/minigrid/spec.json").read_text())
         ({"arms": "ppo"}, 'arms is "ppo", which must be a non-empty array of arm names'),
         ({"evaluations": 0.5}, "evaluations is 0.5, which must be an int >= 1"),
         ({"device": "tpu"}, 'device is "tpu", which must be a torch device name'),
+        ({"device": ["cpu"]}, 'device is ["cpu"], which must be a torch device name: cpu, cuda, '
+         'cuda:N or mps, e.g. "device": "cpu"'),
+        ({"ppo": {"n_steps": 128.0}},
+         'ppo: n_steps is 128.0, which must be an int >= 1 (below 2**63), e.g. "n_steps": 128'),
+        ({"tasks": [{**MINIGRID_SPEC["tasks"][0], "steps": [400000]}]},
+         'tasks[0]: steps is [400000], which must be an int >= 1 (below 2**63), e.g. "steps": '
+         "400000"),
     ],
 )  # fmt: skip
 def test_a_minigrid_spec_value_of_the_wrong_kind_is_named(change, said, tmp_path, capsys):
@@ -141,9 +148,9 @@ def test_a_report_of_a_directory_that_does_not_exist_is_refused(tmp_path, capsys
         (["--preset", "cpux"], "unknown preset 'cpux' (did you mean 'cpu'?)"),
         (["--agent.encoder", "duall"], "must be a known name (did you mean 'dual'?)"),
         (["--video=maybe"], "--video is a switch: it takes true or false"),
-        (["--learning-rate", "1e-3"], "unknown flag --learning-rate (did you mean --agent.lr?)"),
+        (["--learning-rate", "1e-3"], "--learning-rate: simoun-train calls it --agent.lr"),
         (["--agent.gamma=0.9"], "unknown flag --agent.gamma (did you mean --agent.discount?)"),
-        (["--frame-skip", "4"], "unknown flag --frame-skip (did you mean --action-repeat?)"),
+        (["--frame-skip", "4"], "--frame-skip: simoun-train calls it --action-repeat"),
         (["--xyzzy"], "unknown flag --xyzzy; `simoun-train --help` lists every flag"),
     ],
 )

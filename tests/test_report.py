@@ -525,3 +525,13 @@ def test_an_archive_of_the_minigrid_study_is_sent_to_its_own_report(capsys):
     assert "holds runs of the MiniGrid study, which simoun-report does not read" in err
     assert f"python -m simoun_lab.minigrid_study report --archive {root}" in err
     assert not Path("never-written").exists()
+
+
+def test_a_task_folder_of_a_minigrid_archive_is_sent_to_the_archives_report(capsys):
+    root = Path(__file__).resolve().parents[1] / "docs/studies/minigrid"
+    with pytest.raises(SystemExit):
+        report_cli.main([str(root / "MiniGrid-DoorKey-6x6-v0"), "--out", "never-written"])
+    err = capsys.readouterr().err
+    assert "holds runs of the MiniGrid study, which simoun-report does not read" in err
+    assert f"python -m simoun_lab.minigrid_study report --archive {root}`" in err
+    assert not Path("never-written").exists()

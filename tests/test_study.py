@@ -16,8 +16,9 @@ import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 from flag_lists import SMALL_AGENT
 
-from simoun_agent.config import RECIPES, SetupError
+from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_lab.cli import study as cli
+from simoun_lab.study.checks import changes
 from simoun_lab.study.plan import evaluation_runs, tuning_runs
 from simoun_lab.study.provenance import code_version
 from simoun_lab.study.report import RunResult, cost_curves, mean_cpu, read_result
@@ -226,6 +227,18 @@ def test_resume_from_another_commit_is_refused_unless_allowed(study, tmp_path, c
     assert len(parts) == 2 and parts[1]["allowed_other_commit"] is True
 
 
+def test_allow_other_commit_without_resume_is_refused_before_anything_is_made(tmp_path, capsys):
+    spec_path = write_spec(tmp_path / "tiny.toml")
+    argv = ["run", str(spec_path), "--study-dir", str(tmp_path / "s"), "--allow-other-commit"]
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(argv)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "--allow-other-commit works only with --resume" in err
+    assert "add --resume to continue the study in --study-dir, or drop --allow-other-commit" in err
+    assert not (tmp_path / "s").exists()
+
+
 def test_resume_with_another_spec_and_a_new_study_over_an_old_one_are_refused(study, capsys):
     spec_path, study_dir, _ = study
     (spec_path.parent / "changed").mkdir(exist_ok=True)
@@ -309,6 +322,23 @@ def test_plan_without_a_probe_lists_the_runs_only(tmp_path, capsys):
     assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
     out = capsys.readouterr().out
     assert "runs: 8 tuning + 4 evaluation = 12" in out and "estimated" not in out
+    assert "note:" not in out
+
+
+def test_plan_notes_runs_that_evaluate_less_often_than_their_budget(tmp_path, capsys):
+    text = SPEC.replace("eval_every = 40", "eval_every = 100").replace(
+        "env_steps = 80\n\n[resources]", "env_steps = 120\n\n[resources]"
+    )
+    spec = write_spec(tmp_path / "tiny.toml", text)
+    assert cli.main(["plan", str(spec), "--probe-updates", "0"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "note: the tuning runs on simoun-PointReach-v0 evaluate every 100 env steps (eval_every "
+        "in [base]), more than their 80: each is evaluated only at step 0 and at the end; the "
+        "auc selection rule reads those two points; for a learning curve, give an eval_every "
+        "below 80"
+    ) in out
+    assert "the evaluation runs" not in out  # 120 env steps: evaluated at 100 too
 
 
 MAX = "max_concurrent_trials = 2\n"
@@ -322,6 +352,28 @@ BAD_SPECS = [
     ('recipes = ["simoun", "sac"]', 'recipes = ["sac", "sac"]', "'sac' is listed twice"),
     ('description = "a tiny study for tests"', 'selection = "best"',
      "unknown selection rule 'best'; choose one of auc, final"),
+    ('description = "a tiny study for tests"', 'selection = ["auc"]',
+     'selection: give one rule name (auc or final), not an array (["auc"]); e.g. selection = '
+     '"auc"'),
+    ('recipes = ["simoun", "sac"]', 'recipes = [["simoun"], "sac"]',
+     'recipes: give an array of recipe names (strings), not an array holding an array '
+     '(["simoun"]); e.g. recipes = ["simoun", "drq"]'),
+    ("eval_episodes = 1", 'eval_episodes = 1\npreset = ["cpu"]',
+     'highway-cpu), not an array (["cpu"]); e.g. preset = "cpu"'),
+    ("seeds = [101, 102]", 'seeds = [101, "102"]',
+     '[tuning] seeds: give seeds as an array of whole numbers or a range string ("1-5"), or a '
+     'table with one per task, not an array holding a string ("102")'),
+    ('seeds = "1-2"', 'seeds = { "simoun/PointReach-v0" = 2 }',
+     '[evaluation] seeds.simoun/PointReach-v0: give seeds as an array of whole numbers or a '
+     'range string ("1-5"), not an integer (2)'),
+    ("max_concurrent_trials = 2", "max_concurrent_trials = 2.0",
+     "[resources] max_concurrent_trials: give a whole number, not a float (2.0); e.g. "
+     "max_concurrent_trials = 2"),
+    ("max_concurrent_trials = 2", MAX + '[diagnostics]\nsimoun = [{ recipe = "simoun_no_aux" }]',
+     '[diagnostics] simoun: give an array of recipe names (strings), not an array holding a '
+     'table ({"recipe": "simoun_no_aux"})'),
+    ("max_concurrent_trials = 2", MAX + '[generalization]\nmodes = ["color_easy"]\nepisodes = "5"',
+     '[generalization] episodes: give a whole number, not a string ("5"); e.g. episodes = 10'),
     ("agent.n_step = [1, 3]", "agent.n_stepp = [1, 3]",
      "unknown config key 'agent.n_stepp' (did you mean agent.n_step?)"),
     ("agent.n_step = [1, 3]", "agent.n_step = 3",
@@ -375,6 +427,14 @@ BAD_SPECS = [
      "'CartPole-v1' is no task of [tuning] or [evaluation]", '[tasks."CartPole-v1"]'),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\naction_repeatt = 2\n\n[resources]',
      "unknown config key 'action_repeatt' (did you mean action_repeat?)", "action_repeatt = 2"),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\nagent.n_step = 3\n\n[resources]',
+     "[tasks.\"simoun/PointReach-v0\"] agent.n_step: agent.n_step is set in [grid] too (line 20), "
+     "and the grid's values override [tasks.\"simoun/PointReach-v0\"]'s in every run of the task; "
+     "set it in one place only: in [grid] to tune it on every task, or in each task's table (and "
+     "drop it from [grid])", "agent.n_step = 3"),
+    ("[resources]", '[tasks."simoun/PointReach-v0"]\neval_episodes = 2\n\n[resources]',
+     "eval_episodes is set in [base] too (line 9), and [base]'s value is then used for no run of "
+     "this task; set it in one place only", "eval_episodes = 2"),
     ("[resources]", '[tasks."simoun/PointReach-v0"]\nenv_steps = 40\n\n[resources]',
      "unknown config key 'env_steps' (the study sets total_env_steps itself: give it as "
      "env_steps in [tuning] and [evaluation])", "env_steps = 40"),
@@ -985,3 +1045,10 @@ def test_a_study_directory_given_as_a_packed_file_is_told_to_unpack_it(tmp_path,
     err = report_refused(packed, capsys)
     assert f"{packed} is a file, not a directory" in err and "no such directory" not in err
     assert f"tar -xf {packed} -C {tmp_path}" in err
+
+
+def test_a_finished_runs_device_spelled_otherwise_is_no_change():
+    trained = to_dict(resolve(None, {"device": "cpu"}))
+    assert changes(trained, to_dict(resolve(None, {"device": "cpu:0"}))) == []
+    seeded = to_dict(resolve(None, {"device": "cpu", "seed": 7}))
+    assert changes(trained, seeded) == ["seed: 1 when it ran, 7 now"]

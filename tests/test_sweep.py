@@ -19,19 +19,22 @@ from broken_envs import NAN_REACH_ID
 from flag_lists import override
 
 from benchmarks.sweep import tiny_flags
-from simoun_agent.config import SetupError, resolve
+from simoun_agent.config import SetupError, resolve, to_dict
 from simoun_agent.run import train
 from simoun_agent.run.checkpoint import load_checkpoint
 from simoun_agent.run.logger import read_csv
 from simoun_lab.cli import report as report_cli
 from simoun_lab.cli import sweep as cli
+from simoun_lab.cli.sweep import base_differences
 from simoun_lab.sweep.grid import (
     SWEEP_FILE,
     SweepSpec,
     check_devices,
     check_trial_dirs,
+    config_differences,
     parse_seeds,
     split_values,
+    trial_problem,
 )
 from simoun_lab.sweep.launch import gpus_per_trial
 from simoun_lab.sweep.trainable import finished, open_run
@@ -349,6 +352,14 @@ def error_of(argv: list[str], capsys) -> str:
         (["--grid", "agent.encoder=(stacked, single)"], "write --grid "
          "agent.encoder=stacked,single"),
         # a per-trial check of a --grid value sends the fix to --grid, not to the base flag
+        (["--grid", "env_module=nosuchmodule,none"], "trial env_module=nosuchmodule/"
+         "simoun-PointReach-v0/s1: --env-module 'nosuchmodule' is not installed, so the ids it "
+         "registers are unknown; pip install nosuchmodule (or the package that provides "
+         "nosuchmodule); --env-module nosuchmodule is this trial's value from --grid "
+         "env_module=nosuchmodule,none: make the fix in --grid"),
+        (["--grid", 'env_kwargs={"a":1},{}'], "simoun/PointReach-v0 takes no keyword 'a'; it "
+         'accepts: max_steps, size, step_size; --env-kwargs {"a":1} is this trial\'s value from '
+         "--grid"),
         (["--grid", "action_repeat=1,100"], "or --total-env-steps many times 100; "
          "--action-repeat 100 is this trial's value from --grid action_repeat=1,100: make the "
          "fix in --grid (leave 100 out of its values"),
@@ -851,3 +862,21 @@ def test_a_closing_report_that_cannot_be_written_is_named_and_fails_the_sweep(
     assert f"mv {table} {table}.aside) and run the command again" in err
     assert "--out" not in err  # simoun-sweep has none
     assert f"then write it with: simoun-report {sweep_dir}" in err
+
+
+def test_a_device_spelled_otherwise_on_resume_is_the_same_device(tmp_path):
+    env = "simoun/PointReach-v0"
+    flags = {"env": env, "image_size": 24, "device": "cpu"}
+    saved = SweepSpec(None, flags, {}, [1], [env])
+    assert base_differences({"device": "cpu:0"}, saved) == []
+    assert base_differences({"device": "cpu:0", "image_size": 32}, saved) == [
+        "--image-size: saved 24, given 32"
+    ]
+    # a trial trained with device cpu is the sweep's own under device cpu:0
+    (trial,) = SweepSpec(None, {**flags, "device": "cpu:0"}, {}, [1], [env]).trials(tmp_path)
+    run_dir = Path(trial.run_dir)
+    run_dir.mkdir(parents=True)
+    trained = resolve(None, {**trial.overrides, "device": "cpu"})
+    (run_dir / "config.json").write_text(json.dumps(to_dict(trained)))
+    assert trial_problem(trial, {}) is None
+    assert config_differences(trial) == {}

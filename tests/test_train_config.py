@@ -1,7 +1,10 @@
 """TrainConfig, presets and command-line overrides of simoun-train."""
 
 import json
+import subprocess
+import sys
 
+import gymnasium as gym
 import pytest
 
 from simoun_agent.config import (
@@ -50,6 +53,33 @@ def test_highway_preset_is_three_viewports_with_continuous_control():
     assert highway["action"] == {"type": "ContinuousAction"}
     assert highway["duration"] * highway["policy_frequency"] == 200
     assert highway["vehicles_count"] == 20
+
+
+HIGHWAY_TASKS = ("intersection-v0", "racetrack-v0", "parking-v0", "exit-v0", "u-turn-v0")
+
+
+def test_a_highway_preset_takes_every_highway_env_id_in_a_fresh_process():
+    # before anything imports highway_env, its ids are not in the registry; a highway preset
+    # must not call them "not highway-env ids" for that
+    code = (
+        "import sys\n"
+        "from simoun_agent.config import resolve\n"
+        "assert 'highway_env' not in sys.modules\n"
+        f"for env in {HIGHWAY_TASKS!r}:\n"
+        "    assert resolve('highway-cpu', {'env': env}).env == env\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+@pytest.mark.parametrize("env", HIGHWAY_TASKS)
+def test_a_highway_preset_keeps_only_the_settings_the_task_has(env):
+    from gymnasium.envs.registration import load_env_creator
+
+    config = resolve("highway", {"env": env})
+    defaults = load_env_creator(gym.spec(env).entry_point).default_config()
+    assert set(config.env_kwargs["config"]) <= set(defaults)
+    assert config.env_kwargs["config"]["action"] == {"type": "ContinuousAction"}
+    assert resolve("highway", {}).env_kwargs["config"]["lanes_count"] == 4  # its own task's
 
 
 def test_every_value_can_be_overridden_and_overrides_win_over_the_preset():

@@ -11,6 +11,7 @@ from gymnasium.utils.env_checker import check_env
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
+from simoun_agent.run.highway_config import limit_of
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
 from simoun_agent.run.make_env import (
     check_env_kwargs,
@@ -90,7 +91,9 @@ def test_unknown_env_id_suggests_close_matches():
 
 @pytest.mark.filterwarnings("ignore:.*render_mode='rgb_array' that is not in the possible")
 def test_env_without_pixels_or_rgb_array_is_refused():
-    with pytest.raises(SetupError, match=r"neither image observations.*rgb_array"):
+    with pytest.raises(
+        SetupError, match=r"gives no frames.*no rgb_array rendering.*no images either"
+    ):
         make_env(resolve(None, {"env": "simoun-test/StateOnly-v0"}))
 
 
@@ -252,7 +255,6 @@ def test_an_env_kwarg_the_env_fails_on_is_refused_naming_it_not_raised():
     for env, kwargs, shown in (
         ("Pendulum-v1", {"g": None}, "g=None"),
         ("simoun-test/ScaledReach-v0", {"scale": "x"}, "scale='x'"),
-        ("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 7}}, "camera_id"),
     ):
         with pytest.raises(SetupError) as error:
             check_task(env_config(env, kwargs))
@@ -409,6 +411,10 @@ HIGHWAY_CONTINUOUS = {"action": {"type": "ContinuousAction"}}
         ({"controlled_vehicles": 0}, "config.controlled_vehicles=0"),
         ({"vehicles_density": 0}, "config.vehicles_density=0"),
         ({"scaling": -1}, "config.scaling=-1"),
+        ({"ego_spacing": -1}, "config.ego_spacing=-1 (highway-fast-v0's spacing between "
+         "vehicles at the start) must be a number > 0; e.g. '{\"config\": {\"ego_spacing\": "
+         "1.5}}' (its default)"),
+        ({"ego_spacing": 0}, "config.ego_spacing=0"),
     ],
 )  # fmt: skip
 def test_a_highway_config_value_that_breaks_the_task_is_refused_naming_the_key(given, said):
@@ -437,12 +443,11 @@ def test_an_env_that_renders_no_frame_is_refused_at_set_up_naming_the_key():
     with pytest.raises(SetupError) as error:
         check_task(zero_width)
     message = str(error.value)
-    assert message.startswith('--env-kwargs {"render_kwargs": {"width": 0}}: ')
-    assert "returned an array of shape (240, 0, 3)" in message
-    assert "render_kwargs.width=0 is the value that spoils it" in message
-    assert '\'{"render_kwargs": {"width": 32, "height": 32, "camera_id": 0}}\'' in message
+    assert message.startswith("--env-kwargs: render_kwargs.width=0 (")
+    assert "must be a whole number of at least 1" in message
+    assert '\'{"render_kwargs": {"width": 84}}\', or drop render_kwargs.width' in message
     # built without the check (a sweep's trial, a resumed run), it is refused all the same
-    with pytest.raises(SetupError, match=r"--env-kwargs .* gives no frames to learn from"):
+    with pytest.raises(SetupError, match=r"--env-kwargs: render_kwargs.width=0"):
         make_env(zero_width)
     assert check_task(env_config(dmc, {"render_kwargs": {"width": 48, "height": 40}})) == 1000
 
@@ -562,3 +567,212 @@ def test_an_env_id_spelt_another_way_is_offered_first(typed, module, first):
         ensure_registered(typed, module)
     assert f"did you mean {first}" in str(error.value)
     assert "no registered id is close" not in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("env", "given", "said"),
+    [
+        ("HalfCheetah-v5", {"camera_id": 99}, "camera_id=99 is not a camera of HalfCheetah-v5; "
+         "camera_id is a camera id (a whole number), and its cameras are 0 'track' and -1, the "
+         "free camera. Give e.g. '{\"camera_id\": 0}', or drop camera_id"),
+        ("HalfCheetah-v5", {"camera_name": "nope"}, "camera_name=\"nope\" is not a camera of "
+         "HalfCheetah-v5 (gymnasium would render the free camera instead, without a word); its "
+         "named cameras are 'track'. Give e.g. '{\"camera_name\": \"track\"}'"),
+        ("Reacher-v5", {"camera_id": 0}, "camera_id=0 is not a camera of Reacher-v5; camera_id "
+         "is a camera id (a whole number), and its cameras are only -1, the free camera"),
+        ("HalfCheetah-v5", {"camera_id": "track"}, "camera_id=\"track\" is not a camera"),
+        ("HalfCheetah-v5", {"width": 0}, "width=0 (the width of HalfCheetah-v5's rendered "
+         "frames in pixels) must be a whole number of at least 1"),
+        ("HalfCheetah-v5", {"height": 1.5}, "height=1.5 (the height of HalfCheetah-v5's"),
+        ("HalfCheetah-v5", {"default_camera_config": {"distnace": 3}}, "default_camera_config."
+         "distnace is not a setting of MuJoCo's camera; its settings are azimuth, distance"),
+        ("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": "nope"}},
+         "render_kwargs.camera_id=\"nope\" is not a camera of dm_control/cartpole-swingup-v0; "
+         "render_kwargs.camera_id is a camera id (a whole number) or name, and its cameras are "
+         "0 'fixed', 1 'lookatcart' and -1, the free camera"),
+        ("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 2}},
+         "render_kwargs.camera_id=2 is not a camera"),
+    ],
+)  # fmt: skip
+def test_a_camera_or_render_size_the_model_lacks_is_refused_before_the_first_render(
+    env, given, said
+):
+    # MuJoCo ends the process over a camera id it lacks at the first render, and gymnasium
+    # renders the free camera for an unknown camera name: both are refused at set-up
+    with pytest.raises(SetupError) as error:
+        check_task(env_config(env, given))
+    assert str(error.value).startswith(f"--env-kwargs: {said}")
+
+
+def test_the_cameras_a_model_has_are_taken_by_id_and_by_name():
+    assert check_task(env_config("HalfCheetah-v5", {"camera_name": "track", "width": 48})) == 1000
+    assert check_task(env_config("HalfCheetah-v5", {"camera_id": -1})) == 1000
+    lookatcart = {"render_kwargs": {"width": 32, "height": 32, "camera_id": "lookatcart"}}
+    assert check_task(env_config("dm_control/cartpole-swingup-v0", lookatcart)) == 1000
+
+
+def test_an_env_kwarg_naming_a_file_that_is_not_there_is_refused_naming_the_key(
+    tmp_path, monkeypatch
+):
+    with pytest.raises(SetupError) as error:
+        check_env_kwargs("HalfCheetah-v5", {"xml_file": "cheetah.xml"})
+    message = str(error.value)
+    assert message.startswith('--env-kwargs: xml_file="cheetah.xml" names no file: HalfCheetah-v5')
+    assert "gymnasium's MuJoCo assets folder" in message and "half_cheetah.xml" in message
+    assert "give the absolute path of an existing MuJoCo XML file, or drop xml_file" in message
+    # a file in the current directory is not where gymnasium looks for a bare name: ./ is
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "cheetah.xml").write_text("<mujoco/>")
+    with pytest.raises(SetupError, match=r"give it as './cheetah.xml' \(or its absolute path"):
+        check_env_kwargs("HalfCheetah-v5", {"xml_file": "cheetah.xml"})
+    assert check_env_kwargs("HalfCheetah-v5", {"xml_file": "half_cheetah.xml"}) is None
+
+
+def test_an_env_kwarg_naming_a_class_that_does_not_import_is_refused_with_the_classes():
+    careful = {**HIGHWAY_CONTINUOUS, "other_vehicles_type": "highway_env.vehicle.behavior.Careful"}
+    with pytest.raises(SetupError) as error:
+        check_env_kwargs("highway-fast-v0", {"config": careful})
+    message = str(error.value)
+    assert message.startswith(
+        '--env-kwargs: config.other_vehicles_type="highway_env.vehicle.behavior.Careful" names '
+        "no class that imports"
+    )
+    assert "highway_env.vehicle.behavior.AggressiveVehicle" in message
+    assert "or drop config.other_vehicles_type" in message
+    for path in ("highway_env.vehicle.behavior.Aggressive", "no_such_package.Vehicle"):
+        with pytest.raises(SetupError, match="names no class that imports"):
+            check_env_kwargs("merge-v0", {"config": {"other_vehicles_type": path}})
+    aggressive = {
+        **careful,
+        "other_vehicles_type": "highway_env.vehicle.behavior.AggressiveVehicle",
+    }
+    assert check_env_kwargs("highway-fast-v0", {"config": aggressive}) is None
+
+
+class ReadsItsData(gym.Env):
+    """A pixel env that reads a file named by its ``data`` keyword when it is made."""
+
+    metadata = {"render_modes": ["rgb_array"]}  # noqa: RUF012
+
+    def __init__(self, data=None, render_mode=None):
+        if data is not None:
+            with open(data) as file:  # an OSError for a file that is not there
+                file.read()
+        self.render_mode = render_mode
+        self.observation_space = gym.spaces.Box(0, 255, (8, 8, 3), np.uint8)
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (1,), np.float32)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return np.zeros((8, 8, 3), np.uint8), {}
+
+    def step(self, action):
+        return np.zeros((8, 8, 3), np.uint8), 0.0, False, False, {}
+
+    def render(self):
+        return np.zeros((8, 8, 3), np.uint8)
+
+
+gym.register("simoun-test/ReadsItsData-v0", entry_point=ReadsItsData, max_episode_steps=10)
+
+
+def test_any_error_of_an_env_made_with_env_kwargs_is_named_on_one_line_with_the_keys(tmp_path):
+    missing = str(tmp_path / "no-such-file.txt")
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("simoun-test/ReadsItsData-v0", {"data": missing}))
+    message = str(error.value)
+    assert message.startswith(f'--env-kwargs {{"data": "{missing}"}}: ')
+    assert "cannot use data=" in message and "FileNotFoundError: " in message
+    assert "\n" not in message
+    (tmp_path / "data.txt").write_text("x")
+    ok = env_config("simoun-test/ReadsItsData-v0", {"data": str(tmp_path / "data.txt")})
+    assert check_task(ok) == 10
+
+
+def test_an_env_whose_constructor_takes_no_render_mode_is_refused_for_that_reason():
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("lane-keeping-v0", {}))
+    message = str(error.value)
+    assert message.startswith(
+        "lane-keeping-v0 gives no frames to learn from: its constructor does not accept "
+        "render_mode (gym.make('lane-keeping-v0', render_mode='rgb_array') raises TypeError)"
+    )
+    assert "neither" not in message and "Pick a highway-env task that takes render_mode" in message
+
+
+@pytest.mark.parametrize(
+    "env", ["intersection-v0", "racetrack-v0", "parking-v0", "exit-v0", "u-turn-v0"]
+)
+@pytest.mark.parametrize("preset", ["highway", "highway-cpu"])
+def test_a_highway_preset_takes_every_highway_env_task_with_the_settings_it_has(preset, env):
+    config = resolve(preset, {"env": env, "image_size": 32})
+    check_task(config)
+
+
+def test_a_highway_preset_on_a_task_without_continuous_actions_is_refused_for_that():
+    with pytest.raises(SetupError, match=r"^two-way-v0 does not support continuous actions"):
+        check_task(resolve("highway-cpu", {"env": "two-way-v0", "image_size": 32}))
+
+
+def test_every_spacing_length_count_duration_and_noise_of_every_highway_task_is_held():
+    # the limits come from what a key's name says, so every task's keys are covered, and
+    # every task's own default passes them; rewards and costs stay free (a penalty is negative)
+    checked = set()
+    for env_id in (
+        "highway-v0",
+        "merge-v0",
+        "roundabout-v0",
+        "intersection-v0",
+        "racetrack-v0",
+        "parking-v0",
+        "exit-v0",
+        "u-turn-v0",
+        "two-way-v0",
+        "lane-keeping-v0",
+        "roundabout-generic-v0",
+        "merge-generic-v0",
+    ):
+        ensure_registered(env_id)
+        creator = gym.envs.registration.load_env_creator(gym.spec(env_id).entry_point)
+        defaults = creator.default_config()
+        for key, value in defaults.items():
+            limit = limit_of(key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                continue
+            if limit is None:
+                assert any(
+                    word in key for word in ("reward", "cost", "screen", "constraint", "range")
+                ), key
+                continue
+            assert limit.ok(value), (env_id, key, value)
+            assert not limit.ok(-1), key
+            checked.add(key)
+    assert {"ego_spacing", "before_merge_length", "roundabout_radius", "state_noise"} <= checked
+    with pytest.raises(SetupError, match=r"config.roundabout_radius=-20 .* must be a number > 0"):
+        check_env_kwargs("roundabout-generic-v0", {"config": {"roundabout_radius": -20}})
+
+
+def test_env_kwargs_merge_into_simouns_own_settings_key_by_key():
+    dmc = make_env(
+        env_config("dm_control/cartpole-swingup-v0", {"render_kwargs": {"camera_id": 1}})
+    )
+    try:  # the camera is the user's; the frame size stays the run's
+        assert dmc.unwrapped.render_kwargs == {"width": 32, "height": 32, "camera_id": 1}
+    finally:
+        dmc.close()
+    stack = {"observation": {"stack_size": 2}}
+    highway = make_env(env_config("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **stack}}))
+    try:  # simoun's dropped observation keeps its type, shape and weights under the user's stack
+        observation = highway.unwrapped.config["observation"]
+        assert observation["type"] == "GrayscaleObservation"
+        assert observation["stack_size"] == 2
+        assert observation["observation_shape"] == (8, 8)
+    finally:
+        highway.close()
+    # an observation of another type replaces simoun's whole: its settings are another class's
+    other = {"config": {**HIGHWAY_CONTINUOUS, "observation": {"type": "Kinematics"}}}
+    kinematics = make_env(env_config("highway-fast-v0", other))
+    try:
+        assert kinematics.unwrapped.config["observation"] == {"type": "Kinematics"}
+    finally:
+        kinematics.close()

@@ -114,6 +114,28 @@ def test_resume_with_the_saved_values_of_fixed_keys_is_accepted(finished_run, tm
         train.release(run)
 
 
+def test_resume_takes_the_runs_env_and_action_repeat_in_another_spelling(finished_run, tmp_path):
+    run_dir = tmp_path / "copy"
+    shutil.copytree(finished_run, run_dir)
+    same = {
+        "total_env_steps": 60,
+        "env": "simoun_agent.envs:simoun/PointReach-v0",  # MODULE:ID of the run's own id
+        "env_module": None,
+        "action_repeat": 1,  # the repeat the run resolved (it saved none)
+    }
+    run = train.resume_run(run_dir, same)
+    try:
+        assert run.config.env == "simoun/PointReach-v0" and run.config.env_module is None
+        assert run.config.action_repeat is None
+    finally:
+        run.env.close()
+        run.eval_env.close()
+        train.release(run)
+    for other in ({"env": "simoun_agent.envs:Pendulum-v1"}, {"action_repeat": 2}):
+        with pytest.raises(SetupError, match=r"was given another value than the run's"):
+            train.resume_run(run_dir, other)
+
+
 def test_checkpoint_from_another_config_is_refused(finished_run, tmp_path):
     other = tmp_path / "other"
     config = json.loads((finished_run / "config.json").read_text())

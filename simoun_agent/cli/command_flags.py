@@ -67,6 +67,8 @@ class Flag:
     """names a file or directory"""
     json: bool = False
     """takes a JSON object (``--env-kwargs '{"a": 1}'``)"""
+    number: type | None = None
+    """int or float for an option that takes a number (``--episodes 10``)"""
 
 
 @dataclass(frozen=True)
@@ -79,6 +81,8 @@ class PositionalArg:
     """any number of words (``simoun-eval RUN [RUN ...]``)"""
     path: bool
     """names a file or directory"""
+    name: str = ""
+    """its field (``checkpoint``)"""
 
 
 def unwrap(hint: Any) -> tuple[Any, list[Any]]:
@@ -150,7 +154,8 @@ def positionals(command: Any, argv: Sequence[str]) -> list[PositionalArg] | None
         metavar = next(
             (m.metavar for m in markers if isinstance(m, ARG) and m.metavar), field.name.upper()
         )
-        found.append(PositionalArg(metavar, _sequence(kind), _names_path(kind, markers)))
+        path = _names_path(kind, markers)
+        found.append(PositionalArg(metavar, _sequence(kind), path, field.name))
     return found
 
 
@@ -164,6 +169,12 @@ def _names_path(kind: Any, markers: list[Any]) -> bool:
         return True
     inner = {arg for arg in typing.get_args(kind) if arg not in (type(None), Ellipsis)}
     return kind is Path or inner == {Path}
+
+
+def _number(kind: Any) -> type | None:
+    """int or float for a field of that type (optional too), else None."""
+    options = {arg for arg in typing.get_args(kind) if arg is not type(None)} or {kind}
+    return options.pop() if len(options) == 1 and options <= {int, float} else None
 
 
 def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) -> None:
@@ -193,7 +204,8 @@ def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) ->
         )
         path = _names_path(kind, markers) or (config and key in CONFIG_PATHS)
         json = (typing.get_origin(kind) or kind) is dict
-        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path, json)
+        number = _number(kind)
+        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path, json, number)
         if kind is bool and tyro.conf.FlagCreatePairsOff not in markers:
             section, dot, last = flag[2:].rpartition(".")
             negation = Flag(key, doc, False, False, config)

@@ -24,10 +24,11 @@ from tqdm import tqdm
 
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import POSITIONAL, RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
-from simoun_agent.run.rundir import make_output_dir
+from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
 
 
@@ -64,6 +65,27 @@ PROG = "simoun-eval"
 DESCRIPTION = """Evaluate a simoun-train checkpoint: deterministic episodes, metrics and a video.
 
 example: simoun-eval runs/cartpole-swingup-cpu-s1-20260101-120000 --episodes 10"""
+
+
+OTHER_NAMES = RUN_CONFIG_NAMES | {
+    "run-dir": POSITIONAL,
+    "log-dir": POSITIONAL,
+    "logdir": POSITIONAL,
+    "load-path": POSITIONAL,
+    "model-path": POSITIONAL,
+    "trained-agent": POSITIONAL,
+    "n-eval-episodes": Meant(("--episodes",)),
+    "num-eval-episodes": Meant(("--episodes",)),
+    "render": Meant(("--video",)),
+    "distraction": Meant(note="comma-separate the modes, e.g. --distraction train,video_hard"),
+    "num-envs": Meant(note="simoun-eval plays its episodes one after another on one env"),
+    "deterministic": Meant(
+        note="simoun-eval always plays the agent's deterministic action; --random-policy plays "
+        "the random baseline"
+    ),
+}
+"""Other libraries' flags with what simoun-eval calls them, the run itself its positional RUN
+(:mod:`simoun_agent.cli.other_names`); a run config key's is named as the run's setting."""
 
 
 @dataclass
@@ -105,7 +127,13 @@ class EvalCommand:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
     args = parse(
-        EvalCommand, argv, PROG, DESCRIPTION, switches=("--video", "--progress"), reads_runs=True
+        EvalCommand,
+        argv,
+        PROG,
+        DESCRIPTION,
+        switches=("--video", "--progress"),
+        reads_runs=True,
+        other_names=OTHER_NAMES,
     )
     if not args.checkpoint:  # tyro accepts no value for a variable number of them
         fail(PROG, "give the run to evaluate: a run directory or its checkpoint.pt")
@@ -190,7 +218,7 @@ def evaluate_distractions(args: EvalCommand) -> int:
     write the table, CSV and bar chart; bad input exits with status 2, without traceback."""
     if args.random_policy:
         fail(PROG, "--random-policy does not combine with --distraction")
-    from simoun_agent.generalization.evaluation import evaluate_runs
+    from simoun_agent.generalization.evaluation import load_runs, play_runs
     from simoun_agent.generalization.report import (
         REPORT_FILES,
         TABLE_CSV,
@@ -215,19 +243,20 @@ def evaluate_distractions(args: EvalCommand) -> int:
                 f"{out} holds an earlier generalization report; pass --overwrite to replace it, "
                 "or --out DIR to write this one elsewhere"
             )
-        created = make_output_dir(out, files=REPORT_FILES)
+        check_output_dir(out, "--out", REPORT_FILES)
         with stop_at_once():
-            results = evaluate_runs(
-                run_dirs,
+            # every run and mode is refused or taken before the report directory is made
+            runs = load_runs(run_dirs, modes, device=args.device, videos=args.videos)
+            created = make_output_dir(out, files=REPORT_FILES)
+            results = play_runs(
+                runs,
                 modes,
                 args.episodes,
                 seed=args.seed,
-                device=args.device,
                 videos=args.videos,
                 progress=_status if args.progress else None,
             )
     except SetupError as err:
-        # a run or mode refused while loading: leave no empty report directory behind
         if created:
             shutil.rmtree(out, ignore_errors=True)
         fail(PROG, err)

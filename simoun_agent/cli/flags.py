@@ -20,7 +20,9 @@ to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not
   quietly (:func:`quiet_pipe`).
 
 Before tyro reads the command line, :func:`parse` refuses in one line, naming the flag or
-argument: an unknown flag, a word after a switch, a switch given a value it does not take, a
+argument: an unknown flag (another library's name for a flag told this command's own,
+:mod:`simoun_agent.cli.other_names`), a second value of an option that takes one, a word after a
+switch, a switch given a value it does not take, a
 word no argument takes, an empty or blank value, a path the file system cannot hold, a dict's
 value that is not a JSON object (or gives a key twice), an option given twice with different
 values, and a number past int64.
@@ -35,10 +37,11 @@ import itertools
 import json
 import os
 import re
+import shlex
 import sys
 import typing
 import unicodedata
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -65,6 +68,7 @@ from simoun_agent.cli.command_flags import (
     subcommands,
     takes_positional,
 )
+from simoun_agent.cli.other_names import Meant, name_key
 from simoun_agent.config import TrainConfig
 from simoun_agent.config.key_match import NAME_WEIGHT, close_keys, meaning_score
 from simoun_agent.config.keys import (
@@ -268,17 +272,24 @@ def run_setting(name: str) -> str | None:
 
 
 def refuse_unknown(
-    argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str, reads_runs: bool = False
+    argv: Sequence[str],
+    flags: dict[str, Flag],
+    command: Any,
+    prog: str,
+    reads_runs: bool = False,
+    other_names: Mapping[str, Meant] | None = None,
 ) -> None:
     """Raise ValueError for a ``--flag`` of ``argv`` that is not one of ``flags`` (the command's,
-    :func:`~simoun_agent.cli.command_flags.command_flags`), naming the flags it most likely
-    meant, found by meaning as well as spelling (``--learning-rate``: ``--agent.lr``;
-    ``--num-episodes``: ``--episodes``); for a command that ``reads_runs``, a flag of the run
-    config is told to be the run's own. Nothing is checked before a subcommand is named: tyro
-    asks for one."""
+    :func:`~simoun_agent.cli.command_flags.command_flags`), naming what it most likely meant:
+    the command's counterpart of another library's flag (``other_names``, e.g.
+    :data:`~simoun_agent.cli.other_names.RUN_CONFIG_NAMES`: ``--buffer-size``:
+    ``--replay-capacity``), the positional argument it names (``simoun-eval --run-dir``), a
+    switch's negation for a ``--no-`` name, else the flags found by meaning as well as spelling
+    (``--frame-size``: ``--image-size``; ``--num-episodes``: ``--episodes``); for a command that
+    ``reads_runs``, a flag of the run config is told to be the run's own. Nothing is checked
+    before a subcommand is named: tyro asks for one."""
     if not flags:
         return
-    docs = {flag.key: flag.doc for flag in flags.values()}
     named = subcommands(command)
     sub = next((f" {arg}" for arg in argv if arg in named), "")
     for arg in argv:
@@ -289,20 +300,138 @@ def refuse_unknown(
             continue
         if spelled := ascii_flag(arg):
             raise lookalike_error(arg, spelled)
-        close = close_keys(name[2:], docs)
-        # a flag of the command that shares a word of the name is meant (--eval-episodes:
-        # --episodes); else a run setting is named as the run's own
-        alike = any(meaning_score(name[2:], key, docs[key]) >= NAME_WEIGHT for key in close)
-        if reads_runs and not alike and (key := run_setting(name)):
-            value = "" if config_fields()[key][0] is bool else " ..."
-            raise ValueError(
-                f"{name} is not a flag of {prog}{sub}: {key} is a setting of the run, saved in "
-                f"its config.json, and {prog} uses the run's own; it is chosen when the run is "
-                f"trained (simoun-train {name}{value}). `{prog}{sub} --help` lists every flag"
-            )
-        matches = ["--" + key.replace("_", "-") for key in close]
-        hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
-        raise ValueError(f"unknown flag {name}{hint}; `{prog}{sub} --help` lists every flag")
+        raise unknown_flag_error(arg, argv, flags, command, (prog, sub), reads_runs, other_names)
+
+
+def unknown_flag_error(
+    arg: str,
+    argv: Sequence[str],
+    flags: dict[str, Flag],
+    command: Any,
+    called: tuple[str, str],
+    reads_runs: bool,
+    other_names: Mapping[str, Meant] | None,
+) -> ValueError:
+    """The refusal of the unknown flag ``arg`` of ``argv``, for the command ``called`` (its
+    name, and its subcommand with a space before it, or empty)."""
+    name = arg.partition("=")[0]
+    prog = "".join(called)
+    meant = (other_names or {}).get(name_key(name))
+    slot = positional_named(name, command, argv, meant)
+    if slot is not None:
+        return ValueError(
+            f"unknown flag {name}: {slot.metavar} is a positional argument of {prog}, given "
+            f"without a flag: {called[0]} {shlex.join(without_flag(argv, arg))}"
+        )
+    if meant is not None and (text := counterpart(meant, flags, prog)):
+        return ValueError(f"unknown flag {name}: {text}; `{prog} --help` lists every flag")
+    if reads_runs and (key := run_setting_meant(name, flags, meant)):
+        setting = "--" + key.replace("_", "-")
+        value = "" if config_fields()[key][0] is bool else " ..."
+        return ValueError(
+            f"{name} is not a flag of {prog}: {key} is a setting of the run, saved in its "
+            f"config.json, and {prog} uses the run's own; it is chosen when the run is trained "
+            f"(simoun-train {setting}{value}). `{prog} --help` lists every flag"
+        )
+    matches = negated_matches(name, flags)
+    if matches is None:
+        docs = {flag.key: flag.doc for flag in flags.values()}
+        matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
+    hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
+    return ValueError(f"unknown flag {name}{hint}; `{prog} --help` lists every flag")
+
+
+def counterpart(meant: Meant, flags: dict[str, Flag], prog: str) -> str:
+    """What ``meant`` is in a command with ``flags``: its flags there, each with its help, and
+    its note; the note alone, as not supported here, when it names no flag; empty when its
+    flags are none of the command's."""
+    present = [flag for flag in meant.flags if flag in flags]
+    note = f"; {meant.note}" if meant.note else ""
+    if present:
+        said = " or ".join(f"{flag} ({short_doc(flags[flag].doc)})" for flag in present)
+        return f"{prog} calls it {said}{note}"
+    if meant.note and not meant.flags:
+        return f"not supported here: {meant.note}"
+    return ""
+
+
+def short_doc(doc: str) -> str:
+    """A flag's help up to its first clause: what it is, without the details."""
+    first = re.split(r"; |(?<!e\.g)\. |: | \(|, e\.g\.", " ".join(doc.split()), maxsplit=1)[0]
+    return first.rstrip(".")
+
+
+def positional_named(
+    name: str, command: Any, argv: Sequence[str], meant: Meant | None
+) -> PositionalArg | None:
+    """The positional argument the unknown flag ``name`` stands for: the one ``meant`` says, or
+    the one whose name or metavar it spells (``--checkpoint``, ``--run``, ``--spec``)."""
+    slots = positionals(command, argv) or []
+    typed = key_words(name[2:])
+    for slot in slots:
+        if (meant is not None and meant.positional) or typed in (
+            key_words(slot.metavar),
+            key_words(slot.name),
+        ):
+            return slot
+    return None
+
+
+def key_words(text: str) -> list[str]:
+    """The lower-case words of a flag or key: ``--run-dir``, ``run_dir``, ``RUN_DIR``: run, dir."""
+    return re.findall(r"[a-z0-9]+", text.lower())
+
+
+def without_flag(argv: Sequence[str], arg: str) -> list[str]:
+    """``argv`` with the option word ``arg`` left out (``--run-dir=DIR`` becomes ``DIR``): its
+    value then fills the positional argument."""
+    out = []
+    for word in argv:
+        if word == arg:
+            _, eq, value = word.partition("=")
+            out.extend([value] if eq else [])
+            continue
+        out.append(word)
+    return out
+
+
+def run_setting_meant(name: str, flags: dict[str, Flag], meant: Meant | None) -> str | None:
+    """The run config key that the unknown ``name`` sets, by its own spelling or through its
+    counterpart ``meant``; None when a flag of the command shares a word with ``name``
+    (``--eval-episodes``: ``--episodes``), which is then the one meant."""
+    docs = {flag.key: flag.doc for flag in flags.values()}
+    alike = any(
+        meaning_score(name[2:], key, docs[key]) >= NAME_WEIGHT for key in close_keys(name[2:], docs)
+    )
+    if alike:
+        return None
+    candidates = [name, *(meant.flags if meant is not None else ())]
+    return next((key for flag in candidates if (key := run_setting(flag))), None)
+
+
+NEGATING_WORDS = ("no", "disable", "without")
+"""First words of a flag that turn its switch off (``--no-curiosity``, ``--disable-video``)."""
+
+
+def negated_matches(name: str, flags: dict[str, Flag]) -> list[str] | None:
+    """For an unknown ``--no-X`` flag (or ``--disable-X``), the negations of the switches that X
+    most likely means (``--no-curiosity``: ``--agent.no-curiosity``), and never a flag that
+    would turn X on or set another value; None for a name that negates nothing."""
+    section, dot, last = name[2:].rpartition(".")
+    first, _, rest = last.replace("_", "-").partition("-")
+    if first.lower() not in NEGATING_WORDS or not rest:
+        return None
+    switches = {flag.key: flag.doc for flag in flags.values() if flag.switch is True}
+    typed = f"{section}{dot}{rest}"
+    # a switch named by a word of X: one found through its help alone may be another thing
+    # to turn off (--no-eval is not --no-video)
+    keys = [
+        key
+        for key in close_keys(typed, switches)
+        if meaning_score(typed, key, switches[key]) >= NAME_WEIGHT
+    ]
+    negations = (negated("--" + key.replace("_", "-")) for key in keys)
+    return [flag for flag in negations if flag in flags]
 
 
 SHORT_OPTION = re.compile(r"-[A-Za-z][A-Za-z0-9]*(=.*)?")
@@ -523,11 +652,18 @@ def given_values(argv: Sequence[str], flags: dict[str, Flag], command: Any) -> I
 
 
 def refuse_stray_arguments(
-    argv: Sequence[str], flags: dict[str, Flag], command: Any, prog: str
+    argv: Sequence[str],
+    flags: dict[str, Flag],
+    command: Any,
+    prog: str,
+    other_names: Mapping[str, Meant] | None = None,
 ) -> None:
     """Raise ValueError for a word that no option and no positional argument takes
     (``simoun-train foo``, ``simoun-report DIR extra``, ``simoun-eval A --episodes 1 B``): tyro
-    would print a box of help."""
+    would print a box of help. A word right after an option's value is named as a second value
+    of that option (``--seed 1 2``), with what to do instead (``other_names``' note for the
+    flag, one JSON object for a dict); a number or ``KEY=VALUE`` word where a path goes, as
+    the flag's value it was meant to be."""
     slots = positionals(command, argv) or []
     sub = next((f" {arg}" for arg in argv if arg in subcommands(command)), "")
     takes = "no positional argument (every value goes with its --flag)"
@@ -539,8 +675,21 @@ def refuse_stray_arguments(
             for slot in slots
         )
     after_dashes = argv[argv.index("--") + 1 :] if "--" in argv and not slots else []
-    stray = [value.value for value in given_values(argv, flags, command) if value.unplaced]
-    for word in stray + after_dashes:
+    values = list(given_values(argv, flags, command))
+    for before, value in zip([None, *values], values, strict=False):
+        if not value.unplaced:
+            continue
+        forms = setting_forms(value.value, flags)
+        if second_value(before, value.value, flags, bool(slots), other_names) and (
+            not forms or flags[before.flag].repeatable
+        ):
+            raise second_value_error(before, value.value, flags, other_names)
+        if forms:
+            hint = f"a KEY=VALUE setting is not given bare: write {forms}"
+        else:
+            hint = number_hint(value.value, flags) or f"`{prog}{sub} --help` lists its flags"
+        raise ValueError(f"unexpected argument {value.value!r}: {prog}{sub} takes {takes}; {hint}")
+    for word in after_dashes:
         forms = setting_forms(word, flags)
         hint = (
             f"; a KEY=VALUE setting is not given bare: write {forms}"
@@ -548,9 +697,10 @@ def refuse_stray_arguments(
             else f"; `{prog}{sub} --help` lists its flags"
         )
         raise ValueError(f"unexpected argument {word!r}: {prog}{sub} takes {takes}{hint}")
-    for value in given_values(argv, flags, command):
+    for value in values:
         if value.positional is not None and value.positional.path:
             refuse_setting_as_path(value.value, value.positional, flags, f"{prog}{sub}")
+            refuse_number_as_path(value.value, value.positional, flags, f"{prog}{sub}")
 
 
 def refuse_setting_as_path(
@@ -567,6 +717,93 @@ def refuse_setting_as_path(
         f"{word!r} is not a {slot.metavar} (no such file or directory) but a KEY=VALUE setting, "
         f"which {prog} does not take bare: it takes options as flags; {fix}"
     )
+
+
+def second_value(
+    before: Given | None,
+    word: str,
+    flags: dict[str, Flag],
+    positional: bool,
+    other_names: Mapping[str, Meant] | None,
+) -> bool:
+    """Whether the stray ``word``, typed after ``before``, was meant as a second value of
+    ``before``'s option: a number after a number's, a JSON object after a JSON option's;
+    another word when the command takes no positional argument it could have been, or the
+    command says how that option takes several (``other_names``)."""
+    if before is None or before.flag is None or before.value is None:
+        return False
+    flag = flags[before.flag]
+    if flag.number is not None:
+        return NUMBER_WORD.fullmatch(word) is not None
+    if flag.json:
+        return word.lstrip().startswith("{")
+    meant = (other_names or {}).get(name_key(before.flag))
+    return not positional or (meant is not None and bool(meant.note) and not meant.flags)
+
+
+def second_value_error(
+    given: Given, word: str, flags: dict[str, Flag], other_names: Mapping[str, Meant] | None
+) -> ValueError:
+    """The refusal of ``word``, typed after the value of ``given``'s option, which takes one."""
+    name, first = given.flag or "", given.value or ""
+    flag = flags[name]
+    said = f"{name} takes one value, so {word!r} after {first!r} is left over"
+    meant = (other_names or {}).get(name_key(name))
+    if meant is not None and meant.note and not meant.flags:
+        return ValueError(f"{said}: {meant.note}")
+    if flag.json and (merged := merged_json(first, word)):
+        return ValueError(
+            f"{said}: put every key in one JSON object, e.g. {name} {shlex.quote(merged)}"
+        )
+    if flag.repeatable:
+        return ValueError(f"{said}: give {name} once per value, e.g. {name} {first} {name} {word}")
+    return ValueError(f"{said}: give one value, e.g. {name} {first}")
+
+
+def merged_json(first: str, second: str) -> str | None:
+    """The JSON object holding the keys of the objects ``first`` and ``second`` (the second's
+    value where both give a key), None when either is not a JSON object."""
+    try:
+        return json.dumps(json_object(first) | json_object(second))
+    except ValueError:
+        return None
+
+
+NUMBER_WORD = re.compile(r"[+-]?([0-9][0-9_]*)(\.[0-9]*)?([eE][+-]?[0-9]+)?")
+"""A bare number (``1``, ``0.5``, ``1e-3``)."""
+
+
+def refuse_number_as_path(
+    word: str, slot: PositionalArg, flags: dict[str, Flag], prog: str
+) -> None:
+    """Raise ValueError for a number given where a path goes and naming nothing on disk
+    (``simoun-eval RUN 1``): it was meant as a flag's value (``--episodes 1``), and the command
+    would read it as one more path (a second run, say)."""
+    if NUMBER_WORD.fullmatch(word) is None or Path(word).exists():
+        return
+    fix = number_hint(word, flags) or f"`{prog} --help` lists its flags"
+    raise ValueError(
+        f"{word!r} is not a {slot.metavar} (no such file or directory) but a number, which "
+        f"{prog} does not take bare: {fix}"
+    )
+
+
+def number_hint(word: str, flags: dict[str, Flag]) -> str:
+    """For a bare number ``word``, the command's own flags it may be the value of (``--episodes
+    1 (episodes to play)``, three at most); empty for another word, or a command with none."""
+    match = NUMBER_WORD.fullmatch(word)
+    if match is None:
+        return ""
+    fits = (float,) if match.group(2) or match.group(3) else (int, float)
+    numeric = [
+        name
+        for name, flag in flags.items()
+        if flag.number in fits and not flag.config and name == "--" + flag.key.replace("_", "-")
+    ]
+    examples = [f"{name} {word} ({short_doc(flags[name].doc)})" for name in numeric[:3]]
+    if not examples:
+        return ""
+    return f"a number goes with the flag it is for, e.g. {' or '.join(examples)}"
 
 
 def refuse_switch_values(
@@ -725,10 +962,13 @@ def parse(
     default: T | None = None,
     switches: Iterable[str] = (),
     reads_runs: bool = False,
+    other_names: Mapping[str, Meant] | None = None,
 ) -> T:
     """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
     ``switches`` are the boolean flags that also take the older ``--flag false``; a command that
-    ``reads_runs`` tells a run config flag it does not take to be the run's own. Exits 0
+    ``reads_runs`` tells a run config flag it does not take to be the run's own; ``other_names``
+    are other libraries' flags with what they are called in the command
+    (:mod:`simoun_agent.cli.other_names`). Exits 0
     after ``--version`` or ``--help``, 2 with one line for input the checks above refuse, or
     tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -742,10 +982,10 @@ def parse(
         flags = command_flags(cls, argv)
         refuse_short_options(argv, flags, prog)
         refuse_unknown_subcommand(argv, cls, prog)
-        refuse_unknown(argv, flags, cls, prog, reads_runs)
+        refuse_unknown(argv, flags, cls, prog, reads_runs, other_names)
         refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
         refuse_switch_values(argv, flags, switches)
-        refuse_stray_arguments(argv, flags, cls, prog)
+        refuse_stray_arguments(argv, flags, cls, prog, other_names)
         refuse_empty_values(argv, flags, cls)
         refuse_long_paths(argv, flags, cls)
         refuse_unexpanded_home(argv, flags, cls)

@@ -31,6 +31,7 @@ from simoun_agent.cli.config_flags import (
     overrides_from,
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import ONE_SEED, RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import SetupError, TrainConfig, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.layout import CHECKPOINT_NAME
@@ -55,6 +56,14 @@ examples:
 
 Values: booleans as switches (--no-video; --video false works too), None as none, dicts as
 JSON (--env-kwargs '{{"a": 1}}')."""
+
+
+OTHER_NAMES = RUN_CONFIG_NAMES | {
+    "seed": Meant(note=ONE_SEED),
+    "seeds": Meant(("--seed",), ONE_SEED),
+}
+"""Other libraries' flags with what simoun-train calls them
+(:mod:`simoun_agent.cli.other_names`); ``seed`` says what to do for several seeds."""
 
 
 @dataclass
@@ -128,7 +137,9 @@ def parse_command(argv: Sequence[str]) -> TrainCommand:
         default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
     except SetupError as err:
         fail(PROG, err)
-    return parse(TrainCommand, argv, PROG, DESCRIPTION, default, config_switches())
+    return parse(
+        TrainCommand, argv, PROG, DESCRIPTION, default, config_switches(), other_names=OTHER_NAMES
+    )
 
 
 def resumed_dir(given: str) -> Path:

@@ -9,7 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from simoun_agent.config.envs import PAPER_ACTION_REPEAT, is_highway
+import gymnasium as gym
+from gymnasium.envs.registration import load_env_creator
+
+from simoun_agent.config.envs import PAPER_ACTION_REPEAT, is_highway, registered_spec
 
 HIGHWAY_CONFIG = {
     "action": {"type": "ContinuousAction"},
@@ -57,6 +60,20 @@ class Preset:
         if self.envs == "highway":
             return is_highway(env_id)
         return env_id == self.envs
+
+
+def fit_highway_config(config: dict, env_id: str) -> dict:
+    """A highway preset's highway-env ``config`` for the highway-env task ``env_id``: the keys
+    the task's ``default_config()`` has (``lanes_count`` is highway-v0's, not
+    intersection-v0's: highway-env would ignore it there, and simoun refuses a key a task lacks);
+    ``config`` itself when the task's settings cannot be read."""
+    spec = registered_spec(env_id, "highway_env")
+    try:
+        creator = load_env_creator(spec.entry_point) if spec is not None else None
+        defaults = creator.default_config()
+    except (AttributeError, ImportError, TypeError, gym.error.Error):
+        return config
+    return {key: value for key, value in config.items() if key in defaults}
 
 
 def _dmc_preset(task: str) -> Preset:

@@ -30,7 +30,7 @@ from typing import Any
 from simoun_agent.config.envs import dmc_task, split_env_id
 from simoun_agent.config.errors import SetupError
 from simoun_agent.config.keys import check_keys, config_fields, config_sections
-from simoun_agent.config.presets import PRESETS
+from simoun_agent.config.presets import PRESETS, fit_highway_config
 from simoun_agent.config.recipes import RECIPES
 from simoun_agent.config.rules import rules_of
 from simoun_agent.config.train import TrainConfig
@@ -63,6 +63,11 @@ def resolve(preset: str | None, overrides: dict[str, Any]) -> TrainConfig:
                 f"on {meant}, or use a preset for {env_id!r}: {' or '.join(fitting)} (or no "
                 "preset for the paper defaults)"
             )
+        if chosen.envs == "highway":
+            values["env_kwargs"] = {
+                **values["env_kwargs"],
+                "config": fit_highway_config(values["env_kwargs"]["config"], env_id),
+            }
     recipe = overrides.get("agent.recipe", values.get("agent.recipe"))
     if recipe is not None:
         env_id = split_env_id(overrides.get("env", values.get("env", TrainConfig.env)))[1]

@@ -14,7 +14,7 @@ from simoun_agent.generalization.suite import (
     make_distracted_env,
 )
 from simoun_agent.run.evaluate import evaluate
-from simoun_agent.run.load import load_run
+from simoun_agent.run.load import LoadedRun, load_run
 from simoun_wrappers._checks import (
     check_callable,
     check_nonnegative_int,
@@ -60,38 +60,42 @@ def evaluate_runs(
     seeds), so the modes differ only by the distraction. Raises SetupError for a run that
     cannot be loaded or a mode its env does not support, before any episode is played.
     """
-    if isinstance(run_dirs, (str, os.PathLike)):
-        raise TypeError(
-            f"evaluate_runs(run_dirs=...) takes a list of run directories, got the one path "
-            f"{str(run_dirs)!r}; e.g. run_dirs=[{str(run_dirs)!r}]"
-        )
-    if not isinstance(run_dirs, (list, tuple)) or not run_dirs:
-        raise TypeError(
-            f"evaluate_runs(run_dirs=...) takes a non-empty list of run directories, got "
-            f"{type(run_dirs).__name__} {run_dirs!r:.60}; e.g. run_dirs=['runs/my-run']"
-        )
-    for run_dir in run_dirs:
-        check_path(run_dir, "evaluate_runs(run_dirs=[...])", "run_dirs=['runs/my-run']")
-    modes = check_mode_list(modes, "evaluate_runs(modes=...)", list(DISTRACTIONS))
-    check_positive_int(episodes, "evaluate_runs(episodes=...)", "e.g. episodes=10")
-    if seed is not None:
-        check_nonnegative_int(seed, "evaluate_runs(seed=...)", "e.g. seed=0, or None")
-    if videos is not None:
-        check_path(videos, "evaluate_runs(videos=...)", "videos='dmcgb/videos'")
-    if progress is not None:
-        check_callable(
-            progress,
-            "evaluate_runs(progress=...)",
-            "progress(message) before each run and mode",
-            ("message",),
-            "pass a function of one str, e.g. progress=print, or None",
-        )
-    loaded = [load_run(run_dir, device) for run_dir in run_dirs]
-    for run in loaded:
+    modes = _check_run_args("evaluate_runs", run_dirs, modes, videos)
+    _check_play_args("evaluate_runs", episodes, seed, progress)
+    runs = load_runs(run_dirs, modes, device, videos)
+    return play_runs(runs, modes, episodes, seed, videos, progress)
+
+
+def load_runs(
+    run_dirs: Sequence[Path],
+    modes: Sequence[str],
+    device: str | None = None,
+    videos: str | Path | None = None,
+) -> list[LoadedRun]:
+    """Each run of ``run_dirs`` loaded, checked to support each of ``modes``: SetupError for a
+    run that cannot be loaded or a mode its env does not support, before anything is played
+    or written (``simoun-eval --distraction`` makes its report directory after it)."""
+    modes = _check_run_args("load_runs", run_dirs, modes, videos)
+    runs = [load_run(run_dir, device) for run_dir in run_dirs]
+    for run in runs:
         check_supported(run.config, modes, videos)
-    labels = _labels([run.run_dir for run in loaded])
+    return runs
+
+
+def play_runs(
+    runs: Sequence[LoadedRun],
+    modes: Sequence[str],
+    episodes: int,
+    seed: int | None = None,
+    videos: str | Path | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> list[ModeResult]:
+    """Play ``episodes`` episodes of each of ``runs`` (:func:`load_runs`) under each mode, as
+    :func:`evaluate_runs` does; closes each run's env."""
+    _check_play_args("play_runs", episodes, seed, progress)
+    labels = _labels([run.run_dir for run in runs])
     results = []
-    for run, label in zip(loaded, labels, strict=True):
+    for run, label in zip(runs, labels, strict=True):
         first_seed = run.first_seed if seed is None else seed
         for mode in modes:
             if progress:
@@ -114,6 +118,44 @@ def evaluate_runs(
             )
         run.env.close()
     return results
+
+
+def _check_run_args(function: str, run_dirs: object, modes: object, videos: object) -> list[str]:
+    """TypeError or ValueError naming ``function``'s argument for run directories that are
+    not a non-empty list of paths, unknown modes, or a videos folder that is no path; the
+    modes as a list."""
+    if isinstance(run_dirs, (str, os.PathLike)):
+        raise TypeError(
+            f"{function}(run_dirs=...) takes a list of run directories, got the one path "
+            f"{str(run_dirs)!r}; e.g. run_dirs=[{str(run_dirs)!r}]"
+        )
+    if not isinstance(run_dirs, (list, tuple)) or not run_dirs:
+        raise TypeError(
+            f"{function}(run_dirs=...) takes a non-empty list of run directories, got "
+            f"{type(run_dirs).__name__} {run_dirs!r:.60}; e.g. run_dirs=['runs/my-run']"
+        )
+    for run_dir in run_dirs:
+        check_path(run_dir, f"{function}(run_dirs=[...])", "run_dirs=['runs/my-run']")
+    checked = check_mode_list(modes, f"{function}(modes=...)", list(DISTRACTIONS))
+    if videos is not None:
+        check_path(videos, f"{function}(videos=...)", "videos='dmcgb/videos'")
+    return checked
+
+
+def _check_play_args(function: str, episodes: object, seed: object, progress: object) -> None:
+    """TypeError or ValueError naming ``function``'s argument for a count of episodes below 1,
+    a negative seed, or a progress that is no function of one str."""
+    check_positive_int(episodes, f"{function}(episodes=...)", "e.g. episodes=10")
+    if seed is not None:
+        check_nonnegative_int(seed, f"{function}(seed=...)", "e.g. seed=0, or None")
+    if progress is not None:
+        check_callable(
+            progress,
+            f"{function}(progress=...)",
+            "progress(message) before each run and mode",
+            ("message",),
+            "pass a function of one str, e.g. progress=print, or None",
+        )
 
 
 def _labels(run_dirs: Sequence[Path]) -> list[str]:

@@ -70,6 +70,44 @@ at least 1, counts of other vehicles at least 0, a probability in [0, 1]. The sc
 out: simoun's cameras set it for every view. ``controlled_vehicles`` must be 1 (see
 :func:`_check_driven`)."""
 
+LIMIT_PATTERNS = (
+    (("lanes",), Limit("number of lanes", 1, whole=True)),
+    (("_count", "_vehicles"), Limit("number of vehicles", 0, whole=True)),
+    (("spacing",), Limit("spacing between vehicles at the start", 0, open_low=True)),
+    (("length",), Limit("road length in metres", 0, open_low=True)),
+    (("radius",), Limit("radius in metres", 0, open_low=True)),
+    (("duration",), Limit("duration in seconds", 0, open_low=True)),
+    (("frequency",), Limit("rate per second", 0, open_low=True)),
+    (("density",), Limit("traffic density", 0, open_low=True)),
+    (("probability",), Limit("probability", 0, high=1)),
+    (("noise",), Limit("noise scale", 0)),
+    (("speed_limit",), Limit("speed limit in m/s", 0, open_low=True)),
+)
+"""Limits of the numeric keys :data:`HIGHWAY_LIMITS` does not list, by what their names say
+(``ego_spacing``, ``before_merge_length``, ``roundabout_radius``, ``state_noise``, ...), so
+that every task's spacings, lengths, counts, durations, frequencies, densities and noises are
+held to their meaning: a negative spacing puts the ego vehicle before the road's start, off its
+lane. Rewards, costs and weights are left free (a negative one is a penalty), and so are keys
+whose name says none of these."""
+
+FREE_WORDS = ("reward", "cost", "weight")
+"""words of a key whose value may take any sign"""
+
+
+def limit_of(key: str) -> Limit | None:
+    """The :class:`Limit` of the highway-env ``config`` key ``key``: its own in
+    :data:`HIGHWAY_LIMITS`, else the first of :data:`LIMIT_PATTERNS` whose words its name
+    holds; None for a reward, cost or weight, or a key that names no quantity."""
+    if key in HIGHWAY_LIMITS:
+        return HIGHWAY_LIMITS[key]
+    if any(word in key for word in FREE_WORDS):
+        return None
+    for words, limit in LIMIT_PATTERNS:
+        if any(word in key for word in words):
+            return limit
+    return None
+
+
 ORDERED_RANGES = {
     "reward_speed_range": "speeds mapped onto the high-speed reward, [slowest, fastest] in m/s",
     "speed_range": "speeds the vehicle may reach, [lowest, highest] in m/s",
@@ -88,7 +126,7 @@ refused."""
 def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
     """SetupError for a key of ``given`` (the ``config`` of ``--env-kwargs``) that the task's
     ``defaults`` (its ``default_config()``) lack, a value of another kind than the default's,
-    a value :data:`HIGHWAY_LIMITS` refuses, a ``controlled_vehicles`` other than 1, a range in
+    a value :func:`limit_of` refuses, a ``controlled_vehicles`` other than 1, a range in
     the wrong order, an unknown action type or key, or a policy frequency above the simulation
     frequency."""
     if not isinstance(given, dict) or not isinstance(defaults, dict):
@@ -96,8 +134,8 @@ def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
     for key, value in given.items():
         _check_known(env_id, key, defaults)
         _check_kind(env_id, f"config.{key}", value, defaults[key])
-        limit = HIGHWAY_LIMITS.get(key)
-        if limit is not None and not limit.ok(value):
+        limit = limit_of(key)
+        if limit is not None and _is_number(value) and not limit.ok(value):
             raise SetupError(
                 f"--env-kwargs: config.{key}={json.dumps(value)} ({env_id}'s {limit.meaning}) "
                 f"must be {limit.need()}; e.g. {_example(key, defaults[key])} (its "
@@ -166,7 +204,7 @@ def _check_kind(env_id: str, name: str, value: object, default: object) -> None:
     if kind is None or _fits(value, default):
         return
     key = name.split(".")[-1]
-    limit = HIGHWAY_LIMITS.get(key) if name.count(".") == 1 else None
+    limit = limit_of(key) if name.count(".") == 1 else None
     need = limit.need() if limit is not None else kind
     if isinstance(default, (list, tuple)) and all(_is_number(item) for item in default):
         need = f"a list of {len(default)} numbers"

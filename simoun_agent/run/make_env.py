@@ -30,6 +30,8 @@ from gymnasium.wrappers import RescaleAction
 import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
+from simoun_agent.config.resolve import merged
+from simoun_agent.run.env_kwargs_checks import check_class_paths, check_files, check_render_keys
 from simoun_agent.run.highway_config import check_highway_config, nested
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import check_render, image_layout
@@ -244,10 +246,6 @@ GYM_MAKE_KEYWORDS = ("max_episode_steps", "disable_env_checker")
 """``--env-kwargs`` keys that ``gymnasium.make`` takes itself rather than passing them on to the
 env's creator"""
 
-ENV_VALUE_ERRORS = (ValueError, TypeError, AssertionError, KeyError, IndexError, ArithmeticError)
-"""what an env's own code raises over a value it cannot use (made, reset or stepped)"""
-
-
 REGISTRATION_SETTINGS = ("order_enforce", "autoreset", "apply_api_compatibility")
 """settings of an env's registration (``gymnasium.register``) that ``gymnasium.make`` 1.x does not
 take as keywords"""
@@ -348,6 +346,8 @@ def _check_value_kinds(env_id: str, kwargs: dict) -> None:
     if is_highway(env_id):
         check_highway_config(env_id, kwargs.get("config"), defaults.get("config"))
     _check_counts(env_id, kwargs, defaults)
+    check_files(env_id, kwargs, defaults)
+    check_class_paths(env_id, kwargs, defaults)
 
 
 def _check_scalar_kind(env_id: str, key: str, value: object, default: object) -> None:
@@ -453,20 +453,51 @@ def _make_base(config: TrainConfig) -> gym.Env:
 
 
 def _make_kwargs(config: TrainConfig) -> dict:
-    """The keywords ``gym.make`` is given for ``config``: its ``--env-kwargs`` with dm_control's
-    render size and highway-env's dropped observation."""
-    kwargs = dict(config.env_kwargs)
+    """The keywords ``gym.make`` is given for ``config``: simoun's own settings (dm_control's
+    render size, highway-env's dropped observation) with its ``--env-kwargs`` merged over them
+    key by key, as ``--env-kwargs`` is merged over a preset's: a ``render_kwargs`` that names
+    only the camera keeps the run's frame size."""
+    own: dict = {}
     if config.env.startswith("dm_control/"):
-        render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
-        kwargs.setdefault("render_kwargs", render)
+        own["render_kwargs"] = {
+            "width": config.image_size,
+            "height": config.image_size,
+            "camera_id": 0,
+        }
     if is_highway(config.env):
-        kwargs["config"] = {"observation": HIGHWAY_DROPPED_OBSERVATION, **kwargs.get("config", {})}
-    return kwargs
+        own["config"] = {"observation": _dropped_observation(config.env_kwargs)}
+    return merged(own, config.env_kwargs)
+
+
+def _dropped_observation(env_kwargs: dict) -> dict:
+    """The highway-env observation simoun sets under ``env_kwargs``: its dropped one, which a
+    ``config.observation`` of another ``type`` replaces whole (the settings of one observation
+    class mean nothing to another), and one without a type or of the same type is merged into
+    key by key."""
+    given = env_kwargs.get("config", {})
+    observation = given.get("observation") if isinstance(given, dict) else None
+    own_type = HIGHWAY_DROPPED_OBSERVATION["type"]
+    if isinstance(observation, dict) and observation.get("type", own_type) != own_type:
+        return {}
+    return dict(HIGHWAY_DROPPED_OBSERVATION)
 
 
 def _make_rendering_env(config: TrainConfig) -> gym.Env:
     ensure_registered(config.env, config.env_module)
     check_env_kwargs(config.env, config.env_kwargs)
+    env = _gym_make(config)
+    try:
+        check_render_keys(env, config)
+    except SetupError:
+        env.close()
+        raise
+    return env
+
+
+def _gym_make(config: TrainConfig) -> gym.Env:
+    """``gym.make`` ``config``'s env with rgb_array rendering (without it for a creator that
+    takes no render_mode); SetupError for what making it raises, naming ``--env-kwargs`` and
+    the key at fault when the run gives any."""
     kwargs = _make_kwargs(config)
     try:
         try:
@@ -482,10 +513,14 @@ def _make_rendering_env(config: TrainConfig) -> gym.Env:
         raise _refused_by_env(config, err) from None
     except MAKE_ERRORS as err:
         raise unmakeable(config.env, err) from None
-    except ENV_VALUE_ERRORS as err:
+    except SetupError:
+        raise
+    except Exception as err:
         # an env that checks its own arguments refuses a bad value this way; without env
-        # kwargs, only a ValueError is the env's word on its arguments
-        if not (config.env_kwargs or isinstance(err, ValueError)):
+        # kwargs, only a ValueError is the env's word on its arguments. With them, whatever
+        # the env raises (a missing file, a class path that does not import) follows from them;
+        # a MUJOCO_GL that mujoco refuses is named by _make_base
+        if not (config.env_kwargs or isinstance(err, ValueError)) or "MUJOCO_GL" in str(err):
             raise
         raise _refused_by_env(config, err) from None
 
@@ -498,8 +533,9 @@ def _kwargs_text(kwargs: dict) -> str:
 def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
     """The SetupError for an error an env raised while it was made, naming ``--env-kwargs``
     (and the key at fault, when one is) when the run gives any."""
-    # gymnasium re-raises a creator's TypeError with every keyword appended, simoun's own too
-    message = str(err).split(" was raised from the environment creator")[0]
+    message = one_line(err)
+    if not isinstance(err, (ValueError, TypeError)):  # the kind says what went wrong
+        message = f"{type(err).__name__}: {message}"
     if not config.env_kwargs:
         return SetupError(f"gymnasium.make({config.env!r}) failed: {message}")
     culprit = faulty_key(config)
@@ -515,9 +551,17 @@ def _refused_by_env(config: TrainConfig, err: Exception) -> SetupError:
             f"(making it failed: {message}). Fix or drop that key"
         )
     return SetupError(
-        f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} refused them ({message}). "
-        "Fix or drop --env-kwargs"
+        f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} made with the keys "
+        f"{', '.join(config.env_kwargs)} failed ({message}). Fix those values or drop "
+        "--env-kwargs"
     )
+
+
+def one_line(err: Exception) -> str:
+    """``err``'s text on one line, without gymnasium's appended keywords (it re-raises a
+    creator's TypeError with every keyword, simoun's own too)."""
+    text = str(err).split(" was raised from the environment creator")[0]
+    return " ".join(text.split()) or type(err).__name__
 
 
 def no_continuous_actions(config: TrainConfig, culprit: str) -> bool:
@@ -580,13 +624,16 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
             f"Give it a render width and height of at least 1{_render_example(config)}, or drop "
             "the render settings from --env-kwargs"
         ) from None
-    except ENV_VALUE_ERRORS as err:
+    except SetupError:
+        raise
+    except Exception as err:  # whatever the env raises follows from the kwargs it was given
         culprit = faulty_key(config)
         at_fault = f"; {culprit} is the value it cannot use" if culprit else ""
         raise SetupError(
             f"--env-kwargs {json.dumps(config.env_kwargs)}: {config.env} was made with "
             f"{_kwargs_text(config.env_kwargs)} but failed at its first reset and step "
-            f"({type(err).__name__}: {err}){at_fault}. Fix the values or drop --env-kwargs"
+            f"({type(err).__name__}: {one_line(err)}){at_fault}. Fix the values or drop "
+            "--env-kwargs"
         ) from None
     if ended:
         # an episode that ends at its first step holds no decision to learn from, and every
@@ -603,7 +650,7 @@ def check_first_step(env: gym.Env, config: TrainConfig) -> None:
 
 def _render_example(config: TrainConfig) -> str:
     """`` (e.g. '{"render_kwargs": ...}')``: the render settings of a dm_control task at the
-    run's image size, which simoun gives it when --env-kwargs names none; empty for others."""
+    run's image size, which simoun gives it under --env-kwargs; empty for others."""
     if not config.env.startswith("dm_control/"):
         return ""
     render = {"width": config.image_size, "height": config.image_size, "camera_id": 0}
@@ -654,11 +701,12 @@ def _works(config: TrainConfig, kwargs: dict) -> bool:
         env = gym.make(
             config.env, render_mode="rgb_array", **_make_kwargs(replace(config, env_kwargs=kwargs))
         )
-    except (*ENV_VALUE_ERRORS, *MAKE_ERRORS):
+    except Exception:  # any failure to make it counts against these kwargs
         return False
     try:
+        check_render_keys(env, replace(config, env_kwargs=kwargs))
         return not _first_step(env)
-    except ENV_VALUE_ERRORS:
+    except Exception:
         return False
     finally:
         env.close()
@@ -685,11 +733,40 @@ def _check_env(env: gym.Env, env_id: str) -> None:
     renders = env.render_mode == "rgb_array" and "rgb_array" in env.metadata.get("render_modes", [])
     if not (has_pixels or renders):
         raise SetupError(
-            f"{env_id} has neither image observations (its observation space is "
-            f"{env.observation_space}) nor rgb_array rendering (render modes "
-            f"{env.metadata.get('render_modes', [])}); Simoun learns from pixels. Use an env "
-            "that renders rgb_array images, or wrap yours so it returns (H, W, 3) uint8 images."
+            f"{env_id} gives no frames to learn from: {_no_render_reason(env, env_id)}, "
+            f"{_observation_reason(env, env_id)}"
         )
+
+
+def _no_render_reason(env: gym.Env, env_id: str) -> str:
+    """Why ``env`` renders no rgb_array frames: its creator takes no ``render_mode`` (its
+    metadata may still list rgb_array), or it has no such mode."""
+    modes = env.metadata.get("render_modes", [])
+    if "rgb_array" in modes and env.render_mode != "rgb_array":
+        return (
+            f"its constructor does not accept render_mode (gym.make({env_id!r}, "
+            "render_mode='rgb_array') raises TypeError), so it cannot be made to render "
+            f"rgb_array frames, though its metadata lists the render modes {modes}"
+        )
+    return f"it has no rgb_array rendering (its render modes are {modes})"
+
+
+def _observation_reason(env: gym.Env, env_id: str) -> str:
+    """Why ``env``'s observations are no frames either, and the fix; for highway-env, whose
+    observation simoun replaces with a tiny one (its views come from renders), that they
+    cannot stand in."""
+    if is_highway(env_id):
+        return (
+            "and simoun draws the agent's views of a highway-env task with that renderer (in "
+            "place of the task's own observation). Pick a highway-env task that takes "
+            "render_mode (e.g. highway-fast-v0)"
+        )
+    return (
+        f"and its observations are no images either (observation space "
+        f"{env.observation_space}, where (H, W, 3), (H, W, 1) or (H, W) frames are needed). "
+        "Simoun learns from pixels: use an env that renders rgb_array images, or wrap yours so "
+        "it returns (H, W, 3) uint8 images."
+    )
 
 
 def check_task(config: TrainConfig) -> int | None:

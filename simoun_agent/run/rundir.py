@@ -12,6 +12,7 @@ with a checkpoint is never overwritten: it is resumed, or the user deletes it.
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import os
 import shutil
@@ -224,23 +225,14 @@ def lock_run_dir(run_dir: Path) -> IO[str]:
     try:
         handle = path.open("a+")
     except OSError as err:
-        raise SetupError(
-            f"cannot write to the run directory {run_dir} ({err.strerror}): a run writes its "
-            "lock, checkpoints and logs there. Make it writable (a read-only mount, or files "
-            "of another user: chmod -R u+w), or copy the run to a writable place and --resume "
-            "the copy"
-        ) from None
+        raise not_writable(run_dir, err.strerror) from None
     try:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
         handle.seek(0)
         holder = handle.read().strip() or "unknown"
         handle.close()
-        raise SetupError(
-            f"{run_dir} is in use by another simoun-train (PID {holder}); two trainers in one "
-            f"directory would overwrite each other's checkpoints. Wait for it to end, stop it "
-            f"with `kill -TERM {holder}` (it checkpoints first), or pass another --run-dir"
-        ) from None
+        raise in_use(run_dir, holder) from None
     handle.seek(0)
     handle.truncate()
     handle.write(f"{os.getpid()}\n")
@@ -249,13 +241,82 @@ def lock_run_dir(run_dir: Path) -> IO[str]:
     return handle
 
 
-def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
-    """Make ``run_dir`` ready for a new run, or raise SetupError saying what to do instead.
+def not_writable(run_dir: Path, why: str) -> SetupError:
+    """The refusal of a run directory the run cannot write its lock in (``why``: the OS's
+    word)."""
+    return SetupError(
+        f"cannot write to the run directory {run_dir} ({why}): a run writes its lock, "
+        "checkpoints and logs there. Make it writable (a read-only mount, or files of another "
+        "user: chmod -R u+w), or copy the run to a writable place and --resume the copy"
+    )
 
-    A directory that already holds a run (``config.json``) is refused, with ``--resume`` as the
-    way on when it has a checkpoint and ``--overwrite`` when it has none; with ``overwrite`` the
-    files of the crashed attempt are removed. Call it while holding the lock.
-    """
+
+def in_use(run_dir: Path, holder: str) -> SetupError:
+    """The refusal of a run directory whose lock the trainer of PID ``holder`` holds."""
+    return SetupError(
+        f"{run_dir} is in use by another simoun-train (PID {holder}); two trainers in one "
+        f"directory would overwrite each other's checkpoints. Wait for it to end, stop it "
+        f"with `kill -TERM {holder}` (it checkpoints first), or pass another --run-dir"
+    )
+
+
+def refuse_live_lock(run_dir: Path) -> None:
+    """SetupError when another process holds ``run_dir``'s lock, or the run could not write it,
+    found without writing anything: a directory without a lock file has no live trainer."""
+    path = run_dir / LOCK_NAME
+    if not os.access(run_dir, os.W_OK | os.X_OK):
+        read_only = os.statvfs(run_dir).f_flag & os.ST_RDONLY
+        raise not_writable(run_dir, os.strerror(errno.EROFS if read_only else errno.EACCES))
+    if not path.is_file():
+        return
+    try:
+        handle = path.open()
+    except OSError as err:
+        raise not_writable(run_dir, err.strerror) from None
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise in_use(run_dir, handle.read().strip() or "unknown") from None
+        fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def check_run_dir(run_dir: Path, *, resume: bool = False, overwrite: bool = False) -> None:
+    """Every refusal of :func:`take_run_dir` for ``run_dir``, without writing anything there
+    (no lock file, no file of an earlier attempt removed): trainers call it before they build
+    anything, so that a refused run leaves the directory as it was."""
+    refuse_held_here(run_dir)
+    problem = wrong_kind(run_dir)
+    if problem:
+        raise SetupError(problem)
+    refuse_live_lock(run_dir)
+    if resume:
+        require_checkpoint(run_dir)
+    else:
+        refuse_new_run_dir(run_dir, overwrite)
+
+
+def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
+    """Make ``run_dir`` ready for a new run (:func:`refuse_new_run_dir`); with ``overwrite``
+    the files of a crashed attempt are removed. Call it while holding the lock."""
+    refuse_new_run_dir(run_dir, overwrite)
+    if not (run_dir / TRAINER_FILES[0]).exists():
+        return
+    for name in TRAINER_FILES:
+        (run_dir / name).unlink(missing_ok=True)
+    shutil.rmtree(run_dir / TENSORBOARD_DIR, ignore_errors=True)
+
+
+def refuse_new_run_dir(run_dir: Path, overwrite: bool) -> None:
+    """SetupError saying what to do instead when ``run_dir`` cannot take a new run: a study's
+    or sweep's own folder, whose files a run would mix with, or a directory that already
+    holds a run (``config.json``), with ``--resume`` as the way on when it has a checkpoint
+    and ``--overwrite`` when it has none (a study's run: never)."""
+    if (kind := folder_kind(run_dir)) is not None:
+        raise SetupError(
+            f"--run-dir {run_dir} is {kind}; a new run there would write its files among its "
+            "records. Pass a --run-dir outside it"
+        )
     if not (run_dir / TRAINER_FILES[0]).exists():
         return
     if (run_dir / CHECKPOINT_NAME).exists():
@@ -270,9 +331,6 @@ def claim_new_run_dir(run_dir: Path, overwrite: bool) -> None:
             f"{run_dir} holds a run that stopped before its first checkpoint, so there is "
             "nothing to resume; pass --overwrite to start over in it, or another --run-dir"
         )
-    for name in TRAINER_FILES:
-        (run_dir / name).unlink(missing_ok=True)
-    shutil.rmtree(run_dir / TENSORBOARD_DIR, ignore_errors=True)
 
 
 STUDY_RECORD = "study.json"

@@ -51,7 +51,7 @@ import torch
 
 from simoun_agent import SimounAgent
 from simoun_agent.config import SetupError, TrainConfig, from_dict, to_dict
-from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, env_label
+from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, env_label, split_env_id
 from simoun_agent.config.train import RESUMABLE_FIELDS, check_train_config
 from simoun_agent.replay import FrameReplay
 from simoun_agent.run.arguments import (
@@ -101,6 +101,7 @@ from simoun_agent.run.logger import RunLogger, damaged_log, read_log
 from simoun_agent.run.make_env import check_decisions, episode_limit, make_env, video_fps
 from simoun_agent.run.progress import Progress
 from simoun_agent.run.rundir import (
+    check_run_dir,
     folder_kind,
     make_output_dir,
     study_of,
@@ -209,7 +210,7 @@ def create_run(
         config.run_dir = os.fspath(config.run_dir)  # a Path set after the config was built
     run_dir = Path(config.run_dir) if config.run_dir else default_run_dir(config)
     if run_dir.is_dir():  # fail fast, before the envs are built: another trainer, an old run
-        take_run_dir(run_dir, overwrite=overwrite).close()
+        check_run_dir(run_dir, overwrite=overwrite)
     check_config_rules(config)
     check_budget(config)
     env, eval_env, agent, replay = build(config, check)
@@ -324,6 +325,32 @@ def changes(saved: Any, key: str, value: Any, run_dir: Path) -> bool:
     )
 
 
+def saved_spellings(saved: Any, overrides: dict[str, Any]) -> dict[str, Any]:
+    """``overrides`` less the values that are the ``saved`` run's own, spelled another way:
+    ``--env MODULE:ID`` of the run's ID (its module the run's ``env_module``, or one the run
+    did without), an ``--env-module`` equal to the run's, and an ``--action-repeat`` equal to
+    the one the run resolved (a dm_control task's paper value when it saved none)."""
+    if not isinstance(saved, dict):
+        return overrides
+    kept = dict(overrides)
+    env = kept.get("env")
+    if isinstance(env, str):
+        module, env_id = split_env_id(env)
+        if module and env_id == saved.get("env") and saved.get("env_module") in (None, module):
+            del kept["env"]
+    if "env_module" in kept and kept["env_module"] == saved.get("env_module"):
+        del kept["env_module"]
+    repeat = kept.get("action_repeat")
+    if (
+        repeat is not None
+        and saved.get("action_repeat") is None
+        and isinstance(saved.get("env"), str)
+    ):
+        if repeat == PAPER_ACTION_REPEAT.get(dmc_task(saved["env"]), 1):
+            del kept["action_repeat"]
+    return kept
+
+
 def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | None = None) -> Run:
     """Reload a run from its directory; ``overrides`` may only change resumable fields;
     ``check(config)`` (:data:`ConfigCheck`) runs before any env is built."""
@@ -372,6 +399,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
         raise damaged_config(config_path, str(err)) from None
     if isinstance(saved, dict) and (problem := kind_problem(CONFIG_NAME, list(saved))):
         raise damaged_config(config_path, problem)
+    overrides = saved_spellings(saved, overrides)
     fixed = [key for key, value in overrides.items() if changes(saved, key, value, run_dir)]
     if fixed:
         raise SetupError(
@@ -395,7 +423,7 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
     except ValueError as err:
         raise SetupError(str(err)) from None
     config.run_dir = str(run_dir)
-    take_run_dir(run_dir, resume=True).close()  # fail fast; held from the end of set-up on
+    check_run_dir(run_dir, resume=True)  # fail fast; held from the end of set-up on
     payload = load_checkpoint(run_dir)
     check_seed_scheme(payload, run_dir)
     check_config(payload, as_saved, run_dir, saved=config_path)

@@ -22,6 +22,7 @@ from tyro.constructors import PrimitiveConstructorSpec
 
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import POSITIONAL
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
 from simoun_agent.run.layout import CHECKPOINT_NAME
@@ -72,6 +73,13 @@ VIDEO_FORMAT = PrimitiveConstructorSpec(
     str_from_instance=lambda value: [] if value is None else [value],
 )
 """``--video`` takes an optional format: gif without one."""
+
+
+OTHER_NAMES = {
+    name: POSITIONAL for name in ("run-dir", "log-dir", "logdir", "checkpoint", "load-path")
+}
+"""Other flags for the run simoun-analyze takes as its positional RUN
+(:mod:`simoun_agent.cli.other_names`)."""
 
 
 @dataclass
@@ -344,7 +352,7 @@ DESCRIPTION = (
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-analyze``."""
-    args = parse(Command, argv, PROG, DESCRIPTION)
+    args = parse(Command, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)
     name = "masks" if isinstance(args, Masks) else "bias"
     try:
         check_device(args.device)

@@ -18,6 +18,7 @@ import tyro
 
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import POSITIONAL
 from simoun_agent.config import SetupError
 from simoun_lab.sweep.report import write_report
 
@@ -35,6 +36,11 @@ DESCRIPTION = (
 
 
 BUDGET = tyro.conf.create_mutex_group(required=False, title="equal budget (one of)")
+
+
+OTHER_NAMES = {name: POSITIONAL for name in ("log-dir", "logdir", "run-dir", "sweep-dir", "runs")}
+"""Other flags for the directory simoun-report takes as its positional DIR
+(:mod:`simoun_agent.cli.other_names`)."""
 
 
 @dataclass
@@ -82,7 +88,7 @@ def budget_of(args: ReportCommand) -> tuple[str, float] | None:
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""
-    args = parse(ReportCommand, argv, PROG, DESCRIPTION)
+    args = parse(ReportCommand, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)
     budget = budget_of(args)
     try:
         written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)

@@ -32,6 +32,7 @@ import tyro
 
 from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import POSITIONAL, Meant
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import (
     check_output_dir,
@@ -61,6 +62,17 @@ full example. A MiniGrid PPO spec (SB3 PPO with or without an intrinsic reward, 
 docs/studies/minigrid-v2/tuning/spec.json) runs the same way:
   simoun-study run docs/studies/minigrid-v2/tuning/spec.json --study-dir runs/minigrid-v2 \\
       --archive docs/studies/minigrid-v2/tuning --resume"""
+
+
+OTHER_NAMES = {
+    "config": POSITIONAL,
+    "spec-file": POSITIONAL,
+    "log-dir": Meant(("--study-dir",), "every run's directory goes under it"),
+    "logdir": Meant(("--study-dir",), "every run's directory goes under it"),
+    "exp-name": Meant(("--study-dir",), "a study is named by its directory"),
+}
+"""Other flags for the spec simoun-study takes as its positional SPEC, and for its
+--study-dir (:mod:`simoun_agent.cli.other_names`)."""
 
 
 @dataclass
@@ -112,7 +124,7 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""
-    args = parse(Command, argv, PROG, DESCRIPTION)
+    args = parse(Command, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)
     # torch comes with the spec readers, imported once the flags are read: --help, --version and
     # a bad flag are answered in about a second
     from simoun_lab.minigrid_study.study_command import is_ppo_spec
@@ -134,6 +146,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"report: {report_study(spec, args.study_dir)}")
             return 0
         options = absolute(args)
+        check_switches(options)
         check_outputs(options)  # before Ray, which takes seconds to import
         ray = load_ray()
         for flag, path in outputs(options).items():
@@ -157,6 +170,18 @@ def ppo_study(args: Plan | Run | Report) -> int:
     options = absolute(args)
     check_outputs(options)
     return study_command.run(spec, options)
+
+
+def check_switches(options: Run) -> None:
+    """Refuse a switch given without the flag it works with: it would be accepted and change
+    nothing."""
+    if options.allow_other_commit and not options.resume:
+        raise SetupError(
+            "--allow-other-commit works only with --resume: it lets a resumed study go on at "
+            "another commit than the one it started from, and a new study starts at this one "
+            "(and records it); add --resume to continue the study in --study-dir, or drop "
+            "--allow-other-commit to start one"
+        )
 
 
 def outputs(options: Run) -> dict[str, Path]:

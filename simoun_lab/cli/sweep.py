@@ -31,7 +31,9 @@ from simoun_agent.cli.config_flags import (
     overrides_from,
 )
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
+from simoun_agent.config.device import same_setting
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import flag_name
 from simoun_agent.run.kept import present
@@ -66,6 +68,24 @@ examples:
 agent recipes (--grid agent.recipe=A,B): {", ".join(RECIPES)}
 
 Each trial runs in SWEEP_DIR/<variant>/<env>/s<seed>, an ordinary run directory."""
+
+
+SEED_LIST = "list the seeds in one word, e.g. --seeds 1,2,3 or a range, --seeds 0-4"
+
+OTHER_NAMES = RUN_CONFIG_NAMES | {
+    "seed": Meant(note=f"a trial has one seed; for several, {SEED_LIST}"),
+    "seeds": Meant(note=SEED_LIST),
+    "envs": Meant(note="list the ids in one word, e.g. --envs highway-v0,merge-v0"),
+    "log-dir": Meant(("--sweep-dir",), "every trial's run directory goes under it"),
+    "logdir": Meant(("--sweep-dir",), "every trial's run directory goes under it"),
+    "exp-name": Meant(("--sweep-dir",), "a sweep is named by its directory"),
+    "local-dir": Meant(("--sweep-dir",)),
+    "storage-path": Meant(("--sweep-dir",)),
+    "num-samples": Meant(("--seeds",), "every variant runs once per seed"),
+}
+"""Other libraries' flags (Ray Tune's too) with what simoun-sweep calls them
+(:mod:`simoun_agent.cli.other_names`); ``seed``, ``seeds`` and ``envs`` say how to give
+several."""
 
 
 @dataclass
@@ -187,7 +207,7 @@ def base_differences(base: dict[str, Any], saved: SweepSpec) -> list[str]:
         mine = plain(value)
         if key in saved.grid:
             theirs = f"{json.dumps(saved.grid[key])} (its --grid)"
-        elif plain(effective.get(key)) != mine:
+        elif not same_setting(key, plain(effective.get(key)), mine):
             theirs = json.dumps(plain(effective.get(key)))
         else:
             continue
@@ -208,7 +228,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         default = SweepCommand(flags=ConfigFlags(config=config_default(argv)))
     except SetupError as err:
         fail(PROG, err)
-    args = parse(SweepCommand, argv, PROG, DESCRIPTION, default, config_switches())
+    args = parse(
+        SweepCommand, argv, PROG, DESCRIPTION, default, config_switches(), other_names=OTHER_NAMES
+    )
     if args.resume and not args.sweep_dir:
         fail(PROG, "--resume needs the --sweep-dir of the sweep")
     stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")

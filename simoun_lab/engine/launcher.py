@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.config.device import device_keys
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import Damaged, present, read_text
 from simoun_lab.engine.trial import SUMMARY, Trial, summary_written
@@ -39,6 +40,7 @@ FILES_KEY = "files_json"
 def changed_keys(saved: dict[str, Any], wanted: dict[str, Any]) -> list[str]:
     """The keys of two specs (as JSON objects) whose values differ: a study refuses to go on
     under another spec, whose runs it would compare with the finished ones."""
+    saved, wanted = device_keys(saved), device_keys(wanted)  # a device however it is spelled
     return [key for key in {**saved, **wanted} if saved.get(key) != wanted.get(key)]
 
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Annotated, Union
 import tyro
 
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.other_names import Meant
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import check_output_dir
 from simoun_lab.minigrid_study.probe_settings import PROBE_NAMES, ProbeSettings
@@ -99,6 +100,17 @@ def check_archive_spec(spec: StudySpec, path: Path, saved: Path) -> None:
         )
 
 
+OTHER_NAMES = {
+    "log-dir": Meant(("--work-dir", "--archive")),
+    "logdir": Meant(("--work-dir", "--archive")),
+    "tensorboard-log": Meant(("--work-dir",)),
+    "n-envs": Meant(("--settings.n-envs",)),
+    "num-envs": Meant(("--settings.n-envs",)),
+}
+"""Other libraries' flags (SB3's, rl-zoo's) with what the study's command line calls them
+(:mod:`simoun_agent.cli.other_names`)."""
+
+
 @dataclass
 class Report:
     """Write the report."""
@@ -155,7 +167,7 @@ DESCRIPTION = (
 
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
-    args = parse(Command, argv, PROG, DESCRIPTION)
+    args = parse(Command, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)
     if isinstance(args, Probe):
         from simoun_lab.minigrid_study.probe_settings import check_probes, check_settings
         from simoun_lab.minigrid_study.spec import MINIGRID_ID

@@ -23,6 +23,7 @@ from matplotlib.ticker import EngFormatter
 
 from simoun_agent import table
 from simoun_agent.config import SetupError
+from simoun_agent.config.device import device_keys
 from simoun_agent.config.rules import is_real
 from simoun_agent.run.checkpoint import atomic_write
 from simoun_agent.run.kept import (
@@ -168,7 +169,7 @@ def check_config(path: Path, spec: StudySpec, run: Run) -> None:
         trained = spec_from_dict(saved, str(path)).to_json()
     except SetupError as err:
         raise damaged(path, f"its spec cannot be read ({err})") from None
-    wanted = spec.to_json()
+    trained, wanted = device_keys(trained), device_keys(spec.to_json())
     changed = sorted(key for key in {**trained, **wanted} if trained.get(key) != wanted.get(key))
     if changed:
         raise damaged(

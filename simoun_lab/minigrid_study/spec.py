@@ -272,12 +272,28 @@ def build(cls: type, values: dict[str, Any], where: str) -> Any:
                 raise SetupError(f"{where}: no {name!r}; give it: {rules[name].need}")
         elif not rules[name].ok(values[name]):
             raise SetupError(
-                f"{where}: {name} is {json.dumps(values[name])}, which must be {rules[name].need}"
+                f"{where}: {name} is {json.dumps(values[name])}, which must be "
+                f"{rules[name].need}{example(cls, f)}"
             )
     try:
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
     except SetupError as err:  # a check of the values together: name the file too
         raise SetupError(f"{where}: {err}") from None
+
+
+def example(cls: type, f: dataclasses.Field) -> str:
+    """``, e.g. "n_steps": 128``: the field's default (a default task's value for a task's
+    field), as JSON; empty when the field's rule gives an example itself."""
+    rule = rules_of(cls)[f.name]
+    if "e.g." in rule.need:
+        return ""
+    if f.default is not dataclasses.MISSING:
+        value = f.default
+    elif f.default_factory is not dataclasses.MISSING:
+        value = f.default_factory()
+    else:
+        value = getattr(default_tasks()[0], f.name)
+    return f", e.g. {json.dumps(f.name)}: {json.dumps(value)}"
 
 
 def spec_from_dict(values: dict[str, Any], where: str) -> StudySpec:

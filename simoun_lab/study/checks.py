@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
+from simoun_agent.config.device import device_keys, same_setting
 from simoun_agent.run.kept import (
     Damaged,
     folder_problem,
@@ -304,7 +305,7 @@ def changes(saved: dict[str, Any], wanted: dict[str, Any]) -> list[str]:
     return [
         f"{key}: {old.get(key)!r} when it ran, {new.get(key)!r} now"
         for key in sorted(set(old) | set(new))
-        if key not in NOT_TRAINING and old.get(key) != new.get(key)
+        if key not in NOT_TRAINING and not same_setting(key, old.get(key), new.get(key))
     ]
 
 
@@ -316,7 +317,8 @@ def check_fixed_spec(
     now be trained otherwise, or an evaluation run whose recipe would be selected from other
     tuning runs or by another rule."""
     saved = StudySpec.from_json(record["spec"])
-    old, new = saved.to_json(), spec.to_json()  # a key added since the record: its default
+    # a key added since the record: its default; a device however it is spelled
+    old, new = device_keys(saved.to_json()), device_keys(spec.to_json())
     changed = [key for key in {**old, **new} if old.get(key) != new.get(key)]
     if not changed:
         return []

@@ -186,6 +186,42 @@ def duration(seconds: float) -> str:
     return f"{seconds / 60:.1f} min" if seconds < 5400 else f"{seconds / 3600:.1f} h"
 
 
+def sparse_evaluation_notes(spec: StudySpec) -> list[str]:
+    """A note for each phase and task whose runs evaluate less often than their budget (an
+    ``eval_every`` beyond ``env_steps``): simoun-train then evaluates only at step 0 and at the
+    end, which the spec may mean (a final score) or not (a learning curve, an area under it)."""
+    from simoun_lab.study.checks import key_place  # it reads the plan: imported when needed
+
+    notes = []
+    for phase in (spec.tuning, spec.evaluation):
+        for task in phase.tasks:
+            steps = phase.env_steps[task]
+            seed = phase.seeds[task][0]
+            every = {
+                resolve(spec.preset, spec.overrides(recipe, task, setting, seed, steps)).eval_every
+                for recipe in spec.recipes
+                for setting in spec.settings()
+            }
+            if max(every) <= steps:
+                continue
+            place = key_place(spec, task, "eval_every")
+            said = _table(place) if place else "the preset's default"
+            reads = f"; the {spec.selection} selection rule reads" if phase is spec.tuning else ""
+            notes.append(
+                f"note: the {phase.name} runs on {env_label(task)} evaluate every "
+                f"{max(every)} env steps ({said}), more than their {steps}: each is evaluated "
+                f"only at step 0 and at the end{reads and reads + ' those two points'}; for a "
+                f"learning curve, give an eval_every below {steps}"
+            )
+    return notes
+
+
+def _table(place: tuple[str, ...]) -> str:
+    """``("tasks", "x", "eval_every")`` -> ``eval_every in [tasks."x"]``."""
+    table = f'[tasks."{place[1]}"]' if place[0] == "tasks" else f"[{place[0]}]"
+    return f"eval_every in {table}"
+
+
 def describe(spec: StudySpec, spec_path: str, updates: int) -> str:
     """``simoun-study plan``: every run of both phases (phase, task, recipe, setting, seed,
     env steps) with its estimated CPU time, and the totals; ``updates`` 0: no estimate."""
@@ -225,6 +261,7 @@ def describe(spec: StudySpec, spec_path: str, updates: int) -> str:
         f"runs: {len(tuning)} tuning + {len(evaluation)} evaluation = {len(runs)}"
         + (f" ({diagnostic} of the evaluation runs are diagnostics)" if diagnostic else ""),
     ]
+    lines += sparse_evaluation_notes(spec)
     if spec.generalization:
         lines.append(
             "after training, each evaluation run's final agent plays "

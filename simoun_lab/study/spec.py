@@ -42,6 +42,10 @@ printed without a traceback). The layout (``docs/studies/dmc100k.toml`` is a ful
     modes = ["color_hard", "video_hard"]       # played on distraction modes (and ``train``)
     episodes = 10                              # on the run's evaluation seeds
 
+A config key is given in one place: [base] for every run, [grid] to tune it, or the tasks'
+tables per task (a run takes [base], then its task's table, then its grid setting, so a key in
+two of them would drop one value without a word).
+
 A grid key that a recipe fixes (drqv2's ``n_step = 3``) is refused, unless the top-level
 ``grid_overrides = ["agent.n_step"]`` names it and the grid offers the recipe's own value: then
 every recipe is tuned over the same values and the recipe as published is one of its settings.
@@ -71,6 +75,7 @@ from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.given_path import blanks_note, shown
 from simoun_lab.study.record_file import record_not_spec
 from simoun_lab.study.selection import SELECTION_RULES
+from simoun_lab.study.spec_kinds import kind_problem
 from simoun_lab.study.toml_lines import key_line
 from simoun_lab.sweep.grid import MAX_SEEDS, close_key_here, parse_seeds
 
@@ -363,6 +368,9 @@ class _Reader:
 
     def spec(self, data: dict[str, Any], name: str) -> StudySpec:
         self.check_keys(data, ())
+        wrong_kind = kind_problem(data)
+        if wrong_kind:
+            raise self.fail(*wrong_kind)
         missing = [key for key in REQUIRED if key not in data]
         if missing:
             raise SetupError(
@@ -407,7 +415,9 @@ class _Reader:
         tuning = self.phase(data["tuning"], "tuning")
         evaluation = self.phase(data["evaluation"], "evaluation")
         self.disjoint(tuning, evaluation)
-        task_config = self.tasks(data.get("tasks", {}), tuning, evaluation, every, preset, base)
+        task_config = self.tasks(
+            data.get("tasks", {}), tuning, evaluation, every, preset, base, grid
+        )
         resources = self.resources(data.get("resources", {}))
         modes, episodes = self.generalization(data.get("generalization"), evaluation)
         spec = StudySpec(
@@ -610,7 +620,12 @@ class _Reader:
             self.check_config_key(key, path, [], "[grid]")
             if key in base:
                 line = key_line(self.source.text, ("base", *key.split(".")))
-                raise self.fail(path, f"{key} is in [base] too (line {line}); keep it in one place")
+                raise self.fail(
+                    path,
+                    f"{key} is in [base] too (line {line}), and the grid's values would override "
+                    "it in every run; set it in one place only: in [grid] to tune it, or in "
+                    "[base] to fix it",
+                )
             if not isinstance(values, list) or not values:
                 example = self.example_value(key, values, path, preset, base)
                 raise self.fail(
@@ -724,6 +739,7 @@ class _Reader:
         recipes: list[str],
         preset: str | None,
         base: dict[str, Any],
+        grid: dict[str, list],
     ) -> dict[str, dict]:
         used = list(dict.fromkeys(tuning.tasks + evaluation.tasks))
         config = {}
@@ -736,14 +752,36 @@ class _Reader:
         ):
             extras = self.config_table(self.table(extras, where), where, recipes)
             for key in extras:
-                if key in base:
-                    raise self.fail(
-                        (*where, *key.split(".")),
-                        f"{key} is in [base] too; keep it in one place",
-                    )
+                self.set_once(key, where, base, grid)
             self.resolves(preset, {**base, "env": task, **extras}, where)
             config[task] = extras
         return config
+
+    def set_once(
+        self, key: str, where: tuple[str, ...], base: dict[str, Any], grid: dict[str, list]
+    ) -> None:
+        """Refuse a per-task ``key`` that [base] or [grid] sets too: a run takes [base], then its
+        task's table, then its grid setting, so one of the two values would be dropped without
+        a word (a gridded key would override every task's own value)."""
+        task = f'[tasks."{where[1]}"]'
+        for table, values, dropped, there in (
+            ("base", base, "[base]'s value is then used for no run of this task", "for every task"),
+            (
+                "grid",
+                grid,
+                f"the grid's values override {task}'s in every run of the task",
+                "to tune it on every task",
+            ),
+        ):
+            if key not in values:
+                continue
+            line = key_line(self.source.text, (table, *key.split(".")))
+            raise self.fail(
+                (*where, *key.split(".")),
+                f"{key} is set in [{table}] too (line {line}), and {dropped}; set it in one "
+                f"place only: in [{table}] {there}, or in each task's table (and drop it from "
+                f"[{table}])",
+            )
 
     def resources(self, value: Any) -> dict[str, Any]:
         where = ("resources",)

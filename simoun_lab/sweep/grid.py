@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from simoun_agent.config import SetupError, TrainConfig, resolve, to_dict
+from simoun_agent.config.device import same_setting
 from simoun_agent.config.envs import env_label
 from simoun_agent.config.key_match import close_keys
 from simoun_agent.config.keys import HELP_FIX, close_match, config_fields, parse_value
@@ -529,7 +530,7 @@ def trial_problem(trial: Trial, grid: dict[str, list[Any]]) -> str | None:
     saved = flatten(record)
     for key in ("env", "seed", *grid):
         recorded, wanted = _plain(saved.get(key)), _plain(trial.overrides[key])
-        if key in saved and recorded != wanted:
+        if key in saved and not same_setting(key, recorded, wanted):
             return (
                 f"{CONFIG_NAME} records {key} {show(recorded)}, but the sweep's trial "
                 f"{trial.name} has {show(wanted)}: it is another run's config"
@@ -558,7 +559,9 @@ def config_differences(trial: Trial) -> dict[str, tuple[Any, Any]]:
     return {
         key: (_plain(saved[key]), _plain(value))
         for key, value in wanted.items()
-        if key in saved and key not in RESUMED_AS_GIVEN and _plain(saved[key]) != _plain(value)
+        if key in saved
+        and key not in RESUMED_AS_GIVEN
+        and not same_setting(key, _plain(saved[key]), _plain(value))
     }
 
 
@@ -654,7 +657,7 @@ def check_runnable(
             try:
                 made[env] = check_task(config)
             except SetupError as err:
-                raise SetupError(f"{envs_flag} {trial.env}: {err}") from None
+                raise task_refusal(trial, err, envs_flag, grid) from None
         try:
             check_trial_config(config, grid)
             check_decisions(config, made[env])  # the action repeat may differ by trial
@@ -678,24 +681,62 @@ def check_runnable(
                     print(f"simoun-sweep: warning: trial {trial.name}: {said}", file=sys.stderr)
 
 
+ENV_KEYS = ("env_module", "env_kwargs", "cameras", "action_repeat")
+"""Config keys that change how a trial's env is made or stepped: a task refused with one of
+them from ``--grid``, and made without it, is refused for that grid value, not for ``--envs``."""
+
+DROP_MODULE = ", or drop the module from --env"
+"""The fix a refused module is given when it came with ``--env MODULE:ID``."""
+
+
+def task_refusal(
+    trial: Trial, err: SetupError, envs_flag: str, grid: dict[str, list[Any]]
+) -> SetupError:
+    """The refusal of ``trial``'s task (``err``, from making it): for the grid value of an env
+    setting (:data:`ENV_KEYS`) without which the task is made, that value and the fix in
+    ``--grid``; else the task, as ``envs_flag`` gave it."""
+    from simoun_agent.run.make_env import check_task
+
+    for key in ENV_KEYS:
+        if key not in grid:
+            continue
+        without = {k: v for k, v in trial.overrides.items() if k != key}
+        try:
+            check_task(resolve(trial.preset, without))
+        except SetupError:
+            continue
+        said = str(err).replace(DROP_MODULE, "")
+        return SetupError(f"trial {trial.name}: {said}; {value_note(key, trial, grid[key])}")
+    return SetupError(f"{envs_flag} {trial.env}: {err}")
+
+
 def grid_note(said: str, trial: Trial, grid: dict[str, list[Any]]) -> str:
     """For each ``grid`` key whose flag the message ``said`` about ``trial`` names (its fix
     advises ``--action-repeat 40``), the note that the trial's value came from ``--grid`` and
-    that the fix goes there: the key's base flag is refused beside ``--grid``. Empty when the
-    message names no gridded key."""
-    notes = []
-    for key, values in grid.items():
-        flag = "--" + key.replace("_", "-")
-        if re.search(re.escape(flag) + r"(?![\w.-])", said) is None:
-            continue
-        value = show(trial.overrides[key])
-        given = f"{key}={','.join(show(v) for v in values)}"
-        notes.append(
-            f"{flag} {value} is this trial's value from --grid {given}: make the fix in "
-            f"--grid (leave {value} out of its values, or replace it by a value that works), "
-            f"not as a base {flag}, which --grid refuses beside it"
-        )
+    that the fix goes there (:func:`value_note`). Empty when the message names no gridded key."""
+    notes = [
+        value_note(key, trial, values)
+        for key, values in grid.items()
+        if re.search(re.escape(key_flag(key)) + r"(?![\w.-])", said) is not None
+    ]
     return "".join(f"; {note}" for note in notes)
+
+
+def key_flag(key: str) -> str:
+    """``agent.n_step`` -> ``--agent.n-step``."""
+    return "--" + key.replace("_", "-")
+
+
+def value_note(key: str, trial: Trial, values: list[Any]) -> str:
+    """The note that ``trial``'s value of ``key`` came from ``--grid`` (of ``values``) and that
+    the fix goes there: the key's base flag is refused beside ``--grid``."""
+    flag, value = key_flag(key), show(trial.overrides[key])
+    given = f"{key}={','.join(show(v) for v in values)}"
+    return (
+        f"{flag} {value} is this trial's value from --grid {given}: make the fix in "
+        f"--grid (leave {value} out of its values, or replace it by a value that works), "
+        f"not as a base {flag}, which --grid refuses beside it"
+    )
 
 
 def check_trial_config(config: TrainConfig, grid: dict[str, list[Any]]) -> None:

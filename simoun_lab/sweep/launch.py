@@ -18,6 +18,7 @@ from types import ModuleType
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.config.device import device_key
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import present
 from simoun_lab.engine.launcher import run_trials
@@ -39,7 +40,7 @@ def gpus_per_trial(ray: ModuleType, wanted: str, device: str | None) -> float:
                 "but the Ray cluster has no GPU (so gpus_per_trial auto gives them none); train "
                 "on device cpu, or run on a cluster with GPUs"
             )
-        return 1.0 if has_gpus and device not in ("cpu", "mps") else 0.0
+        return 1.0 if has_gpus and device_key(device) not in ("cpu", "mps") else 0.0
     return gpus
 
 

@@ -742,7 +742,8 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
         if damaged and all(line.endswith(MINIGRID_RUN) for line in damaged):
             raise SetupError(
                 f"{root} holds runs of the MiniGrid study, which simoun-report does not read; "
-                f"report them with `python -m simoun_lab.minigrid_study report --archive {root}`"
+                "report them with `python -m simoun_lab.minigrid_study report --archive "
+                f"{minigrid_archive(root)}`"
             )
         if damaged:
             raise SetupError(
@@ -1131,6 +1132,18 @@ def _improvement_table(improvements: list[dict[str, Any]]) -> list[str]:
 AGGREGATE_COLUMNS = ["variant", "tasks", "runs", "iqm", "iqm_low", "iqm_high", "mean", "mean_low"]
 AGGREGATE_COLUMNS += ["mean_high"]
 IMPROVEMENT_COLUMNS = ["x", "y", "tasks", "p", "low", "high"]
+
+
+def minigrid_archive(root: Path) -> Path:
+    """The archive of the MiniGrid study whose runs lie under ``root``: ``root`` when it keeps
+    the study's spec, else the archive it lies inside (``root`` a task folder of it), which the
+    MiniGrid study's report takes; ``root`` when it lies in none."""
+    from simoun_lab.study.owner import enclosing_study, minigrid_study
+
+    found = enclosing_study(root)
+    if minigrid_study(root) is None and found is not None and minigrid_study(found[0]):
+        return found[0]
+    return root
 
 
 def refuse_study(root: Path) -> None:
