@@ -206,7 +206,8 @@ ELEVENTH_CODES = [
     (f"v = gym.wrappers.vector.RescaleAction(w.ConstantBonusVectorReward({PEND}, 0.1), -1.0, "
      "1.0); " + STEPS3, ""),
     (f"v = w.ConstantBonusVectorReward(gym.wrappers.vector.TransformObservation({PEND}, "
-     "lambda o: {'frames': o['frames'][:, -1]}), 0.1)", ("frames", "TransformObservation")),
+     "lambda o: {'frames': o['frames'][:, -1]}), 0.1); " + STEPS3,
+     ("frames", "TransformObservation")),
     (NOV + f"w.RNDReward({S}, nov, normalization='ReturnStd')", "return_std"),
     # the normalisations called directly, as their examples call them
     (NORM + "RewardStd()(np.array([1.0, 3.0]))", ("extrinsic", "counted")),
