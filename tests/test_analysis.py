@@ -378,7 +378,11 @@ OBSERVATIONS = np.random.default_rng(0).integers(0, 256, (4, 3, 3, 32, 32), dtyp
             ValueError,
             r"channel-last.*permute\(0, 1, 4, 2, 3\)",
         ),
-        (OBSERVATIONS[:, 1:], ValueError, r"\(2 frames of 3 x 32 x 32\) do not fit"),
+        (
+            OBSERVATIONS[:, 1:],
+            ValueError,
+            r"\(2 frames of 3 x 32 x 32\) do not fit.*needs 3 frames",
+        ),
         (OBSERVATIONS[..., :16, :16], ValueError, r"3 x 16 x 16\) do not fit.*observation_space"),
         (OBSERVATIONS[:0], ValueError, r"holds no observation"),
         ([[1, 2]], TypeError, r"must be a uint8 array \(N, k, C, H, W\)"),

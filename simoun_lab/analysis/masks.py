@@ -59,7 +59,7 @@ def structure_masks(
     check_encoder(encoder, "structure_masks")
     check_batch_size(batch_size, "structure_masks")
     batch = observation_batch(observations, "structure_masks")
-    check_fits(encoder, batch, "structure_masks", lambda encoder, x: encoder(x))
+    check_fits(encoder, batch, "structure_masks")
     device = next(encoder.parameters()).device
     parts: list[StructureMasks] = []
     with torch.inference_mode():

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -156,15 +156,25 @@ def observation_batch(
     return batch
 
 
-def check_fits(encoder: PixelEncoder, batch: torch.Tensor, function: str, forward: Any) -> None:
+def check_fits(
+    encoder: PixelEncoder,
+    batch: torch.Tensor,
+    function: str,
+    layers: Callable[[PixelEncoder, torch.Tensor], object] | None = None,
+) -> None:
     """A ValueError naming ``function``'s ``observations`` when their frames do not fit
     ``encoder`` (another frame count, channel count or size than the run's), found on one
-    observation before the whole batch goes through ``forward(encoder, observations)``."""
+    observation through the encoder, and ``layers(encoder, observations)`` when given, before
+    the whole batch goes through them."""
     shape = tuple(batch.shape)
     device = next(encoder.parameters()).device
+    one = batch[:1].to(device)
     try:
         with torch.inference_mode():
-            forward(encoder, batch[:1].to(device))
+            # the encoder's own checks first: they name what it reads (the dual's three frames)
+            encoder(one)
+            if layers is not None:
+                layers(encoder, one)
     except (RuntimeError, IndexError, ValueError) as error:
         reason = str(error).splitlines()[0][:200]
         raise ValueError(
