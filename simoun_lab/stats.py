@@ -4,8 +4,9 @@ the edge of the statistical precipice", the ``rliable`` package) define them, in
 Scores are given per task as ``{task: array of runs}`` (one score per seed), normalized by the
 task's maximum return (:func:`normalize`). Tasks may have different numbers of runs. Every
 function checks its arguments: a task with no runs, a NaN or infinite score, learning curves
-``(runs, steps)`` where final scores go (or the reverse) and a non-integer ``reps`` or ``seed``
-are refused with a ValueError or TypeError that names the argument and a fix.
+``(runs, steps)`` where final scores go (or the reverse), runs of different lengths, replicates
+that are no resamples and a non-integer ``reps`` or ``seed`` are refused with a ValueError or
+TypeError that names the argument and a fix.
 
 - :func:`iqm` / :func:`aggregate_iqm`: the interquartile mean, the 25 % trimmed mean over all
   runs (of all tasks): robust to one outlying seed, less noisy than the median.
@@ -27,6 +28,7 @@ an rliable call both give the same resamples and the same intervals (tests/test_
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -53,10 +55,28 @@ def _kind(value: object) -> str:
     return f"{type(value).__name__} {value!r}"[:120]
 
 
+def _lengths(values: object) -> list[int] | None:
+    """The lengths of the entries of a list or tuple of sequences, None for anything else."""
+    if not isinstance(values, list | tuple) or not values:
+        return None
+    if not all(hasattr(entry, "__len__") and not isinstance(entry, str) for entry in values):
+        return None
+    return [len(entry) for entry in values]
+
+
 def _numbers(values: object, where: str) -> np.ndarray:
-    """``values`` as a float array; a TypeError naming ``where`` when they are not numbers."""
+    """``values`` as a float array; a TypeError naming ``where`` when they are not numbers, a
+    ValueError when its rows (runs) are of different lengths."""
     if isinstance(values, Mapping | str | bytes):
         raise TypeError(f"{where} must be an array of numbers, got {_kind(values)}")
+    lengths = _lengths(values)
+    if lengths is not None and len(set(lengths)) > 1:
+        raise ValueError(
+            f"{where} has runs of different lengths ({lengths} values), so they make no array: "
+            f"every run needs a value at every evaluation step; cut them to the shortest, e.g. "
+            f"np.stack([np.asarray(run)[:{min(lengths)}] for run in runs]), or evaluate the runs "
+            "at the same steps"
+        )
     try:
         array = np.asarray(values, dtype=float)
     except (TypeError, ValueError) as error:
@@ -91,13 +111,23 @@ _SHAPES = {
 }
 
 
-def _shape_hint(ndim: int | None, got: int, function: str, argument: str) -> str:
-    """The fix for a task whose array has ``got`` dimensions where ``ndim`` go."""
-    if ndim == 1 and got == 2:
+def _shape_hint(ndim: int | None, shape: tuple[int, ...], function: str, argument: str) -> str:
+    """The fix for a task whose array has the ``shape`` given where ``ndim`` dimensions go."""
+    got = len(shape)
+    if ndim == 1 and got == 2 and shape[1] == 1:
         return (
-            "this looks like learning curves (runs, steps); pass each run's final score, e.g. "
-            f"{{task: np.asarray(c)[:, -1] for task, c in {argument}.items()}}, or use "
-            "iqm_over_steps for the curves"
+            "one score per run is a 1-D array, e.g. "
+            f"{{task: np.ravel(r) for task, r in {argument}.items()}}"
+        )
+    if ndim == 1 and got == 2:
+        runs, columns = shape
+        return (
+            f"if these are learning curves of {runs} runs over {columns} steps, pass each run's "
+            f"final score, e.g. {{task: np.asarray(c)[:, -1] for task, c in "
+            f"{argument}.items()}}, or use iqm_over_steps for the curves; if it is rliable's "
+            f"matrix of {runs} runs x {columns} tasks, give each task its own key, e.g. "
+            f"{{name: m[:, j] for j, name in enumerate(task_names)}}, or use iqm(m) for the IQM "
+            "of the whole matrix"
         )
     if ndim == 2 and got == 1:
         return (
@@ -122,7 +152,7 @@ def _task_runs(
     if (ndim is None and array.ndim == 0) or (ndim is not None and array.ndim != ndim):
         raise ValueError(
             f"{where} must be {_SHAPES[ndim]}, got shape {array.shape}; "
-            f"{_shape_hint(ndim, array.ndim, function, argument)}"
+            f"{_shape_hint(ndim, array.shape, function, argument)}"
         )
     if array.size == 0:
         raise ValueError(
@@ -249,7 +279,9 @@ def max_return(env_id: str) -> float | None:
 
 def normalize(env_id: str, returns: np.ndarray) -> np.ndarray:
     """``returns`` divided by the task's maximum return (:data:`NORMALIZERS`); unchanged (as
-    float) for envs without a known maximum.
+    float) for envs without a known maximum. A task key in the env id's place
+    (``'cheetah-run'``) and a return above the task's maximum (returns summed over episodes)
+    are refused: either would pass for a normalized score.
 
     >>> normalize("dm_control/walker-walk-v0", np.array([500.0, 1000.0]))
     array([0.5, 1. ])
@@ -259,8 +291,57 @@ def normalize(env_id: str, returns: np.ndarray) -> np.ndarray:
             f"normalize takes (env_id, returns), got the returns first: env_id={_kind(env_id)}, "
             f"returns={returns!r}; e.g. normalize({returns!r}, returns)"
         )
-    maximum = max_return(env_id) or 1.0
-    return _numbers(returns, "normalize: returns") / maximum
+    maximum = max_return(env_id)
+    values = _numbers(returns, "normalize: returns")
+    if maximum is None:
+        _refuse_unknown_id(env_id)
+        return values
+    above = values > maximum * (1 + 1e-9)
+    if above.any():
+        first = tuple(int(i) for i in np.argwhere(above)[0])
+        index = first[0] if len(first) == 1 else first
+        raise ValueError(
+            f"normalize: returns of {env_id} must be at most its maximum return {maximum:g} "
+            f"(NORMALIZERS), got {values[first]:g} at index {index}; "
+            "a return above it is not one episode's return (often returns summed over several "
+            "episodes, or rewards scaled upstream); pass each episode's return, e.g. the mean "
+            "return of a run's evaluation episodes"
+        )
+    return values / maximum
+
+
+GYMNASIUM_ID = re.compile(r"^(?:[\w.-]+:)?(?:[\w.-]+/)?[\w.:-]+-v\d+$")
+"""A Gymnasium env id: ``[module:][namespace/]name-vN``."""
+
+
+def _refuse_unknown_id(env_id: str) -> None:
+    """A ValueError for an ``env_id`` without a known maximum that is no env id (a task key
+    such as ``'cheetah-run'``: no version, namespace or module, not registered) or that names
+    the task of an id with one (``'cheetah-run-v0'`` for ``'dm_control/cheetah-run-v0'``):
+    dividing its returns by 1 would pass raw returns for normalized scores. The ids of other
+    envs (Pendulum-v1, highway-fast-v0, MODULE:ID) keep their raw returns."""
+    import difflib
+
+    import gymnasium as gym
+
+    from simoun_agent.config.envs import PAPER_ACTION_REPEAT, env_label
+
+    known = [f"dm_control/{task}-v0" for task in PAPER_ACTION_REPEAT]
+    known += [name for name in gym.registry if max_return(name) is not None]
+    label = env_label(env_id).rsplit("-v", 1)[0]
+    same = [name for name in known if env_label(name).rsplit("-v", 1)[0] == label]
+    named = GYMNASIUM_ID.match(env_id) or "/" in env_id or ":" in env_id
+    if not same and (named or env_id in gym.registry):
+        return
+    close = same or difflib.get_close_matches(env_id, known, n=3, cutoff=0.5)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ValueError(
+        f"normalize: {env_id!r} is not an env id it knows the maximum return of, and its returns "
+        f"would be passed on unchanged as normalized scores; {hint}give the Gymnasium env id: "
+        f"the maximum is known for ids starting with {', '.join(map(repr, NORMALIZERS))} (e.g. "
+        "'dm_control/cheetah-run-v0'); ids of other envs (e.g. 'Pendulum-v1') keep their raw "
+        "returns"
+    )
 
 
 def _trimmed_mean(values: np.ndarray) -> np.ndarray:
@@ -367,10 +448,42 @@ def percentile_interval(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The percentile bootstrap interval of ``replicates`` along axis 0: the (1 - c) / 2 and
     (1 + c) / 2 quantiles (linear interpolation, as rliable through ``arch``)."""
+    values = _replicates(replicates)
     confidence = _confidence(confidence)
     alpha = (1.0 - confidence) / 2
-    low, high = np.percentile(replicates, [100 * alpha, 100 * (1.0 - alpha)], axis=0)
+    low, high = np.percentile(values, [100 * alpha, 100 * (1.0 - alpha)], axis=0)
     return low, high
+
+
+def _replicates(replicates: object) -> np.ndarray:
+    """:func:`percentile_interval`'s replicates checked: numbers, one resample per row, at least
+    one, all finite; an interval (point, low, high) given in their place is refused."""
+    example = "percentile_interval(bootstrap_replicates(scores, aggregate_iqm))"
+    if (
+        isinstance(replicates, tuple)
+        and len(replicates) == 3
+        and all(np.ndim(part) == 0 for part in replicates)
+    ):
+        raise TypeError(
+            "percentile_interval: replicates must be the statistic of each bootstrap resample "
+            f"(an array, one row per resample), got the tuple {replicates!r:.120}, which is an "
+            "interval (point, low, high) as stratified_bootstrap_ci returns it: its low and high "
+            f"are the interval already; for the replicates use e.g. {example}"
+        )
+    values = _numbers(replicates, "percentile_interval: replicates")
+    if values.ndim == 0 or len(values) == 0:
+        raise ValueError(
+            f"percentile_interval: replicates must hold at least one resample's statistic "
+            f"(one row per resample), got shape {values.shape}; e.g. {example}"
+        )
+    _finite(
+        values,
+        "percentile_interval: replicates",
+        "np.asarray(replicates)[np.isfinite(replicates)], after finding why the statistic gave "
+        "them",
+        "a NaN replicate would shift both bounds silently",
+    )
+    return values
 
 
 def stratified_bootstrap_ci(

@@ -1,6 +1,9 @@
 """Where a public name of the project's packages is defined, for the packages' ``__getattr__``:
 ``from simoun_wrappers import SimounParallelObservation`` names the module to import it from
-(``simoun_wrappers.pettingzoo``), where Python's own ImportError names only the package.
+(``simoun_wrappers.pettingzoo``), where Python's own ImportError names only the package. Every
+package with submodules, subpackages included (``from simoun_lab.analysis import
+layer_activations`` names ``simoun_lab.analysis.layers``), defines
+``__getattr__(name)`` as ``raise missing_name(__name__, name)``.
 
 The modules are read as source (``ast``), never imported: asking ``simoun_wrappers`` for a name
 must not import torch or PettingZoo."""
@@ -14,6 +17,14 @@ from pathlib import Path
 
 PACKAGES = ("simoun_wrappers", "simoun_agent", "simoun_lab")
 """The packages searched, after the one asked."""
+
+
+def search_order(package: str) -> tuple[str, ...]:
+    """The packages searched for a name that ``package`` lacks: itself (a subpackage such as
+    ``simoun_lab.analysis`` first, for the names of its own submodules), then its top-level
+    package, then the other packages."""
+    top = package.partition(".")[0]
+    return tuple(dict.fromkeys((package, top, *PACKAGES)))
 
 
 def defined_names(tree: ast.Module) -> set[str]:
@@ -80,7 +91,7 @@ def missing_name(package: str, name: str) -> Exception:
     if name.startswith("_") or is_submodule(package, name):
         # an AttributeError lets ``from package import submodule`` import the submodule
         return plain
-    for searched in (package, *(other for other in PACKAGES if other != package)):
+    for searched in search_order(package):
         module = homes(searched).get(name)
         if module is not None and module != package:
             return ImportError(

@@ -355,3 +355,81 @@ def test_the_run_functions_check_their_arguments_and_name_a_swap():
     ):
         replay_recoloured(agent, 0, np.zeros((1, 1)), np.random.default_rng(0))
     assert play_episode(agent, env, 0).length > 0
+
+
+def small_encoder():
+    config = AgentConfig(encoder="dual_interactive", num_filters=4, feature_dim=8)
+    return make_encoder(config, (3, 32, 32))
+
+
+OBSERVATIONS = np.random.default_rng(0).integers(0, 256, (4, 3, 3, 32, 32), dtype=np.uint8)
+"""Four observations of three 3 x 32 x 32 uint8 frames, as the env gives them."""
+
+
+@pytest.mark.parametrize(
+    ("observations", "error", "message"),
+    [
+        (torch.rand(OBSERVATIONS.shape), TypeError, r"must be uint8 pixels.*got torch\.float32"),
+        (OBSERVATIONS.astype(np.float32) / 255, TypeError, r"uint8 pixels.*got float32"),
+        (OBSERVATIONS[0], ValueError, r"got shape \(3, 3, 32, 32\).*observations\[None\]"),
+        (OBSERVATIONS[0, 0], ValueError, r"this is one frame \(C, H, W\)"),
+        (
+            OBSERVATIONS.transpose(0, 1, 3, 4, 2),
+            ValueError,
+            r"channel-last.*permute\(0, 1, 4, 2, 3\)",
+        ),
+        (
+            OBSERVATIONS[:, 1:],
+            ValueError,
+            r"\(2 frames of 3 x 32 x 32\) do not fit.*needs 3 frames",
+        ),
+        (OBSERVATIONS[..., :16, :16], ValueError, r"3 x 16 x 16\) do not fit.*observation_space"),
+        (OBSERVATIONS[:0], ValueError, r"holds no observation"),
+        ([[1, 2]], TypeError, r"must be a uint8 array \(N, k, C, H, W\)"),
+    ],
+)
+@pytest.mark.parametrize("function", [layer_activations, mask_pictures.structure_masks])
+def test_the_layer_functions_check_their_observations_against_the_encoder(
+    function, observations, error, message
+):
+    with pytest.raises(error, match=rf"{function.__name__}\(observations=\.\.\.\).*{message}"):
+        function(small_encoder(), observations)
+
+
+def test_the_layer_functions_take_numpy_or_torch_observations_and_check_batch_size():
+    encoder = small_encoder()
+    from_numpy = layer_activations(encoder, OBSERVATIONS, batch_size=3)
+    from_torch = layer_activations(encoder, torch.as_tensor(OBSERVATIONS))
+    assert all(torch.allclose(from_numpy[n], from_torch[n], atol=1e-5) for n in from_torch)
+    assert len(mask_pictures.structure_masks(encoder, torch.as_tensor(OBSERVATIONS)).motion) == 4
+    with pytest.raises(
+        ValueError, match=r"layer_activations\(batch_size=\.\.\.\) must be an int >= 1"
+    ):
+        layer_activations(encoder, OBSERVATIONS, batch_size=0)
+    with pytest.raises(TypeError, match=r"structure_masks\(batch_size=\.\.\.\)"):
+        mask_pictures.structure_masks(encoder, OBSERVATIONS, batch_size=2.5)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "error", "message"),
+    [
+        ({"observations": OBSERVATIONS / 255.0}, TypeError, r"observations=\.\.\.\) must be uint8"),
+        ({"observations": OBSERVATIONS[0, 0]}, ValueError, r"one frame \(C, H, W\)"),
+        ({"observations": OBSERVATIONS[:, :1]}, ValueError, r"need k >= 2 frames"),
+        ({"seed": -1}, ValueError, r"make_pairs\(seed=\.\.\.\) must be an int in \[0, 2\*\*63\)"),
+        ({"seed": 0.5}, TypeError, r"make_pairs\(seed=\.\.\.\)"),
+        ({"recoloured": OBSERVATIONS[:2]}, ValueError, r"recoloured=\.\.\.\) must hold one recol"),
+        ({"recoloured": OBSERVATIONS / 255.0}, TypeError, r"recoloured=\.\.\.\) must be uint8"),
+    ],
+)
+def test_make_pairs_checks_its_arguments(arguments, error, message):
+    with pytest.raises(error, match=message):
+        make_pairs(**{"observations": OBSERVATIONS, "seed": 0, **arguments})
+
+
+def test_make_pairs_takes_torch_observations_and_the_estimator_detaches_activations():
+    pairs = make_pairs(torch.as_tensor(OBSERVATIONS), seed=0)
+    assert pairs["static"][1].shape == OBSERVATIONS.shape
+    z = torch.as_tensor(np.random.default_rng(0).normal(size=(50, 4))).requires_grad_()
+    estimate = information_bias({"dynamic": (z, z * 2), "static": (z, -z)})
+    assert estimate.categories["dynamic"] == 4

@@ -352,8 +352,47 @@ def test_a_budget_that_leaves_every_run_out_is_refused_naming_the_steps_the_runs
     assert "the runs evaluate at 40, 60, 80, 120" in message
     assert "e.g. --at-step 120" in message
     assert not (tmp_path / "at-25").exists()
-    with pytest.raises(report.SetupError, match="--at-step 200 leaves every run out"):
+    # from Python the budget is named as the argument it is, and so is the fix
+    with pytest.raises(report.SetupError) as err:
         report.write_report(root, tmp_path / "at-200", budget=("env_step", 200))
+    assert str(err.value).startswith("budget=('env_step', 200) leaves every run out")
+    assert "e.g. budget=('env_step', 120), or pass budget=None" in str(err.value)
+    assert "--at-step" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("budget", "error", "message"),
+    [
+        (("env_steps", 40), ValueError, "got 'env_steps'; did you mean 'env_step'?"),
+        (("env_step", "40"), TypeError, r"budget's value must be a number \(env steps\), got str"),
+        (40, TypeError, r"budget must be None or a pair \(column, value\), got int 40"),
+        (("env_step",), TypeError, r"budget must be None or a pair \(column, value\), got tuple"),
+        ("env_step", TypeError, r"budget must be None or a pair \(column, value\), got str"),
+        (
+            ("env_step", -5),
+            ValueError,
+            r"budget=\('env_step', -5\): give a number of env steps >= 0",
+        ),
+        (("wall_time_s", float("nan")), ValueError, "give a positive finite number of seconds"),
+        (("wall_time_s", 0), ValueError, "give a positive finite number of seconds"),
+    ],
+)
+def test_a_budget_from_python_is_checked_in_python_terms(
+    runs_dir, tmp_path, budget, error, message
+):
+    with pytest.raises(error, match=message) as err:
+        report.write_report(runs_dir, tmp_path / "out", budget=budget)
+    assert "--at-" not in str(err.value) and "budget" in str(err.value)
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_report_root_must_be_one_directory(runs_dir, tmp_path):
+    with pytest.raises(TypeError, match=r"write_report\(root=\.\.\.\) must be one directory"):
+        report.write_report([str(runs_dir)], tmp_path / "out")
+    with pytest.raises(TypeError, match=r"write_report\(out=\.\.\.\) must be a path"):
+        report.write_report(runs_dir, ["out"])
+    with pytest.raises(TypeError, match=r"root must be one directory"):
+        report.compare_runs([runs_dir])
 
 
 def test_a_row_holds_runs_of_one_evaluation_grid(runs_dir, grid_run, tmp_path):
@@ -385,9 +424,11 @@ def test_at_wall_time_uses_the_last_evaluation_within_it_of_runs_that_trained_pa
     assert float(row["final_return_mean"]) == pytest.approx(evaluations[1]["return_mean"])
     assert int(row["env_steps"]) == 60
     beyond = evaluations[-1]["wall_time_s"] + 100
-    with pytest.raises(report.SetupError, match=r"--at-wall-time .* leaves every run out") as err:
+    with pytest.raises(
+        report.SetupError, match=r"budget=\('wall_time_s', .*\) leaves every"
+    ) as err:
         report.write_report(root, tmp_path / "beyond", budget=("wall_time_s", beyond))
-    example = float(str(err.value).split("e.g. --at-wall-time ")[1].split(",")[0])
+    example = float(str(err.value).split("e.g. budget=('wall_time_s', ")[1].split(")")[0])
     report.write_report(root, tmp_path / "example", budget=("wall_time_s", example))
     assert rows_of(tmp_path / "example")[0]["n"] == "1"
 

@@ -166,7 +166,7 @@ CURVES = np.array([[0.1, 0.5, 0.7], [0.2, 0.4, 0.6]])
         (
             lambda: stats.probability_of_improvement({"t": CURVES}, {"t": [1.0, 2.0]}),
             ValueError,
-            r"x\['t'\] must be a 1-D array.*looks like learning curves",
+            r"x\['t'\] must be a 1-D array.*if these are learning curves",
         ),
         (
             lambda: stats.probability_of_improvement({"t": [1.0]}, {"t": CURVES}),
@@ -195,6 +195,21 @@ CURVES = np.array([[0.1, 0.5, 0.7], [0.2, 0.4, 0.6]])
         ),
         (lambda: stats.normalize("Pendulum-v1", "500"), TypeError, r"returns must be an array"),
         (lambda: stats.iqm({"t": [1.0]}), TypeError, r"use aggregate_iqm\(scores\)"),
+        (
+            lambda: stats.iqm_over_steps({"t": [[0.1, 0.2, 0.3], [0.1, 0.2]]}),
+            ValueError,
+            r"scores\['t'\] has runs of different lengths \(\[3, 2\] values\).*\[:2\]",
+        ),
+        (
+            lambda: stats.aggregate_iqm({"simoun": np.zeros((5, 3))}),
+            ValueError,
+            r"5 runs over 3 steps.*\[:, -1\].*rliable's matrix of 5 runs x 3 tasks.*m\[:, j\]",
+        ),
+        (
+            lambda: stats.aggregate_iqm({"t": np.array([[0.5], [0.6], [0.7]])}),
+            ValueError,
+            r"np\.ravel\(r\)",
+        ),
     ],
 )
 def test_scores_of_the_wrong_kind_are_refused_naming_the_argument(call, error, message):
@@ -274,3 +289,53 @@ def test_valid_scores_in_other_forms_still_work():
     ] == pytest.approx(0.3)
     np.testing.assert_allclose(stats.iqm_over_steps({"t": CURVES.tolist()}), [0.15, 0.45, 0.65])
     assert stats.performance_profile({"t": [0.2, 0.6]}, [0.5]).tolist() == [0.5]
+
+
+@pytest.mark.parametrize(
+    ("replicates", "error", "message"),
+    [
+        (np.array([]), ValueError, r"replicates must hold at least one resample"),
+        (np.array(0.5), ValueError, r"replicates must hold at least one resample"),
+        (np.array([0.1, np.nan, 0.3]), ValueError, r"replicates has 1 NaN"),
+        ((0.57, 0.2, 0.88), TypeError, r"interval \(point, low, high\).*bootstrap_replicates"),
+        ({"t": [0.1]}, TypeError, r"replicates must be an array of numbers"),
+    ],
+)
+def test_percentile_interval_checks_its_replicates(replicates, error, message):
+    with pytest.raises(error, match=message):
+        stats.percentile_interval(replicates)
+
+
+def test_percentile_interval_takes_replicates_and_refuses_an_interval():
+    scores = {"t": [0.2, 0.6, 0.9]}
+    low, high = stats.percentile_interval(stats.bootstrap_replicates(scores, stats.aggregate_iqm))
+    assert low <= high
+    with pytest.raises(TypeError, match="stratified_bootstrap_ci returns it"):
+        stats.percentile_interval(stats.stratified_bootstrap_ci(scores, stats.aggregate_iqm))
+
+
+@pytest.mark.parametrize(
+    ("env_id", "message"),
+    [
+        (
+            "cheetah-run",
+            r"'cheetah-run' is not an env id.*did you mean 'dm_control/cheetah-run-v0'",
+        ),
+        ("cheetah-run-v0", r"did you mean 'dm_control/cheetah-run-v0'"),
+        ("no-such-task", r"'no-such-task' is not an env id.*'dm_control/'"),
+    ],
+)
+def test_normalize_refuses_an_id_that_names_no_env(env_id, message):
+    with pytest.raises(ValueError, match=message):
+        stats.normalize(env_id, [500.0])
+
+
+def test_normalize_refuses_a_return_above_the_task_maximum():
+    with pytest.raises(ValueError, match=r"at most its maximum return 1000.*got 1500 at index 1"):
+        stats.normalize("dm_control/cheetah-run-v0", [500.0, 1500.0])
+    with pytest.raises(ValueError, match=r"at most its maximum return 1 "):
+        stats.normalize("MiniGrid-DoorKey-6x6-v0", [0.5, 2.0])
+    assert stats.normalize("dm_control/cheetah-run-v0", [1000.0]) == pytest.approx([1.0])
+    # envs without a known maximum keep their raw returns, whatever their size
+    np.testing.assert_array_equal(stats.normalize("Pendulum-v1", [-1500.0]), [-1500.0])
+    np.testing.assert_array_equal(stats.normalize("highway-fast-v0", [30.0]), [30.0])

@@ -78,3 +78,34 @@ def test_the_package_lookup_keeps_hasattr_submodules_and_torch_free_imports():
     )
     out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
+
+
+@pytest.mark.parametrize(
+    ("statement", "home"),
+    [
+        ("from simoun_lab.analysis import layer_activations", "simoun_lab.analysis.layers"),
+        ("from simoun_lab.analysis import play_episode", "simoun_lab.analysis.runs"),
+        ("from simoun_lab.sweep import write_report", "simoun_lab.sweep.report"),
+        ("from simoun_lab.study import load_spec", "simoun_lab.study.spec"),
+        ("from simoun_agent.run import load_run", "simoun_agent.run.load"),
+        ("from simoun_agent.models import SimounAgent", "simoun_agent.agent"),
+        (
+            "from simoun_agent.generalization import ModeResult",
+            "simoun_agent.generalization.evaluation",
+        ),
+    ],
+)
+def test_a_subpackage_names_the_module_of_a_name_it_lacks(statement, home):
+    name = statement.split()[-1]
+    with pytest.raises(ImportError) as raised:
+        exec(statement, {})
+    assert f"from {home}" in str(raised.value) and f"import {name}" in str(raised.value)
+
+
+def test_a_subpackage_lookup_keeps_its_submodules_and_hasattr():
+    import simoun_lab.analysis
+
+    assert not hasattr(simoun_lab.analysis, "nope")
+    from simoun_lab.analysis import layers
+
+    assert layers.__name__ == "simoun_lab.analysis.layers"

@@ -6,3 +6,9 @@
 (:mod:`simoun_lab.cli`) included. The layers below (:mod:`simoun_agent.run` and the optional
 parts) never import this package.
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

@@ -14,6 +14,7 @@ from simoun_agent.generalization.suite import (
     make_distracted_env,
     parse_distractions,
 )
+from simoun_wrappers._homes import missing_name
 
 __all__ = [
     "DISTRACTIONS",
@@ -25,3 +26,7 @@ __all__ = [
     "make_distracted_env",
     "parse_distractions",
 ]
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

@@ -5,5 +5,10 @@ The command ``simoun-analyze`` (:mod:`simoun_lab.cli.analyze`) runs both; the es
 """
 
 from simoun_lab.analysis.bias import BiasEstimate, information_bias
+from simoun_wrappers._homes import missing_name
 
 __all__ = ["BiasEstimate", "information_bias"]
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

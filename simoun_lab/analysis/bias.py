@@ -186,6 +186,10 @@ def _activations(factor: str, pair: tuple[np.ndarray, np.ndarray]) -> tuple[np.n
     sides = []
     for side, values in enumerate(pair):
         where = f"pairs[{factor!r}][{side}]"
+        if callable(getattr(values, "detach", None)):
+            # torch activations taken with gradient (outside torch.no_grad()): only their values
+            # count here
+            values = values.detach().cpu()
         try:
             array = np.asarray(values, np.float64)
         except (TypeError, ValueError) as error:

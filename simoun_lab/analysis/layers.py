@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import torch
 
 from simoun_agent.config import SetupError
@@ -19,7 +20,12 @@ from simoun_agent.models.encoder import (
     SingleFrameEncoder,
     StackedEncoder,
 )
-from simoun_lab.analysis.runs import check_encoder
+from simoun_lab.analysis.runs import (
+    check_batch_size,
+    check_encoder,
+    check_fits,
+    observation_batch,
+)
 
 PATH, MOTION, APPEARANCE, STATE = "path", "motion path", "appearance path", "fused state"
 """Layer names: the conv path of a single-path encoder, the two paths of a dual encoder, f_t."""
@@ -71,15 +77,19 @@ def _dual(encoder: DualPathEncoder, obs: torch.Tensor) -> dict[str, torch.Tensor
 
 
 def layer_activations(
-    encoder: PixelEncoder, observations: torch.Tensor, batch_size: int = 64
+    encoder: PixelEncoder, observations: torch.Tensor | np.ndarray, batch_size: int = 64
 ) -> dict[str, torch.Tensor]:
-    """:func:`feature_layers` over many observations, in batches, without gradient, on CPU."""
+    """:func:`feature_layers` over many uint8 observations ``(N, k, C, H, W)`` (a torch tensor
+    or a numpy array), in batches, without gradient, on CPU."""
     check_encoder(encoder, "layer_activations")
+    check_batch_size(batch_size, "layer_activations")
+    batch = observation_batch(observations, "layer_activations")
+    check_fits(encoder, batch, "layer_activations", feature_layers)
     parts: dict[str, list[torch.Tensor]] = {}
     device = next(encoder.parameters()).device
     with torch.inference_mode():
-        for start in range(0, len(observations), batch_size):
-            chunk = observations[start : start + batch_size].to(device)
+        for start in range(0, len(batch), batch_size):
+            chunk = batch[start : start + batch_size].to(device)
             for name, value in feature_layers(encoder, chunk).items():
                 parts.setdefault(name, []).append(value.float().cpu())
     return {name: torch.cat(values) for name, values in parts.items()}

@@ -19,7 +19,12 @@ from simoun_agent.config import SetupError
 from simoun_agent.models.encoder import PixelEncoder
 from simoun_agent.models.interaction import StructureMasks
 from simoun_agent.run.atomic import atomic_write
-from simoun_lab.analysis.runs import check_encoder
+from simoun_lab.analysis.runs import (
+    check_batch_size,
+    check_encoder,
+    check_fits,
+    observation_batch,
+)
 
 COLORMAP = "magma"
 """Perceptual colour map of the heat maps (uniform in lightness, readable in grey)."""
@@ -49,14 +54,17 @@ def require_masks(encoder: PixelEncoder, name: str) -> None:
 def structure_masks(
     encoder: PixelEncoder, observations: np.ndarray, batch_size: int = 32
 ) -> StructureMasks:
-    """Masks of uint8 observations ``(N, 3, C, H, W)``, on CPU (attention ``(N, hw, hw)``, masks
-    ``(N, c, h, w)``)."""
+    """Masks of uint8 observations ``(N, 3, C, H, W)`` (a numpy array or a torch tensor), on
+    CPU (attention ``(N, hw, hw)``, masks ``(N, c, h, w)``)."""
     check_encoder(encoder, "structure_masks")
+    check_batch_size(batch_size, "structure_masks")
+    batch = observation_batch(observations, "structure_masks")
+    check_fits(encoder, batch, "structure_masks")
     device = next(encoder.parameters()).device
     parts: list[StructureMasks] = []
     with torch.inference_mode():
-        for start in range(0, len(observations), batch_size):
-            chunk = torch.as_tensor(observations[start : start + batch_size], device=device)
+        for start in range(0, len(batch), batch_size):
+            chunk = batch[start : start + batch_size].to(device)
             masks = encoder(chunk).masks
             parts.append(StructureMasks(*(part.float().cpu() for part in masks)))
     return StructureMasks(*(torch.cat(column) for column in zip(*parts, strict=True)))

@@ -27,6 +27,8 @@ import itertools
 import numpy as np
 import torch
 
+from simoun_lab.analysis.runs import OBSERVATIONS_EXAMPLE, observation_batch
+from simoun_wrappers._checks import is_int
 from simoun_wrappers.augment import random_conv
 
 RECOLOUR_KERNEL = 3
@@ -58,6 +60,7 @@ def make_pairs(
     ``(N, k, C, H, W)`` uint8, reproducible from ``seed``. ``recoloured`` gives the second
     member of the dynamic pairs instead (e.g. re-rendered by :mod:`simoun_lab.analysis.recolour`).
     """
+    observations = _pair_inputs(observations, seed, recoloured)
     generator = torch.Generator().manual_seed(seed)
     rng = np.random.default_rng(seed)
     if recoloured is None:
@@ -66,6 +69,34 @@ def make_pairs(
         "dynamic": (observations, recoloured),
         "static": (observations, shuffle_frames(observations, rng)),
     }
+
+
+def _pair_inputs(observations: object, seed: object, recoloured: object) -> np.ndarray:
+    """:func:`make_pairs`' arguments checked, ``observations`` as a numpy array: uint8
+    ``(N, k, C, H, W)`` with k >= 2 (the static pairs shuffle the frames), a seed of numpy's
+    range, and ``recoloured`` one uint8 copy of every observation."""
+    batch = observation_batch(observations, "make_pairs")
+    if batch.shape[1] < 2:
+        raise ValueError(
+            f"make_pairs(observations=...) need k >= 2 frames per observation (the static pairs "
+            f"shuffle them), got shape {tuple(batch.shape)}; pass the env's stacked frames, e.g. "
+            f"{OBSERVATIONS_EXAMPLE}"
+        )
+    if not (is_int(seed) and 0 <= seed < 2**63):
+        raise (ValueError if is_int(seed) else TypeError)(
+            f"make_pairs(seed=...) must be an int in [0, 2**63) (it seeds the recolouring and the "
+            f"shuffles), got {type(seed).__name__} {seed!r:.60}; e.g. seed=0"
+        )
+    if recoloured is not None:
+        second = observation_batch(recoloured, "make_pairs", "recoloured")
+        if second.shape != batch.shape:
+            raise ValueError(
+                f"make_pairs(recoloured=...) must hold one recoloured copy of every observation, "
+                f"the shape of observations {tuple(batch.shape)}, got {tuple(second.shape)}; "
+                "give the recoloured copies of the same observations, in their order, or "
+                "recoloured=None to recolour them with a random convolution"
+            )
+    return observations if isinstance(observations, np.ndarray) else batch.numpy()
 
 
 def usable_steps(length: int, block: int | None = None) -> np.ndarray:

@@ -5,3 +5,9 @@ and ``study`` (``simoun-study``); each also runs as ``python -m simoun_lab.cli.<
 share the conventions of :mod:`simoun_agent.cli.flags` with ``simoun-train`` and
 ``simoun-eval``.
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

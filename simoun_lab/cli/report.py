@@ -20,7 +20,7 @@ from simoun_agent.cli.command_flags import PATH
 from simoun_agent.cli.flags import fail, parse, quiet_pipe
 from simoun_agent.cli.other_names import POSITIONAL
 from simoun_agent.config import SetupError
-from simoun_lab.sweep.report import write_report
+from simoun_lab.sweep.report import BUDGET_FLAGS, write_report
 
 PROG = "simoun-report"
 
@@ -91,7 +91,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parse(ReportCommand, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)
     budget = budget_of(args)
     try:
-        written = write_report(Path(args.root), Path(args.out) if args.out else None, budget)
+        out = Path(args.out) if args.out else None
+        written = write_report(Path(args.root), out, budget, budget_flags=BUDGET_FLAGS)
     except SetupError as err:
         fail(PROG, err)
     print((Path(written[0])).read_text(), end="")

@@ -4,3 +4,9 @@
 :mod:`~simoun_lab.engine.launcher` runs a list of them on Ray Tune, archiving each finished run's
 files and each in-progress checkpoint, and resuming from either.
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

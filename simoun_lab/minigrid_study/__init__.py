@@ -21,3 +21,9 @@ engine, :mod:`simoun_lab.engine`), :mod:`~simoun_lab.minigrid_study.report` and
 ``python -m simoun_lab.minigrid_study run`` (needs the ``sb3``, ``minigrid`` and ``lab``
 extras).
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

@@ -21,3 +21,9 @@ directories as ``simoun-train`` writes them; diagnostic recipes' runs among the 
 ``selection.json``, ``tune/`` (Ray Tune's records), ``report/`` and, once measured,
 ``update_cost.json``.
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

@@ -12,3 +12,9 @@ trial at ``<variant>/<env>/s<seed>`` (the same files as ``simoun-train`` writes,
 inspected, evaluated or resumed alone), ``tune/`` (Ray Tune's own records) and the report
 (``report.md``, ``report.csv``, ``curves_env_steps.png``, ``curves_wall_time.png``).
 """
+
+from simoun_wrappers._homes import missing_name
+
+
+def __getattr__(name: str) -> object:
+    raise missing_name(__name__, name)

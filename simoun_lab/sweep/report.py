@@ -33,6 +33,7 @@ one evaluation grid (:func:`one_evaluation_grid`). Writes:
 from __future__ import annotations
 
 import csv
+import difflib
 import functools
 import itertools
 import json
@@ -74,6 +75,8 @@ from simoun_lab.sweep.grid import (
     trial_problem,
 )
 from simoun_lab.sweep.report_plots import Band, plot_panels
+from simoun_wrappers._checks import check_path
+from simoun_wrappers._checks import is_real as is_number
 
 REPORT_MD = "report.md"
 REPORT_CSV = "report.csv"
@@ -621,17 +624,81 @@ def shortfall(record: RunRecord, column: str, budget: float) -> str | None:
 
 
 BUDGET_FLAGS = {"env_step": "--at-step", "wall_time_s": "--at-wall-time"}
-"""The command-line flag of each budget column."""
+"""The command-line flag of each budget column, as ``simoun-report`` passes them
+(``budget_flags``) so that its errors name its flags."""
+
+BUDGET_EXAMPLE = "budget=('env_step', 100000) or budget=('wall_time_s', 3600.0)"
+"""The Python form of a budget, for errors."""
 
 
-def check_budget_keeps_a_run(records: list[RunRecord], column: str, budget: float) -> None:
+def budget_form(column: str, value: float, flags: dict[str, str] | None) -> str:
+    """``value`` of ``column`` as the user gave it: ``--at-step 40`` on the command line
+    (``flags``), ``budget=('env_step', 40)`` in Python."""
+    if flags is not None:
+        return f"{flags[column]} {value:g}"
+    return f"budget=({column!r}, {value:g})"
+
+
+def without_budget(column: str, flags: dict[str, str] | None) -> str:
+    """How to compare the runs at their ends instead: leave the flag out, or budget=None."""
+    return f"leave {flags[column]} out" if flags is not None else "pass budget=None"
+
+
+def check_budget(budget: object) -> tuple[str, float] | None:
+    """``budget`` of :func:`compare_runs` and :func:`write_report` in Python's terms: None or a
+    pair (column, value), the column ``env_step`` (a number of env steps >= 0) or
+    ``wall_time_s`` (a positive finite number of seconds); a TypeError or ValueError naming
+    ``budget`` otherwise (the command line checks its flags itself)."""
+    if budget is None:
+        return None
+    if isinstance(budget, str | bytes) or not isinstance(budget, tuple | list) or len(budget) != 2:
+        raise TypeError(
+            f"budget must be None or a pair (column, value), got {type(budget).__name__} "
+            f"{budget!r:.60}; e.g. {BUDGET_EXAMPLE}, or budget=None to compare the runs at "
+            "their ends"
+        )
+    column, value = budget
+    if not isinstance(column, str) or column not in BUDGETS:
+        close = difflib.get_close_matches(str(column), list(BUDGETS), n=1)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise ValueError(
+            f"budget's column must be one of {', '.join(map(repr, BUDGETS))} (an eval.csv "
+            f"column), got {column!r}; {hint}e.g. {BUDGET_EXAMPLE}"
+        )
+    if not is_number(value):
+        raise TypeError(
+            f"budget's value must be a number ({BUDGETS[column]}), got "
+            f"{type(value).__name__} {value!r:.40}; e.g. budget=({column!r}, "
+            f"{100000 if column == 'env_step' else 3600.0})"
+        )
+    if column == "env_step" and not (math.isfinite(value) and value >= 0):
+        raise ValueError(
+            f"budget=({column!r}, {value:g}): give a number of env steps >= 0, e.g. "
+            f"budget=('env_step', 100000) (or 0, the evaluation before any training)"
+        )
+    if column == "wall_time_s" and not (math.isfinite(value) and value > 0):
+        raise ValueError(
+            f"budget=({column!r}, {value:g}): give a positive finite number of seconds, e.g. "
+            "budget=('wall_time_s', 3600.0)"
+        )
+    return column, float(value) if column == "wall_time_s" else value
+
+
+def check_budget_keeps_a_run(
+    records: list[RunRecord],
+    column: str,
+    budget: float,
+    flags: dict[str, str] | None = None,
+) -> None:
     """Raise SetupError when runs with evaluations exist but none counts at ``budget`` of
-    ``column``: a report of empty rows compares nothing. The message names the flag, the
-    budgets the runs do reach and one that keeps them all."""
+    ``column``: a report of empty rows compares nothing. The message names the budget as the
+    user gave it (:func:`budget_form`: a flag of ``flags``, or Python's form), the budgets the
+    runs do reach and one that keeps them all."""
     curves = [record.curve[column] for record in records if len(record.curve[column])]
     if not curves:
         return
-    flag = BUDGET_FLAGS[column]
+    given = budget_form(column, budget, flags)
+    leave = without_budget(column, flags)
     if column == "env_step":
         # the evaluation at step 0 is before any training: no budget to compare at
         reached = [{float(x) for x in curve if x > 0} for curve in curves]
@@ -641,17 +708,17 @@ def check_budget_keeps_a_run(records: list[RunRecord], column: str, budget: floa
         shared = set.intersection(*reached)
         example = max(shared) if shared else steps[-1]
         raise SetupError(
-            f"{flag} {budget:g} leaves every run out: no run has an evaluation at {budget:g} env "
-            f"steps (the runs evaluate at {listed(steps)}); pass one of those, e.g. {flag} "
-            f"{example:g}, or leave {flag} out to compare the runs at their ends"
+            f"{given} leaves every run out: no run has an evaluation at {budget:g} env steps "
+            f"(the runs evaluate at {listed(steps)}); pass one of those, e.g. "
+            f"{budget_form(column, example, flags)}, or {leave} to compare the runs at their ends"
         )
     longest = max(float(curve.max()) for curve in curves)
     example = round_down(min(float(curve.max()) for curve in curves))
     raise SetupError(
-        f"{flag} {budget:g} leaves every run out: no run trained that long with an evaluation "
-        f"within it (the longest trained {longest:.3g} s, by its last evaluation); pass a budget "
-        f"every run reached, e.g. {flag} {example:g}, or leave {flag} out to compare the runs "
-        "at their ends"
+        f"{given} leaves every run out: no run trained that long with an evaluation within it "
+        f"(the longest trained {longest:.3g} s, by its last evaluation); pass a budget every run "
+        f"reached, e.g. {budget_form(column, example, flags)}, or {leave} to compare the runs at "
+        "their ends"
     )
 
 
@@ -719,11 +786,19 @@ class Comparison:
     """runs counted at an ``--at-step`` budget with their evaluation nearest to it"""
 
 
-def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Comparison:
+def compare_runs(
+    root: Path,
+    budget: tuple[str, float] | None = None,
+    budget_flags: dict[str, str] | None = None,
+) -> Comparison:
     """Find the runs under ``root``, cut them at ``budget`` (:func:`at_budget`), group them,
     keep one evaluation grid per row (:func:`one_evaluation_grid`) and one run per seed
     (:func:`drop_duplicate_seeds`). Raises SetupError when ``root`` holds no run, or when
-    ``budget`` leaves out every run that has evaluations (:func:`check_budget_keeps_a_run`)."""
+    ``budget`` leaves out every run that has evaluations (:func:`check_budget_keeps_a_run`),
+    naming the budget by the flags of ``budget_flags`` (a command's :data:`BUDGET_FLAGS`) or,
+    without them, in Python's form."""
+    check_path(root, "root", "compare_runs('sweeps/baselines')", ROOT_WHAT)
+    budget = check_budget(budget)
     root = Path(root)
     if not root.exists():
         raise SetupError(
@@ -772,7 +847,7 @@ def compare_runs(root: Path, budget: tuple[str, float] | None = None) -> Compari
                 record.summary = None
             cut_records.append(cut or record)
         if not any(record.summary is not None for record in cut_records):
-            check_budget_keeps_a_run(records, column, value)
+            check_budget_keeps_a_run(records, column, value, budget_flags)
         records = cut_records
     comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
     comparison.damaged = damaged
@@ -1160,6 +1235,13 @@ def refuse_study(root: Path) -> None:
         )
 
 
+ROOT_WHAT = (
+    "one directory: a sweep directory or the parent of the runs to compare (for runs in "
+    "several places, copy or link them under one directory)"
+)
+"""What the report's ``root`` is, for errors."""
+
+
 def default_out(root: Path) -> Path:
     """Where the report goes without ``--out``: into ``root``, except for a single run
     directory (its own ``config.json``), whose report goes beside it
@@ -1175,6 +1257,7 @@ def write_report(
     out: Path | None = None,
     budget: tuple[str, float] | None = None,
     flag: str | None = "--out",
+    budget_flags: dict[str, str] | None = None,
 ) -> list[Path]:
     """Write the tables and figures of the runs under ``root`` into ``out`` (default:
     :func:`default_out`); returns the files written. Raises SetupError when ``root`` holds no
@@ -1184,10 +1267,15 @@ def write_report(
 
     ``budget`` = (``"env_step"`` or ``"wall_time_s"``, value) compares the runs at an equal
     budget instead of at their ends (:func:`at_budget`); the runs short of it are listed.
+    ``budget_flags`` names it in errors by a command's flags (:data:`BUDGET_FLAGS`), else as
+    ``budget=(column, value)``.
     """
+    check_path(root, "write_report(root=...)", "write_report('sweeps/baselines')", ROOT_WHAT)
+    if out is not None:
+        check_path(out, "write_report(out=...)", "write_report('runs', out='runs/report')")
     root = Path(root)
     out = Path(out) if out is not None else default_out(root)
-    comparison = compare_runs(root, budget)
+    comparison = compare_runs(root, budget, budget_flags)
     make_output_dir(out, flag, REPORT_FILES)
     groups = comparison.groups
     rows = [group.row() for group in groups]
