@@ -66,8 +66,9 @@ def refused(capsys, main, argv) -> str:
         (eval_cli.main, ["RUN", "--env", "Pendulum-v1"], "--env is not a flag of simoun-eval"),
         (eval_cli.main, ["RUN", "--agent.no-curiosity"], "agent.curiosity is a setting of the "
          "run"),
-        (eval_cli.main, ["RUN", "--eval-episodes", "5"], "unknown flag --eval-episodes (did you "
-         "mean --episodes?)"),
+        (eval_cli.main, ["RUN", "--eval-episodes", "5"], "--eval-episodes is simoun-train's "
+         "flag (episodes per evaluation (deterministic actions)), not simoun-eval's; "
+         "simoun-eval has --episodes (episodes to play)"),
     ],
 )  # fmt: skip
 def test_every_command_names_the_flag_an_unknown_one_meant(main, argv, said, capsys):
@@ -582,12 +583,57 @@ def test_a_study_archive_nested_with_the_study_dir_is_refused_before_ray(
         (['--env-kwargs={"x": {"b": 1, "b": 1}}'], "--env-kwargs: the key 'b' is given twice"),
         (["--set", 'env_kwargs={"a": 1, "a": 2}'], "env_kwargs='{\"a\": 1, \"a\": 2}': the key "
          "'a' is given twice"),
-        (["--env-kwargs", "nope"], "--env-kwargs: expected a JSON object"),
+        (["--env-kwargs", "nope"], "--env-kwargs: 'nope' is not JSON (Expecting value at line 1 "
+         "column 1)"),
+        (["--env-kwargs", "[1]"], "--env-kwargs: expected a JSON object, e.g. '{\"a\": 1}', got "
+         "'[1]' (a JSON list)"),
     ],
 )  # fmt: skip
 def test_a_json_object_that_gives_a_key_twice_is_refused_naming_the_key(argv, said, capsys):
     err = refused(capsys, train_cli.main, argv)
     assert said in err, err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--env-kwargs", "{\u201csize\u201d: 32}"], "--env-kwargs: '{\u201csize\u201d: 32}' is "
+         "not JSON (Expecting property name enclosed in double quotes at line 1 column 2: it has "
+         "typographic quotes (\u201c \u201d), as a word processor or web page writes them; JSON "
+         "takes straight double quotes (\")); give --env-kwargs '{\"size\": 32}'"),
+        (["--env-kwargs", '{"visualize_reward": True}'], "(Expecting value at line 1 column 22: "
+         "True is Python's spelling; JSON writes true, false and null in lower case); give "
+         "--env-kwargs '{\"visualize_reward\": true}'"),
+        (["--env-kwargs", "{'size': 32}"], "JSON strings take double quotes, not single ones; in "
+         "a shell, put the whole object in single quotes and its strings in double quotes); "
+         "give --env-kwargs '{\"size\": 32}'"),
+        (["--env-kwargs", '{"size": 32,}'], "a comma after the last item, which JSON does not "
+         "allow; remove it); give --env-kwargs '{\"size\": 32}'"),
+        (["--env-kwargs", '{"size": 32'], "is not JSON (Expecting ',' delimiter at line 1 column "
+         "12); a JSON object is written e.g."),
+        (["--set", "env_kwargs={'a': None}"], "cannot read env_kwargs=\"{'a': None}\": expected "
+         "JSON for a dict: Expecting property name enclosed in double quotes at line 1 column 2: "
+         "JSON strings take double quotes, not single ones; in a shell, put the whole object in "
+         "single quotes and its strings in double quotes; in JSON: {\"a\": null}"),
+    ],
+)  # fmt: skip
+def test_a_value_that_is_not_json_is_refused_with_what_is_wrong_and_where(argv, said, capsys):
+    err = refused(capsys, train_cli.main, ["--preset", "cpu", *argv])
+    assert said in err, err
+
+
+def test_every_flag_that_takes_json_says_what_is_wrong_with_its_text(capsys):
+    commands = [
+        (train_cli.main, train_cli.TrainCommand, []),
+        (sweep_cli.main, sweep_cli.SweepCommand, ["--sweep-dir", "s"]),
+    ]
+    for main, command, argv in commands:
+        json_flags = [name for name, flag in command_flags(command, argv).items() if flag.json]
+        assert json_flags, command
+        for name in json_flags:
+            err = refused(capsys, main, [*argv, name, '{"a": False}'])
+            assert "False is Python's spelling; JSON writes true, false and null" in err, err
+            assert f"give {name} '{{\"a\": false}}'" in err, err
 
 
 def test_an_output_directory_that_cannot_be_made_is_refused_before_ray(tmp_path, capsys):
@@ -785,3 +831,63 @@ def test_a_tilde_the_shell_did_not_expand_is_named_with_the_expanded_path(
     expanded = os.path.expanduser("~/simoun-absent")
     assert f"{where} ~/simoun-absent" in err
     assert "the shell did not expand ~" in err and f"give {expanded}" in err
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        # the command's own flag in other letter case or with _ for -, before anything else
+        (train_cli.main, ["--Seed", "3"], "unknown flag --Seed: flags are written in lower case "
+         "with dashes; give --seed (seed of every random stream)"),
+        (train_cli.main, ["--agent.batch_size", "8"], "give --agent.batch-size"),
+        (eval_cli.main, ["RUN", "--Episodes", "2"], "give --episodes (episodes to play)"),
+        (sweep_cli.main, ["--Seeds", "1"], "give --seeds"),
+        # another simoun command's flag is named as that command's, with its counterpart here
+        (train_cli.main, ["--videos", "v"], "--videos is simoun-eval's flag (with --distraction: "
+         "a folder of video files"),
+        (train_cli.main, ["--videos", "v"], "simoun-train takes no background videos (its --video "
+         "records an evaluation video"),
+        (train_cli.main, ["--random-policy"], "--random-policy is simoun-eval's flag (play "
+         "uniformly random actions"),
+        (train_cli.main, ["--random-policy"], "a run's first --warmup-agent-steps agent steps take "
+         "uniformly random actions; the random baseline of a trained run is simoun-eval RUN "
+         "--random-policy"),
+        (train_cli.main, ["--episodes", "3"], "--episodes is simoun-eval's flag (episodes to "
+         "play), not simoun-train's; simoun-train calls it --eval-episodes"),
+        (eval_cli.main, ["RUN", "--warmup-agent-steps", "5"], "--warmup-agent-steps is "
+         "simoun-train's flag (agent decisions taken uniformly at random before learning "
+         "starts), not simoun-eval's; simoun-eval has no such flag"),
+        # other libraries' flags with their counterparts
+        (train_cli.main, ["--config", "cfg.yaml"], "there is no config file flag: --preset picks "
+         "a preset, and --set KEY=VALUE"),
+        (eval_cli.main, ["RUN", "--config", "cfg.yaml"], "simoun-eval reads the run's own "
+         "config.json"),
+        (train_cli.main, ["--checkpoint", "run/checkpoint.pt"], "simoun-train calls it --resume "
+         "(continue a run); give the run directory or its checkpoint.pt: --resume "
+         "run/checkpoint.pt"),
+        (train_cli.main, ["--render"], "simoun-train calls it --video (record one evaluation "
+         "episode"),
+        (train_cli.main, ["--max-episode-steps", "100"], "simoun-train calls it --env-kwargs "
+         "(extra keyword arguments for gymnasium.make); an episode's step limit is the env's "
+         "keyword, e.g. --env-kwargs '{\"max_episode_steps\": 100}'"),
+        (sweep_cli.main, ["--max-episode-steps", "100"], "--env-kwargs '{\"max_episode_steps\": "
+         "100}'"),
+        (eval_cli.main, ["RUN", "--render-mode", "human"], "simoun-eval calls it --video (record "
+         "the first episode to video.mp4); frames are rendered off screen (rgb_array) for the "
+         "agent and the video: no window opens"),
+    ],
+)  # fmt: skip
+def test_an_unknown_flag_is_offered_only_a_flag_of_its_meaning(main, argv, said, capsys):
+    assert said in refused(capsys, main, argv)
+
+
+@pytest.mark.parametrize(
+    ("argv", "never"),
+    [
+        (["--checkpoint-evry", "runs/a"], "--checkpoint-every"),  # a path for a number flag
+        (["--image-siz", "--no-video"], "--image-size"),  # a switch for a flag with a value
+        (["--vide", "mp4"], "--video"),  # a value for a switch
+    ],
+)
+def test_a_close_spelling_that_takes_another_kind_of_value_is_not_offered(argv, never, capsys):
+    assert never not in refused(capsys, train_cli.main, argv)

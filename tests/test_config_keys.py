@@ -87,3 +87,18 @@ def test_a_key_with_another_separator_is_answered_with_the_key_itself(typed, mea
     with pytest.raises(SetupError) as error:
         resolve("cpu", {typed: 1e-3})
     assert f"unknown config key {typed} (did you mean {meant}?)" in str(error.value)
+
+
+@pytest.mark.parametrize(
+    ("name", "meant"),
+    [("Highway-CPU", "highway-cpu"), ("HIGHWAY_CPU", "highway-cpu"), ("CPU", "cpu")],
+)
+def test_a_preset_in_other_letter_case_is_answered_with_that_preset(name, meant):
+    with pytest.raises(SetupError, match=rf"unknown preset '{name}' \(did you mean '{meant}'\?\)"):
+        resolve(name, {})
+
+
+def test_a_recipe_in_other_letter_case_is_answered_with_that_recipe():
+    name = next(iter(RECIPES))
+    with pytest.raises(SetupError, match=rf"\(did you mean '{name}'\?\)"):
+        resolve(None, {"agent.recipe": name.upper()})

@@ -76,7 +76,12 @@ OTHER_NAMES = RUN_CONFIG_NAMES | {
     "trained-agent": POSITIONAL,
     "n-eval-episodes": Meant(("--episodes",)),
     "num-eval-episodes": Meant(("--episodes",)),
-    "render": Meant(("--video",)),
+    "resume": POSITIONAL,
+    "max-episode-steps": Meant(
+        note="simoun-eval plays the run's own episodes, whose step limit is the run's env_kwargs, "
+        "chosen when it is trained (simoun-train --env-kwargs '{\"max_episode_steps\": {value}}')"
+    ),
+    "config": Meant(note="simoun-eval reads the run's own config.json: give the run directory"),
     "distraction": Meant(note="comma-separate the modes, e.g. --distraction train,video_hard"),
     "num-envs": Meant(note="simoun-eval plays its episodes one after another on one env"),
     "deterministic": Meant(
@@ -134,6 +139,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         switches=("--video", "--progress"),
         reads_runs=True,
         other_names=OTHER_NAMES,
+        siblings={"simoun-train": train_command()},
     )
     if not args.checkpoint:  # tyro accepts no value for a variable number of them
         fail(PROG, "give the run to evaluate: a run directory or its checkpoint.pt")
@@ -211,6 +217,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(text, end="")
     print(f"wrote {out}/{METRICS_NAME}" + (f" and {out}/{VIDEO_NAME}" if args.video else ""))
     return 0
+
+
+def train_command() -> type:
+    """simoun-train's command, whose flags an unknown flag of simoun-eval is named as (imported
+    here: the two commands name each other's flags)."""
+    from simoun_agent.cli.train import TrainCommand
+
+    return TrainCommand
 
 
 def evaluate_distractions(args: EvalCommand) -> int:

@@ -20,11 +20,13 @@ to ``tyro.cli`` with :data:`REGISTRY`, which adds four conventions tyro does not
   quietly (:func:`quiet_pipe`).
 
 Before tyro reads the command line, :func:`parse` refuses in one line, naming the flag or
-argument: an unknown flag (another library's name for a flag told this command's own,
-:mod:`simoun_agent.cli.other_names`), a second value of an option that takes one, a word after a
+argument: an unknown flag (the command's own in other letter case, another library's name for
+a flag told this command's own, :mod:`simoun_agent.cli.other_names`, another simoun command's
+flag named as that command's; a flag offered by spelling takes the kind of value given), a
+second value of an option that takes one, a word after a
 switch, a switch given a value it does not take, a
 word no argument takes, an empty or blank value, a path the file system cannot hold, a dict's
-value that is not a JSON object (or gives a key twice), an option given twice with different
+value that is not a JSON object (what json found and where, or a key given twice), an option given twice with different
 values, and a number past int64.
 """
 
@@ -77,6 +79,8 @@ from simoun_agent.config.keys import (
     TRUE_WORDS,
     config_fields,
     field_docs,
+    json_mistake,
+    json_repaired,
     json_value,
 )
 
@@ -143,15 +147,25 @@ def _default(field: dataclasses.Field, given: Any) -> Any:
     return MISSING_NONPROP
 
 
-def json_object(text: str) -> dict:
-    """The JSON object ``text`` (a dict option's value); ValueError when it is not one, or
-    gives a key twice (:func:`~simoun_agent.config.keys.json_value`)."""
+def json_object(text: str, flag: str = "") -> dict:
+    """The JSON object ``text`` (a dict option's value, of ``flag`` when given); ValueError when
+    it is not one, saying what json found and where, and the object meant when the text is one
+    but for a usual slip (:func:`~simoun_agent.config.keys.json_mistake`), or when it gives a
+    key twice (:func:`~simoun_agent.config.keys.json_value`)."""
     try:
         value = json_value(text)
-    except json.JSONDecodeError:
-        value = None
+    except json.JSONDecodeError as err:
+        fixed = json_repaired(text)
+        fix = f"give {flag} {shlex.quote(fixed)}" if flag else f"e.g. {shlex.quote(fixed)}"
+        raise ValueError(
+            f"{text!r} is not JSON ({json_mistake(text, err)})"
+            + (f"; {fix}" if fixed else "; a JSON object is written e.g. '{\"a\": 1}'")
+        ) from None
     if not isinstance(value, dict):
-        raise ValueError(f"expected a JSON object, e.g. '{{\"a\": 1}}', got {text!r}")
+        raise ValueError(
+            f"expected a JSON object, e.g. '{{\"a\": 1}}', got {text!r} (a JSON "
+            f"{type(value).__name__})"
+        )
     return value
 
 
@@ -278,16 +292,20 @@ def refuse_unknown(
     prog: str,
     reads_runs: bool = False,
     other_names: Mapping[str, Meant] | None = None,
+    siblings: Mapping[str, Any] | None = None,
 ) -> None:
     """Raise ValueError for a ``--flag`` of ``argv`` that is not one of ``flags`` (the command's,
     :func:`~simoun_agent.cli.command_flags.command_flags`), naming what it most likely meant:
+    the command's own flag in other letter case or with ``_`` for ``-`` (``--Seed``: ``--seed``),
     the command's counterpart of another library's flag (``other_names``, e.g.
     :data:`~simoun_agent.cli.other_names.RUN_CONFIG_NAMES`: ``--buffer-size``:
     ``--replay-capacity``), the positional argument it names (``simoun-eval --run-dir``), a
-    switch's negation for a ``--no-`` name, else the flags found by meaning as well as spelling
-    (``--frame-size``: ``--image-size``; ``--num-episodes``: ``--episodes``); for a command that
-    ``reads_runs``, a flag of the run config is told to be the run's own. Nothing is checked
-    before a subcommand is named: tyro asks for one."""
+    flag of another simoun command (``siblings``: its name -> its command dataclass) as that
+    command's, a switch's negation for a ``--no-`` name, else the flags found by meaning as
+    well as spelling (``--frame-size``: ``--image-size``; ``--num-episodes``: ``--episodes``)
+    that take the kind of value it was given; for a command that ``reads_runs``, a flag of the
+    run config is told to be the run's own. Nothing is checked before a subcommand is named:
+    tyro asks for one."""
     if not flags:
         return
     named = subcommands(command)
@@ -300,7 +318,10 @@ def refuse_unknown(
             continue
         if spelled := ascii_flag(arg):
             raise lookalike_error(arg, spelled)
-        raise unknown_flag_error(arg, argv, flags, command, (prog, sub), reads_runs, other_names)
+        meant = (other_names or {}).get(name_key(name))
+        raise unknown_flag_error(
+            arg, argv, flags, command, (prog, sub), reads_runs, meant, siblings
+        )
 
 
 def unknown_flag_error(
@@ -310,48 +331,142 @@ def unknown_flag_error(
     command: Any,
     called: tuple[str, str],
     reads_runs: bool,
-    other_names: Mapping[str, Meant] | None,
+    meant: Meant | None,
+    siblings: Mapping[str, Any] | None = None,
 ) -> ValueError:
     """The refusal of the unknown flag ``arg`` of ``argv``, for the command ``called`` (its
-    name, and its subcommand with a space before it, or empty)."""
+    name, and its subcommand with a space before it, or empty); ``meant`` is what the command
+    calls it (:mod:`simoun_agent.cli.other_names`)."""
     name = arg.partition("=")[0]
     prog = "".join(called)
-    meant = (other_names or {}).get(name_key(name))
+    help_line = f"`{prog} --help` lists every flag"
+    if (own := same_flag(name, flags)) is not None:
+        return ValueError(
+            f"unknown flag {name}: flags are written in lower case with dashes; give {own} "
+            f"({short_doc(flags[own].doc)})"
+        )
     slot = positional_named(name, command, argv, meant)
     if slot is not None:
         return ValueError(
             f"unknown flag {name}: {slot.metavar} is a positional argument of {prog}, given "
             f"without a flag: {called[0]} {shlex.join(without_flag(argv, arg))}"
         )
-    if meant is not None and (text := counterpart(meant, flags, prog)):
-        return ValueError(f"unknown flag {name}: {text}; `{prog} --help` lists every flag")
+    other = sibling_flag(name, siblings, prog)
+    value = typed_value(arg, argv)
+    if meant is not None and (text := counterpart(meant, flags, prog, value)):
+        return ValueError(f"unknown flag {name}: {other}{text}; {help_line}")
     if reads_runs and (key := run_setting_meant(name, flags, meant)):
         setting = "--" + key.replace("_", "-")
-        value = "" if config_fields()[key][0] is bool else " ..."
+        shown = "" if config_fields()[key][0] is bool else " ..."
         return ValueError(
             f"{name} is not a flag of {prog}: {key} is a setting of the run, saved in its "
             f"config.json, and {prog} uses the run's own; it is chosen when the run is trained "
-            f"(simoun-train {setting}{value}). `{prog} --help` lists every flag"
+            f"(simoun-train {setting}{shown}). {help_line}"
         )
     matches = negated_matches(name, flags)
     if matches is None:
-        docs = {flag.key: flag.doc for flag in flags.values()}
-        matches = ["--" + key.replace("_", "-") for key in close_keys(name[2:], docs)]
+        matches = close_flags(name, flags, value_kind(value), by_name=bool(other))
+    if other:
+        said = " or ".join(f"{flag} ({short_doc(flags[flag].doc)})" for flag in matches)
+        here = f"{prog} has {said}" if matches else f"{prog} has no such flag"
+        return ValueError(f"unknown flag {name}: {other}{here}; {help_line}")
     hint = f" (did you mean {' or '.join(matches)}?)" if matches else ""
-    return ValueError(f"unknown flag {name}{hint}; `{prog} --help` lists every flag")
+    return ValueError(f"unknown flag {name}{hint}; {help_line}")
 
 
-def counterpart(meant: Meant, flags: dict[str, Flag], prog: str) -> str:
+def close_flags(name: str, flags: dict[str, Flag], kind: str, by_name: bool) -> list[str]:
+    """The flags of ``flags`` that the unknown ``name``, given a value of ``kind``
+    (:func:`value_kind`), most likely meant, by meaning and spelling; only those that take such
+    a value, and with ``by_name`` only those that share a word of their name (``name`` is
+    another command's flag: a flag found through its help alone is another thing)."""
+    docs = {flag.key: flag.doc for flag in flags.values()}
+    typed = name[2:]
+    keys = [
+        key
+        for key in close_keys(typed, docs)
+        if not by_name or meaning_score(typed, key, docs[key]) >= NAME_WEIGHT
+    ]
+    found = ["--" + key.replace("_", "-") for key in keys]
+    return [flag for flag in found if flag not in flags or takes(flags[flag], kind)]
+
+
+def same_flag(name: str, flags: dict[str, Flag]) -> str | None:
+    """The flag of ``flags`` that ``name`` spells in other letter case, or with ``_`` for ``-``
+    (``--Seed``, ``--run_dir``, ``--Agent.LR``), else None."""
+    typed = name_key(name)
+    return next((flag for flag in flags if name_key(flag) == typed), None)
+
+
+def sibling_flag(name: str, siblings: Mapping[str, Any] | None, prog: str) -> str:
+    """``"--videos is simoun-eval's flag (its help), not simoun-train's; "`` when ``name`` (in
+    any letter case) is a flag of another simoun command of ``siblings`` (its name -> its
+    command dataclass), else empty."""
+    typed = name_key(name)
+    for other, command in (siblings or {}).items():
+        for flag, given in command_flags(command, []).items():
+            if name_key(flag) == typed:
+                doc = " ".join(given.doc.split()).rstrip(".")
+                return f"{flag} is {other}'s flag ({doc}), not {prog}'s; "
+    return ""
+
+
+def typed_value(arg: str, argv: Sequence[str]) -> str | None:
+    """The value the unknown option ``arg`` of ``argv`` was given: its ``=VALUE``, else the
+    word after it unless that is a flag; None when it has none (it was typed as a switch)."""
+    _, eq, value = arg.partition("=")
+    if eq:
+        return value
+    at = list(argv).index(arg) + 1
+    following = argv[at] if at < len(argv) else None
+    if following is None or (following.startswith("-") and not NUMBER_WORD.fullmatch(following)):
+        return None
+    return following
+
+
+def value_kind(value: str | None) -> str:
+    """What kind of value ``value`` is: switch (none), bool (true/false words), number, json or
+    word."""
+    if value is None:
+        return "switch"
+    if NUMBER_WORD.fullmatch(value):
+        return "number"
+    if value.lower() in TRUE_WORDS + FALSE_WORDS:
+        return "bool"
+    return "json" if value.lstrip().startswith("{") else "word"
+
+
+def takes(flag: Flag, kind: str) -> bool:
+    """Whether ``flag`` takes a value of ``kind`` (:func:`value_kind`): a flag that takes
+    another (a number for a path, a value for a switch) is no flag that was meant."""
+    own = flag_kind(flag)
+    if kind == "number":
+        return own == "number" or (own == "word" and not flag.path)
+    if kind == "bool":
+        return own in ("switch", "word")
+    return own == kind
+
+
+def flag_kind(flag: Flag) -> str:
+    """What kind of value ``flag`` takes, in :func:`value_kind`'s words (bool is a switch's)."""
+    if flag.switch is not None:
+        return "switch"
+    if flag.json:
+        return "json"
+    return "number" if flag.number else "word"
+
+
+def counterpart(meant: Meant, flags: dict[str, Flag], prog: str, value: str | None = None) -> str:
     """What ``meant`` is in a command with ``flags``: its flags there, each with its help, and
-    its note; the note alone, as not supported here, when it names no flag; empty when its
-    flags are none of the command's."""
+    its note (``{value}`` there the value typed, else N); the note alone, as not supported
+    here, when it names no flag; empty when its flags are none of the command's."""
     present = [flag for flag in meant.flags if flag in flags]
-    note = f"; {meant.note}" if meant.note else ""
+    written = meant.note.replace("{value}", value if value is not None else "N")
+    note = f"; {written}" if written else ""
     if present:
         said = " or ".join(f"{flag} ({short_doc(flags[flag].doc)})" for flag in present)
         return f"{prog} calls it {said}{note}"
-    if meant.note and not meant.flags:
-        return f"not supported here: {meant.note}"
+    if written and not meant.flags:
+        return f"not supported here: {written}"
     return ""
 
 
@@ -849,7 +964,7 @@ def refuse_bad_json(argv: Sequence[str], flags: dict[str, Flag], command: Any) -
     for value in given_values(argv, flags, command):
         if value.flag is not None and value.value is not None and flags[value.flag].json:
             try:
-                json_object(value.value)
+                json_object(value.value, value.flag)
             except ValueError as err:
                 raise ValueError(f"{value.flag}: {err}") from None
 
@@ -963,12 +1078,14 @@ def parse(
     switches: Iterable[str] = (),
     reads_runs: bool = False,
     other_names: Mapping[str, Meant] | None = None,
+    siblings: Mapping[str, Any] | None = None,
 ) -> T:
     """``cls`` from ``argv`` (None: ``sys.argv[1:]``) with tyro and :data:`REGISTRY`;
     ``switches`` are the boolean flags that also take the older ``--flag false``; a command that
     ``reads_runs`` tells a run config flag it does not take to be the run's own; ``other_names``
     are other libraries' flags with what they are called in the command
-    (:mod:`simoun_agent.cli.other_names`). Exits 0
+    (:mod:`simoun_agent.cli.other_names`); ``siblings`` the other simoun commands (name ->
+    command dataclass) whose flags an unknown flag is named as. Exits 0
     after ``--version`` or ``--help``, 2 with one line for input the checks above refuse, or
     tyro's message for other input it cannot read."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -982,7 +1099,7 @@ def parse(
         flags = command_flags(cls, argv)
         refuse_short_options(argv, flags, prog)
         refuse_unknown_subcommand(argv, cls, prog)
-        refuse_unknown(argv, flags, cls, prog, reads_runs, other_names)
+        refuse_unknown(argv, flags, cls, prog, reads_runs, other_names, siblings)
         refuse_stray_words(argv, flags, takes_positional(cls, argv), switches)
         refuse_switch_values(argv, flags, switches)
         refuse_stray_arguments(argv, flags, cls, prog, other_names)

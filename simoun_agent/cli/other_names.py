@@ -53,6 +53,21 @@ LEARNED_TEMPERATURE = "the gaussian actor's temperature is always learned; this 
 
 ONE_LR = "one Adam learning rate serves the encoder, critic, actor and auxiliary heads"
 
+NO_WINDOW = (
+    "frames are rendered off screen (rgb_array) for the agent and the video: no window opens"
+)
+
+TIME_LIMIT = (
+    "an episode's step limit is the env's keyword, e.g. --env-kwargs "
+    "'{\"max_episode_steps\": {value}}'"
+)
+
+NO_CONFIG_FILE = (
+    "there is no config file flag: --preset picks a preset, and --set KEY=VALUE (or each key's "
+    "own flag) changes it; a config kept in a file is passed in Python, "
+    "simoun_agent.config.resolve(preset, overrides)"
+)
+
 RUN_CONFIG_NAMES: dict[str, Meant] = {
     # replay and schedule
     "buffer-size": Meant(("--replay-capacity",)),
@@ -125,6 +140,14 @@ RUN_CONFIG_NAMES: dict[str, Meant] = {
     "vec-env": Meant(note=ONE_ENV),
     "num-threads": Meant(("--torch-threads",)),
     "cuda": Meant(("--device",), "e.g. --device cuda"),
+    "render": Meant(("--video",), NO_WINDOW),
+    "render-mode": Meant(("--video",), NO_WINDOW),
+    "max-episode-steps": Meant(("--env-kwargs",), TIME_LIMIT),
+    "config": Meant(("--preset", "--set"), NO_CONFIG_FILE),
+    "config-file": Meant(("--preset", "--set"), NO_CONFIG_FILE),
+    "config-path": Meant(("--preset", "--set"), NO_CONFIG_FILE),
+    "config-name": Meant(("--preset", "--set"), NO_CONFIG_FILE),
+    "cfg": Meant(("--preset", "--set"), NO_CONFIG_FILE),
     "capture-video": Meant(("--video",)),
     "save-video": Meant(("--video",)),
     "verbose": Meant(("--progress", "--no-progress")),

@@ -58,12 +58,34 @@ Values: booleans as switches (--no-video; --video false works too), None as none
 JSON (--env-kwargs '{{"a": 1}}')."""
 
 
+RESUMED = Meant(("--resume",), "give the run directory or its checkpoint.pt: --resume {value}")
+
 OTHER_NAMES = RUN_CONFIG_NAMES | {
     "seed": Meant(note=ONE_SEED),
     "seeds": Meant(("--seed",), ONE_SEED),
+    "checkpoint": RESUMED,
+    "load-checkpoint": RESUMED,
+    "resume-from": RESUMED,
+    "load-path": RESUMED,
+    "model-path": RESUMED,
+    # simoun-eval's flags
+    "episodes": Meant(("--eval-episodes",)),
+    "distraction": Meant(("--eval-distraction",)),
+    "out": Meant(("--run-dir",)),
+    "videos": Meant(
+        note="simoun-train takes no background videos (its --video records an evaluation video, "
+        "and its --eval-distraction video_* modes use a procedural moving background); to "
+        "evaluate a trained run on your videos: simoun-eval RUN --distraction video_hard "
+        "--videos DIR"
+    ),
+    "random-policy": Meant(
+        note="a run's first --warmup-agent-steps agent steps take uniformly random actions; the "
+        "random baseline of a trained run is simoun-eval RUN --random-policy"
+    ),
 }
 """Other libraries' flags with what simoun-train calls them
-(:mod:`simoun_agent.cli.other_names`); ``seed`` says what to do for several seeds."""
+(:mod:`simoun_agent.cli.other_names`), simoun-eval's among them; ``seed`` says what to do for
+several seeds."""
 
 
 @dataclass
@@ -137,8 +159,17 @@ def parse_command(argv: Sequence[str]) -> TrainCommand:
         default = TrainCommand(flags=ConfigFlags(config=config_default(argv)))
     except SetupError as err:
         fail(PROG, err)
+    from simoun_agent.cli.eval import EvalCommand  # the commands name each other's flags
+
     return parse(
-        TrainCommand, argv, PROG, DESCRIPTION, default, config_switches(), other_names=OTHER_NAMES
+        TrainCommand,
+        argv,
+        PROG,
+        DESCRIPTION,
+        default,
+        config_switches(),
+        other_names=OTHER_NAMES,
+        siblings={"simoun-eval": EvalCommand},
     )
 
 

@@ -10,6 +10,7 @@ import functools
 import inspect
 import itertools
 import json
+import re
 import textwrap
 import types
 import typing
@@ -146,8 +147,12 @@ def _parse_one(text: str, kind: Any) -> Any:
     if origin in (dict, list, tuple):
         try:
             value = json_value(text)
-        except json.JSONDecodeError:
-            raise ValueError(f"expected JSON for a {origin.__name__}") from None
+        except json.JSONDecodeError as err:
+            fixed = json_repaired(text)
+            fix = f"; in JSON: {fixed}" if fixed else ""
+            raise ValueError(
+                f"expected JSON for a {origin.__name__}: {json_mistake(text, err)}{fix}"
+            ) from None
         return tuple(value) if origin is tuple else value
     raise ValueError(f"unsupported type {kind}")
 
@@ -165,6 +170,57 @@ def json_value(text: str) -> Any:
         return value
 
     return json.loads(text, object_pairs_hook=unique)
+
+
+TYPOGRAPHIC_QUOTES = {
+    **dict.fromkeys("\u201c\u201d\u201e\u201f\u2033\u00ab\u00bb", '"'),
+    **dict.fromkeys("\u2018\u2019\u201a\u201b\u2032", "'"),
+}
+"""Quotes a word processor, a chat or a web page writes for a typed ``"`` or ``'`` (curly
+quotes, primes, guillemets), each with the straight quote it stands for."""
+
+PYTHON_LITERAL = re.compile(r"(True|False|None)\b")
+
+
+def json_mistake(text: str, err: json.JSONDecodeError) -> str:
+    """What json found wrong in ``text`` typed as a value (``err``: its error on it), and where,
+    with the cause named when it is one of the usual slips: typographic quotes, Python's
+    True/False/None, strings in single quotes, a comma after the last item."""
+    found = f"{err.msg} at line {err.lineno} column {err.colno}"
+    typographic = sorted({char for char in text if char in TYPOGRAPHIC_QUOTES})
+    if typographic:
+        return (
+            f"{found}: it has typographic quotes ({' '.join(typographic)}), as a word processor "
+            'or web page writes them; JSON takes straight double quotes (")'
+        )
+    before, rest = text[: err.pos].rstrip(), text[err.pos :]
+    if before.endswith(",") and rest.lstrip()[:1] in ("}", "]"):
+        return f"{found}: a comma after the last item, which JSON does not allow; remove it"
+    if literal := PYTHON_LITERAL.match(rest):
+        return (
+            f"{found}: {literal.group(1)} is Python's spelling; JSON writes true, false and null "
+            "in lower case"
+        )
+    if rest.startswith("'"):
+        return (
+            f"{found}: JSON strings take double quotes, not single ones; in a shell, put the whole "
+            "object in single quotes and its strings in double quotes"
+        )
+    return found
+
+
+def json_repaired(text: str) -> str | None:
+    """``text`` as the JSON its author meant, when it is JSON but for the slips
+    :func:`json_mistake` names (typographic quotes, a Python dict or list literal); else
+    None."""
+    straight = text.translate(str.maketrans(TYPOGRAPHIC_QUOTES))
+    for read in (json.loads, ast.literal_eval):
+        try:
+            value = read(straight)
+            return json.dumps(value, ensure_ascii=False) if isinstance(value, dict | list) else None
+        except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
+            continue
+    return None
 
 
 HELP_FIX = "`simoun-train --help` lists every key"

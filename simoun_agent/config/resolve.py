@@ -22,7 +22,6 @@ Example:
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import json
 import typing
 from typing import Any
@@ -32,7 +31,7 @@ from simoun_agent.config.errors import SetupError
 from simoun_agent.config.keys import check_keys, config_fields, config_sections
 from simoun_agent.config.presets import PRESETS, fit_highway_config
 from simoun_agent.config.recipes import RECIPES
-from simoun_agent.config.rules import rules_of
+from simoun_agent.config.rules import did_you_mean_name, rules_of
 from simoun_agent.config.train import TrainConfig
 
 
@@ -101,11 +100,9 @@ def preset_values(name: str) -> dict[str, Any]:
     """The flat overrides of the preset ``name`` with ``"preset": name``; SetupError for an
     unknown preset or a preset entry with an unknown key."""
     if not isinstance(name, str) or name not in PRESETS:
-        hint = difflib.get_close_matches(str(name), PRESETS, n=1)
         raise SetupError(
-            f"unknown preset {name!r}"
-            + (f" (did you mean {hint[0]!r}?)" if hint else "")
-            + f"; choose one of {', '.join(PRESETS)}"
+            f"unknown preset {name!r}{did_you_mean_name(name, list(PRESETS))}; choose one of "
+            f"{', '.join(PRESETS)}"
         )
     values = flatten(PRESETS[name].overrides)
     check_keys(values, f"preset {name!r}", "fix its entry in simoun_agent.config.presets.PRESETS")
@@ -117,11 +114,9 @@ def recipe_values(name: str, task: str | None = None) -> dict[str, Any]:
     DMC ``task`` (its ``per_task`` values there; None: any other env); SetupError for an unknown
     recipe or a recipe entry with an unknown key."""
     if not isinstance(name, str) or name not in RECIPES:
-        hint = difflib.get_close_matches(str(name), RECIPES, n=1)
         raise SetupError(
-            f"unknown recipe --agent.recipe {name!r}"
-            + (f" (did you mean {hint[0]!r}?)" if hint else "")
-            + f"; choose one of {', '.join(RECIPES)}"
+            f"unknown recipe --agent.recipe {name!r}{did_you_mean_name(name, list(RECIPES))}; "
+            f"choose one of {', '.join(RECIPES)}"
         )
     values = {"agent." + key: value for key, value in RECIPES[name].values_for(task).items()}
     check_keys(values, f"recipe {name!r}", "fix its entry in simoun_agent.config.recipes.RECIPES")

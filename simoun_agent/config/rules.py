@@ -110,14 +110,29 @@ def optional_name(options: Sequence[str]) -> Rule:
     )
 
 
+def fold_name(name: str) -> str:
+    """``name`` in lower case with ``-`` for ``_``: two spellings of one name fold alike."""
+    return name.lower().replace("_", "-")
+
+
+def closest_name(typed: Any, options: Sequence[str], cutoff: float = 0.6) -> str | None:
+    """The name of ``options`` that ``typed`` most likely meant: first one spelled in other
+    letter case or with ``_`` for ``-`` (``'DrQ'``, ``'Highway_CPU'``), else the closest
+    spelling (difflib, ``cutoff``); None when none is close."""
+    if not isinstance(typed, str) or not typed:
+        return None
+    folded = {fold_name(name): name for name in options}
+    if fold_name(typed) in folded:
+        return folded[fold_name(typed)]
+    match = difflib.get_close_matches(typed, list(options), n=1, cutoff=cutoff)
+    return match[0] if match else None
+
+
 def did_you_mean_name(typed: Any, options: Sequence[str]) -> str:
-    """`` (did you mean 'dual'?)`` for a mistyped name of ``options`` (``'DrQ'`` as well: a
-    name in other letter case), or empty."""
-    folded = {name.lower(): name for name in options}
-    if isinstance(typed, str) and typed.lower() in folded:
-        return f" (did you mean {folded[typed.lower()]!r}?)"
-    match = difflib.get_close_matches(str(typed), list(options), n=1) if typed else []
-    return f" (did you mean {match[0]!r}?)" if match else ""
+    """`` (did you mean 'dual'?)`` for a mistyped name of ``options`` (:func:`closest_name`),
+    or empty."""
+    close = closest_name(typed, options)
+    return f" (did you mean {close!r}?)" if close else ""
 
 
 def text(optional: bool = False, fix: str = "") -> Rule:

@@ -7,7 +7,6 @@ How a run's config is resolved from presets, recipes and the user's overrides:
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import functools
 import os
 from collections.abc import Callable, Mapping
@@ -23,6 +22,7 @@ from simoun_agent.config.rules import (
     Rule,
     boolean,
     check_fields,
+    closest_name,
     fail,
     integer,
     is_int,
@@ -86,8 +86,7 @@ def _closest_modes(value: Any) -> str:
 
 
 def _closest_mode(name: str) -> str | None:
-    match = difflib.get_close_matches(name.lower(), DISTRACTION_MODES, n=1, cutoff=0.6)
-    return match[0] if match else None
+    return closest_name(name, DISTRACTION_MODES)
 
 
 _DISTRACTION_MODES_RULE = Rule(

@@ -7,7 +7,6 @@ cameras and image size included, with only the appearance changed.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
@@ -16,6 +15,7 @@ from typing import Any
 import gymnasium as gym
 
 from simoun_agent.config import SetupError, TrainConfig
+from simoun_agent.config.rules import closest_name
 from simoun_wrappers import ColorShift, MovingBackground
 
 DISTRACTIONS: dict[str, tuple[type[gym.Wrapper], str] | None] = {
@@ -61,8 +61,8 @@ def parse_distractions(
         if name.lower() in NO_DISTRACTION_WORDS:
             hint = f"for no distraction, {undistracted}; "
         else:
-            close = difflib.get_close_matches(name, list(modes), n=1, cutoff=0.5)
-            hint = f"did you mean {close[0]!r}? " if close else ""
+            close = closest_name(name, list(modes), cutoff=0.5)
+            hint = f"did you mean {close!r}? " if close else ""
         raise SetupError(
             f"unknown distraction {name!r} in {flag}; {hint}choose from "
             f"{', '.join(modes)} (comma-separated, e.g. {flag} color_easy,video_hard)"
@@ -103,8 +103,8 @@ def check_mode_list(modes: Any, argument: str, allowed: Sequence[str]) -> list[s
     names = _mode_texts(modes, argument)
     for name in names:
         if name not in allowed:
-            close = difflib.get_close_matches(name, list(allowed), n=1, cutoff=0.5)
-            hint = f"did you mean {close[0]!r}? " if close else ""
+            close = closest_name(name, list(allowed), cutoff=0.5)
+            hint = f"did you mean {close!r}? " if close else ""
             raise SetupError(
                 f"{argument}: unknown mode {name!r}; {hint}choose from {', '.join(allowed)}"
             )

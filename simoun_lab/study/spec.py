@@ -69,7 +69,7 @@ from simoun_agent.config.keys import (
     parse_value,
 )
 from simoun_agent.config.resolve import flatten
-from simoun_agent.config.rules import show
+from simoun_agent.config.rules import did_you_mean_name, show
 from simoun_agent.generalization import DISTRACTIONS, parse_distractions
 from simoun_agent.run.kept import Damaged, read_text
 from simoun_lab.study.given_path import blanks_note, shown
@@ -390,11 +390,9 @@ class _Reader:
         base_table = self.table(data.get("base", {}), ("base",))
         preset = base_table.pop("preset", None)
         if preset is not None and preset not in PRESETS:
-            hint = difflib.get_close_matches(str(preset), PRESETS, n=1)
             raise self.fail(
                 ("base", "preset"),
-                f"unknown preset {preset!r}"
-                + (f" (did you mean {hint[0]!r}?)" if hint else "")
+                f"unknown preset {preset!r}{did_you_mean_name(preset, list(PRESETS))}"
                 + f"; choose one of {', '.join(PRESETS)}",
             )
         diagnostics = self.diagnostics(data.get("diagnostics", {}), recipes)
@@ -472,11 +470,9 @@ class _Reader:
     def known_recipe(self, recipe: Any, where: tuple[str, ...]) -> None:
         """Refuse a name that is no recipe, suggesting the closest one."""
         if recipe not in RECIPES:
-            hint = difflib.get_close_matches(str(recipe), RECIPES, n=1)
             raise self.fail(
                 where,
-                f"unknown recipe {recipe!r}"
-                + (f" (did you mean {hint[0]!r}?)" if hint else "")
+                f"unknown recipe {recipe!r}{did_you_mean_name(recipe, list(RECIPES))}"
                 + f"; choose from {', '.join(RECIPES)} (simoun_agent/config/recipes.py)",
             )
 
