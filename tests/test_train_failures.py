@@ -67,8 +67,9 @@ def named_unwritten_file(done, prog: str, elsewhere: str) -> Path:
     NO_SPACE_EXIT, no traceback, the reason and the fixes said, and no temporary beside it."""
     err = done.stderr
     assert done.returncode == train.NO_SPACE_EXIT, done.stdout + err
-    assert "Traceback" not in err and err.startswith(f"{prog}: error: cannot write "), err
-    path = Path(err.removeprefix(f"{prog}: error: cannot write ").split(": ", 1)[0])
+    assert "Traceback" not in err and f"{prog}: error: cannot write " in err, err
+    line = err[err.index(f"{prog}: error: cannot write ") :]  # after the progress lines
+    path = Path(line.removeprefix(f"{prog}: error: cannot write ").split(": ", 1)[0])
     said = (
         f"the file is larger than the file size limit allows (File too large); {path.name} was "
         "not written (an earlier version of it is kept). To go on, raise the limit (ulimit -f "
