@@ -8,6 +8,7 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 import torch
+from test_train_failures import named_unwritten_file, under_file_size_limit
 from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent.config import AgentConfig, resolve
@@ -173,6 +174,13 @@ def test_masks_command_writes_pictures_and_heat_maps(runs, tmp_path, capsys):
     assert exit_info.value.code == 2
     assert "--overwrite" in capsys.readouterr().err
     assert (out / "ep0-step0002.png").stat().st_mtime_ns == before
+
+
+def test_a_mask_picture_that_does_not_fit_is_named_with_the_fix_and_left_unwritten(runs, tmp_path):
+    args = ["masks", str(runs["dual_interactive"]), "--steps", "1", "--out", str(tmp_path)]
+    done = under_file_size_limit("simoun_lab.cli.analyze", args)
+    path = named_unwritten_file(done, "simoun-analyze", "pass --out DIR on another disk")
+    assert path == tmp_path / "ep0-step0001.png" and not path.exists()
 
 
 def test_masks_command_refuses_bad_input(runs, tmp_path, capsys):

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 import torch
 from flag_lists import TINY_AGENT, override
+from test_train_failures import named_unwritten_file, under_file_size_limit
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
@@ -174,6 +175,13 @@ def test_simoun_eval_does_not_overwrite_an_earlier_evaluation(finished, capsys):
     assert "eval-40" in err and "--overwrite" in err and "--out" in err
     assert (finished / "eval-40" / "metrics.json").read_bytes() == written
     assert eval_cli.main([*argv, "--overwrite"]) == 0
+
+
+def test_simoun_eval_names_metrics_that_do_not_fit_and_leaves_no_part_of_them(finished, tmp_path):
+    argv = [str(finished), "--episodes", "1", "--no-video", "--out", str(tmp_path / "e")]
+    done = under_file_size_limit("simoun_agent.cli.eval", argv, limit=100)
+    path = named_unwritten_file(done, "simoun-eval", "pass --out DIR on another disk")
+    assert path == tmp_path / "e" / "metrics.json" and not path.exists()
 
 
 def test_simoun_eval_stops_promptly_on_sigterm_even_when_sdl_took_it(tmp_path):

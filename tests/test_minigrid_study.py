@@ -20,6 +20,7 @@ import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 import torch
 from gymnasium.vector import AutoresetMode
+from test_train_failures import named_unwritten_file, under_file_size_limit
 
 from simoun_agent.config import SetupError
 from simoun_lab.minigrid_study.__main__ import main
@@ -573,6 +574,15 @@ def test_a_report_directory_that_is_a_file_is_named(v1_copy):
     status, printed = study("report", "--archive", str(v1_copy))
     assert status == 2 and "Traceback" not in printed
     assert f"{v1_copy / 'report'} is where the report is written, but it is a file" in printed
+
+
+def test_a_report_figure_that_does_not_fit_is_named_with_the_fix_and_left_unwritten(v1_copy):
+    done = under_file_size_limit(
+        "simoun_lab.minigrid_study.__main__", ["report", "--archive", str(v1_copy)]
+    )
+    fix = "copy the archive to another disk and pass the copy as --archive"
+    path = named_unwritten_file(done, "python -m simoun_lab.minigrid_study", fix)
+    assert path.parent == v1_copy / "report" and path.suffix == ".png" and not path.exists()
 
 
 def test_a_sac_study_archive_is_told_apart_from_a_minigrid_one(tmp_path, capsys):

@@ -17,6 +17,7 @@ import matplotlib.colors
 import matplotlib.image
 import numpy as np
 import pytest
+from test_train_failures import named_unwritten_file, under_file_size_limit
 from test_train_resume import TINY as RESUME_TINY
 
 from simoun_agent.config import resolve, to_dict
@@ -142,6 +143,12 @@ def test_cli_prints_the_table_and_refuses_a_directory_without_runs(runs_dir, tmp
         report_cli.main([str(tmp_path / "out")])
     assert exit_info.value.code == 2
     assert "no runs under" in capsys.readouterr().err
+
+
+def test_a_figure_that_does_not_fit_is_named_with_the_fix_and_left_unwritten(runs_dir, tmp_path):
+    done = under_file_size_limit("simoun_lab.cli.report", [str(runs_dir), "--out", str(tmp_path)])
+    path = named_unwritten_file(done, "simoun-report", "pass --out DIR on another disk")
+    assert path.parent == tmp_path and path.suffix == ".png" and not path.exists()
 
 
 def test_a_recipe_names_the_variant_without_the_values_it_implies(tmp_path):

@@ -5,8 +5,10 @@ check, and the bad specs it refuses before Ray starts, each naming its line."""
 import csv
 import json
 import math
+import os
 import re
 import shutil
+import subprocess
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -15,6 +17,7 @@ import numpy as np
 import pytest
 import ray  # noqa: F401  (the lab extra: a missing install fails instead of skipping)
 from flag_lists import SMALL_AGENT
+from test_train_failures import named_unwritten_file, under_file_size_limit
 
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_lab.cli import study as cli
@@ -852,6 +855,60 @@ def test_a_finished_runs_unreadable_summary_is_named_on_resume_before_it_counts(
     assert f"{path} (the mark that run {run} finished) is damaged: {said}" in err
     assert f"mv {dmc_archive / run} {dmc_archive / run}.damaged" in err
     assert not (tmp_path / "s" / run).exists()  # nothing restored from the archive
+
+
+def test_a_report_figure_that_does_not_fit_is_named_with_the_fix_and_left_unwritten(dmc_archive):
+    argv = ["report", "docs/studies/dmc100k.toml", "--study-dir", str(dmc_archive)]
+    done = under_file_size_limit("simoun_lab.cli.study", argv)
+    fix = "copy the study directory to another disk and pass the copy as --study-dir"
+    path = named_unwritten_file(done, "simoun-study", fix)
+    committed = DMC / path.relative_to(dmc_archive)  # the report the archive held is kept
+    assert path.suffix == ".png" and path.read_bytes() == committed.read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("renamed", "kind", "meant"),
+    [
+        ("evaluation/Simoun", "recipe", "simoun"),
+        ("tuning/simoun/agent.n_step=1/Cartpole-Swingup", "task", "cartpole-swingup"),
+        ("Evaluation", "phase", "evaluation"),
+    ],
+)
+def test_a_folder_of_runs_in_other_capitals_is_named_not_counted_as_unfinished(
+    renamed, kind, meant, dmc_archive, capsys
+):
+    stray = dmc_archive / renamed
+    (stray.parent / meant).rename(stray)
+    report = (dmc_archive / "report" / "report.md").read_bytes()
+    err = report_refused(dmc_archive, capsys)
+    assert f"{stray} is not a {kind} of the spec: did you mean {meant}?" in err
+    assert f"rename it (mv {stray} {stray.parent / meant})" in err
+    assert (dmc_archive / "report" / "report.md").read_bytes() == report
+
+
+def test_a_second_copy_of_a_recipes_runs_in_other_capitals_is_named_not_counted_twice(
+    dmc_archive, capsys
+):
+    stray = dmc_archive / "evaluation" / "Simoun"
+    shutil.copytree(dmc_archive / "evaluation" / "simoun", stray)
+    err = report_refused(dmc_archive, capsys)
+    assert f"{stray} is a second copy, which the phase report would count twice" in err
+    assert f"(mv {stray} {dmc_archive.parent / 'dmc100k-evaluation-Simoun'})" in err
+
+
+def test_the_code_version_reads_the_checkout_without_writing_its_index(tmp_path):
+    def git(*args: str) -> None:
+        subprocess.run(["git", "-C", str(tmp_path), *args], check=True, capture_output=True)
+
+    git("init", "-q")
+    (tmp_path / "a.txt").write_text("a\n")
+    git("add", "a.txt")
+    git("-c", "user.name=t", "-c", "user.email=t@t", "commit", "-q", "-m", "a")
+    os.utime(tmp_path / "a.txt", (1, 1))  # stat data changed: a plain git status rewrites the index
+    index = tmp_path / ".git" / "index"
+    before = (index.read_bytes(), index.stat().st_mtime_ns)
+    assert code_version(tmp_path)["dirty"] is False
+    assert (index.read_bytes(), index.stat().st_mtime_ns) == before
 
 
 def test_a_report_directory_that_is_a_file_is_named(dmc_archive, capsys):

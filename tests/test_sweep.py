@@ -17,6 +17,7 @@ import pytest
 import ray  # the lab extra: a missing install fails instead of skipping
 from broken_envs import NAN_REACH_ID
 from flag_lists import override
+from test_train_failures import under_file_size_limit
 
 from benchmarks.sweep import tiny_flags
 from simoun_agent.config import SetupError, resolve, to_dict
@@ -863,6 +864,19 @@ def test_a_closing_report_that_cannot_be_written_is_named_and_fails_the_sweep(
     assert f"mv {table} {table}.aside) and run the command again" in err
     assert "--out" not in err  # simoun-sweep has none
     assert f"then write it with: simoun-report {sweep_dir}" in err
+
+
+def test_a_closing_report_figure_that_does_not_fit_is_named_and_fails_the_sweep(
+    trained_sweep, tmp_path
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    argv = ["--resume", "--sweep-dir", str(sweep_dir)]
+    done = under_file_size_limit("simoun_lab.cli.sweep", argv)
+    assert done.returncode == 1 and "Traceback" not in done.stderr, done.stderr
+    said = re.search(r"report not written: cannot write (\S+): the file is larger", done.stderr)
+    assert said and "ulimit -f unlimited" in done.stderr, done.stderr
+    assert f"(or write the report with: simoun-report {sweep_dir})" in done.stderr
+    assert not list(Path(said[1]).parent.glob(".*.tmp*"))
 
 
 def test_a_device_spelled_otherwise_on_resume_is_the_same_device(tmp_path):

@@ -23,6 +23,7 @@ from test_train_sigterm import TINY
 from simoun_agent.cli import train as train_cli
 from simoun_agent.envs import PointReach
 from simoun_agent.run import train
+from simoun_agent.run.atomic import space_problem
 from simoun_agent.run.checkpoint import NoSpace, atomic_write, load_checkpoint
 from simoun_agent.run.logger import read_csv
 
@@ -39,6 +40,46 @@ limit = int(sys.argv[1])
 resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 sys.exit(train_cli.main(sys.argv[2:]))
 """
+UNDER_LIMIT_MAIN = """
+import importlib, resource, signal, sys
+
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG instead
+limit = int(sys.argv[1])
+main = importlib.import_module(sys.argv[2]).main
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+def under_file_size_limit(module: str, argv: list[str], limit: int = 10_000):
+    """``module``'s ``main(argv)`` in a subprocess whose files can grow to ``limit`` bytes
+    only: a write past it fails part-way with EFBIG, as one on a full disk does with ENOSPC."""
+    return subprocess.run(
+        [sys.executable, "-c", UNDER_LIMIT_MAIN, str(limit), module, *argv],
+        capture_output=True,
+        text=True,
+        timeout=LIMIT_S,
+    )
+
+
+def named_unwritten_file(done, prog: str, elsewhere: str) -> Path:
+    """The file ``prog``'s error names after a write that did not fit, checked: status
+    NO_SPACE_EXIT, no traceback, the reason and the fixes said, and no temporary beside it."""
+    err = done.stderr
+    assert done.returncode == train.NO_SPACE_EXIT, done.stdout + err
+    assert "Traceback" not in err and f"{prog}: error: cannot write " in err, err
+    line = err[err.index(f"{prog}: error: cannot write ") :]  # after the progress lines
+    path = Path(line.removeprefix(f"{prog}: error: cannot write ").split(": ", 1)[0])
+    said = (
+        f"the file is larger than the file size limit allows (File too large); {path.name} was "
+        "not written (an earlier version of it is kept). To go on, raise the limit (ulimit -f "
+        "unlimited"
+    )
+    assert said in err and elsewhere in err, err
+    assert not list(path.parent.glob(".*.tmp*")), err
+    return path
+
+
 FILE_SIZE_LIMIT = 300_000
 """Above every file of the run but the replay past about 90 frames (3 KB a frame at 32x32): the
 checkpoints at env steps 20-80 fit, those from 100 on do not."""
@@ -208,6 +249,43 @@ def test_atomic_write_leaves_nothing_when_the_write_fails(tmp_path):
         atomic_write(target, lambda tmp: tmp.write_text("new" * 10_000))
     assert failure.value.errno == errno.ENOSPC
     assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["file.txt"]
+
+
+def test_atomic_write_names_the_file_a_write_that_does_not_fit_was_for(tmp_path):
+    target = tmp_path / "curves.png"
+    (tmp_path / f".curves.{os.getpid()}.tmp.png").symlink_to("/dev/full")
+    with pytest.raises(OSError) as failure:
+        atomic_write(target, lambda tmp: tmp.write_bytes(b"x" * 10_000))
+    assert failure.value.filename == str(target)
+    said = space_problem(failure.value, "pass --out DIR on another disk")
+    assert said == (
+        f"cannot write {target}: the disk is full (No space left on device); curves.png was not "
+        f"written (an earlier version of it is kept). To go on, free space on that disk (df -h "
+        f"{tmp_path} shows it), or pass --out DIR on another disk, and run the command again"
+    )
+
+
+@pytest.mark.parametrize(
+    ("number", "said"),
+    [
+        (errno.EDQUOT, "the disk quota is used up (Disk quota exceeded)"),
+        (errno.EFBIG, "the file is larger than the file size limit allows (File too large)"),
+    ],
+)
+def test_a_full_quota_and_a_file_size_limit_are_told_with_their_own_fix(number, said):
+    error = OSError(number, os.strerror(number), "out/report.md")
+    fix = "free space under your quota" if number == errno.EDQUOT else "ulimit -f unlimited"
+    text = space_problem(error)
+    assert text.startswith(f"cannot write out/report.md: {said}") and fix in text
+    assert space_problem(OSError(errno.EACCES, "Permission denied", "out/report.md")) is None
+
+
+def test_simoun_train_names_a_config_that_does_not_fit(tmp_path):
+    run_dir = tmp_path / "run"
+    flags = override(TINY, "--env", "simoun/PointReach-v0", "--run-dir", str(run_dir))
+    done = under_file_size_limit("simoun_agent.cli.train", flags, limit=100)
+    path = named_unwritten_file(done, "simoun-train", "pass --run-dir DIR on another disk")
+    assert path.parent == run_dir and not path.exists()
 
 
 def test_atomic_write_names_a_directory_in_place_of_its_file_and_leaves_it(tmp_path):

@@ -23,10 +23,11 @@ import tyro
 from tqdm import tqdm
 
 from simoun_agent.cli.command_flags import PATH
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import POSITIONAL, RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
+from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.layout import METRICS_NAME, VIDEO_NAME
 from simoun_agent.run.rundir import check_output_dir, make_output_dir
 from simoun_agent.run.signals import Stopped, stop_at_once
@@ -128,6 +129,7 @@ class EvalCommand:
     video_* modes (none: a procedural moving background)"""
 
 
+@names_full_disk(PROG, "pass --out DIR on another disk")
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-eval``."""
@@ -210,7 +212,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         env_step=step, episodes=args.episodes, first_seed=seed, random_policy=args.random_policy
     )
     text = metrics_json(metrics)
-    (out / METRICS_NAME).write_text(text)
+    atomic_write(out / METRICS_NAME, lambda tmp: tmp.write_text(text))
     if frames:
         write_video(out / VIDEO_NAME, frames, video_fps(env, config.resolved_action_repeat()))
     env.close()

@@ -83,6 +83,7 @@ from simoun_agent.config.keys import (
     json_repaired,
     json_value,
 )
+from simoun_agent.run.atomic import NO_SPACE_EXIT, space_problem
 
 T = TypeVar("T")
 
@@ -1163,3 +1164,29 @@ def quiet_pipe(main: Callable[..., int]) -> Callable[..., int]:
             return CLOSED_PIPE_EXIT
 
     return wrapped
+
+
+def names_full_disk(
+    prog: str, elsewhere: str | None = None
+) -> Callable[[Callable[..., int]], Callable[..., int]]:
+    """``main`` that ends a write that did not fit (a full disk or quota, a file size limit) with
+    one clear error, ``PROG: error: cannot write FILE: REASON. To go on, FIX``
+    (:func:`~simoun_agent.run.atomic.space_problem`), and :data:`NO_SPACE_EXIT`, instead of the
+    traceback of the library that wrote it (PIL, numpy). ``elsewhere``: how the command writes
+    to another place (``"pass --out DIR on another disk"``), None where it cannot."""
+
+    def decorate(main: Callable[..., int]) -> Callable[..., int]:
+        @functools.wraps(main)
+        def wrapped(argv: Sequence[str] | None = None) -> int:
+            try:
+                return main(argv)
+            except OSError as err:
+                problem = space_problem(err, elsewhere)
+                if problem is None:
+                    raise
+                print(f"{prog}: error: {problem}", file=sys.stderr)
+                return NO_SPACE_EXIT
+
+        return wrapped
+
+    return decorate

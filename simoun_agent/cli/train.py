@@ -30,7 +30,7 @@ from simoun_agent.cli.config_flags import (
     config_switches,
     overrides_from,
 )
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import ONE_SEED, RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import SetupError, TrainConfig, resolve
 from simoun_agent.config.train import RESUMABLE_FIELDS
@@ -109,6 +109,9 @@ class TrainCommand:
     """the run config"""
 
 
+@names_full_disk(
+    PROG, "pass --run-dir DIR on another disk (a run resumed: copy it there and --resume the copy)"
+)
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-train``."""

@@ -25,7 +25,7 @@ import torch
 from simoun_agent.config import SetupError
 from simoun_agent.config.keys import config_sections
 from simoun_agent.config.train import RESUMABLE_FIELDS
-from simoun_agent.run.atomic import atomic_write, dead_temporaries
+from simoun_agent.run.atomic import SPACE_ERRNOS, atomic_write, dead_temporaries
 from simoun_agent.run.kept import binary_problem, broken_link, packed_problem, present
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
 from simoun_agent.run.rundir import folder_kind, study_of
@@ -33,8 +33,6 @@ from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
 _REQUIRED = ("format", "config", "agent", "replay_file", "rng", "state")
-SPACE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
-"""Write errors that mean the data did not fit: a full disk, a full quota, a file size limit."""
 
 
 class NoSpace(OSError):

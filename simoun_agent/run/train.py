@@ -63,7 +63,7 @@ from simoun_agent.run.arguments import (
     check_metrics,
     check_run_arg,
 )
-from simoun_agent.run.atomic import atomic_write
+from simoun_agent.run.atomic import NO_SPACE_EXIT, atomic_write
 from simoun_agent.run.callback import TrainCallback
 from simoun_agent.run.checkpoint import (
     SPACE_ERRNOS,
@@ -125,8 +125,6 @@ freed meanwhile saves all the work. After this many failures in a row, or when t
 a stop or of the run's end fails, the run stops with :data:`NO_SPACE_EXIT` (training on would
 only add work that cannot be saved) and ``--resume`` continues from the last checkpoint. A log
 write that fails for lack of space stops it the same way."""
-NO_SPACE_EXIT = 75
-"""Exit status after a stop for lack of space: sysexits' EX_TEMPFAIL (free space, then retry)."""
 
 
 class TrainingError(RuntimeError):

@@ -21,7 +21,7 @@ import tyro
 from tyro.constructors import PrimitiveConstructorSpec
 
 from simoun_agent.cli.command_flags import PATH
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import POSITIONAL
 from simoun_agent.config import SetupError
 from simoun_agent.config.device import device_problem
@@ -349,6 +349,7 @@ DESCRIPTION = (
 )
 
 
+@names_full_disk(PROG, "pass --out DIR on another disk")
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-analyze``."""

@@ -17,7 +17,7 @@ from typing import Annotated
 import tyro
 
 from simoun_agent.cli.command_flags import PATH
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import POSITIONAL
 from simoun_agent.config import SetupError
 from simoun_lab.sweep.report import BUDGET_FLAGS, write_report
@@ -85,6 +85,7 @@ def budget_of(args: ReportCommand) -> tuple[str, float] | None:
     return None
 
 
+@names_full_disk(PROG, "pass --out DIR on another disk")
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-report``."""

@@ -31,7 +31,7 @@ from typing import Annotated, Union
 import tyro
 
 from simoun_agent.cli.command_flags import PATH
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import POSITIONAL, Meant
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import (
@@ -121,6 +121,7 @@ Command = Union[  # noqa: UP007  (tyro 1.0 does not read the `|` of two Annotate
 """The command line: plan a study, run it, or write its report again."""
 
 
+@names_full_disk(PROG, "copy the study directory to another disk and pass the copy as --study-dir")
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-study``."""

@@ -30,12 +30,13 @@ from simoun_agent.cli.config_flags import (
     config_switches,
     overrides_from,
 )
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import RUN_CONFIG_NAMES, Meant
 from simoun_agent.config import RECIPES, SetupError, resolve, to_dict
 from simoun_agent.config.device import same_setting
 from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import flag_name
+from simoun_agent.run.atomic import space_problem
 from simoun_agent.run.kept import present
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.rundir import check_output_dir
@@ -220,6 +221,10 @@ def plain(value: Any) -> Any:
     return json.loads(json.dumps(value))
 
 
+@names_full_disk(
+    PROG,
+    "pass --sweep-dir DIR on another disk (a sweep resumed: copy it there and resume the copy)",
+)
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``simoun-sweep``."""
@@ -310,14 +315,19 @@ def check_finished_trials(trials: list[Trial]) -> None:
 
 def closing_report(spec: SweepSpec, sweep_dir: Path) -> tuple[list[Path], str | None]:
     """The report the sweep writes at its end (``SWEEP_DIR/report``): its files, and why it
-    could not be written (None when it was, or when no trial got as far as its config.json:
-    nothing to report, which the trials' own lines say)."""
+    could not be written, a full disk included (None when it was, or when no trial got as far
+    as its config.json: nothing to report, which the trials' own lines say)."""
     if not any(present(Path(trial.run_dir) / CONFIG_NAME) for trial in spec.trials(sweep_dir)):
         return [], None
     try:
         return report.write_report(sweep_dir, flag=None), None
     except SetupError as err:
         return [], f"{err}; then write it with: simoun-report {sweep_dir}"
+    except OSError as err:  # a full disk: the trials are done, only their report is to write
+        problem = space_problem(err)
+        if problem is None:
+            raise
+        return [], f"{problem} (or write the report with: simoun-report {sweep_dir})"
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Annotated, Union
 
 import tyro
 
-from simoun_agent.cli.flags import fail, parse, quiet_pipe
+from simoun_agent.cli.flags import fail, names_full_disk, parse, quiet_pipe
 from simoun_agent.cli.other_names import Meant
 from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import check_output_dir
@@ -165,6 +165,7 @@ DESCRIPTION = (
 )
 
 
+@names_full_disk(PROG, "copy the archive to another disk and pass the copy as --archive")
 @quiet_pipe
 def main(argv: Sequence[str] | None = None) -> int:
     args = parse(Command, argv, PROG, DESCRIPTION, other_names=OTHER_NAMES)

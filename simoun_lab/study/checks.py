@@ -15,8 +15,10 @@ evaluation started would select another setting.
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
+from collections.abc import Iterable
 from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
@@ -34,7 +36,7 @@ from simoun_agent.run.kept import (
 from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
-from simoun_lab.study.plan import TUNING, StudyRun, evaluation_runs, tuning_runs
+from simoun_lab.study.plan import EVALUATION, TUNING, StudyRun, evaluation_runs, tuning_runs
 from simoun_lab.study.spec import Source, StudySpec, spec_text
 from simoun_lab.sweep.grid import devices_problem
 
@@ -236,6 +238,73 @@ def check_run_folder(where: Path, name: str) -> None:
             f"copy (the study directory and its archive each keep one), or move it aside (mv "
             f"{path} {path}.damaged) and resume the study, which trains that run again"
         )
+
+
+def check_folder_names(where: Path, names: Iterable[str]) -> None:
+    """SetupError naming a folder in the study directory or archive ``where`` whose name is a
+    part of a run's place (``names``: run names, ``evaluation/simoun/...``) in other capitals
+    (``evaluation/Simoun``), as a copy through a case-insensitive file system or a rename
+    leaves it: the runs in it are not at the spec's places, so they would be taken for runs not
+    finished (trained again, listed as not counted) while the phase report, which walks the
+    folders, counts them. A case-insensitive file system, where both names are the one folder,
+    passes."""
+    wanted: dict[tuple[str, ...], set[str]] = {}
+    for name in names:
+        parts = tuple(name.split("/"))
+        for i, part in enumerate(parts):
+            wanted.setdefault(parts[:i], set()).add(part)
+    for parent, parts in wanted.items():
+        folder = where.joinpath(*parent)
+        meant_by = {part.casefold(): part for part in parts}
+        for entry in _entries(folder):
+            meant = meant_by.get(entry.casefold())
+            if meant is not None and entry != meant and not _same(folder, entry, meant):
+                raise SetupError(_stray_folder(where, parent, entry, meant))
+
+
+def _entries(folder: Path) -> list[str]:
+    """The names in ``folder``; none when it is not there or cannot be listed (the runs' own
+    checks name a folder that cannot be read)."""
+    try:
+        return sorted(os.listdir(folder))
+    except OSError:
+        return []
+
+
+def _same(folder: Path, entry: str, meant: str) -> bool:
+    try:
+        return os.path.samefile(folder / entry, folder / meant)
+    except OSError:
+        return False
+
+
+_PART_KINDS = {
+    TUNING: ("phase", "recipe", "setting", "task", "seed"),
+    EVALUATION: ("phase", "recipe", "task", "seed"),
+}
+"""What each part of a run's place names (``evaluation/<recipe>/<task>/s<seed>``)."""
+
+
+def _stray_folder(where: Path, parent: tuple[str, ...], entry: str, meant: str) -> str:
+    stray, place = where.joinpath(*parent, entry), where.joinpath(*parent, meant)
+    kinds = _PART_KINDS.get(parent[0], ()) if parent else ("phase",)
+    kind = kinds[len(parent)] if len(parent) < len(kinds) else "folder"
+    said = (
+        f"{stray} is not a {kind} of the spec: did you mean {meant}? The study reads its runs "
+        f"at the spec's places ({'/'.join([*parent, meant])}/...), and the name differs in "
+        "capitals only (a copy through a case-insensitive file system, or a rename)"
+    )
+    if present(place):
+        aside = where.parent / f"{where.name}-{'-'.join([*parent, entry])}"
+        return (
+            f"{said}; {place} is there too, so {stray} is a second copy, which the phase "
+            f"report would count twice: move it out of {where} (mv {stray} {aside}) and run the "
+            "command again"
+        )
+    return (
+        f"{said}, so its runs would be listed as not finished, or trained again, while the phase "
+        f"report counts them: rename it (mv {stray} {place}) and run the command again"
+    )
 
 
 def check_summary(name: str, places: list[Path]) -> None:

@@ -21,22 +21,29 @@ CHECKOUT = Path(simoun_agent.__file__).resolve().parent.parent
 """The directory simoun is imported from (a git checkout, unless installed from a wheel)."""
 
 
-def _git(*args: str) -> str | None:
+def _git(checkout: Path, *args: str) -> str | None:
+    # --no-optional-locks: reading the checkout must not write its index (``git status``
+    # refreshes it), which a full disk or the user's own git at the same moment would break
     try:
         done = subprocess.run(
-            ["git", *args], cwd=CHECKOUT, capture_output=True, text=True, timeout=30, check=True
+            ["git", "--no-optional-locks", *args],
+            cwd=checkout,
+            capture_output=True,
+            text=True,
+            timeout=30,
+            check=True,
         )
     except (OSError, subprocess.SubprocessError):
         return None
     return done.stdout.strip()
 
 
-def code_version() -> dict[str, Any]:
-    """``{"commit": git rev-parse HEAD of the checkout (None outside git), "dirty": whether
+def code_version(checkout: Path = CHECKOUT) -> dict[str, Any]:
+    """``{"commit": git rev-parse HEAD of the ``checkout`` (None outside git), "dirty": whether
     ``git status --porcelain`` lists changes (None outside git), "version": the installed
-    package's version}``."""
-    commit = _git("rev-parse", "HEAD")
-    status = _git("status", "--porcelain") if commit else None
+    package's version}``. Only reads the checkout: its index is left as it is."""
+    commit = _git(checkout, "rev-parse", "HEAD")
+    status = _git(checkout, "status", "--porcelain") if commit else None
     try:
         installed = version("simoun")
     except PackageNotFoundError:

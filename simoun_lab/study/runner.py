@@ -28,6 +28,7 @@ from simoun_lab.study import archive as archiving
 from simoun_lab.study.archive import GENERALIZATION_CSV
 from simoun_lab.study.checks import (
     check_fixed_spec,
+    check_folder_names,
     check_run_folder,
     check_study,
     check_summary,
@@ -384,6 +385,8 @@ class Phases:
     def run(self, phase: str, runs: list[StudyRun]) -> dict[str, list]:
         """Run the unfinished ``runs`` of ``phase``; the sweep's outcome of those it ran."""
         places = [where for where in (self.study_dir, self.archive) if where is not None]
+        for where in places:  # a run's folder renamed in other capitals is not trained anew
+            check_folder_names(where, [run.name for run in runs])
         for run in runs:  # before anything is restored or trained: a damaged run is named
             for where in places:
                 check_run_folder(where, run.name)
@@ -473,6 +476,8 @@ def report_study(spec: StudySpec, study_dir: Path) -> Path:
         f"{study_dir} holds a study of another spec",
         f"pass the spec it was run with ({record['spec_file']})",
     )
+    # a run's folder renamed in other capitals: the report would count its runs as not finished
+    check_folder_names(study_dir, [run.name for run in tuning_runs(spec) + evaluation_runs(spec)])
     for run in tuning_runs(spec):  # before the selection reads them: a damaged run is named
         check_run_folder(study_dir, run.name)
     code = code_version()
