@@ -514,9 +514,10 @@ def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
     files = (REPORT, "*_success.png", "*_intrinsic.png")
     # checked before the runs are read: a report folder that cannot be written would fail
-    # only at its first figure
-    copy = copy_fix(archive, "python -m simoun_lab.minigrid_study report --archive")
-    check_output_dir(archive / "report", None, files, fix=copy)  # made once the runs read well
+    # only at its first figure (a file in its place is named by report_dir, with its fix)
+    if (archive / "report").is_dir() or not present(archive / "report"):
+        copy = copy_fix(archive, "python -m simoun_lab.minigrid_study report --archive")
+        check_output_dir(archive / "report", None, files, fix=copy)  # made once the runs read well
     records = Records(spec, archive)
     out = report_dir(archive / "report", files)
     total = len(spec.runs())
