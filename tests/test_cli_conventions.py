@@ -392,7 +392,10 @@ def test_resume_of_a_read_only_run_directory_is_one_clear_error(finished):
     assert done.returncode == 2, done.stderr
     assert "Traceback" not in done.stderr
     assert f"cannot write to the run directory {finished} (Read-only file system)" in done.stderr
-    assert "Make it writable" in done.stderr and "--resume the copy" in done.stderr
+    assert "Make it writable" in done.stderr
+    assert f"cp -r {finished} ~/{finished.name} && simoun-train --resume ~/{finished.name}" in (
+        done.stderr
+    )
 
 
 def test_an_unknown_mujoco_gl_is_refused_in_one_line(tmp_path):

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import torch
+from other_users import restored, run_as_user, unwritable
 
 from simoun_agent.cli import eval as eval_cli
 from simoun_agent.cli import train as train_cli
@@ -21,6 +22,7 @@ from simoun_lab.cli import report as report_cli
 from simoun_lab.cli import study as study_cli
 from simoun_lab.cli import sweep as sweep_cli
 from simoun_lab.minigrid_study import __main__ as minigrid_cli
+from simoun_lab.sweep.grid import SweepSpec
 
 MINIGRID = "python -m simoun_lab.minigrid_study"
 DRIVING = "python -m simoun_agent.run.driving_reference"
@@ -891,3 +893,37 @@ def test_an_unknown_flag_is_offered_only_a_flag_of_its_meaning(main, argv, said,
 )
 def test_a_close_spelling_that_takes_another_kind_of_value_is_not_offered(argv, never, capsys):
     assert never not in refused(capsys, train_cli.main, argv)
+
+
+def test_a_read_only_sweep_resumed_is_told_to_resume_a_copy(tmp_path):
+    """Another --sweep-dir holds no sweep to resume: the fix for another user's sweep is a
+    copy of it, resumed."""
+    sweep_dir = tmp_path / "sw"
+    sweep_dir.mkdir()
+    SweepSpec(None, {"device": "cpu"}, {}, [0], ["simoun/PointReach-v0"]).save(sweep_dir)
+    unwritable(sweep_dir)
+    try:
+        result = run_as_user("simoun_lab.cli.sweep", "--resume", "--sweep-dir", str(sweep_dir))
+    finally:
+        restored(sweep_dir)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"cannot write to the output directory {sweep_dir}" in result.stderr
+    copy = f"cp -r {sweep_dir} ~/sw && simoun-sweep --resume --sweep-dir ~/sw"
+    assert copy in result.stderr
+    assert "pass a writable --sweep-dir" not in result.stderr
+
+
+def test_a_read_only_study_resumed_is_told_to_resume_a_copy(tmp_path):
+    study_dir = tmp_path / "s"
+    study_dir.mkdir()
+    unwritable(study_dir)
+    spec = Path(__file__).parents[1] / "docs" / "studies" / "dmc100k.toml"
+    try:
+        argv = ["run", str(spec), "--study-dir", str(study_dir), "--resume"]
+        result = run_as_user("simoun_lab.cli.study", *argv)
+    finally:
+        restored(study_dir)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"cannot write to the output directory {study_dir}" in result.stderr
+    copy = f"cp -r {study_dir} ~/s && simoun-study run {spec} --resume --study-dir ~/s"
+    assert copy in result.stderr

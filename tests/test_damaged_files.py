@@ -10,6 +10,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from other_users import restored, run_as_user, unreadable
 from test_train_resume import TINY
 
 from simoun_agent import FrameReplay
@@ -657,3 +658,51 @@ def test_a_refused_distraction_evaluation_makes_no_report_directory(tmp_path, ca
     assert stop.value.code == 2
     assert "Traceback" not in capsys.readouterr().err
     assert not (tmp_path / "reports").exists()
+
+
+@pytest.mark.parametrize(
+    ("module", "args", "name"),
+    [
+        ("simoun_agent.cli.train", ("--resume", "{run}", "--total-env-steps=120"), "config.json"),
+        ("simoun_agent.cli.eval", ("{run}", "--episodes=1", "--no-video"), "checkpoint.pt"),
+        ("simoun_lab.cli.analyze", ("bias", "{run}", "--pairs=8", "--out", "{out}"), "config.json"),
+    ],
+)
+def test_a_kept_file_the_user_may_not_read_is_named_with_the_fix_for_permissions(
+    trained_run, module, args, name, tmp_path
+):
+    """Another user's file (``sudo cp`` leaves it root's, mode 600) is whole: the command says
+    it cannot be read, whose it is and how to make it readable, never that it is damaged, to be
+    restored, deleted or trained anew."""
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    (run_dir / ".lock").unlink(missing_ok=True)
+    unreadable(run_dir / name)
+    try:
+        argv = [arg.format(run=run_dir, out=tmp_path / "out") for arg in args]
+        result = run_as_user(module, *argv)
+    finally:
+        restored(run_dir / name)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"{run_dir / name} cannot be read: permission denied (owner " in result.stderr
+    assert "chmod" in result.stderr
+    for word in ("Traceback", "damaged", "corrupt", "Restore", "delete", "start a new run"):
+        assert word not in result.stderr
+
+
+def test_another_users_lock_in_the_users_run_is_named_with_its_removal(trained_run, tmp_path):
+    """A lock file another user left (a trainer once run with sudo) in the user's writable run:
+    the lock is named, and since no process holds it, removing it is the fix."""
+    run_dir = shutil.copytree(trained_run, tmp_path / "run")
+    lock = run_dir / ".lock"
+    lock.write_text("")
+    unreadable(lock)
+    try:
+        result = run_as_user(
+            "simoun_agent.cli.train", "--resume", str(run_dir), "--total-env-steps", "120"
+        )
+    finally:
+        restored(lock)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"{lock} is another user's" in result.stderr
+    assert "no process holds it" in result.stderr and f"rm {lock}" in result.stderr
+    assert "cannot write to the run directory" not in result.stderr

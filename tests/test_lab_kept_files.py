@@ -7,9 +7,11 @@ study archives."""
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
 import json
 import os
+import pwd
 import re
 import shutil
 import signal
@@ -17,9 +19,17 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from other_users import restored, run_as_user, run_code_as_user, unreadable, unwritable
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import Damaged, csv_number, read_csv_rows, read_json_object
+from simoun_agent.run.kept import (
+    Damaged,
+    Unreadable,
+    csv_number,
+    read_csv_rows,
+    read_json_object,
+    reading,
+)
 from simoun_lab.cli import report as report_cli
 from simoun_lab.cli import study as study_cli
 from simoun_lab.engine.launcher import read_run_files
@@ -809,3 +819,121 @@ def test_every_kept_json_file_is_read_alike_in_utf16(tmp_path):
     utf16(spec)
     with pytest.raises(SetupError, match="saved as UTF-16 text, not UTF-8; convert it"):
         load_minigrid_spec(spec)
+
+
+def test_a_read_refused_for_permission_is_told_apart_from_damage(tmp_path):
+    """The OSError of a file the user may not read (EACCES, EPERM) names the file, its owner and
+    mode and the fix for permissions; any other OSError is left to its reader."""
+    path = tmp_path / "summary.json"
+    path.write_text("{}")
+    path.chmod(0o640)
+    for code in (errno.EACCES, errno.EPERM):
+        with pytest.raises(Unreadable) as refusal, reading(path):
+            raise OSError(code, os.strerror(code), str(path))
+        said = str(refusal.value)
+        owner = pwd.getpwuid(os.geteuid()).pw_name
+        assert said.startswith(
+            f"{path} cannot be read: permission denied (owner {owner}, mode 640)"
+        )
+        assert f"chmod u+r {path}" in said
+        assert not re.search("damaged|corrupt|restore|delete|anew", said, re.IGNORECASE)
+    with pytest.raises(OSError, match="Input/output error"), reading(path):
+        raise OSError(errno.EIO, os.strerror(errno.EIO), str(path))
+
+
+def test_every_shared_reader_names_a_file_or_folder_the_user_may_not_read(tmp_path):
+    """The readers every command uses raise Unreadable, as an ordinary user, for another
+    user's file and for a file in a colleague's private folder, where they would name damage
+    or let a PermissionError escape."""
+    (tmp_path / "checkpoint.pt").write_bytes(b"PK\3\4" + bytes(100))
+    (tmp_path / "summary.json").write_text("{}")
+    private = tmp_path / "private"
+    private.mkdir()
+    (private / "summary.json").write_text("{}")
+    readers = {
+        "read_text": "summary.json",
+        "read_json_object": "summary.json",
+        "summary_problem": "summary.json",
+        "checkpoint_problem": "checkpoint.pt",
+        "binary_problem": "checkpoint.pt",
+        "present": "private/summary.json",
+        "summary_written": "private",
+    }
+    for name in ("checkpoint.pt", "summary.json", "private"):
+        unreadable(tmp_path / name)
+    code = """
+import sys
+from pathlib import Path
+from simoun_agent.run import kept
+from simoun_lab.engine.trial import summary_written
+for name, path in zip(sys.argv[1::2], sys.argv[2::2]):
+    try:
+        getattr(kept, name, summary_written)(Path(path))
+    except kept.Unreadable as err:
+        print(name, "->", err)
+"""
+    argv = [part for name, file in readers.items() for part in (name, str(tmp_path / file))]
+    try:
+        result = run_code_as_user(code, *argv)
+    finally:
+        for name in ("checkpoint.pt", "summary.json", "private"):
+            restored(tmp_path / name)
+    assert result.returncode == 0, result.stderr[-3000:]
+    said = dict(line.split(" -> ") for line in result.stdout.splitlines())
+    assert sorted(said) == sorted(readers)
+    for name, file in readers.items():
+        assert said[name].startswith(str(tmp_path / file)), said[name]
+        assert "cannot be read" in said[name]
+        assert "permission denied (owner " in said[name] and "chmod" in said[name]
+    assert all(f"(its folder {private})" in said[name] for name in ("present", "summary_written"))
+
+
+def test_a_private_run_folder_is_named_by_the_minigrid_report(minigrid_archive):
+    run = minigrid_archive / MINIGRID_RUNS[0]
+    unreadable(run)
+    try:
+        result = run_as_user(
+            "simoun_lab.minigrid_study.__main__", "report", "--archive", str(minigrid_archive)
+        )
+    finally:
+        restored(run)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"{run / 'summary.json'} cannot be read (its folder {run}): permission denied" in (
+        result.stderr
+    )
+    assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("command", ["report", "select"])
+def test_a_minigrid_archive_that_cannot_be_written_is_refused_before_it_is_read(
+    command, minigrid_archive
+):
+    """The report and the selection check the folder they write into first, as the other
+    commands do, with the fix for another user's archive: a copy of it."""
+    unwritable(minigrid_archive)
+    try:
+        result = run_as_user(
+            "simoun_lab.minigrid_study.__main__", command, "--archive", str(minigrid_archive)
+        )
+    finally:
+        restored(minigrid_archive)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert "cannot write to the output directory" in result.stderr
+    assert f"cp -r {minigrid_archive} ~/archive && python -m simoun_lab.minigrid_study " in (
+        result.stderr
+    )
+    assert "Traceback" not in result.stderr
+
+
+def test_a_private_evaluation_run_is_named_by_the_study_report(dmc_archive):
+    run = dmc_archive / EVALUATION_RUN
+    unreadable(run)
+    try:
+        result = run_as_user(
+            "simoun_lab.cli.study", "report", str(DMC_SPEC), "--study-dir", str(dmc_archive)
+        )
+    finally:
+        restored(run)
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"cannot be read (its folder {run}): permission denied" in result.stderr
+    assert "Traceback" not in result.stderr

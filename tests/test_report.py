@@ -17,6 +17,7 @@ import matplotlib.colors
 import matplotlib.image
 import numpy as np
 import pytest
+from other_users import restored, run_as_user, unreadable
 from test_train_failures import named_unwritten_file, under_file_size_limit
 from test_train_resume import TINY as RESUME_TINY
 
@@ -583,3 +584,31 @@ def test_a_task_folder_of_a_minigrid_archive_is_sent_to_the_archives_report(caps
     assert "holds runs of the MiniGrid study, which simoun-report does not read" in err
     assert f"python -m simoun_lab.minigrid_study report --archive {root}`" in err
     assert not Path("never-written").exists()
+
+
+def test_a_run_the_user_may_not_read_is_named_not_left_out_in_silence(runs_dir, tmp_path):
+    """A colleague's private run folder (mode 700) among the user's runs is listed as a run
+    that cannot be read, with its owner and the fix; the others are reported."""
+    root = copy_runs(runs_dir, ("a-s0", "a-s1"), tmp_path / "runs")
+    unreadable(root / "a-s1")
+    try:
+        result = run_as_user("simoun_lab.cli.report", str(root), "--out", str(tmp_path / "r"))
+    finally:
+        restored(root / "a-s1")
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "## Runs that cannot be read (not counted)" in result.stdout
+    assert f"- a-s1: {root / 'a-s1'} cannot be read: permission denied (owner " in result.stdout
+    assert "chmod" in result.stdout
+
+
+def test_a_run_whose_log_the_user_may_not_read_is_not_called_damaged(runs_dir, tmp_path):
+    root = copy_runs(runs_dir, ("a-s0",), tmp_path / "runs")
+    unreadable(root / "a-s0" / "eval.csv")
+    try:
+        result = run_as_user("simoun_lab.cli.report", str(root), "--out", str(tmp_path / "r"))
+    finally:
+        restored(root / "a-s0" / "eval.csv")
+    assert result.returncode == 2, result.stderr[-3000:]
+    assert f"{root / 'a-s0' / 'eval.csv'} cannot be read: permission denied" in result.stderr
+    for word in ("Traceback", "damaged", "restore", "remove"):
+        assert word not in result.stderr

@@ -23,11 +23,10 @@ Before tyro reads the command line, :func:`parse` refuses in one line, naming th
 argument: an unknown flag (the command's own in other letter case, another library's name for
 a flag told this command's own, :mod:`simoun_agent.cli.other_names`, another simoun command's
 flag named as that command's; a flag offered by spelling takes the kind of value given), a
-second value of an option that takes one, a word after a
-switch, a switch given a value it does not take, a
-word no argument takes, an empty or blank value, a path the file system cannot hold, a dict's
-value that is not a JSON object (what json found and where, or a key given twice), an option given twice with different
-values, and a number past int64.
+second value of an option that takes one, a word after a switch, a switch given a value it
+does not take, a word no argument takes, an empty or blank value, a path the file system cannot
+hold, a dict's value that is not a JSON object (what json found and where, or a key given
+twice), an option given twice with different values, and a number past int64.
 """
 
 from __future__ import annotations

@@ -6,7 +6,8 @@ files a run keeps (``config.json``, ``eval.csv``, ``train.csv``, ``summary.json`
 ``spec.json``, ``trial.json``, ``references.json``, ``generalization.csv`` ...); each names a
 damaged one by its path, what is wrong and the fix, rather than failing inside a parser or taking
 the damage for data. :class:`Damaged` carries what is wrong; each caller adds the fix that fits
-its command.
+its command. A file or folder the user may not read (another user's, a colleague's private run)
+is no damage: :class:`Unreadable` names it with its owner, mode and the fix for permissions.
 """
 
 from __future__ import annotations
@@ -17,11 +18,15 @@ import io
 import json
 import math
 import os
+import pwd
 import stat
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+
+from simoun_agent.config.errors import SetupError
 
 STEP_LIMIT = 2**63
 """Steps at or past it are damage: counters, TensorBoard and numpy hold steps as int64."""
@@ -71,6 +76,75 @@ def json_problem(text: str, err: json.JSONDecodeError) -> str:
 
 class Damaged(ValueError):
     """A kept file that cannot be what the run wrote; ``str()`` says what is wrong with it."""
+
+
+class Unreadable(SetupError):
+    """A kept file or folder the user may not read (permission denied): whole, as far as anyone
+    knows, so that the fix is to make it readable, never to restore, delete or train it anew;
+    ``str()`` names it, its owner and mode, and the command that makes it readable."""
+
+
+DENIED = (errno.EACCES, errno.EPERM)
+"""The errors of a file or folder the user may not read (its mode, its owner)."""
+
+
+def blocking(path: Path) -> Path:
+    """What stops a read of ``path``: the outermost of its folders that the user may not enter
+    (a colleague's private run folder, mode 700), else ``path`` itself."""
+    for folder in reversed(Path(path).parents):
+        if str(folder) not in ("", ".") and not os.access(folder, os.X_OK):
+            return folder
+    return Path(path)
+
+
+def owner_and_mode(path: Path) -> tuple[str, str]:
+    """The user name (or number) that owns ``path`` and its permission bits, as ``ls -l`` and
+    ``chmod`` show them (``600``); ``?`` for what cannot be looked at."""
+    try:
+        info = os.lstat(path)
+    except OSError:
+        return "?", "?"
+    try:
+        owner = pwd.getpwuid(info.st_uid).pw_name
+    except KeyError:
+        owner = str(info.st_uid)
+    return owner, f"{stat.S_IMODE(info.st_mode):o}"
+
+
+def permission_problem(path: Path) -> str:
+    """``path`` (a file or folder the user may not read) named with what blocks it, its owner and
+    mode, and the fix that works: ``chmod`` for the user's own, the owner's or ``sudo chown``
+    for another user's. Nothing in it is damaged."""
+    where = blocking(path)
+    owner, mode = owner_and_mode(where)
+    folder = os.path.isdir(where)
+    bits = "u+rx" if folder else "u+r"
+    what = f"{path} cannot be read" + ("" if where == Path(path) else f" (its folder {where})")
+    try:
+        mine = os.lstat(where).st_uid == os.geteuid()
+    except OSError:
+        mine = False
+    fix = (
+        f"make it readable (chmod {bits} {where})"
+        if mine
+        else (
+            f"ask its owner ({owner}) to make it readable (chmod a{bits[1:]} {where}), or take it "
+            f"as an administrator (sudo chown {'-R ' if folder else ''}$USER {where})"
+        )
+    )
+    return f"{what}: permission denied (owner {owner}, mode {mode}); {fix}"
+
+
+@contextmanager
+def reading(path: Path) -> Iterator[None]:
+    """Reads of ``path`` (a kept file or folder) inside it that are refused for permission
+    raise :class:`Unreadable` naming it (:func:`permission_problem`); other OSErrors pass."""
+    try:
+        yield
+    except OSError as err:
+        if err.errno in DENIED:
+            raise Unreadable(permission_problem(Path(path))) from None
+        raise
 
 
 def broken_link(path: Path) -> str | None:
@@ -135,11 +209,12 @@ def read_text(path: Path) -> str:
     before it is opened), a Git LFS pointer (:func:`lfs_problem`), text in another encoding
     (UTF-16 named with the command that converts it) or NUL bytes, which no run writes. Every
     kept text file, JSON or CSV, is read here, so that each is refused or taken alike. OSError
-    for a file that cannot be read."""
-    problem = broken_link(path) or not_a_file(path)
-    if problem:
-        raise Damaged(problem)
-    data = path.read_bytes()
+    for a file that cannot be read, :class:`Unreadable` for one the user may not read."""
+    with reading(path):
+        problem = broken_link(path) or not_a_file(path)
+        if problem:
+            raise Damaged(problem)
+        data = path.read_bytes()
     problem = lfs_problem(path, data)
     if problem:
         raise Damaged(problem)
@@ -158,8 +233,10 @@ def read_text(path: Path) -> str:
 def present(path: Path) -> bool:
     """Whether anything is at ``path``: a file, a directory, a named pipe or a symbolic link,
     even one to nothing. A kept file is read when present, so that what stands in its place is
-    named rather than taken for a file not written yet."""
-    return path.is_symlink() or path.exists()
+    named rather than taken for a file not written yet. :class:`Unreadable` where a folder on
+    the way may not be entered (a colleague's private run folder)."""
+    with reading(path):
+        return path.is_symlink() or path.exists()
 
 
 def json_kind(value: Any) -> str:
@@ -171,7 +248,8 @@ def json_kind(value: Any) -> str:
 def read_json_object(path: Path) -> dict[str, Any]:
     """The JSON object in ``path``; :class:`Damaged` for what :func:`read_text` refuses, an
     empty file, text that is not JSON (cut short, say), JSON that is not an object, or a file
-    that cannot be read (its callers name every such file the same way)."""
+    that cannot be read (its callers name every such file the same way); :class:`Unreadable`
+    for one the user may not read."""
     try:
         text = read_text(path)
     except OSError as err:
@@ -291,7 +369,8 @@ def step_count(text: str) -> int:
 def binary_problem(path: Path) -> str:
     """What is visibly wrong with a binary file that its reader refused: empty, a Git LFS
     pointer (:func:`lfs_problem`), or all zero bytes (a disk that lost the data, a copy cut
-    off); else that it cannot be read."""
+    off); else that it cannot be read. :class:`Unreadable` for a file the user may not read:
+    its reader's refusal was not damage."""
     try:
         size = path.stat().st_size
         if size == 0:
@@ -304,6 +383,8 @@ def binary_problem(path: Path) -> str:
                 if chunk.count(0) != len(chunk):
                     return f"it cannot be read ({size} bytes, cut short or overwritten)"
     except OSError as err:
+        if err.errno in DENIED:
+            raise Unreadable(permission_problem(path)) from None
         return f"it cannot be read ({err.strerror})"
     return f"all its {size} bytes are zero (a disk or copy failure)"
 
@@ -311,8 +392,10 @@ def binary_problem(path: Path) -> str:
 def checkpoint_problem(path: Path) -> str | None:
     """What is wrong with the checkpoint at ``path`` (a ``torch.save`` file, which is a zip
     archive), checked without torch by reading every member against its checksum; None when it
-    is whole. A link to nothing or something that is not a file is named too."""
-    problem = broken_link(path) or not_a_file(path)
+    is whole. A link to nothing or something that is not a file is named too;
+    :class:`Unreadable` for a file the user may not read."""
+    with reading(path):
+        problem = broken_link(path) or not_a_file(path)
     if problem:
         return problem
     try:
@@ -321,6 +404,8 @@ def checkpoint_problem(path: Path) -> str | None:
     except (zipfile.BadZipFile, EOFError, ValueError):
         return binary_problem(path)
     except OSError as err:
+        if err.errno in DENIED:
+            raise Unreadable(permission_problem(path)) from None
         return f"it cannot be read ({err.strerror})"
     return None if bad is None else f"its part {bad} does not match its checksum (overwritten)"
 
@@ -384,8 +469,10 @@ def summary_problem(path: Path) -> str | None:
     resume cannot rely on it: it cannot be read (:func:`read_json_object`), holds another file's
     keys (:func:`kind_problem`), or has no env_step >= 0 or no finite final_eval.return_mean,
     which every reader of a finished run reads. None when there is no summary.json (the run is
-    not finished) or it is sound."""
-    if not path.is_file():
+    not finished) or it is sound. :class:`Unreadable` for one the user may not read."""
+    with reading(path):
+        written = path.is_file()
+    if not written:
         return None
     try:
         summary = read_json_object(path)

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import broken_link, not_a_file
+from simoun_agent.run.kept import DENIED, broken_link, not_a_file, owner_and_mode
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -87,7 +87,19 @@ def output_files(directory: Path, names: Iterable[str]) -> list[Path]:
     return [path for name in names for path in sorted(directory.glob(name))]
 
 
-def check_output_dir(path: Path, flag: str | None, files: Iterable[str] = ()) -> None:
+def copy_fix(path: Path, command: str) -> str:
+    """The fix for a folder that cannot be written but holds work to go on with (a run, a
+    sweep, a study resumed; an archive read): copy it to a writable place (the user's home)
+    and run ``command``, which ends with the folder's flag, on the copy."""
+    copy = f"~/{Path(path).absolute().name}"
+    return (
+        f"copy {path} to a writable place and go on there: cp -r {path} {copy} && {command} {copy}"
+    )
+
+
+def check_output_dir(
+    path: Path, flag: str | None, files: Iterable[str] = (), fix: str | None = None
+) -> None:
     """Raise SetupError naming ``flag`` when the output directory ``path`` could not be made or
     written: it is a file, a folder on its way is a file or a symbolic link that loops or leads
     nowhere, a name is too long, or the nearest folder of it that exists takes no new folder
@@ -96,7 +108,8 @@ def check_output_dir(path: Path, flag: str | None, files: Iterable[str] = ()) ->
     (:func:`check_output_files`). Leaves nothing behind (its probe folder is removed at once),
     so a command can check before the work whose set-up takes long (Ray) rather than fail
     after it. ``flag`` None: a folder the command names itself, which the fixes say how to
-    free rather than naming a flag the command does not have."""
+    free rather than naming a flag the command does not have. ``fix``: the fix to give instead
+    (:func:`copy_fix` for a folder whose contents the command goes on with)."""
     try:
         refuse_a_file(path, flag)
         reason = unwritable(path.absolute())
@@ -104,7 +117,7 @@ def check_output_dir(path: Path, flag: str | None, files: Iterable[str] = ()) ->
         reason = getattr(err, "strerror", None) or str(err)
     if reason:
         raise SetupError(
-            f"cannot write to the output directory {path} ({reason}); {writable_fix(flag)}"
+            f"cannot write to the output directory {path} ({reason}); {fix or writable_fix(flag)}"
         )
     check_output_files(output_files(path, files), flag)
 
@@ -222,10 +235,7 @@ def lock_run_dir(run_dir: Path) -> IO[str]:
         # This process held it already (a run that raised, in a notebook or a Ray worker): flock
         # would refuse a second handle of our own, so the old one goes.
         earlier.close()
-    try:
-        handle = path.open("a+")
-    except OSError as err:
-        raise not_writable(run_dir, err.strerror) from None
+    handle = open_lock(run_dir, "a+")
     try:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
@@ -246,9 +256,53 @@ def not_writable(run_dir: Path, why: str) -> SetupError:
     word)."""
     return SetupError(
         f"cannot write to the run directory {run_dir} ({why}): a run writes its lock, "
-        "checkpoints and logs there. Make it writable (a read-only mount, or files of another "
-        "user: chmod -R u+w), or copy the run to a writable place and --resume the copy"
+        "checkpoints and logs there. Make it writable (chmod -R u+w, for your own files), or "
+        + copy_fix(run_dir, "simoun-train --resume")
     )
+
+
+def foreign_lock(run_dir: Path) -> SetupError:
+    """The refusal of a run directory whose lock file the user may not open (another user's,
+    as a trainer run with sudo leaves it), with who holds it, if anyone: a lock no process
+    holds is stale, and removing it is the fix (the directory being writable)."""
+    path = run_dir / LOCK_NAME
+    owner, mode = owner_and_mode(path)
+    holders = lock_holders(path)
+    seen = f"{path} is another user's (owner {owner}, mode {mode}), and cannot be opened"
+    if holders:
+        return SetupError(
+            f"{seen}: the trainer of PID {', '.join(holders)} holds it; wait for it to end, or "
+            "ask its owner to stop it"
+        )
+    return SetupError(
+        f"{seen}; no process holds it (a trainer once run as that user, with sudo, left it): "
+        f"remove it (rm {path}) and run again: the run writes its lock anew"
+    )
+
+
+def lock_holders(path: Path) -> list[str]:
+    """The PIDs that hold a lock on the file ``path`` (Linux's /proc/locks), found without
+    opening it; none where the file or /proc/locks cannot be looked at."""
+    try:
+        info = os.stat(path)
+        lines = Path("/proc/locks").read_text().splitlines()
+    except OSError:
+        return []
+    where = f"{os.major(info.st_dev):02x}:{os.minor(info.st_dev):02x}:{info.st_ino}"
+    return [fields[4] for line in lines if len(fields := line.split()) > 5 and fields[5] == where]
+
+
+def open_lock(run_dir: Path, mode: str) -> IO[str]:
+    """The run directory's lock file opened in ``mode``, or SetupError: another user's lock
+    file (:func:`foreign_lock`) in a directory the user may write, or a directory the run
+    cannot write in (:func:`not_writable`)."""
+    path = run_dir / LOCK_NAME
+    try:
+        return path.open(mode)
+    except OSError as err:
+        if err.errno in DENIED and os.access(run_dir, os.W_OK | os.X_OK):
+            raise foreign_lock(run_dir) from None
+        raise not_writable(run_dir, err.strerror) from None
 
 
 def in_use(run_dir: Path, holder: str) -> SetupError:
@@ -269,10 +323,7 @@ def refuse_live_lock(run_dir: Path) -> None:
         raise not_writable(run_dir, os.strerror(errno.EROFS if read_only else errno.EACCES))
     if not path.is_file():
         return
-    try:
-        handle = path.open()
-    except OSError as err:
-        raise not_writable(run_dir, err.strerror) from None
+    handle = open_lock(run_dir, "r")
     with handle:
         try:
             fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)

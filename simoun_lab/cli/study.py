@@ -37,6 +37,7 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.rundir import (
     check_output_dir,
     check_output_files,
+    copy_fix,
     make_output_dir,
     output_files,
 )
@@ -191,6 +192,16 @@ def outputs(options: Run) -> dict[str, Path]:
     return {flag: path for flag, path in given.items() if path is not None}
 
 
+def resume_fix(options: Run, flag: str) -> str:
+    """The fix for a study directory or archive that cannot be written, resumed: another
+    folder holds nothing to resume, so the folder is copied and the copy resumed."""
+    given = {"--study-dir": options.study_dir, "--archive": options.archive}
+    others = " ".join(f"{name} {path}" for name, path in given.items() if name != flag and path)
+    switch = " --allow-other-commit" if options.allow_other_commit else ""
+    command = f"simoun-study run {options.spec} {others} --resume{switch}".replace("  ", " ")
+    return copy_fix(given[flag], f"{command} {flag}")
+
+
 def check_outputs(options: Run) -> None:
     """Refuse an output directory that cannot be written (:func:`check_output_dir`) or that
     lies inside another study's archive (:func:`~simoun_lab.study.owner.check_not_inside_study`),
@@ -200,7 +211,7 @@ def check_outputs(options: Run) -> None:
     from simoun_lab.study.report import REPORT_DIR, REPORT_FILES  # numpy: after the flags
 
     for flag, path in outputs(options).items():
-        check_output_dir(path, flag)
+        check_output_dir(path, flag, fix=resume_fix(options, flag) if options.resume else None)
         check_not_inside_study(path, flag)
     check_output_files(output_files(options.study_dir / REPORT_DIR, REPORT_FILES))
     if options.archive is not None:

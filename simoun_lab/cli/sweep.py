@@ -39,7 +39,7 @@ from simoun_agent.config.rules import flag_name
 from simoun_agent.run.atomic import space_problem
 from simoun_agent.run.kept import present
 from simoun_agent.run.layout import CONFIG_NAME
-from simoun_agent.run.rundir import check_output_dir
+from simoun_agent.run.rundir import check_output_dir, copy_fix
 from simoun_lab.engine.ray_start import connect, load_ray
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import (
@@ -245,7 +245,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv, SweepCommand), sweep_dir)
         check_trial_dirs(spec, sweep_dir)
-        check_output_dir(sweep_dir, "--sweep-dir")
+        resumed = copy_fix(sweep_dir, "simoun-sweep --resume --sweep-dir")
+        check_output_dir(sweep_dir, "--sweep-dir", fix=resumed if args.resume else None)
         check_devices(spec.trials(sweep_dir), gpus_wanted(args.gpus_per_trial), spec.grid)
         ray = load_ray()
     except SetupError as err:

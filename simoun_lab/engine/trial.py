@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
+from simoun_agent.run.kept import reading
 from simoun_agent.run.layout import SUMMARY_NAME
 
 __all__ = ["SUMMARY", "Trial", "summary_written"]
@@ -21,8 +22,11 @@ SUMMARY = SUMMARY_NAME
 
 
 def summary_written(run_dir: Path | str) -> bool:
-    """Whether the run directory ``run_dir`` holds a finished run."""
-    return (Path(run_dir) / SUMMARY).is_file()
+    """Whether the run directory ``run_dir`` holds a finished run; :class:`~simoun_agent.run.
+    kept.Unreadable` for a run folder the user may not enter (a colleague's private run)."""
+    path = Path(run_dir) / SUMMARY
+    with reading(path):
+        return path.is_file()
 
 
 @runtime_checkable

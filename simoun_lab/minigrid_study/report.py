@@ -34,7 +34,7 @@ from simoun_agent.run.kept import (
     read_csv_rows,
     read_json_object,
 )
-from simoun_agent.run.rundir import check_output_files, output_files
+from simoun_agent.run.rundir import check_output_dir, copy_fix
 from simoun_lab import stats
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY, TRAIN_CSV
 from simoun_lab.minigrid_study.spec import Run, StudySpec, spec_from_dict
@@ -513,7 +513,11 @@ def plot_training(records: Records, out: Path) -> list[str]:
 def write_report(spec: StudySpec, archive: Path) -> Path:
     """Write ``report.md`` and the curves into ``archive/report``; returns the report's path."""
     files = (REPORT, "*_success.png", "*_intrinsic.png")
-    check_output_files(output_files(archive / "report", files))  # made once the runs read well
+    # checked before the runs are read: a report folder that cannot be written would fail
+    # only at its first figure (a file in its place is named by report_dir, with its fix)
+    if (archive / "report").is_dir() or not present(archive / "report"):
+        copy = copy_fix(archive, "python -m simoun_lab.minigrid_study report --archive")
+        check_output_dir(archive / "report", None, files, fix=copy)  # made once the runs read well
     records = Records(spec, archive)
     out = report_dir(archive / "report", files)
     total = len(spec.runs())

@@ -22,7 +22,7 @@ from simoun_agent import table
 from simoun_agent.config import SetupError
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import present
-from simoun_agent.run.rundir import check_output_files
+from simoun_agent.run.rundir import check_output_dir, check_output_files, copy_fix
 from simoun_lab.minigrid_study.arms import parse_arm
 from simoun_lab.minigrid_study.report import check_run_folder, damaged, read_eval, read_finished
 from simoun_lab.minigrid_study.run import EVAL_CSV, SUMMARY
@@ -94,6 +94,8 @@ def select(spec: StudySpec, archive: Path) -> dict[str, Any]:
 def write_selection(spec: StudySpec, archive: Path) -> Path:
     """Write ``selection.json`` and ``selection.md`` into ``archive``; return the Markdown's
     path."""
+    copy = copy_fix(archive, "python -m simoun_lab.minigrid_study select --archive")
+    check_output_dir(archive, None, fix=copy)  # before the runs are read, as the report does
     check_output_files([archive / f"{SELECTION}.json", archive / f"{SELECTION}.md"])
     result = select(spec, archive)
     if not any(record["areas"] for record in result["arms"].values()):

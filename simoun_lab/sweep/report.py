@@ -40,7 +40,7 @@ import json
 import math
 import os
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -54,11 +54,14 @@ from simoun_agent.config.resolve import flatten
 from simoun_agent.config.rules import is_real, show
 from simoun_agent.run.atomic import atomic_write
 from simoun_agent.run.kept import (
+    DENIED,
     STEP_LIMIT,
     Damaged,
+    Unreadable,
     folder_problem,
     kind_problem,
     packed_problem,
+    permission_problem,
     present,
     read_json_object,
     read_text,
@@ -200,29 +203,51 @@ class DamagedRun(Exception):
     """A run's file cannot be read as the run wrote it (empty, cut short, not a number)."""
 
 
-def find_runs(root: Path, damaged: list[str] | None = None) -> list[RunRecord]:
+def find_runs(
+    root: Path, damaged: list[str] | None = None, unreadable: list[str] | None = None
+) -> list[RunRecord]:
     """Every run directory under ``root`` (Tune's own records under ``tune/`` skipped). A run
     whose config.json, eval.csv or summary.json cannot be read is left out and, when
-    ``damaged`` is given, named there with the file and what is wrong with it."""
+    ``damaged`` is given, named there with the file and what is wrong with it. A run folder or
+    file the user may not read (a colleague's private run) is left out and named in
+    ``unreadable`` (in ``damaged`` where it is not given) with its owner, mode and the fix;
+    :class:`~simoun_agent.run.kept.Unreadable` where neither list is given."""
+    denied = unreadable if unreadable is not None else damaged
     records = []
-    for config_path in config_paths(root, [] if damaged is None else damaged):
+    for config_path in config_paths(root, [] if damaged is None else damaged, denied):
+        label = config_path.parent.relative_to(root).as_posix()
         try:
             records.append(read_run(config_path))
         except DamagedRun as err:
             if damaged is not None:
-                damaged.append(f"{config_path.parent.relative_to(root).as_posix()}: {err}")
+                damaged.append(f"{label}: {err}")
+        except Unreadable as err:
+            if denied is None:
+                raise
+            denied.append(f"{label}: {err}")
     return records
 
 
-def config_paths(root: Path, damaged: list[str]) -> list[Path]:
+def config_paths(root: Path, damaged: list[str], unreadable: list[str] | None = None) -> list[Path]:
     """Every run's ``config.json`` under ``root`` (a link to nothing included: its run is named
     as damaged), Tune's records under ``tune/`` and hidden folders skipped. A link to a folder
     is followed (a run moved elsewhere and linked back is a run), each folder once; a link to a
     folder it is in (a loop), and a folder whose config.json lies packed beside its name
-    (``config.json.gz``), are named in ``damaged``, not walked round or passed over."""
+    (``config.json.gz``), are named in ``damaged``, not walked round or passed over. A folder
+    the user may not open (a colleague's private run) is named in ``unreadable``, not passed
+    over in silence (:class:`~simoun_agent.run.kept.Unreadable` where it is None)."""
     found: list[Path] = []
     seen = {os.path.realpath(root)}
-    for top, folders, files in os.walk(root, followlinks=True):
+
+    def refused(err: OSError) -> None:
+        if err.errno not in DENIED:
+            return  # a folder removed while it was walked
+        problem = permission_problem(Path(err.filename))
+        if unreadable is None:
+            raise Unreadable(problem)
+        unreadable.append(f"{Path(err.filename).relative_to(root).as_posix()}: {problem}")
+
+    for top, folders, files in os.walk(root, onerror=refused, followlinks=True):
         here = Path(top)
         kept = []
         for name in sorted(folders):
@@ -266,6 +291,8 @@ def read_curve(path: Path) -> dict[str, np.ndarray]:
         rows = log_values(path, columns=())  # the missing columns are named below, all at once
     except Damaged as err:
         raise DamagedRun(f"{path.name} is damaged: {err}") from None
+    except Unreadable:
+        raise
     except (OSError, ValueError, TypeError, csv.Error) as err:
         raise DamagedRun(f"{path.name} cannot be read ({err})") from None
     if path.stat().st_size and not rows and "env_step" not in read_text(path):
@@ -382,16 +409,18 @@ def sweep_grid(root: Path) -> dict[str, list[Any]] | None:
     return SweepSpec.load(root).grid if present(root / SWEEP_FILE) else None
 
 
-def sweep_trials_only(root: Path, records: list[RunRecord], damaged: list[str]) -> list[RunRecord]:
+def sweep_trials_only(
+    root: Path, records: list[RunRecord], damaged: list[str], unreadable: Sequence[str] = ()
+) -> list[RunRecord]:
     """``records`` less the trials of the sweep in ``root`` whose run directory is not the
     trial's own (:func:`~simoun_lab.sweep.grid.trial_problem`: config.json missing, or another
     env, seed or grid value), each named in ``damaged``: such a run would be counted as finished
     or reported under another env. Runs of no sweep, and runs outside its trials' directories,
-    are kept as they are."""
+    are kept as they are. Runs in ``unreadable`` (named already) are passed over."""
     if not present(root / SWEEP_FILE):
         return records
     spec = SweepSpec.load(root)
-    named = {line.partition(": ")[0] for line in damaged}
+    named = {line.partition(": ")[0] for line in [*damaged, *unreadable]}
     refused: set[Path] = set()
     for trial in spec.trials(root):
         run_dir = Path(trial.run_dir)
@@ -782,6 +811,8 @@ class Comparison:
     """runs left out for another evaluation grid than their row's"""
     damaged: list[str] = field(default_factory=list)
     """runs left out for a file that cannot be read, with the file and the problem"""
+    unreadable: list[str] = field(default_factory=list)
+    """runs left out for a folder or file the user may not read, with its owner and mode"""
     nearby: list[str] = field(default_factory=list)
     """runs counted at an ``--at-step`` budget with their evaluation nearest to it"""
 
@@ -812,7 +843,13 @@ def compare_runs(
         )
     refuse_study(root)
     damaged: list[str] = []
-    records = sweep_trials_only(root, find_runs(root, damaged), damaged)
+    unreadable: list[str] = []
+    found = find_runs(root, damaged, unreadable)
+    records = sweep_trials_only(root, found, damaged, unreadable)
+    if not records and unreadable and not damaged:
+        raise SetupError(
+            f"no runs under {root} that can be read (permission denied: {'; '.join(unreadable)})"
+        )
     if not records:
         if damaged and all(line.endswith(MINIGRID_RUN) for line in damaged):
             raise SetupError(
@@ -821,10 +858,13 @@ def compare_runs(
                 f"{minigrid_archive(root)}`"
             )
         if damaged:
+            private = (
+                f"; the others: permission denied: {'; '.join(unreadable)}" if unreadable else ""
+            )
             raise SetupError(
                 f"no runs under {root} that can be read (every run is damaged: "
                 f"{'; '.join(damaged)}); restore those files from a copy, or remove the damaged "
-                "runs"
+                f"runs{private}"
             )
         raise SetupError(
             f"no runs under {root} (no config.json); pass a sweep directory or a directory of "
@@ -851,6 +891,7 @@ def compare_runs(
         records = cut_records
     comparison = Comparison(root, budget, group_runs(records, variant_keys(records, root), root))
     comparison.damaged = damaged
+    comparison.unreadable = unreadable
     comparison.nearby = comparison_nearby
     for group in comparison.groups:
         # the grid first, so that a copy of a seed on another grid cannot displace its peer
@@ -1168,6 +1209,12 @@ def markdown(
         "Damaged runs (not counted)",
         comparison.damaged,
         "A file of these runs cannot be read as simoun-train writes it; fix or remove it.",
+    )
+    lines += _run_list(
+        "Runs that cannot be read (not counted)",
+        comparison.unreadable,
+        "These runs, or files of them, are another user's and private (permission denied); "
+        "they are whole, as far as this report knows: make them readable and report again.",
     )
     return "\n".join(lines) + "\n"
 
