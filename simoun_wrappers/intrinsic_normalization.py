@@ -186,6 +186,48 @@ class Normalization(ABC):
         return f"{type(self).__name__}()"
 
 
+BATCH = ("raw", "extrinsic", "envs", "counted")
+"""the arguments of a normalization's call, in order"""
+
+
+def checked_batch(
+    owner: Normalization, raw: Any, extrinsic: Any, envs: Any, counted: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The four arguments of ``owner``'s call as arrays, after checking them: each of shape
+    ``(B,)``, ``raw`` finite numbers and ``extrinsic`` numbers, ``envs`` integer sub-env
+    indices >= 0 (floats would index nothing) and ``counted`` bool (a mask of 0/1 ints would
+    index rows 0 and 1 in its place, and raise the statistics with the wrong rows). TypeError
+    or ValueError naming the argument."""
+    arrays = [np.asarray(value) for value in (raw, extrinsic, envs, counted)]
+    call = f"{type(owner).__name__}()(raw, extrinsic, envs, counted)"
+    size = arrays[0].shape[0] if arrays[0].ndim == 1 else None
+    for name, array in zip(BATCH, arrays, strict=True):
+        if array.ndim != 1 or (size is not None and len(array) != size):
+            want = f"({size},) like raw" if size is not None else "(B,), one value per row"
+            raise ValueError(f"{call}: {name} must have shape {want}, got shape {array.shape}")
+    for name, array in zip(BATCH[:2], arrays[:2], strict=True):
+        if not np.issubdtype(array.dtype, np.number) or np.issubdtype(array.dtype, np.bool_):
+            raise TypeError(
+                f"{call}: {name} must be numbers, got {array.dtype} {array.tolist()!r:.80}"
+            )
+    if not np.isfinite(arrays[0]).all():
+        raise ValueError(f"{call}: raw must be finite, got {arrays[0].tolist()!r:.80}")
+    envs_array, counted_array = arrays[2], arrays[3]
+    if not np.issubdtype(envs_array.dtype, np.integer) or (envs_array < 0).any():
+        raise TypeError(
+            f"{call}: envs must be the sub-env index of each row, ints >= 0, got "
+            f"{envs_array.dtype} {envs_array.tolist()!r:.80}; e.g. np.array([0, 1]), or "
+            "np.zeros(len(raw), int) for a single env"
+        )
+    if counted_array.dtype != np.bool_:
+        raise TypeError(
+            f"{call}: counted must be a bool mask of the rows that raise the statistics, got "
+            f"{counted_array.dtype} {counted_array.tolist()!r:.80} (an int array would index rows "
+            "by number); e.g. np.ones(len(raw), bool), or np.asarray(counted, bool)"
+        )
+    return arrays[0], arrays[1], envs_array, counted_array
+
+
 def normalization_name(normalization: Normalization) -> str:
     """The name ``normalization`` is registered under, or its class name for one of the user's."""
     return getattr(normalization, "name", type(normalization).__name__)
@@ -228,6 +270,7 @@ class PaperMaxima(Normalization):
     def __call__(
         self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
     ) -> np.ndarray:
+        raw, extrinsic, envs, counted = checked_batch(self, raw, extrinsic, envs, counted)
         self.maxima.update(extrinsic[counted], raw[counted])
         return raw * (self.maxima.r_e_max / self.maxima.r_i_max)
 
@@ -264,6 +307,7 @@ class RewardStd(Normalization):
     def __call__(
         self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
     ) -> np.ndarray:
+        raw, extrinsic, envs, counted = checked_batch(self, raw, extrinsic, envs, counted)
         if counted.any():
             self.moments.update(raw[counted])
         centre = float(self.moments.mean) if self.centred else 0.0
@@ -315,6 +359,7 @@ class ReturnStd(Normalization):
     def __call__(
         self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
     ) -> np.ndarray:
+        raw, extrinsic, envs, counted = checked_batch(self, raw, extrinsic, envs, counted)
         if len(envs) and envs.max() >= len(self.returns):
             grown = np.zeros(int(envs.max()) + 1, dtype=np.float64)
             grown[: len(self.returns)] = self.returns
@@ -370,6 +415,7 @@ class Raw(Normalization):
     def __call__(
         self, raw: np.ndarray, extrinsic: np.ndarray, envs: np.ndarray, counted: np.ndarray
     ) -> np.ndarray:
+        raw = checked_batch(self, raw, extrinsic, envs, counted)[0]
         return raw.astype(np.float64)
 
     def state_dict(self) -> dict[str, Any]:

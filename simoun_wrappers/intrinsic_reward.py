@@ -89,16 +89,54 @@ def triplet_shape(space: spaces.Space) -> tuple[int, int, int, int]:
 
 class TripletReader:
     """Takes a batch of observations of ``space`` to ``uint8 (B, 3, C, H, W)``; a class, not a
-    closure, so that the wrappers holding one pickle."""
+    closure, so that the wrappers holding one pickle. ``owner`` (the wrapper that reads) and
+    ``below`` (the wrappers under it, outermost first) name who changed an observation that
+    does not match ``space``."""
 
-    def __init__(self, space: spaces.Space) -> None:
+    def __init__(self, space: spaces.Space, owner: str = "", below: tuple[str, ...] = ()) -> None:
         self.shape = triplet_shape(space)
         self.use_key = isinstance(space, spaces.Dict)
+        frames = space["frames"] if self.use_key else space
+        self.frames_shape = tuple(frames.shape)
+        """the shape of one observation's frames as the space gives it (folded or not)"""
+        self.owner = owner or "The intrinsic-reward wrapper"
+        self.below = below
 
     def __call__(self, batch: Any) -> np.ndarray:
+        if self.use_key:
+            frames = batch.get("frames") if isinstance(batch, Mapping) else None
+        else:
+            frames = batch
         # A copy: the wrappers keep the previous triplet, and the caller owns the observation.
-        array = np.array(batch["frames"] if self.use_key else batch, dtype=np.uint8)
+        array = None if frames is None else np.array(frames, dtype=np.uint8)
+        size = len(self.frames_shape)
+        if array is None or array.shape[array.ndim - size :] != self.frames_shape:
+            raise ValueError(self.mismatch(batch, array))
         return array.reshape(-1, *self.shape)
+
+    def mismatch(self, batch: Any, array: np.ndarray | None) -> str:
+        """Why an observation does not fit the space, and who is to fix it: the wrappers below,
+        which changed the observations without their ``observation_space``."""
+        got = (
+            f"frames of shape {array.shape}"
+            if array is not None
+            else f"{type(batch).__name__} without a 'frames' entry"
+        )
+        expected = f"frames of shape {self.frames_shape} per observation"
+        if not self.below:
+            return (
+                f"{self.owner} got observations with {got}, but the env's observation_space "
+                f"gives {expected}: the env returns observations its space does not describe"
+            )
+        names = ", ".join(self.below)
+        return (
+            f"{self.owner} got observations with {got}, but the observation_space below it "
+            f"gives {expected}: {names} under {self.owner} changed the observations without "
+            f"changing their space. Give that wrapper the space of what it returns (Gymnasium's "
+            f"TransformObservation takes observation_space=..., its vector version "
+            f"single_observation_space=... too), or put it outside {self.owner}: "
+            f"{self.below[0]}({self.owner}(...), ...)"
+        )
 
 
 def triplet_reader(space: spaces.Space) -> Callable[[Any], np.ndarray]:
@@ -110,13 +148,25 @@ def _observation_space(env: gym.Env | VectorEnv) -> spaces.Space:
     return env.single_observation_space if isinstance(env, VectorEnv) else env.observation_space
 
 
+def wrapper_names(env: gym.Env | VectorEnv) -> tuple[str, ...]:
+    """The class names of the wrappers of ``env`` above the first of this package (the one
+    that made the triplets), outermost first: those that may change the observations."""
+    names = []
+    while isinstance(env, (gym.Wrapper, VectorWrapper)):
+        if type(env).__module__.startswith("simoun_wrappers"):
+            break
+        names.append(type(env).__name__)
+        env = env.env
+    return tuple(names)
+
+
 def env_triplet_reader(env: gym.Env | VectorEnv, owner: str) -> TripletReader:
     """The :class:`TripletReader` of ``env``'s (for a vector env, each sub-env's) observations.
     When they are no triplets but wrappers over an env of triplets changed them (Gymnasium's
     ``NormalizeObservation``, ``FlattenObservation``), the TypeError names those wrappers and
     the order that works: ``owner`` reads the triplets, the wrappers go outside it."""
     try:
-        return TripletReader(_observation_space(env))
+        return TripletReader(_observation_space(env), owner, wrapper_names(env))
     except (TypeError, ValueError):
         over: list[str] = []
         inner = env

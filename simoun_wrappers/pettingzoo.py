@@ -30,7 +30,8 @@ class SimounParallelObservation(BaseParallelWrapper):
     knights_archers_zombies' vector observation is no image) every agent
     sees the env's global ``render()`` frame (then, with ``size=None``, ``observation_space``
     needs a render, so call ``reset()`` first). ``observation_space(agent)`` returns the same
-    cached object on every call, as ``parallel_api_test`` requires.
+    cached object on every call, as ``parallel_api_test`` requires, and ``observation_spaces``
+    holds those objects.
 
     Example:
         >>> import pettingzoo
@@ -163,6 +164,13 @@ class SimounParallelObservation(BaseParallelWrapper):
     def observation_space(self, agent: Any) -> spaces.Space:
         self._check_agent(agent, "observation_space")
         return self._stack_of(agent).observation_space
+
+    @property
+    def observation_spaces(self) -> dict[Any, spaces.Space]:
+        """Every possible agent's space, the same objects :meth:`observation_space` returns:
+        the wrapped observations' Dict of frames (and motion), not the env's own images, which
+        ``observation_spaces`` would otherwise reach through the wrapper."""
+        return {agent: self.observation_space(agent) for agent in self.env.possible_agents}
 
     def action_space(self, agent: Any) -> spaces.Space:
         self._check_agent(agent, "action_space")

@@ -71,7 +71,9 @@ def mixed_twins(agent: SimounAgent, next_obs: torch.Tensor) -> None:
 
 def agent_for_targets(**overrides) -> SimounAgent:
     torch.manual_seed(0)
-    config = small_config(init_temperature=ALPHA, discount=GAMMA, r_i_max_init=1e-3, **overrides)
+    # the running maximum is read by curiosity alone (elsewhere refused)
+    curiosity = {"r_i_max_init": 1e-3} if overrides.get("curiosity", True) else {}
+    config = small_config(init_temperature=ALPHA, discount=GAMMA, **curiosity, **overrides)
     return SimounAgent(FRAME, ACTIONS, config, "cpu")
 
 

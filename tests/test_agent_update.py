@@ -8,6 +8,7 @@ import torch
 import torch.nn.functional as F
 
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
+from simoun_agent.config.shapes import ENCODER_SHAPES
 from simoun_agent.losses import contrastive_loss
 from simoun_wrappers.augment import random_conv
 
@@ -23,10 +24,11 @@ def small_config(**overrides) -> AgentConfig:
         aux_hidden_dim=16,
         num_filters=8,
         feature_dim=16,
-        reduce_kernel=3,
-        reduce_stride=2,
     )
     values.update(overrides)
+    if ENCODER_SHAPES[values.get("encoder", "dual_interactive")].interactive:
+        # the reducing convs are read by the interactive module alone (elsewhere refused)
+        values = dict(reduce_kernel=3, reduce_stride=2) | values
     return AgentConfig(**values)
 
 

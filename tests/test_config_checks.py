@@ -333,3 +333,79 @@ def test_two_spellings_of_one_device_are_the_same_device():
         "base": {"device": "cpu"},
         "device": f"cuda:{current}",
     }
+
+
+@pytest.mark.parametrize(
+    ("given", "said"),
+    [
+        (
+            dict(curiosity=False, curiosity_scale=0.5),
+            ["AgentConfig.curiosity_scale", "curiosity is false", "AgentConfig.curiosity=True"],
+        ),
+        (
+            dict(exploration_std_start=0.5, exploration_std_end=0.05),
+            ["AgentConfig.exploration_std_start", "AgentConfig.actor='deterministic'"],
+        ),
+        (
+            dict(actor="deterministic", init_temperature=0.5),
+            ["AgentConfig.init_temperature", "AgentConfig.actor='gaussian'"],
+        ),
+        (
+            dict(contrastive_weight=0.0, similarity_init="uniform"),
+            ["AgentConfig.similarity_init", "AgentConfig.contrastive_weight=1.0"],
+        ),
+        (
+            dict(contrastive_view="shift", random_conv_kernel=5),
+            ["AgentConfig.random_conv_kernel", "AgentConfig.contrastive_view='random_conv'"],
+        ),
+        (
+            dict(encoder="dual", reduce_stride=2),
+            ["AgentConfig.reduce_stride", "AgentConfig.encoder='dual_interactive'"],
+        ),
+        (
+            dict(encoder="stacked", curiosity=False, detach_past_frames=False),
+            ["AgentConfig.detach_past_frames", "AgentConfig.detach_past_frames=True"],
+        ),
+    ],
+)
+def test_a_setting_its_config_does_not_read_is_refused_naming_what_turns_it_on(given, said):
+    with pytest.raises(ValueError) as refused:
+        AgentConfig(**given)
+    assert "would change nothing" in str(refused.value)
+    for part in said:
+        assert part in str(refused.value), str(refused.value)
+
+
+def test_a_setting_at_its_default_or_its_recipes_value_passes_with_its_part_off():
+    # the defaults, and a recipe's values left as the recipe gave them, are no user's setting
+    assert AgentConfig(curiosity=False, curiosity_scale=0.2).curiosity_scale == 0.2
+    gaussian = resolve(None, {"agent.recipe": "drqv2", "env": "dm_control/cartpole-swingup-v0"})
+    assert gaussian.agent.exploration_steps == 200_000
+    assert AgentConfig(recipe="drqv2", actor="gaussian").actor == "gaussian"
+
+
+def test_a_rising_exploration_schedule_is_refused_as_a_swap():
+    with pytest.raises(ValueError) as refused:
+        AgentConfig(actor="deterministic", exploration_std_start=0.1, exploration_std_end=1.0)
+    said = str(refused.value)
+    assert "AgentConfig.exploration_std_end" in said and "would rise" in said
+    assert "exploration_std_start=1.0" in said and "exploration_std_end=0.1" in said
+    constant = dict(exploration_std_start=0.2, exploration_std_end=0.2)
+    assert AgentConfig(actor="deterministic", **constant).exploration_std_end == 0.2
+
+
+def test_env_kwargs_from_python_are_kept_as_json_types():
+    config = TrainConfig(env_kwargs={"max_steps": np.int64(10), "config": {"range": (20, 30)}})
+    assert config.env_kwargs == {"max_steps": 10, "config": {"range": [20, 30]}}
+    assert type(config.env_kwargs["max_steps"]) is int
+    config.env_kwargs["config"]["range"] = (np.float32(1.5), 2)  # set after it was built
+    check_train_config(config)
+    assert config.env_kwargs["config"]["range"] == [1.5, 2]
+    assert type(config.env_kwargs["config"]["range"][0]) is float
+
+
+def test_every_setting_read_only_with_a_part_is_a_field_of_the_agent():
+    from simoun_agent.config.agent import READ_ONLY_WITH
+
+    fields = {f.name for f in dataclasses.fields(AgentConfig)}
+    assert {name for group in READ_ONLY_WITH for name in group.fields} <= fields

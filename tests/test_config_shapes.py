@@ -120,8 +120,12 @@ def test_a_reducing_kernel_too_wide_for_the_frames_names_every_setting_that_fixe
     # each fix it names works: 32 -> 15 -> 13 -> 11 -> 9 through the trunk
     assert resolve(None, {"image_size": 95, "agent.reduce_kernel": 41}).image_size == 95
     assert resolve(None, {"image_size": 32, "agent.reduce_kernel": 9}).agent.reduce_kernel == 9
-    dual = {"image_size": 32, "agent.reduce_kernel": 41, "agent.encoder": "dual"}
-    assert resolve(None, dual).agent.encoder == "dual"
+    # the dual encoder reads no reducing kernel, so that fix puts the kernel back too
+    assert (
+        "--agent.encoder dual (AgentConfig.encoder='dual'), which has no reducing conv and "
+        "--agent.reduce-kernel 3 (AgentConfig.reduce_kernel=3)"
+    ) in message
+    assert resolve(None, {"image_size": 32, "agent.encoder": "dual"}).agent.encoder == "dual"
 
 
 def test_a_frame_the_trunk_alone_cannot_take_is_answered_with_the_image_size_only():
@@ -148,9 +152,11 @@ def test_a_random_conv_kernel_wider_than_the_frames_is_refused_before_training()
         assert fix in message
     assert resolve(None, {"image_size": 32, "agent.random_conv_kernel": 31}).image_size == 32
     assert resolve(None, {"image_size": 33, "agent.random_conv_kernel": 33}).image_size == 33
-    # a kernel nothing runs is no problem: L_con off, or its positive a shift
+    # a kernel nothing runs (L_con off, or its positive a shift) is refused as unread
     for unused in ({"agent.contrastive_weight": 0.0}, {"agent.contrastive_view": "shift"}):
-        resolve(None, {"image_size": 32, "agent.random_conv_kernel": 33, **unused})
+        with pytest.raises(SetupError, match="would change nothing"):
+            resolve(None, {"image_size": 32, "agent.random_conv_kernel": 33, **unused})
+        assert resolve(None, {"image_size": 32, **unused}).agent.random_conv_kernel == 3
 
 
 def test_the_agent_refuses_frames_its_random_convolution_or_reducing_conv_cannot_take():

@@ -367,3 +367,23 @@ def test_an_instance_without_statistics_may_serve_several_wrappers():
 def test_a_normalization_of_the_wrong_type_is_refused_naming_the_names():
     with pytest.raises(ValueError, match=r"normalization=\['none'\] is not one of .*'return_std'"):
         RNDReward(cartpole(), Brightness(), normalization=["none"])
+
+
+@pytest.mark.parametrize("cls", list(NORMALIZATIONS.values()))
+@pytest.mark.parametrize(
+    ("envs", "counted", "error", "said"),
+    [
+        (np.array([0.0, 1.0, 0.0]), ALL, TypeError, "envs must be the sub-env index"),
+        (np.array([0, -1, 0]), ALL, TypeError, "envs must be the sub-env index"),
+        (ENV0, np.array([1, 1, 0]), TypeError, "counted must be a bool mask"),
+        (ENV0, np.ones(2, bool), ValueError, r"counted must have shape \(3,\) like raw"),
+    ],
+)
+def test_a_normalization_called_directly_checks_its_arguments_naming_them(
+    cls, envs, counted, error, said
+):
+    # a 0/1 int mask would fancy-index rows 1, 1, 0 and raise the statistics with wrong rows
+    call = rf"{cls.__name__}\(\)\(raw, extrinsic, envs, counted\)"
+    with pytest.raises(error, match=rf"{call}: {said}"):
+        cls()(np.array([1.0, 3.0, 2.0]), np.zeros(3), envs, counted)
+    assert cls()(np.array([1.0, 3.0, 2.0]), np.zeros(3), ENV0, ALL).shape == (3,)

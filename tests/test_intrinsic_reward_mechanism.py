@@ -518,3 +518,36 @@ def test_an_error_inside_a_source_names_the_source_and_the_numpy_triplets():
     )
     fixed.reset(seed=0)
     fixed.step(fixed.action_space.sample())
+
+
+def test_a_wrapper_below_that_changes_the_observations_but_not_their_space_is_named():
+    def pixels(env: gym.Env) -> gym.Env:
+        return SimounObservation(env, size=16)
+
+    vector = gym.make_vec(
+        "Pendulum-v1",
+        2,
+        vectorization_mode="sync",
+        render_mode="rgb_array",
+        vector_kwargs={"autoreset_mode": AutoresetMode.NEXT_STEP},
+        wrappers=[pixels],
+    )
+    last_frame = gym.wrappers.vector.TransformObservation(
+        vector, lambda obs: {"frames": obs["frames"][:, -1]}
+    )  # keeps the triplet's space: nothing at construction can see the change
+    env = ConstantBonusVectorReward(last_frame, 0.1)
+    with pytest.raises(
+        ValueError,
+        match=r"ConstantBonusVectorReward got observations with frames of shape \(2, 3, 16, 16\), "
+        r"but the observation_space below it gives frames of shape \(3, 3, 16, 16\) per "
+        r"observation: TransformObservation under ConstantBonusVectorReward changed",
+    ):
+        env.reset(seed=0)
+    single = gym.wrappers.TransformObservation(
+        pixels(gym.make("Pendulum-v1", render_mode="rgb_array")),
+        lambda obs: {"frames": obs["frames"][:2]},
+        None,
+    )
+    wrapped = ConstantBonusReward(single, scale=0.1)
+    with pytest.raises(ValueError, match=r"TransformObservation under ConstantBonusReward"):
+        wrapped.reset(seed=0)

@@ -111,7 +111,8 @@ def test_the_dual_encoder_takes_three_frames_of_any_channel_count_and_refuses_fo
 
 
 def test_make_encoder_builds_the_dual_encoders_from_every_config_value():
-    values = dict(num_filters=4, feature_dim=6, reduce_kernel=2, reduce_stride=2)
+    values = dict(num_filters=4, feature_dim=6)
+    reducing = dict(reduce_kernel=2, reduce_stride=2)  # the interactive module's alone
     for name, detach, channels_last in (("dual_interactive", False, False), ("dual", True, True)):
         config = AgentConfig(
             encoder=name,
@@ -119,6 +120,7 @@ def test_make_encoder_builds_the_dual_encoders_from_every_config_value():
             detach_past_frames=detach,
             channels_last=channels_last,
             **values,
+            **(reducing if name == "dual_interactive" else {}),
         )
         encoder = make_encoder(config, (1, 24, 28))
         assert encoder.appearance[0].in_channels == 1 and encoder.motion[0].in_channels == 2

@@ -18,6 +18,7 @@ from test_train_resume import TINY
 from simoun_agent import AgentConfig, FrameReplay, SimounAgent
 from simoun_agent.config import RECIPES, SetupError, from_dict, resolve, to_dict
 from simoun_agent.config.keys import config_sections
+from simoun_agent.config.shapes import ENCODER_SHAPES
 from simoun_agent.models.actors import DeterministicActor
 from simoun_agent.models.encoder import ENCODERS
 from simoun_agent.run import train
@@ -31,7 +32,9 @@ AUX_LOSSES = {"transition_loss", "contrastive_loss", "reward_loss"}
 
 def recipe_agent(name: str, **overrides) -> SimounAgent:
     config = resolve(None, {"agent.recipe": name}).agent
-    config = dataclasses.replace(config, **SMALL, reduce_stride=2, **overrides)
+    # the reducing convs are set only where the encoder has them (elsewhere they are refused)
+    reduce = {"reduce_stride": 2} if ENCODER_SHAPES[config.encoder].interactive else {}
+    config = dataclasses.replace(config, **SMALL, **reduce, **overrides)
     return SimounAgent(FRAME, 2, config, device="cpu")
 
 

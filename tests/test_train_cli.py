@@ -149,3 +149,37 @@ def test_a_warmup_that_takes_the_whole_run_is_warned_of(tmp_path, capsys):
         "simoun-train: warning: --warmup-agent-steps 40 takes all the run's 40 agent decisions "
         "(--total-env-steps 40 at action repeat 1): it ends before its first update"
     ) in err
+    assert err.count("before its first update") == 1  # said once, not again by train()
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["trained"] is False and summary["updates"] == 0
+
+
+def test_a_run_without_an_update_is_warned_of_in_python_and_marked_untrained(tmp_path):
+    from simoun_agent.config import resolve
+    from simoun_agent.run.train import UntrainedRunWarning, create_run, train
+
+    base = {
+        "env": "simoun/PointReach-v0",
+        "image_size": 32,
+        "warmup_agent_steps": 20,
+        "total_env_steps": 40,
+        "eval_episodes": 1,
+        "progress": False,
+        "video": False,
+        "device": "cpu",
+        "torch_threads": 1,
+        "agent.batch_size": 8,
+        "agent.num_filters": 8,
+        "agent.feature_dim": 16,
+        "agent.hidden_dim": 32,
+    }
+    untrained = resolve(None, {**base, "run_dir": tmp_path / "untrained"})
+    untrained.warmup_agent_steps = 1000  # set after the config was built, as in a notebook
+    with pytest.warns(UntrainedRunWarning, match=r"--warmup-agent-steps 1000 takes all"):
+        train(create_run(untrained))
+    summary = json.loads((tmp_path / "untrained" / "summary.json").read_text())
+    assert summary["trained"] is False and summary["updates"] == 0
+    trained = resolve(None, {**base, "run_dir": tmp_path / "trained"})
+    train(create_run(trained))
+    summary = json.loads((tmp_path / "trained" / "summary.json").read_text())
+    assert summary["trained"] is True and summary["updates"] > 0

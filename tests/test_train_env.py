@@ -776,3 +776,13 @@ def test_env_kwargs_merge_into_simouns_own_settings_key_by_key():
         assert kinematics.unwrapped.config["observation"] == {"type": "Kinematics"}
     finally:
         kinematics.close()
+
+
+def test_numpy_numbers_and_tuples_in_env_kwargs_are_read_as_json_numbers_and_lists():
+    # from Python a count is often a numpy integer and a range a tuple: both are valid
+    assert check_env_kwargs(POINT_REACH_ID, {"max_steps": np.int64(10)}) is None
+    given = {"reward_speed_range": (20, 30), "lanes_count": np.int64(3), "duration": np.float32(9)}
+    config = {**HIGHWAY_CONTINUOUS, **given}
+    assert check_env_kwargs("highway-fast-v0", {"config": config}) is None
+    with pytest.raises(SetupError, match=r"config.reward_speed_range=\[30, 20\]"):
+        check_env_kwargs("highway-fast-v0", {"config": {"reward_speed_range": (30, 20)}})

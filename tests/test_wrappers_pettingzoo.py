@@ -272,3 +272,13 @@ def test_a_reset_or_step_after_close_is_refused(call):
     env.close()
     with pytest.raises(ValueError, match=rf"SimounParallelObservation\.{call}\(\) after close"):
         env.step(actions) if call == "step" else env.reset(seed=0)
+
+
+def test_observation_spaces_hold_the_wrapped_spaces_of_observation_space():
+    pistons = pettingzoo.make("parallel", "butterfly/pistonball-v6", n_pistons=3)
+    env = SimounParallelObservation(pistons, size=16)
+    assert set(env.observation_spaces) == set(pistons.possible_agents)
+    for agent, space in env.observation_spaces.items():
+        assert space is env.observation_space(agent)  # not pistonball's (457, 120, 3) images
+    obs, _ = env.reset(seed=0)
+    assert all(env.observation_spaces[agent].contains(obs[agent]) for agent in obs)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import signal
 import sys
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -137,7 +138,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return stop.exit_code
     tqdm.write(f"run directory: {run.run_dir}")
     try:
-        final = loop.train(run, distraction_callbacks(run.config))
+        with warnings.catch_warnings():  # said once, as a simoun-train warning, in setup
+            warnings.simplefilter("ignore", loop.UntrainedRunWarning)
+            final = loop.train(run, distraction_callbacks(run.config))
     except KeyboardInterrupt as stop:  # Stopped after a checkpoint, or a second Ctrl-C
         return getattr(stop, "exit_code", 130)
     except loop.TrainingError as err:
@@ -202,6 +205,9 @@ def setup(command: TrainCommand, argv: Sequence[str]) -> Run:
             run = loop.resume_run(
                 resumed_dir(command.resume), overrides, check=check_eval_distractions
             )
+            untrained = loop.budget_warning(run.config) if run.counters.updates == 0 else None
+            if untrained:  # a longer --total-env-steps given to a resume may clear it
+                print(f"{PROG}: warning: {untrained}", file=sys.stderr)
         else:
             config = resolve(command.flags.preset, overrides)
             for warning in (check_memory(config), loop.budget_warning(config)):

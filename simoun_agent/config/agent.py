@@ -60,6 +60,9 @@ class AgentConfig:
     ``simoun_agent.config.resolve(preset, {"agent.recipe": "drqv2", "env": ...}).agent``.
     A recipe named later (``config.recipe = "drq"``, ``dataclasses.replace``) changes the name
     only.
+    A setting read only when another turns its part on (``curiosity_scale`` with curiosity, the
+    exploration schedule with the deterministic actor: :data:`READ_ONLY_WITH`) is refused when
+    given a value of its own with that part off, as it would change nothing.
 
     Example:
         >>> config = AgentConfig(recipe="drqv2", lr=3e-4)
@@ -291,7 +294,8 @@ def check_agent_config(config: Any) -> None:
                 f"'none' (every view would be the same); set "
                 f"{knob(config, AGENT, 'augmentation', 'shift')} or {knob(config, AGENT, name, 1)}",
             )
-    check_shift_settings(config)
+    check_read_settings(config)
+    check_exploration_schedule(config)
     if config.separate_trunks:
         check_separate_trunks(config)
     motion_path = ENCODER_SHAPES[config.encoder].motion_path
@@ -324,23 +328,160 @@ def check_agent_config(config: Any) -> None:
         )
 
 
-def check_shift_settings(config: Any) -> None:
-    """``shift_pad`` only with a shift that reads it (the RL augmentation or CURL's contrastive
-    view), as more than one view is refused without an augmentation: set alone it would change
-    nothing, and a user expecting DrQ's pad-4 shift would train without one.
-    (``independent_next_shift`` stays allowed: the recipes carry it as how their method shifts
-    once a shift is asked for.)"""
-    shift = knob(config, AGENT, "augmentation", "shift")
-    contrastive_shift = config.contrastive_weight and config.contrastive_view == "shift"
-    if config.shift_pad is not None and config.augmentation != "shift" and not contrastive_shift:
+@dataclass(frozen=True)
+class ReadOnlyWith:
+    """Fields that only one part of the agent reads, and when a config uses that part. Given a
+    value of their own while the part is off, they would change nothing: a user expecting
+    DrQ-v2's exploration schedule on the Gaussian actor, or a curiosity scale without
+    curiosity, would train as if they had not been set."""
+
+    fields: tuple[str, ...]
+    """the AgentConfig fields only the part reads"""
+    part: str
+    """the part, completing "is read only by ..." """
+    used: Callable[[Any], bool]
+    """whether a config uses the part"""
+    state: Callable[[Any], str]
+    """why a config that does not use the part does not, e.g. "curiosity is false" """
+    turn_on: Callable[[Any], str]
+    """the setting that turns the part on, as :func:`knob` writes it"""
+
+
+def _uses_shift(config: Any) -> bool:
+    return config.augmentation == "shift" or (
+        bool(config.contrastive_weight) and config.contrastive_view == "shift"
+    )
+
+
+def _uses_random_conv(config: Any) -> bool:
+    return bool(config.contrastive_weight) and config.contrastive_view == "random_conv"
+
+
+READ_ONLY_WITH = (
+    ReadOnlyWith(
+        ("shift_pad",),
+        "the shift (the augmentation, or CURL's contrastive view)",
+        _uses_shift,
+        lambda c: f"augmentation is {c.augmentation!r} and the contrastive view is no shift",
+        lambda c: f"{knob(c, AGENT, 'augmentation', 'shift')} to shift the frames",
+    ),
+    ReadOnlyWith(
+        ("curiosity_scale", "curiosity_decay", "r_e_max_init", "r_i_max_init"),
+        "the intrinsic reward of Eq. 13",
+        lambda c: c.curiosity,
+        lambda c: "curiosity is false",
+        lambda c: knob(c, AGENT, "curiosity", True) + " with a dual encoder",
+    ),
+    ReadOnlyWith(
+        ("exploration_std_start", "exploration_std_end", "exploration_steps", "noise_clip"),
+        "the deterministic actor (DrQ-v2's scheduled exploration noise)",
+        lambda c: c.actor == "deterministic",
+        lambda c: f"the actor is {c.actor!r}, whose exploration is SAC's learned entropy",
+        lambda c: knob(c, AGENT, "actor", "deterministic"),
+    ),
+    ReadOnlyWith(
+        ("init_temperature", "alpha_lr", "alpha_beta", "log_std_min", "log_std_max"),
+        "the Gaussian actor (SAC's temperature and its policy's std bounds)",
+        lambda c: c.actor == "gaussian",
+        lambda c: f"the actor is {c.actor!r}, which has no temperature and no learned std",
+        lambda c: knob(c, AGENT, "actor", "gaussian"),
+    ),
+    ReadOnlyWith(
+        ("contrastive_view", "contrastive_step", "similarity_init"),
+        "L_con (Eq. 3)",
+        lambda c: bool(c.contrastive_weight),
+        lambda c: "contrastive_weight is 0",
+        lambda c: knob(c, AGENT, "contrastive_weight", 1.0),
+    ),
+    ReadOnlyWith(
+        ("random_conv_kernel",),
+        "the random convolution of L_con's positives (Eq. 3)",
+        _uses_random_conv,
+        lambda c: (
+            "contrastive_weight is 0"
+            if not c.contrastive_weight
+            else f"the contrastive view is {c.contrastive_view!r}"
+        ),
+        lambda c: (
+            f"{knob(c, AGENT, 'contrastive_weight', 1.0)} and "
+            f"{knob(c, AGENT, 'contrastive_view', 'random_conv')}"
+        ),
+    ),
+    ReadOnlyWith(
+        ("reduce_kernel", "reduce_stride"),
+        "the interactive module's reducing convs",
+        lambda c: ENCODER_SHAPES[c.encoder].interactive,
+        lambda c: f"encoder {c.encoder!r} has no interactive module",
+        lambda c: knob(c, AGENT, "encoder", "dual_interactive"),
+    ),
+    ReadOnlyWith(
+        ("detach_past_frames",),
+        "the dual-path encoders' appearance path",
+        lambda c: ENCODER_SHAPES[c.encoder].motion_path,
+        lambda c: f"encoder {c.encoder!r} has no appearance path",
+        lambda c: (
+            f"{knob(c, AGENT, 'encoder', 'dual_interactive')} or "
+            f"{knob(c, AGENT, 'encoder', 'dual')}"
+        ),
+    ),
+)
+"""Every AgentConfig field read only when another setting turns its part on (``shift_pad``
+with a shift, the curiosity constants with curiosity, the exploration schedule with the
+deterministic actor, ...). ``independent_next_shift`` is not among them: the recipes carry it
+as how their method shifts once a shift is asked for."""
+
+
+def check_read_settings(config: Any) -> None:
+    """Refuse a field of :data:`READ_ONLY_WITH` given a value of its own (neither its default
+    nor one its recipe gives) while its part is off, naming the setting that turns the part on
+    and the field's default."""
+    for group in READ_ONLY_WITH:
+        if group.used(config):
+            continue
+        for name in group.fields:
+            default = dataclass_default(name)
+            if getattr(config, name) == default or given_by_recipe(config, name):
+                continue
+            raise fail(
+                config,
+                AGENT,
+                name,
+                f"is read only by {group.part}, which this config does not use "
+                f"({group.state(config)}), so it would change nothing; set "
+                f"{group.turn_on(config)}, or {knob(config, AGENT, name, default)}",
+            )
+
+
+def dataclass_default(name: str) -> Any:
+    """The default of the AgentConfig field ``name``."""
+    return next(f.default for f in dataclasses.fields(AgentConfig) if f.name == name)
+
+
+def given_by_recipe(config: Any, name: str) -> bool:
+    """Whether ``config``'s recipe gives field ``name`` its value (on any task): a recipe's
+    value stays, whatever the user turned off after choosing the recipe (``drqv2`` with the
+    Gaussian actor keeps its schedule, unread)."""
+    recipe = RECIPES.get(config.recipe) if isinstance(config.recipe, str) else None
+    if recipe is None:
+        return False
+    values = [recipe.values, *recipe.per_task.values()]
+    return any(name in given and given[name] == getattr(config, name) for given in values)
+
+
+def check_exploration_schedule(config: Any) -> None:
+    """The deterministic actor's noise falls (or stays): one rising from ``start`` to ``end``
+    is almost surely the two swapped, as a ``log_std_min`` above ``log_std_max`` is."""
+    start, end = config.exploration_std_start, config.exploration_std_end
+    if config.actor == "deterministic" and end > start:
         raise fail(
             config,
             AGENT,
-            "shift_pad",
-            "is the padding of the shift augmentation, which this config does not use "
-            f"(augmentation is {config.augmentation!r} and the contrastive view is no shift), so "
-            f"it would change nothing; set {shift} to shift the frames, or "
-            f"{knob(config, AGENT, 'shift_pad', None)}",
+            "exploration_std_end",
+            f"is above {knob(config, AGENT, 'exploration_std_start', start)}: the exploration "
+            f"noise would rise over training, where DrQ-v2's falls (1.0 -> 0.1); swap them, "
+            f"{knob(config, AGENT, 'exploration_std_start', end)} and "
+            f"{knob(config, AGENT, 'exploration_std_end', start)}, or give both the same value "
+            "for a constant noise",
         )
 
 

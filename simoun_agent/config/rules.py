@@ -238,7 +238,8 @@ def check_fields(config: Any, prefix: str) -> None:
     cls = type(config).__name__
     rules = rules_of(config)
     for f in dataclasses.fields(config):
-        value = plain_scalar(getattr(config, f.name))
+        value = getattr(config, f.name)
+        value = plain_json(value) if isinstance(value, dict) else plain_scalar(value)
         setattr(config, f.name, value)
         if dataclasses.is_dataclass(value):
             continue
@@ -260,6 +261,24 @@ def plain_scalar(value: Any) -> Any:
     if type(value).__module__ == "numpy" and getattr(value, "ndim", None) == 0:
         return value.item()
     return value
+
+
+def plain_json(value: Any) -> Any:
+    """``value`` in the types JSON holds, as the same value read from the command line's JSON
+    would be: numpy scalars as Python numbers and tuples as lists, inside dicts and lists too
+    (``{"max_steps": np.int64(10)}``, ``{"config": {"reward_speed_range": (20, 30)}}`` from
+    Python). ``config.json`` can then hold it, and the env gets what the command line gives.
+
+    Example:
+        >>> import numpy as np
+        >>> plain_json({"max_steps": np.int64(10), "config": {"range": (20, 30)}})
+        {'max_steps': 10, 'config': {'range': [20, 30]}}
+    """
+    if isinstance(value, dict):
+        return {key: plain_json(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain_json(item) for item in value]
+    return plain_scalar(value)
 
 
 def wrong_kind(value: Any, annotation: str) -> tuple[str, str]:

@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from simoun_agent.config.agent import AGENT, AgentConfig, check_agent_config
+from simoun_agent.config.agent import AGENT, AgentConfig, check_agent_config, dataclass_default
 from simoun_agent.config.device import device_problem
 from simoun_agent.config.envs import PAPER_ACTION_REPEAT, dmc_task, split_env_id
 from simoun_agent.config.keywords import refuse_unknown
@@ -311,8 +311,20 @@ def check_frame_size(config: TrainConfig) -> None:
             f"frame sees only its padding; set {knob(agent, AGENT, 'random_conv_kernel', 3)} "
             f"(the paper's; any odd value up to {largest_odd(size)}), or "
             f"{knob(config, '', 'image_size', kernel)} or more, or "
-            f"{knob(agent, AGENT, 'contrastive_view', 'shift')}",
+            f"{knob(agent, AGENT, 'contrastive_view', 'shift')} and "
+            f"{knob(agent, AGENT, 'random_conv_kernel', 3)} (a shift reads no kernel)",
         )
+
+
+def reducing_resets(agent: AgentConfig) -> list[str]:
+    """The reducing conv settings of ``agent`` away from their defaults, each as the setting
+    that puts it back: an encoder without the interactive module reads none, and refuses them
+    (:data:`~simoun_agent.config.agent.READ_ONLY_WITH`)."""
+    return [
+        knob(agent, AGENT, name, dataclass_default(name))
+        for name in ("reduce_kernel", "reduce_stride")
+        if getattr(agent, name) != dataclass_default(name)
+    ]
 
 
 def too_small_for_encoder(config: TrainConfig) -> str:
@@ -331,7 +343,10 @@ def too_small_for_encoder(config: TrainConfig) -> str:
         fixes.append(
             knob(agent, AGENT, "reduce_kernel", widest) + (" or less" if widest > 1 else "")
         )
-        fixes.append(f"{knob(agent, AGENT, 'encoder', 'dual')}, which has no reducing conv")
+        fixes.append(
+            f"{knob(agent, AGENT, 'encoder', 'dual')}, which has no reducing conv"
+            + "".join(f" and {reset}" for reset in reducing_resets(agent))
+        )
     return (
         f"too small for the conv trunk of encoder {agent.encoder!r} with "
         f"{knob(agent, AGENT, 'reduce_kernel', agent.reduce_kernel)}; set "

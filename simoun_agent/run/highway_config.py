@@ -22,10 +22,12 @@ import difflib
 import inspect
 import json
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
 from simoun_agent.config import SetupError
+from simoun_agent.config.rules import plain_json
 
 
 @dataclass(frozen=True)
@@ -128,9 +130,10 @@ def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
     ``defaults`` (its ``default_config()``) lack, a value of another kind than the default's,
     a value :func:`limit_of` refuses, a ``controlled_vehicles`` other than 1, a range in
     the wrong order, an unknown action type or key, or a policy frequency above the simulation
-    frequency."""
+    frequency. Numpy scalars and tuples are read as the numbers and lists they hold."""
     if not isinstance(given, dict) or not isinstance(defaults, dict):
         return
+    given = plain_json(given)
     for key, value in given.items():
         _check_known(env_id, key, defaults)
         _check_kind(env_id, f"config.{key}", value, defaults[key])
@@ -186,7 +189,7 @@ def _fits(value: object, default: object) -> bool:
         return isinstance(value, str)
     if isinstance(default, (list, tuple)):
         return (
-            isinstance(value, list)
+            isinstance(value, (list, tuple))
             and len(value) == len(default)
             and all(_fits(item, expected) for item, expected in zip(value, default, strict=True))
         )
@@ -313,7 +316,7 @@ def _action_parameters(kind: str) -> dict[str, Any]:
 
 
 def _is_pair(value: object) -> bool:
-    return isinstance(value, list) and len(value) == 2 and all(map(_is_number, value))
+    return isinstance(value, (list, tuple)) and len(value) == 2 and all(map(_is_number, value))
 
 
 def _plain(value: object) -> object:
@@ -350,7 +353,8 @@ def _check_frequencies(env_id: str, given: dict, defaults: dict) -> None:
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    """A finite number, a numpy one too (not a bool)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _example(key: str, value: object) -> str:

@@ -16,6 +16,7 @@ import importlib.util
 import inspect
 import json
 import math
+import numbers
 import os
 import re
 from collections.abc import Callable
@@ -31,6 +32,7 @@ import simoun_agent.envs  # noqa: F401  (registers simoun/PointReach-v0)
 from simoun_agent.config import SetupError, TrainConfig
 from simoun_agent.config.envs import is_highway
 from simoun_agent.config.resolve import merged
+from simoun_agent.config.rules import plain_json
 from simoun_agent.run.env_kwargs_checks import check_class_paths, check_files, check_render_keys
 from simoun_agent.run.highway_config import check_highway_config, nested
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
@@ -255,7 +257,8 @@ def check_env_kwargs(env_id: str, kwargs: dict) -> None:
     """Refuse ``--env-kwargs`` keys that neither ``gymnasium.make`` nor the env's creator take,
     before it is made, naming the accepted ones; ``render_mode`` is refused too (simoun sets
     rgb_array), and so are values of the wrong kind for a keyword with a number or string
-    default."""
+    default. Numpy scalars and tuples are read as the numbers and lists they hold."""
+    kwargs = plain_json(kwargs)
     if "render_mode" in kwargs:
         raise SetupError(
             f"--env-kwargs sets render_mode={kwargs['render_mode']!r}; simoun makes {env_id} "
@@ -287,7 +290,7 @@ def _check_make_keywords(env_id: str, kwargs: dict) -> None:
     """SetupError for a value of a gymnasium.make keyword that make would misread."""
     if "max_episode_steps" in kwargs:
         steps = kwargs["max_episode_steps"]
-        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+        if isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1:
             raise SetupError(
                 f"--env-kwargs: max_episode_steps={steps!r} (gymnasium.make's episode step limit "
                 f"for {env_id}) must be a whole number of at least 1, e.g. "
@@ -320,7 +323,7 @@ def _creator_defaults(env_id: str) -> dict:
 
 
 def _is_number(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 DMC_OBJECT_KWARGS = {

@@ -38,6 +38,7 @@ import os
 import random
 import signal
 import time
+import warnings
 import zipfile
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, replace
@@ -268,19 +269,43 @@ def check_budget(config: TrainConfig) -> None:
     )
 
 
+class UntrainedRunWarning(UserWarning):
+    """A run whose warm-up (or batch size) takes all its agent decisions: it ends before its
+    first update, and its agent is the untrained one it started with."""
+
+
 def budget_warning(config: TrainConfig) -> str | None:
-    """A warning when the warm-up takes every agent decision of the run, so that it ends
-    before its first update; else None."""
-    decisions = config.total_env_steps // config.resolved_action_repeat()
-    if decisions == 0 or config.warmup_agent_steps < decisions:  # none: check_budget refuses
-        return None
+    """A warning when the warm-up, or the first batch, takes every agent decision of the run,
+    so that it ends before its first update; else None."""
+    repeat = config.resolved_action_repeat()
+    decisions = config.total_env_steps // repeat
+    batch = config.agent.batch_size
+    if decisions == 0 or max(config.warmup_agent_steps, batch) < decisions:
+        return None  # no decision at all: check_budget refuses
+    run = f"the run's {decisions} agent decisions (--total-env-steps {config.total_env_steps} at "
+    run += f"action repeat {repeat})"
+    if config.warmup_agent_steps >= decisions:
+        cause = f"--warmup-agent-steps {config.warmup_agent_steps} takes all {run}"
+        fix = f"lower --warmup-agent-steps (TrainConfig.warmup_agent_steps) below {decisions}"
+    else:
+        cause = (
+            f"--agent.batch-size {batch}: the first update needs that many stored transitions, "
+            f"more than {run} give"
+        )
+        fix = f"lower --agent.batch-size (AgentConfig.batch_size) below {decisions}"
     return (
-        f"--warmup-agent-steps {config.warmup_agent_steps} takes all the run's {decisions} "
-        f"agent decisions (--total-env-steps {config.total_env_steps} at action repeat "
-        f"{config.resolved_action_repeat()}): it ends before its first update and the agent "
-        f"learns nothing; lower --warmup-agent-steps below {decisions}, or raise "
-        "--total-env-steps"
+        f"{cause}: it ends before its first update and the agent learns nothing (its "
+        f'summary.json says "trained": false); {fix}, or raise --total-env-steps '
+        "(TrainConfig.total_env_steps)"
     )
+
+
+def warn_if_untrained(run: Run) -> None:
+    """Warn (:class:`UntrainedRunWarning`) when ``run`` has not updated yet and will not before
+    its end: its final metrics would read as a trained agent's."""
+    message = budget_warning(run.config)
+    if message and run.counters.updates == 0:
+        warnings.warn(message, UntrainedRunWarning, stacklevel=3)
 
 
 def write_config(run_dir: Path, config: TrainConfig) -> None:
@@ -812,6 +837,8 @@ class Trainer:
         summary = {
             "env_step": counters.env_step,
             "wall_time_s": counters.wall_time_s,
+            "updates": counters.updates,
+            "trained": counters.updates > 0,  # false: the final eval is of the initial agent
             "final_eval": final,
             "files": files,
         }
@@ -845,10 +872,13 @@ def train(run: Run, callbacks: Sequence[TrainCallback] = ()) -> dict[str, Any]:
     ``on_end`` run whatever happens. The loop knows only the callbacks it is given: a config key
     that a callback carries out (:attr:`TrainCallback.serves`, such as ``eval_distraction``,
     served by :func:`simoun_agent.generalization.distraction_callbacks`) is refused without one.
+    A run that ends before its first update (its warm-up takes every agent decision) warns with
+    :class:`UntrainedRunWarning`, and its ``summary.json`` says ``"trained": false``.
     """
     check_run_arg(run, "train")
     check_callbacks(callbacks, "train")
     check_served(run.config, callbacks)
+    warn_if_untrained(run)
     final = None
     # Entered after the envs were built, so a library that took the signals then (SDL) is found
     with deferred_stop(run.stop):
