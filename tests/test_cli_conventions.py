@@ -2,6 +2,7 @@
 plain status lines without a terminal, resume and rerun mistakes, one trainer per run directory,
 no silent overwrite of an evaluation; simoun-eval stops promptly on SIGTERM."""
 
+import ctypes.util
 import json
 import os
 import shutil
@@ -413,3 +414,75 @@ def test_an_unknown_mujoco_gl_is_refused_in_one_line(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
     assert "MUJOCO_GL='bogus'" in done.stderr and "egl or osmesa or glfw" in done.stderr
     assert not run_dir.exists()
+
+
+def refusal_in_one_line(command: str, argv: list[str], **variables: str) -> str:
+    """What simoun-COMMAND prints when it refuses ``argv`` run on a machine without a display,
+    with the environment ``variables``; it must exit 2 without a traceback or a destructor's
+    'Exception ignored'."""
+    unset = ("DISPLAY", "WAYLAND_DISPLAY", "MUJOCO_GL", "PYOPENGL_PLATFORM", "SDL_VIDEODRIVER")
+    env = {key: value for key, value in os.environ.items() if key not in unset}
+    done = subprocess.run(
+        [sys.executable, "-m", f"simoun_agent.cli.{command}", *argv],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**env, **variables},
+    )
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
+    assert "GLFWError" not in done.stderr, done.stderr
+    return done.stderr
+
+
+@pytest.mark.parametrize(
+    ("env", "variables", "said"),
+    [
+        ("HalfCheetah-v5", {"MUJOCO_GL": "glfw"}, "MUJOCO_GL=glfw cannot render HalfCheetah-v5 "
+         "on this machine: GLFW opens a window, and this machine has no display (DISPLAY is "
+         "unset) (FatalError: an OpenGL platform library has not been loaded"),
+        ("dm_control/cartpole-swingup-v0", {"MUJOCO_GL": "glfw"}, "MUJOCO_GL=glfw cannot "
+         "render dm_control/cartpole-swingup-v0 on this machine: GLFW opens a window"),
+        ("dm_control/cartpole-swingup-v0", {"MUJOCO_GL": "osmesa"}, "MUJOCO_GL=osmesa cannot "
+         "render dm_control/cartpole-swingup-v0 on this machine: OSMesa needs the library "
+         "libOSMesa, which is not installed"),
+        ("HalfCheetah-v5", {"MUJOCO_GL": "osmesa"}, "MUJOCO_GL=osmesa cannot render "
+         "HalfCheetah-v5 on this machine: OSMesa needs the library libOSMesa"),
+    ],
+)  # fmt: skip
+def test_a_mujoco_gl_that_cannot_run_here_is_named_with_the_fix(tmp_path, env, variables, said):
+    if variables["MUJOCO_GL"] == "osmesa" and ctypes.util.find_library("OSMesa") is not None:
+        pytest.skip("libOSMesa is installed here: OSMesa renders")
+    run_dir = tmp_path / "run"
+    stderr = refusal_in_one_line("train", run_flags(run_dir, 40, "--env", env), **variables)
+    assert said in stderr
+    assert stderr.strip().endswith(
+        "set MUJOCO_GL=egl, or unset it (simoun sets egl when there is no display)"
+    )
+    assert not run_dir.exists()
+
+
+def test_a_pyopengl_platform_at_odds_with_mujoco_gl_is_named(tmp_path):
+    argv = run_flags(tmp_path / "run", 40, "--env", "dm_control/cartpole-swingup-v0")
+    stderr = refusal_in_one_line("train", argv, MUJOCO_GL="egl", PYOPENGL_PLATFORM="glx")
+    assert "PYOPENGL_PLATFORM=glx does not match MUJOCO_GL=egl, so dm_control/" in stderr
+    assert "unset PYOPENGL_PLATFORM (dm_control and mujoco set it from MUJOCO_GL)" in stderr
+    assert "not installed" not in stderr
+
+
+def test_an_sdl_video_driver_that_cannot_run_here_is_named_not_the_env_kwargs(tmp_path):
+    argv = run_flags(tmp_path / "run", 40, "--env", "highway-fast-v0", "--preset", "highway-cpu")
+    stderr = refusal_in_one_line("train", argv, SDL_VIDEODRIVER="x11")
+    assert "SDL_VIDEODRIVER=x11 cannot draw highway-fast-v0's frames on this machine" in stderr
+    assert "set SDL_VIDEODRIVER=offscreen, or unset it" in stderr
+    assert "--env-kwargs" not in stderr
+
+
+def test_simoun_eval_names_a_mujoco_gl_that_cannot_run_here(tmp_path):
+    run_dir = tmp_path / "dmc"
+    argv = run_flags(run_dir, 16, "--env", "dm_control/cartpole-swingup-v0", "--action-repeat", "4")
+    assert train_cli.main(override(argv, "--warmup-agent-steps", "2")) == 0
+    stderr = refusal_in_one_line(
+        "eval", [str(run_dir), "--no-video", "--episodes", "1"], MUJOCO_GL="glfw"
+    )
+    assert "MUJOCO_GL=glfw cannot render dm_control/cartpole-swingup-v0 on this machine" in stderr

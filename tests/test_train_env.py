@@ -11,6 +11,7 @@ from gymnasium.utils.env_checker import check_env
 from simoun_agent.config import SetupError, resolve
 from simoun_agent.envs import POINT_REACH_ID, PointReach
 from simoun_agent.run.driving_metrics import DrivingEpisode, summarize
+from simoun_agent.run.env_packages import provider
 from simoun_agent.run.highway_config import limit_of
 from simoun_agent.run.logger import CsvLog, plot_learning_curve, read_csv
 from simoun_agent.run.make_env import (
@@ -364,6 +365,46 @@ def test_a_negative_count_in_env_kwargs_is_refused_naming_the_key():
 gym.register("simoun-test/NeedsMissing-v0", entry_point="simoun_test_absent.envs:Env")
 
 
+def test_a_camera_id_beside_several_cameras_is_refused_naming_both():
+    dmc = "dm_control/cartpole-swingup-v0"
+    chosen = env_config(dmc, {"render_kwargs": {"camera_id": 1}}, cameras=2)
+    for make in (check_task, make_env):
+        with pytest.raises(SetupError) as error:
+            make(chosen)
+        assert str(error.value) == (
+            "--cameras 2 with --env-kwargs render_kwargs.camera_id=1: --cameras N shows "
+            f"{dmc}'s cameras 0..N-1 side by side (here 0..1), so the camera_id would be "
+            "ignored; for the one camera of your choice pass --cameras 1 with "
+            "render_kwargs.camera_id, or drop camera_id to see cameras 0..N-1"
+        )
+    assert check_task(env_config(dmc, {"render_kwargs": {"camera_id": 1}})) == 1000
+    assert check_task(env_config(dmc, {"render_kwargs": {"width": 40}}, cameras=2)) == 1000
+
+
+def test_a_highway_action_with_no_axis_is_named_for_that_not_for_the_task():
+    # made directly (a sweep's trial, a resumed run): the same refusal as before the env is made
+    none = {"type": "ContinuousAction", "lateral": False, "longitudinal": False}
+    with pytest.raises(SetupError, match=r"^--env-kwargs: config.action has longitudinal=false"):
+        make_env(env_config("highway-fast-v0", {"config": {"action": none}}))
+
+
+def test_an_id_of_a_package_that_is_not_imported_names_the_package():
+    assert provider("ALE/Pong-v5").pip == "ale-py"
+    assert provider("FetchReach-v4").pip == "gymnasium-robotics"
+    assert provider("MiniGrid-DoorKey-6x6-v0").module == "minigrid"
+    assert provider("Hopper-v5") is None and provider("dm_control/walker-walk-v0") is None
+    with pytest.raises(SetupError) as error:
+        check_task(env_config("ALE/Pong-v5", {}))
+    if importlib.util.find_spec("ale_py") is None:
+        assert str(error.value) == (
+            "--env ALE/Pong-v5: ids like this one belong to the Atari games of the Arcade "
+            "Learning Environment, which the package ale-py registers when it is imported, and "
+            "ale-py is not installed; pip install ale-py, then pass --env ale_py:ALE/Pong-v5"
+        )
+    else:
+        assert "pass --env ale_py:ALE/Pong-v5" in str(error.value)
+
+
 def test_an_env_whose_package_is_missing_is_refused_with_the_install():
     for make in (check_task, make_env):
         with pytest.raises(SetupError) as error:
@@ -410,7 +451,6 @@ HIGHWAY_CONTINUOUS = {"action": {"type": "ContinuousAction"}}
         ({"vehicles_count": -1}, "config.vehicles_count=-1"),
         ({"controlled_vehicles": 0}, "config.controlled_vehicles=0"),
         ({"vehicles_density": 0}, "config.vehicles_density=0"),
-        ({"scaling": -1}, "config.scaling=-1"),
         ({"ego_spacing": -1}, "config.ego_spacing=-1 (highway-fast-v0's spacing between "
          "vehicles at the start) must be a number > 0; e.g. '{\"config\": {\"ego_spacing\": "
          "1.5}}' (its default)"),
@@ -489,8 +529,30 @@ def test_an_env_that_renders_no_frame_is_refused_at_set_up_naming_the_key():
          "config.action.speed_range=[30, 0] (speeds the vehicle may reach, [lowest, highest] in "
          "m/s) must have its low end first"),
         ({"action": {"type": "ContinuousAction", "steering_range": [0.5, 0.5]}},
-         "config.action.steering_range=[0.5, 0.5] has equal ends, so that axis of the agent's "
-         "action would have no effect"),
+         "config.action.steering_range=[0.5, 0.5] (steering angles the action's [-1, 1] maps "
+         "onto, [lowest, highest] in radians) has equal ends"),
+        ({"action": {"type": "ContinuousAction", "steering_range": [0.5, -0.5]}},
+         "config.action.steering_range=[0.5, -0.5] (steering angles the action's [-1, 1] maps "
+         "onto, [lowest, highest] in radians) must have its low end first and below its high "
+         "end, and swapped ends would mirror that axis of the agent's action; e.g. "
+         "'{\"config\": {\"action\": {\"steering_range\": [-0.5, 0.5]}}}'"),
+        ({"action": {"type": "ContinuousAction", "acceleration_range": [5, -5]}},
+         "config.action.acceleration_range=[5, -5] (accelerations the action's [-1, 1] maps "
+         "onto, [lowest, highest] in m/s^2) must have its low end first"),
+        ({"manual_control": True}, "config.manual_control=true makes highway-fast-v0 drive the "
+         "vehicle from the keyboard of a window, and highway-env would never apply the agent's "
+         "actions"),
+        ({"action": {"type": "ContinuousAction", "lateral": False, "longitudinal": False}},
+         "config.action has longitudinal=false and lateral=false, so highway-env's "
+         "ContinuousAction has no axis (neither throttle nor steering) and the agent could not "
+         "drive; set one of them true"),
+        ({"scaling": 3}, "config.scaling=3 sets highway-env's rendered view, which simoun's "
+         "cameras set for every view the agent sees (from --cameras and --image-size), so the "
+         "value would be replaced; drop config.scaling"),
+        ({"scaling": -1}, "config.scaling=-1 sets highway-env's rendered view"),
+        ({"centering_position": [0.3, 0.5]}, "config.centering_position=[0.3, 0.5] sets "
+         "highway-env's rendered view"),
+        ({"screen_width": 200}, "config.screen_width=200 sets highway-env's rendered view"),
         ({"action": {"type": "ContinuousAction", "steering_range": 0.5}},
          "config.action.steering_range=0.5 must be a list of 2 numbers [low, high]"),
     ],
@@ -513,9 +575,12 @@ def test_highway_config_values_of_the_defaults_kind_are_taken():
         "reward_speed_range": [10.5, 20],
     }
     assert check_env_kwargs("highway-fast-v0", {"config": {**HIGHWAY_CONTINUOUS, **kept}}) is None
-    # swapped acceleration or steering ends only flip the sign of an action axis: same task
-    flipped = {"type": "ContinuousAction", "acceleration_range": [5, -5], "clip": False}
-    assert check_env_kwargs("highway-fast-v0", {"config": {"action": flipped}}) is None
+    # ranges in order, switches that keep one axis or leave the keyboard alone are the user's
+    ordered = {"type": "ContinuousAction", "acceleration_range": [-3, 4], "clip": False}
+    assert check_env_kwargs("highway-fast-v0", {"config": {"action": ordered}}) is None
+    steering_only = {"type": "ContinuousAction", "longitudinal": False}
+    keys = {"action": steering_only, "manual_control": False}
+    assert check_env_kwargs("highway-fast-v0", {"config": keys}) is None
     # racetrack's own default action holds a key its action class ignores: copying it is fine
     ensure_registered("racetrack-v0")
     own = {"type": "ContinuousAction", "lateral": True, "target_speeds": [0, 5, 10]}
@@ -740,9 +805,8 @@ def test_every_spacing_length_count_duration_and_noise_of_every_highway_task_is_
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 continue
             if limit is None:
-                assert any(
-                    word in key for word in ("reward", "cost", "screen", "constraint", "range")
-                ), key
+                free = ("reward", "cost", "screen", "scaling", "constraint", "range")
+                assert any(word in key for word in free), key
                 continue
             assert limit.ok(value), (env_id, key, value)
             assert not limit.ok(-1), key

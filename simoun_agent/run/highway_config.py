@@ -1,9 +1,11 @@
 """The keys and values of a highway-env task's ``config`` that turn it into another task, or
 none: a key the task does not have (highway-env ignores it, so a misspelt ``lane_count`` leaves
 the default), a value of another kind than the default's (``"offroad_terminal": "no"`` is taken
-by its truth value), a second driven vehicle (the agent drives one; the other gets no driver), a
-range whose ends are swapped (the high-speed reward then pays for driving slowly), a simulation
-that never advances, a road without lanes, an episode over before it starts. highway-env takes
+by its truth value), a second driven vehicle (the agent drives one; the other gets no driver),
+manual control (the agent's actions would never reach the vehicle), an action with no axis, a
+range whose ends are swapped (the high-speed reward then pays for driving slowly, a steering
+range mirrors the wheel), a view setting simoun's cameras replace, a simulation that never
+advances, a road without lanes, an episode over before it starts. highway-env takes
 such values without a word, so they are refused before the env is made, naming ``config.KEY``
 and a value that works.
 
@@ -64,12 +66,11 @@ HIGHWAY_LIMITS = {
     "vehicles_density": Limit("traffic density", 0, open_low=True),
     "spawn_probability": Limit("chance of a new vehicle at each step", 0, high=1),
     "speed_limit": Limit("speed limit in m/s", 0, open_low=True),
-    "scaling": Limit("pixels per metre of the env's own viewer", 0, open_low=True),
 }
 """What each numeric key of a highway-env ``config`` (in any task that has it) must be for the
 task to be one: frequencies, durations, densities and the speed limit above 0, a count of lanes
-at least 1, counts of other vehicles at least 0, a probability in [0, 1]. The screen size is left
-out: simoun's cameras set it for every view. ``controlled_vehicles`` must be 1 (see
+at least 1, counts of other vehicles at least 0, a probability in [0, 1]. The view's keys are
+refused whole (:data:`CAMERA_KEYS`). ``controlled_vehicles`` must be 1 (see
 :func:`_check_driven`)."""
 
 LIMIT_PATTERNS = (
@@ -113,29 +114,42 @@ def limit_of(key: str) -> Limit | None:
 ORDERED_RANGES = {
     "reward_speed_range": "speeds mapped onto the high-speed reward, [slowest, fastest] in m/s",
     "speed_range": "speeds the vehicle may reach, [lowest, highest] in m/s",
+    "acceleration_range": "accelerations the action's [-1, 1] maps onto, [lowest, highest] "
+    "in m/s^2",
+    "steering_range": "steering angles the action's [-1, 1] maps onto, [lowest, highest] in "
+    "radians",
 }
-"""``[low, high]`` keys (of ``config`` or of ``config.action``) whose order makes the task:
-highway-env maps a speed through ``reward_speed_range`` with a linear map, so swapped ends pay
-the high-speed reward for driving slowly, and takes ``speed_range`` as (MIN_SPEED, MAX_SPEED)."""
+"""``[low, high]`` keys (of ``config`` or of ``config.action``) whose order makes the task, with
+what they set: highway-env maps a speed through ``reward_speed_range`` with a linear map, so
+swapped ends pay the high-speed reward for driving slowly; it takes ``speed_range`` as
+(MIN_SPEED, MAX_SPEED); and it maps the agent's [-1, 1] action onto ``acceleration_range`` and
+``steering_range`` linearly, so swapped ends mirror that axis (+1 brakes, or steers the other
+way) without a word. Every other ``*_range`` key must run low to high too."""
 
-SIGNED_RANGES = ("acceleration_range", "steering_range")
-"""``[low, high]`` keys of ``config.action`` whose swapped ends only flip the sign of one axis of
-the agent's action (highway-env maps [-1, 1] onto them linearly): the task is the same, with the
-axis read the other way, so the order is free; equal ends leave the axis no effect and are
-refused."""
+CAMERA_KEYS = {
+    "scaling": "--cameras and --image-size",
+    "centering_position": "--cameras",
+    "screen_width": "--image-size",
+    "screen_height": "--image-size",
+}
+"""keys of highway-env's ``config`` that set the rendered view, which simoun's cameras set for
+every view (their layout from ``--cameras``, their size and zoom from ``--image-size``): a
+value given here would be replaced without a word; each with the flags that set it"""
 
 
 def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
     """SetupError for a key of ``given`` (the ``config`` of ``--env-kwargs``) that the task's
     ``defaults`` (its ``default_config()``) lack, a value of another kind than the default's,
-    a value :func:`limit_of` refuses, a ``controlled_vehicles`` other than 1, a range in
-    the wrong order, an unknown action type or key, or a policy frequency above the simulation
-    frequency. Numpy scalars and tuples are read as the numbers and lists they hold."""
+    a value :func:`limit_of` refuses, a view key simoun's cameras set, a ``controlled_vehicles``
+    other than 1, manual control, a range in the wrong order, an unknown action type or key, an
+    action with no axis, or a policy frequency above the simulation frequency. Numpy scalars and
+    tuples are read as the numbers and lists they hold."""
     if not isinstance(given, dict) or not isinstance(defaults, dict):
         return
     given = plain_json(given)
     for key, value in given.items():
         _check_known(env_id, key, defaults)
+        _check_not_camera(key, value)
         _check_kind(env_id, f"config.{key}", value, defaults[key])
         limit = limit_of(key)
         if limit is not None and _is_number(value) and not limit.ok(value):
@@ -146,6 +160,7 @@ def check_highway_config(env_id: str, given: Any, defaults: Any) -> None:
             )
         _check_range(f"config.{key}", value)
     _check_driven(env_id, given)
+    _check_manual(env_id, given)
     _check_action(env_id, given.get("action"), defaults.get("action"))
     _check_frequencies(env_id, given, defaults)
 
@@ -219,30 +234,54 @@ def _check_kind(env_id: str, name: str, value: object, default: object) -> None:
 
 
 def _check_range(name: str, value: object) -> None:
-    """SetupError for a ``[low, high]`` range in the wrong order (:data:`ORDERED_RANGES`, and
-    any other ``*_range`` key but :data:`SIGNED_RANGES`) or, for a signed one, with equal
-    ends."""
+    """SetupError for a ``[low, high]`` range (any ``*_range`` key) whose ends are swapped or
+    equal (:data:`ORDERED_RANGES`)."""
     key = name.split(".")[-1]
     if not key.endswith("_range") or not _is_pair(value):
         return
     low, high = value
-    if key in SIGNED_RANGES:
-        if low != high:
-            return
-        raise SetupError(
-            f"--env-kwargs: {name}={json.dumps(value)} has equal ends, so that axis of the "
-            f"agent's action would have no effect; give two different ends, e.g. "
-            f"'{json.dumps(nested(name, [-abs(low) or -1, abs(low) or 1]))}', or drop {name}"
-        )
     if low < high:
         return
     meaning = ORDERED_RANGES.get(key, "range [low, high]")
+    if low == high:
+        raise SetupError(
+            f"--env-kwargs: {name}={json.dumps(value)} ({meaning}) has equal ends, so it holds "
+            f"one value; give a low end below the high end, e.g. "
+            f"'{json.dumps(nested(name, [-abs(low) or -1, abs(low) or 1]))}', or drop {name}"
+        )
+    mirrored = (
+        ", and swapped ends would mirror that axis of the agent's action"
+        if key in ("acceleration_range", "steering_range")
+        else ""
+    )
     raise SetupError(
         f"--env-kwargs: {name}={json.dumps(value)} ({meaning}) must have its low end first and "
-        f"below its high end; e.g. '{json.dumps(nested(name, sorted(value)))}', or drop {name}"
-        if low != high
-        else f"--env-kwargs: {name}={json.dumps(value)} ({meaning}) has equal ends; give a low "
-        f"end below the high end, or drop {name}"
+        f"below its high end{mirrored}; e.g. '{json.dumps(nested(name, sorted(value)))}', or "
+        f"drop {name}"
+    )
+
+
+def _check_not_camera(key: str, value: object) -> None:
+    """SetupError for a view key (:data:`CAMERA_KEYS`): simoun's cameras set it for every view."""
+    if key not in CAMERA_KEYS:
+        return
+    flags = CAMERA_KEYS[key]
+    raise SetupError(
+        f"--env-kwargs: config.{key}={json.dumps(value)} sets highway-env's rendered view, which "
+        f"simoun's cameras set for every view the agent sees (from {flags}), so the value "
+        f"would be replaced; drop config.{key} and pick the views with {flags}"
+    )
+
+
+def _check_manual(env_id: str, given: dict) -> None:
+    """SetupError for ``manual_control`` switched on: highway-env then drives the vehicle from
+    the keyboard and never applies the agent's actions."""
+    if given.get("manual_control") is not True:
+        return
+    raise SetupError(
+        f"--env-kwargs: config.manual_control=true makes {env_id} drive the vehicle from the "
+        "keyboard of a window, and highway-env would never apply the agent's actions, so the "
+        "agent could learn nothing; drop config.manual_control (or set it false)"
     )
 
 
@@ -301,6 +340,22 @@ def _check_action(env_id: str, action: object, default: object) -> None:
                 f"numbers [low, high]; e.g. '{example}', or drop config.action.{key}"
             )
         _check_range(f"config.action.{key}", value)
+    _check_axes(kind, action, parameters)
+
+
+def _check_axes(kind: str, action: dict, parameters: dict[str, Any]) -> None:
+    """SetupError for an action with ``lateral`` and ``longitudinal`` both false: highway-env
+    then gives it no axis at all (an empty action), and the agent has nothing to drive with."""
+    if not {"lateral", "longitudinal"} <= set(parameters):
+        return
+    axes = [axis for axis in ("longitudinal", "lateral") if action.get(axis, parameters[axis])]
+    if axes:
+        return
+    raise SetupError(
+        f"--env-kwargs: config.action has longitudinal=false and lateral=false, so highway-env's "
+        f"{kind} has no axis (neither throttle nor steering) and the agent could not drive; set "
+        "one of them true, or drop both (the agent then controls throttle and steering)"
+    )
 
 
 def _action_parameters(kind: str) -> dict[str, Any]:

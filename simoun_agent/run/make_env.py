@@ -17,7 +17,6 @@ import inspect
 import json
 import math
 import numbers
-import os
 import re
 from collections.abc import Callable
 from dataclasses import replace
@@ -34,7 +33,9 @@ from simoun_agent.config.envs import is_highway
 from simoun_agent.config.resolve import merged
 from simoun_agent.config.rules import plain_json
 from simoun_agent.run.env_kwargs_checks import check_class_paths, check_files, check_render_keys
+from simoun_agent.run.env_packages import unregistered_package
 from simoun_agent.run.highway_config import check_highway_config, nested
+from simoun_agent.run.render_backend import backend_failure, named_backend, probe_render
 from simoun_wrappers import ActionRepeat, MultiCamera, SimounObservation
 from simoun_wrappers.observation import check_render, image_layout
 
@@ -118,7 +119,9 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
             continue
         try:
             importlib.import_module(suite)
-        except ImportError:
+        except ImportError as err:
+            if backend_failure(err, env_id) is not None:  # installed, but cannot render here
+                raise
             if prefix:
                 raise SetupError(
                     f"{env_id!r} needs {suite}, which is not installed; "
@@ -133,6 +136,9 @@ def ensure_registered(env_id: str, module: str | None = None) -> None:
             f"id (e.g. {several[0]}): train one run per env, or sweep them with simoun-sweep "
             f"--envs {','.join(several)}"
         )
+    packaged = unregistered_package(env_id) if module is None else None
+    if packaged is not None:
+        raise packaged
     matches = close_env_ids(f"{module}:{env_id}" if module else env_id)
     hint = f"did you mean {', '.join(matches)}?" if matches else "no registered id is close."
     if module is not None:
@@ -434,25 +440,15 @@ def _refused_kwargs(env_id: str, kwargs: dict, err: TypeError) -> SetupError:
     )
 
 
-MUJOCO_GL_WORKING = ("egl", "osmesa", "glfw")
-"""the ``MUJOCO_GL`` rendering back-ends dm_control and mujoco render with"""
-
-
 def _make_base(config: TrainConfig) -> gym.Env:
-    """``gym.make`` the env with rgb_array rendering at the run's image size; a SetupError for a
-    ``MUJOCO_GL`` that dm_control or mujoco refuse (they read it on import, when the env's suite
-    registers or the env is made)."""
-    try:
-        return _make_rendering_env(config)
-    except RuntimeError as err:
-        if "MUJOCO_GL" not in str(err):
-            raise
-        value = os.environ.get("MUJOCO_GL", "")
-        raise SetupError(
-            f"MUJOCO_GL={value!r} is not a rendering back-end dm_control and mujoco know, so "
-            f"{config.env} cannot be made; set MUJOCO_GL to {' or '.join(MUJOCO_GL_WORKING)} "
-            "(egl on a machine without a display), or unset it"
-        ) from None
+    """``gym.make`` the env with rgb_array rendering at the run's image size, and render it once
+    when it draws with MuJoCo; a SetupError for a rendering back-end that cannot run here (an
+    unknown ``MUJOCO_GL``, which dm_control and mujoco read on import, or one they know that
+    this machine cannot run: :mod:`render_backend`)."""
+    with named_backend(config.env):
+        env = _make_rendering_env(config)
+    probe_render(env, config.env)
+    return env
 
 
 def _make_kwargs(config: TrainConfig) -> dict:
@@ -488,6 +484,7 @@ def _dropped_observation(env_kwargs: dict) -> dict:
 def _make_rendering_env(config: TrainConfig) -> gym.Env:
     ensure_registered(config.env, config.env_module)
     check_env_kwargs(config.env, config.env_kwargs)
+    _check_camera_choice(config)
     env = _gym_make(config)
     try:
         check_render_keys(env, config)
@@ -497,19 +494,41 @@ def _make_rendering_env(config: TrainConfig) -> gym.Env:
     return env
 
 
+def _check_camera_choice(config: TrainConfig) -> None:
+    """SetupError for a dm_control ``render_kwargs.camera_id`` beside ``--cameras`` above 1:
+    the views are then cameras 0..N-1, rendered by their ids, and the camera chosen would be
+    dropped without a word."""
+    render = config.env_kwargs.get("render_kwargs")
+    if not (
+        config.env.startswith("dm_control/")
+        and config.cameras > 1
+        and isinstance(render, dict)
+        and "camera_id" in render
+    ):
+        return
+    raise SetupError(
+        f"--cameras {config.cameras} with --env-kwargs render_kwargs.camera_id="
+        f"{json.dumps(render['camera_id'])}: --cameras N shows {config.env}'s cameras 0..N-1 "
+        f"side by side (here 0..{config.cameras - 1}), so the camera_id would be ignored; for "
+        "the one camera of your choice pass --cameras 1 with render_kwargs.camera_id, or drop "
+        "camera_id to see cameras 0..N-1"
+    )
+
+
 def _gym_make(config: TrainConfig) -> gym.Env:
     """``gym.make`` ``config``'s env with rgb_array rendering (without it for a creator that
     takes no render_mode); SetupError for what making it raises, naming ``--env-kwargs`` and
     the key at fault when the run gives any."""
     kwargs = _make_kwargs(config)
     try:
-        try:
-            return gym.make(config.env, render_mode="rgb_array", **kwargs)
-        except TypeError as err:
-            if "render_mode" not in str(err):
-                raise
-        # an env whose creator takes no render_mode: it may still return image observations
-        return gym.make(config.env, **kwargs)
+        with named_backend(config.env):
+            try:
+                return gym.make(config.env, render_mode="rgb_array", **kwargs)
+            except TypeError as err:
+                if "render_mode" not in str(err):
+                    raise
+            # an env whose creator takes no render_mode: it may still return image observations
+            return gym.make(config.env, **kwargs)
     except TypeError as err:
         if "keyword argument" in str(err):
             raise _refused_kwargs(config.env, config.env_kwargs, err) from None
@@ -521,9 +540,8 @@ def _gym_make(config: TrainConfig) -> gym.Env:
     except Exception as err:
         # an env that checks its own arguments refuses a bad value this way; without env
         # kwargs, only a ValueError is the env's word on its arguments. With them, whatever
-        # the env raises (a missing file, a class path that does not import) follows from them;
-        # a MUJOCO_GL that mujoco refuses is named by _make_base
-        if not (config.env_kwargs or isinstance(err, ValueError)) or "MUJOCO_GL" in str(err):
+        # the env raises (a missing file, a class path that does not import) follows from them
+        if not (config.env_kwargs or isinstance(err, ValueError)):
             raise
         raise _refused_by_env(config, err) from None
 
@@ -569,11 +587,12 @@ def one_line(err: Exception) -> str:
 
 def no_continuous_actions(config: TrainConfig, culprit: str) -> bool:
     """Whether ``culprit`` (:func:`faulty_key`) is the continuous action type a highway-env
-    task cannot be made with."""
+    task cannot be made with (the type itself, or the action that holds it: another key of
+    the action at fault is named as itself)."""
     action = config.env_kwargs.get("config", {}).get("action", {})
     return (
         is_highway(config.env)
-        and culprit.startswith("config.action")
+        and culprit.startswith(("config.action.type=", "config.action="))
         and isinstance(action, dict)
         and action.get("type") == "ContinuousAction"
     )
