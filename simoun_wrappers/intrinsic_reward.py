@@ -203,10 +203,13 @@ class IntrinsicSignal(ABC):
     def call_source(self, triplets: np.ndarray) -> Any:
         """The source's answer for ``triplets``; an error raised inside the source (say a torch
         module given the numpy triplets) is raised again naming the source and what it was
-        given, since the error alone names neither."""
+        given, since the error alone names neither. The project's own models (CuriosityModel,
+        RNDModel) name themselves and their fix: their errors pass unchanged."""
         try:
             return self.source(triplets)
         except Exception as err:
+            if is_own(self.source):
+                raise
             raise source_failure(err, self.source, self.source_protocol, triplets) from err
 
     def watch(self, *transitions: np.ndarray) -> None:
@@ -221,6 +224,11 @@ class IntrinsicSignal(ABC):
         close = getattr(self.source, "close", None)
         if close is not None:
             close()
+
+
+def is_own(source: Any) -> bool:
+    """Whether ``source`` is an instance of a class of simoun's packages."""
+    return type(source).__module__.partition(".")[0] in ("simoun_agent", "simoun_wrappers")
 
 
 def class_for_instance(source: type, wanted: SourceProtocol) -> str:

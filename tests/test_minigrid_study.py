@@ -241,11 +241,11 @@ def test_the_minigrid_study_reads_a_toml_spec_and_tells_a_sac_one_apart(tmp_path
     with pytest.raises(SetupError) as refused:
         load_spec(sac)
     said = str(refused.value)
-    assert said.startswith(f"--spec {sac} is a SAC study's spec (it has recipes)")
+    assert said.startswith(f"the spec file {sac} is a SAC study's spec (it has recipes)")
     assert f"simoun-study plan {sac}" in said and "comment" not in said
     broken = tmp_path / "broken.toml"
     broken.write_text(TINY_TOML.replace("evaluations = 2", "evaluations = "))
-    with pytest.raises(SetupError, match=f"--spec {broken} is not valid TOML .*line 2"):
+    with pytest.raises(SetupError, match=f"the spec file {broken} is not valid TOML .*line 2"):
         load_spec(broken)
 
 
@@ -620,7 +620,7 @@ def test_a_study_record_given_as_a_minigrid_spec_is_named_with_its_spec(tmp_path
     with pytest.raises(SetupError) as refused:
         load_spec(record)
     said = str(refused.value)
-    assert f"--spec {record} is a study's record" in said and "not a study spec" in said
+    assert f"the spec file {record} is a study's record" in said and "not a study spec" in said
     assert "docs/studies/dmc100k.toml" in said and "unknown key" not in said
 
 

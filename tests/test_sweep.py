@@ -157,7 +157,8 @@ def test_cameras_and_env_kwargs_a_trial_fails_on_are_named_before_ray_starts(tmp
     dmc = override(TINY, "--env", "dm_control/cartpole-swingup-v0")
     grids = {
         "cameras=2,3": "--cameras 3: dm_control/cartpole-swingup-v0 has only 2 cameras",
-        'env_kwargs={"render_kwargs": {"camera_id": 7}},{}': "failed at its first reset and step",
+        'env_kwargs={"render_kwargs": {"camera_id": 7}},{}': "render_kwargs.camera_id=7 is not a "
+        "camera of dm_control/cartpole-swingup-v0",
     }
     for grid, said in grids.items():
         sweep_dir = tmp_path / "refused"
