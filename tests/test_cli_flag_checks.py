@@ -927,3 +927,38 @@ def test_a_read_only_study_resumed_is_told_to_resume_a_copy(tmp_path):
     assert f"cannot write to the output directory {study_dir}" in result.stderr
     copy = f"cp -r {study_dir} ~/s && simoun-study run {spec} --resume --study-dir ~/s"
     assert copy in result.stderr
+
+
+def test_a_list_flag_given_twice_is_refused_with_every_value_after_one_flag(tmp_path, capsys):
+    probe = ["probe", "--out", str(tmp_path / "no" / "p")]
+    err = refused(capsys, minigrid_cli.main, [*probe, "--probes", "rnd", "--probes", "consistency"])
+    assert (
+        "--probes is given twice with different values (--probes rnd and --probes consistency), "
+        "and only the last would count; give every value after one --probes: --probes rnd "
+        "consistency"
+    ) in err
+    err = refused(capsys, minigrid_cli.main, [*probe, "--probes=rnd", "--probes", "rnd", "count"])
+    assert "--probes rnd count" in err
+    # the same list twice changes nothing: refused for the missing folder, not the repetition
+    err = refused(capsys, minigrid_cli.main, [*probe, "--probes", "rnd", "--probes", "rnd"])
+    assert "given twice" not in err and "its folder" in err
+
+
+@pytest.mark.parametrize(
+    ("main", "argv", "said"),
+    [
+        (sweep_cli.main, ["--grid", "--agent.lr=1e-3,3e-4"],
+         "--grid takes a KEY=VALUE word, and '--agent.lr=1e-3,3e-4' after it starts with dashes, "
+         "so it was read as a flag of its own and --grid was left without a value; write the key "
+         "without dashes: --grid agent.lr=1e-3,3e-4"),
+        (sweep_cli.main, ["--grid", "--agent.curiosity=on,off"],
+         "write the key without dashes: --grid agent.curiosity=on,off"),
+        (sweep_cli.main, ["--set", "--agent.batch-size=8"], "--set agent.batch_size=8"),
+        (train_cli.main, ["--set", "-image_size=32"], "--set image_size=32"),
+    ],
+)  # fmt: skip
+def test_a_setting_written_with_dashes_after_its_flag_is_named_with_the_fix(
+    main, argv, said, capsys
+):
+    err = refused(capsys, main, argv)
+    assert said in err and "Missing value" not in err, err

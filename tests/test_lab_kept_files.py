@@ -937,3 +937,37 @@ def test_a_private_evaluation_run_is_named_by_the_study_report(dmc_archive):
     assert result.returncode == 2, result.stderr[-3000:]
     assert f"cannot be read (its folder {run}): permission denied" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_a_minigrid_run_or_archive_is_named_by_the_commands_of_simoun_train_runs(
+    minigrid_archive,
+):
+    from simoun_agent.cli import eval as eval_cli
+    from simoun_agent.cli import train as train_cli
+    from simoun_lab.cli import analyze as analyze_cli
+
+    run = minigrid_archive / MINIGRID_RUNS[0]
+    before = sorted(p.relative_to(minigrid_archive) for p in minigrid_archive.rglob("*"))
+    report = f"`python -m simoun_lab.minigrid_study report --archive {minigrid_archive}`"
+    only = "simoun-train, simoun-eval and simoun-analyze work on simoun-train runs only"
+    for main, args in (
+        (analyze_cli.main, ["bias", str(run), "--pairs", "8", "--out", str(run.parent / "b")]),
+        (analyze_cli.main, ["masks", str(run)]),
+        (eval_cli.main, [str(run)]),
+        (train_cli.main, ["--resume", str(run)]),
+    ):
+        printed = refused(main, *args)
+        assert (
+            f"{run} is a run of a MiniGrid PPO study (its config.json names the study's" in printed
+        )
+        assert f"{report} reports" in printed and only in printed, printed
+        assert "no checkpoint" not in printed and "unknown config key" not in printed
+    for where, said in (
+        (minigrid_archive, "the archive of a MiniGrid PPO study"),
+        (run.parent, f"a folder of {minigrid_archive}, the archive of a MiniGrid PPO study"),
+    ):
+        printed = refused(analyze_cli.main, "masks", str(where))
+        assert (
+            f"{where} is {said} ({minigrid_archive / 'spec.json'})" in printed and only in printed
+        )
+    assert sorted(p.relative_to(minigrid_archive) for p in minigrid_archive.rglob("*")) == before

@@ -785,3 +785,63 @@ def test_load_spec_from_python_names_its_file_not_the_flag(tmp_path):
     assert "--spec" not in str(info.value)
     with pytest.raises(SetupError, match=r"^--spec .*s\.json is not valid JSON"):
         load_spec(path, "--spec")
+
+
+def test_a_minigrid_run_refuses_another_studys_archive_or_a_sweep_as_its_work_dir(tmp_path):
+    other = Path(shutil.copytree("docs/studies/minigrid-v2/tuning", tmp_path / "mg"))
+    sweep = tmp_path / "sw"
+    sweep.mkdir()
+    (sweep / "sweep.json").write_text("{}")
+    kept = {root: tree_bytes(root) for root in (other, sweep)}
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(TINY))
+    archive = tmp_path / "arch"
+    archive.mkdir()
+    for work, said in (
+        (other, f"--work-dir {other} is the archive of another study, a MiniGrid PPO study "
+                f"({other / 'spec.json'})"),
+        (sweep, f"--work-dir {sweep} is a simoun-sweep directory ({sweep / 'sweep.json'})"),
+        (sweep / "w", f"--work-dir {sweep / 'w'} lies inside {sweep}, a simoun-sweep directory"),
+    ):  # fmt: skip
+        status, printed = study("run", "--archive", str(archive), "--spec", str(spec),
+                                "--work-dir", str(work))  # fmt: skip
+        assert status == 2 and said in printed and "Traceback" not in printed, printed
+        if work == other:
+            assert "pass a new directory to --work-dir" in printed
+    status, printed = simoun_study("run", str(spec), "--study-dir", str(other), "--archive",
+                                   str(archive))  # fmt: skip
+    assert status == 2 and f"--study-dir {other} is the archive of another study" in printed
+    assert {root: tree_bytes(root) for root in (other, sweep)} == kept
+    assert not any(archive.iterdir())
+
+
+def test_a_minigrid_study_whose_run_still_trains_is_refused_before_ray(tmp_path):
+    from simoun_agent.run.rundir import lock_run_dir
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(TINY))
+    archive, work = tmp_path / "arch", tmp_path / "work"
+    archive.mkdir()
+    run_dir = work / "runs" / RUN
+    run_dir.mkdir(parents=True)
+    with lock_run_dir(run_dir):  # as a study's trial holds it while it trains
+        status, printed = study("run", "--archive", str(archive), "--spec", str(spec),
+                                "--work-dir", str(work))  # fmt: skip
+        again, said = simoun_study("run", str(spec), "--study-dir", str(work), "--archive",
+                                   str(archive))  # fmt: skip
+    for code, text in ((status, printed), (again, said)):
+        assert code == 2 and "Traceback" not in text, text
+        assert (
+            f"run {RUN} of the study in {work / 'runs'} is in use by another trainer (PID " in text
+        )
+        assert f"{os.getpid()}): the study is still running in another process" in text
+        assert "runs finished in" not in text
+    assert not any(archive.iterdir())
+
+
+def test_a_minigrid_trial_holds_its_run_directorys_lock_while_it_trains(tiny_study):
+    from simoun_agent.run.rundir import lock_holder
+
+    paths, _, _, _ = tiny_study
+    run_dir = Path(paths[paths.index("--work-dir") + 1]) / "runs" / RUN
+    assert (run_dir / ".lock").is_file() and lock_holder(run_dir) is None  # released at its end

@@ -1109,3 +1109,58 @@ def test_a_finished_runs_device_spelled_otherwise_is_no_change():
     assert changes(trained, to_dict(resolve(None, {"device": "cpu:0"}))) == []
     seeded = to_dict(resolve(None, {"device": "cpu", "seed": 7}))
     assert changes(trained, seeded) == ["seed: 1 when it ran, 7 now"]
+
+
+def test_a_study_whose_run_still_trains_is_refused_before_its_record_changes(tmp_path, capsys):
+    from simoun_agent.run.rundir import lock_run_dir
+
+    spec_path = write_spec(tmp_path / "tiny.toml")
+    study_dir = tmp_path / "s"
+    run = "tuning/simoun-PointReach-v0/simoun/n_step=1/s101"
+    (study_dir / run).mkdir(parents=True)
+    with lock_run_dir(study_dir / run):  # as the trial of a study started earlier holds it
+        with pytest.raises(SystemExit) as exit_info:
+            cli.main(["run", str(spec_path), "--study-dir", str(study_dir)])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert f"run {run} of the study in {study_dir} is in use by another trainer (PID " in err
+    assert "the study is still running in another process" in err and "Traceback" not in err
+    assert not (study_dir / "study.json").exists()
+
+
+def test_a_study_is_refused_a_sweep_directory_or_a_folder_inside_one(tmp_path, capsys):
+    sweep = tmp_path / "sw"
+    sweep.mkdir()
+    (sweep / "sweep.json").write_text("{}")
+    spec_path = str(write_spec(tmp_path / "tiny.toml"))
+    for flag, where, said in (
+        ("--study-dir", sweep, f"--study-dir {sweep} is a simoun-sweep directory"),
+        ("--study-dir", sweep / "s", f"--study-dir {sweep / 's'} lies inside {sweep}, a "),
+        ("--archive", sweep / "a", f"--archive {sweep / 'a'} lies inside {sweep}, a "),
+    ):
+        argv = ["run", spec_path, "--study-dir", str(where if flag == "--study-dir" else tmp_path)]
+        argv += ["--archive", str(where)] if flag == "--archive" else []
+        with pytest.raises(SystemExit) as exit_info:
+            cli.main(argv)
+        assert exit_info.value.code == 2
+        err = capsys.readouterr().err
+        assert said in err and "Traceback" not in err, err
+    assert sorted(p.name for p in sweep.iterdir()) == ["sweep.json"]
+
+
+def test_an_env_setting_of_base_at_fault_is_named_at_its_base_line(tmp_path, capsys):
+    text = (DOCS / "highway50k.toml").read_text()
+    assert "\nvideo = false\n" in text and "env_kwargs" not in text.partition("[grid]")[0]
+    text = text.replace(
+        "\nvideo = false\n", "\nvideo = false\nenv_kwargs = { config = { durration = 40 } }\n"
+    )
+    path = write_spec(tmp_path / "edit.toml", text)
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["plan", str(path), "--probe-updates", "0"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    line = key_line(text, ("base", "env_kwargs"))
+    assert f"{path}:{line}: [base] env_kwargs: highway-fast-v0 cannot be trained with it" in err
+    assert "config.durration is not a setting of highway-fast-v0's config" in err
+    assert "did you mean config.duration?" in err
+    assert "[tuning] tasks" not in err and "Traceback" not in err

@@ -1,9 +1,12 @@
 """simoun-sweep on a local Ray instance: a grid of tiny PointReach runs, a failing trial, Ctrl-C
 and --resume, and the bad inputs it refuses."""
 
+import contextlib
 import csv
 import dataclasses
+import fcntl
 import json
+import os
 import re
 import shutil
 import signal
@@ -11,6 +14,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -895,3 +899,42 @@ def test_a_device_spelled_otherwise_on_resume_is_the_same_device(tmp_path):
     (run_dir / "config.json").write_text(json.dumps(to_dict(trained)))
     assert trial_problem(trial, {}) is None
     assert config_differences(trial) == {}
+
+
+@contextlib.contextmanager
+def trainer_holding(run_dir: Path) -> Iterator[int]:
+    """``run_dir``'s lock held as a running trainer holds it (its PID in the file); the PID."""
+    with (run_dir / ".lock").open("a+") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        handle.write(f"{os.getpid()}\n")  # after the PID of the trainer that ran before
+        handle.flush()
+        yield os.getpid()
+
+
+def test_a_resume_while_a_trial_still_trains_is_refused_before_ray(trained_sweep, tmp_path, capsys):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    run_dir = sweep_dir / TRIAL.format(2)
+    (run_dir / "summary.json").unlink()
+    with trainer_holding(run_dir) as pid:
+        err = error_of(["--resume", "--sweep-dir", str(sweep_dir)], capsys)
+    assert f"trial {TRIAL.format(2)} of the sweep in {sweep_dir} is in use by another " in err
+    assert f"trainer (PID {pid}): the sweep is still running in another process" in err
+    assert f"kill -TERM {pid}" in err and "Traceback" not in err
+    assert "trials to run" not in capsys.readouterr().out
+    assert not (run_dir / "summary.json").exists()
+
+
+def test_a_sweep_dir_inside_another_sweep_or_a_study_archive_is_refused(
+    trained_sweep, tmp_path, capsys
+):
+    sweep_dir = copy_sweep(trained_sweep, tmp_path)
+    archive = Path(shutil.copytree("docs/studies/dmc100k", tmp_path / "arch"))
+    for inside, said in (
+        (sweep_dir / "base", f"lies inside {sweep_dir}, a simoun-sweep directory"),
+        (archive / "tuning" / "new", f"lies inside {archive}, the archive of a SAC study"),
+    ):
+        err = error_of([*TINY, "--sweep-dir", str(inside)], capsys)
+        assert f"--sweep-dir {inside} {said}" in err and "Traceback" not in err
+    assert not (sweep_dir / "base" / "sweep.json").exists()
+    assert not (archive / "tuning" / "new").exists()
+    cli.check_sweep_place(sweep_dir / "base" / "..")  # the sweep itself, written another way

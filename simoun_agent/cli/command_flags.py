@@ -69,6 +69,8 @@ class Flag:
     """takes a JSON object (``--env-kwargs '{"a": 1}'``)"""
     number: type | None = None
     """int or float for an option that takes a number (``--episodes 10``)"""
+    setting: bool = False
+    """takes a ``KEY=VALUE`` word (``--set agent.lr=1e-3``, ``--grid agent.lr=1e-3,3e-4``)"""
 
 
 @dataclass(frozen=True)
@@ -205,7 +207,10 @@ def _add_fields(cls: type, prefix: str, config: bool, flags: dict[str, Flag]) ->
         path = _names_path(kind, markers) or (config and key in CONFIG_PATHS)
         json = (typing.get_origin(kind) or kind) is dict
         number = _number(kind)
-        flags[flag] = Flag(key, doc, switch, repeatable, config, variadic, path, json, number)
+        setting = any("=" in (m.metavar or "") for m in given)
+        flags[flag] = Flag(
+            key, doc, switch, repeatable, config, variadic, path, json, number, setting
+        )
         if kind is bool and tyro.conf.FlagCreatePairsOff not in markers:
             section, dot, last = flag[2:].rpartition(".")
             negation = Flag(key, doc, False, False, config)

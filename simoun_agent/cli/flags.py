@@ -624,6 +624,31 @@ def setting_forms(word: str, flags: dict[str, Flag]) -> str:
     return " or ".join(forms)
 
 
+DASHED_SETTING = re.compile(r"-{1,2}([A-Za-z_][A-Za-z0-9_.-]*)=(.*)", re.DOTALL)
+"""A ``KEY=VALUE`` word written with a flag's dashes (``--agent.lr=1e-3,3e-4``)."""
+
+
+def refuse_setting_read_as_flag(argv: Sequence[str], flags: dict[str, Flag]) -> None:
+    """Raise ValueError for an option that takes a ``KEY=VALUE`` word (``--grid``, ``--set``)
+    followed by one written with dashes (``--grid --agent.lr=1e-3,3e-4``): the shell hands it
+    on as a flag of its own, so the option is left without its value, and tyro says only that
+    the value is missing."""
+    for arg, following in itertools.pairwise(argv):
+        if arg == "--":
+            break
+        flag = flags.get(arg)
+        match = DASHED_SETTING.fullmatch(following)
+        if flag is None or not flag.setting or match is None:
+            continue
+        key, value = match.groups()
+        meant = f"{key.replace('-', '_')}={value}"
+        raise ValueError(
+            f"{arg} takes a KEY=VALUE word, and {following!r} after it starts with dashes, so it "
+            f"was read as a flag of its own and {arg} was left without a value; write the key "
+            f"without dashes: {arg} {shlex.quote(meant)}"
+        )
+
+
 def switch_use(name: str, flag: Flag, switches: Iterable[str]) -> str:
     """How the switch ``name`` is given: with true or false when its flag is one of
     ``switches`` (:func:`bool_argv` reads those), else alone."""
@@ -641,10 +666,12 @@ def switch_use(name: str, flag: Flag, switches: Iterable[str]) -> str:
 def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
     """Raise ValueError for an option of ``flags`` given twice with different values
     (``--episodes 1 --episodes 2``, ``--video --no-video``, a subcommand's ``--study-dir a
-    --study-dir b``): tyro would keep the last without a word. Switches come as ``--video`` /
-    ``--no-video`` here (:func:`bool_argv` ran first); a list's flag is meant to be repeated,
+    --study-dir b``, a list's ``--probes rnd --probes consistency``): tyro would keep the last
+    without a word. Switches come as ``--video`` / ``--no-video`` here (:func:`bool_argv` ran
+    first); a list given by repeating its flag (``--grid``, ``--set``) is meant to be repeated,
     and the run config's keys are compared by value where they are read
     (:func:`simoun_agent.cli.config_flags.check_given_once`)."""
+    refuse_repeated_lists(argv, flags)
     given: dict[str, dict[str, str]] = {}
     for i, arg in enumerate(argv):
         if arg == "--":
@@ -667,6 +694,41 @@ def refuse_repeated(argv: Sequence[str], flags: dict[str, Flag]) -> None:
                 f"--{key.replace('_', '-')} is given twice with different values "
                 f"({' and '.join(values.values())}); give it once"
             )
+
+
+def list_values(argv: Sequence[str], flags: dict[str, Flag]) -> dict[str, list[list[str]]]:
+    """For each list option that takes its values after one flag (``--probes rnd consistency``),
+    the words given after each of its flags, in order."""
+    given: dict[str, list[list[str]]] = {}
+    for i, arg in enumerate(argv):
+        if arg == "--":
+            break
+        name, eq, text = arg.partition("=")
+        flag = flags.get(name)
+        if flag is None or not (flag.repeatable and flag.variadic) or flag.config:
+            continue
+        words = (
+            [text]
+            if eq
+            else list(itertools.takewhile(lambda w: not w.startswith("--"), argv[i + 1 :]))
+        )
+        given.setdefault(name, []).append(words)
+    return given
+
+
+def refuse_repeated_lists(argv: Sequence[str], flags: dict[str, Flag]) -> None:
+    """Raise ValueError for a list option that takes its values after one flag given twice with
+    different values (``--probes rnd --probes consistency``): tyro keeps the last list and drops
+    the first without a word, so every value goes after one flag."""
+    for name, lists in list_values(argv, flags).items():
+        if len({tuple(words) for words in lists}) < 2:
+            continue
+        said = " and ".join(shlex.join([name, *words]) for words in lists)
+        every = list(dict.fromkeys(word for words in lists for word in words))
+        raise ValueError(
+            f"{name} is given twice with different values ({said}), and only the last would "
+            f"count; give every value after one {name}: {shlex.join([name, *every])}"
+        )
 
 
 LOOKALIKE_DASHES = "\u2010\u2011\u2012\u2013\u2014\u2015\u2212\ufe58\ufe63"
@@ -1095,8 +1157,9 @@ def parse(
         print(f"{prog} {installed_version()}")
         sys.exit(0)
     try:
-        argv = bool_argv(argv, switches)
         flags = command_flags(cls, argv)
+        refuse_setting_read_as_flag(argv, flags)
+        argv = bool_argv(argv, switches)
         refuse_short_options(argv, flags, prog)
         refuse_unknown_subcommand(argv, cls, prog)
         refuse_unknown(argv, flags, cls, prog, reads_runs, other_names, siblings)

@@ -28,7 +28,7 @@ from simoun_agent.config.train import RESUMABLE_FIELDS
 from simoun_agent.run.atomic import SPACE_ERRNOS, atomic_write, dead_temporaries
 from simoun_agent.run.kept import binary_problem, broken_link, packed_problem, present
 from simoun_agent.run.layout import CHECKPOINT_NAME, REPLAY_GLOB, replay_name
-from simoun_agent.run.rundir import folder_kind, study_of
+from simoun_agent.run.rundir import folder_kind, not_a_simoun_run, study_of
 from simoun_agent.run.seeds import SEED_SCHEME
 
 FORMAT = "simoun-checkpoint/1"
@@ -198,6 +198,8 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
             f"{path} does not exist; pass a run directory that simoun-train created, or its "
             f"{CHECKPOINT_NAME}"
         )
+    if foreign := not_a_simoun_run(path if path.is_dir() else path.parent):
+        raise foreign
     if path.is_dir():
         if not present(path / CHECKPOINT_NAME) and (kind := folder_kind(path)) is not None:
             raise SetupError(

@@ -22,7 +22,14 @@ from pathlib import Path
 from typing import IO
 
 from simoun_agent.config import SetupError
-from simoun_agent.run.kept import DENIED, broken_link, not_a_file, owner_and_mode
+from simoun_agent.run.kept import (
+    DENIED,
+    Damaged,
+    broken_link,
+    not_a_file,
+    owner_and_mode,
+    read_json_object,
+)
 from simoun_agent.run.layout import (
     CHECKPOINT_NAME,
     CONFIG_NAME,
@@ -240,7 +247,7 @@ def lock_run_dir(run_dir: Path) -> IO[str]:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
         handle.seek(0)
-        holder = handle.read().strip() or "unknown"
+        holder = (handle.read().split() or ["unknown"])[-1]
         handle.close()
         raise in_use(run_dir, holder) from None
     handle.seek(0)
@@ -323,13 +330,30 @@ def refuse_live_lock(run_dir: Path) -> None:
         raise not_writable(run_dir, os.strerror(errno.EROFS if read_only else errno.EACCES))
     if not path.is_file():
         return
-    handle = open_lock(run_dir, "r")
-    with handle:
+    open_lock(run_dir, "r").close()  # names another user's lock file or an unreadable one
+    try:
+        holder = lock_holder(run_dir)
+    except OSError as err:
+        raise not_writable(run_dir, err.strerror) from None
+    if holder is not None:
+        raise in_use(run_dir, holder)
+
+
+def lock_holder(run_dir: Path) -> str | None:
+    """The PID (as the lock file names it, its last word: the holder writes its own after any
+    left there; or ``unknown``) of the process that holds ``run_dir``'s lock, None when none
+    does; found without writing anything, so a command can ask before it starts a run there.
+    OSError when the lock file cannot be opened."""
+    path = run_dir / LOCK_NAME
+    if not path.is_file():
+        return None
+    with path.open() as handle:
         try:
             fcntl.flock(handle, fcntl.LOCK_SH | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise in_use(run_dir, handle.read().strip() or "unknown") from None
+            return (handle.read().split() or ["unknown"])[-1]
         fcntl.flock(handle, fcntl.LOCK_UN)
+    return None
 
 
 def check_run_dir(run_dir: Path, *, resume: bool = False, overwrite: bool = False) -> None:
@@ -413,6 +437,66 @@ def folder_kind(path: Path) -> str | None:
             f"reports and `simoun-sweep --resume --sweep-dir {path}` resumes"
         )
     return None
+
+
+MINIGRID_SPEC = "spec.json"
+"""A MiniGrid PPO study's spec, kept at the root of its archive."""
+MINIGRID_RUN_KEYS = frozenset({"run", "seeds", "spec"})
+"""Keys of a MiniGrid PPO study run's config.json (an SB3 PPO agent, no simoun config)."""
+MINIGRID_COMMAND = "python -m simoun_lab.minigrid_study"
+
+
+def json_keys(path: Path) -> set[str]:
+    """The keys of the JSON object in ``path``; empty when it is missing, damaged or no object
+    (the reader that needs the file names its problem)."""
+    try:
+        return set(read_json_object(path)) if path.is_file() else set()
+    except Damaged:
+        return set()
+
+
+def minigrid_archive(path: Path) -> Path | None:
+    """The MiniGrid PPO study archive ``path`` is or lies in: the nearest folder, ``path``
+    itself first, whose ``spec.json`` has the study's ``tasks`` and ``arms``; None for none."""
+    folder = Path(os.path.abspath(path))
+    for where in (folder, *folder.parents):
+        if {"tasks", "arms"} <= json_keys(where / MINIGRID_SPEC):
+            return shown(where)
+    return None
+
+
+def minigrid_folder(path: Path) -> str | None:
+    """What the folder ``path`` is when it is the MiniGrid PPO study's (SB3 PPO agents, which
+    simoun-train neither trains nor reads): one of its runs (its config.json names the study's
+    run, seeds and spec), its archive, or a folder of that archive; None otherwise."""
+    archive = minigrid_archive(path)
+    report = f"`{MINIGRID_COMMAND} report --archive {archive or 'ARCHIVE'}` reports"
+    if MINIGRID_RUN_KEYS <= json_keys(path / CONFIG_NAME):
+        return (
+            f"a run of a MiniGrid PPO study (its {CONFIG_NAME} names the study's run, seeds and "
+            f"spec): an SB3 PPO agent, which `{MINIGRID_COMMAND} run` trains and {report}"
+        )
+    if archive is None:
+        return None
+    study = f"a MiniGrid PPO study ({archive / MINIGRID_SPEC}), whose SB3 PPO runs {report}"
+    if Path(os.path.abspath(path)) == archive.absolute():
+        return f"the archive of {study}"
+    return f"a folder of {archive}, the archive of {study}"
+
+
+def not_a_simoun_run(path: Path, flag: str = "") -> SetupError | None:
+    """The refusal of ``path`` given (as ``flag``, or as the command's run) where a
+    simoun-train run goes, when it is the MiniGrid PPO study's (:func:`minigrid_folder`):
+    without it, its missing checkpoint or its config's keys would be blamed. None otherwise."""
+    kind = minigrid_folder(path)
+    if kind is None:
+        return None
+    given = f"{flag} {path}" if flag else str(path)
+    return SetupError(
+        f"{given} is {kind}; it is not a simoun-train run, and simoun-train, simoun-eval and "
+        "simoun-analyze work on simoun-train runs only (those of simoun-train, simoun-sweep and "
+        "a SAC simoun-study): pass the directory of such a run"
+    )
 
 
 def study_of(run_dir: Path) -> Path | None:

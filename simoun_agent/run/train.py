@@ -105,6 +105,7 @@ from simoun_agent.run.rundir import (
     check_run_dir,
     folder_kind,
     make_output_dir,
+    not_a_simoun_run,
     study_of,
     study_run_refusal,
     take_run_dir,
@@ -394,6 +395,8 @@ def resume_run(run_dir: Path, overrides: dict[str, Any], check: ConfigCheck | No
             "path is printed as 'run directory: ...' when a run starts)"
         )
     check_packed_files(run_dir)
+    if foreign := not_a_simoun_run(run_dir, "--resume"):
+        raise foreign
     study = study_of(run_dir)
     if study is not None and not present(run_dir / CHECKPOINT_NAME):  # nothing written there
         raise study_run_refusal(run_dir, study)

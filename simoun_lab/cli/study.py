@@ -204,15 +204,17 @@ def resume_fix(options: Run, flag: str) -> str:
 
 def check_outputs(options: Run) -> None:
     """Refuse an output directory that cannot be written (:func:`check_output_dir`) or that
-    lies inside another study's archive (:func:`~simoun_lab.study.owner.check_not_inside_study`),
+    lies inside another study's archive (:func:`~simoun_lab.study.owner.check_not_inside_study`)
+    or is or lies in a simoun-sweep directory (:func:`~simoun_lab.study.owner.check_not_in_sweep`),
     a folder where the report written after the runs goes, and an archive that is, holds or lies
     in the study directory (:func:`check_archive_apart`), creating nothing."""
-    from simoun_lab.study.owner import check_not_inside_study
+    from simoun_lab.study.owner import check_not_in_sweep, check_not_inside_study
     from simoun_lab.study.report import REPORT_DIR, REPORT_FILES  # numpy: after the flags
 
     for flag, path in outputs(options).items():
         check_output_dir(path, flag, fix=resume_fix(options, flag) if options.resume else None)
         check_not_inside_study(path, flag)
+        check_not_in_sweep(path, flag)
     check_output_files(output_files(options.study_dir / REPORT_DIR, REPORT_FILES))
     if options.archive is not None:
         from simoun_lab.study.archive import check_archive_apart  # torch: after the flags

@@ -41,6 +41,7 @@ from simoun_agent.run.kept import present
 from simoun_agent.run.layout import CONFIG_NAME
 from simoun_agent.run.rundir import check_output_dir, copy_fix
 from simoun_lab.engine.ray_start import connect, load_ray
+from simoun_lab.engine.trial import check_no_live_runs
 from simoun_lab.sweep import report
 from simoun_lab.sweep.grid import (
     SWEEP_FILE,
@@ -242,8 +243,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     # absolute: Tune runs each trial in a working directory of its own
     sweep_dir = Path(args.sweep_dir or Path("sweeps") / stamp).absolute()
     try:
+        check_sweep_place(Path(args.sweep_dir) if args.sweep_dir else sweep_dir)
         # the grid is read before Ray is imported (seconds): a typo is answered at once
         spec = sweep_spec(args, overrides_from(args.flags, argv, SweepCommand), sweep_dir)
+        check_no_live_runs(sweep_dir, "the sweep", "trial")
         check_trial_dirs(spec, sweep_dir)
         resumed = copy_fix(sweep_dir, "simoun-sweep --resume --sweep-dir")
         check_output_dir(sweep_dir, "--sweep-dir", fix=resumed if args.resume else None)
@@ -295,6 +298,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         outcome = {}
     written, unwritten = closing_report(spec, sweep_dir)
     return summarize(outcome, sweep_dir, written, bool(terminated), unwritten=unwritten)
+
+
+def check_sweep_place(sweep_dir: Path) -> None:
+    """Refuse a --sweep-dir (as given) inside another sweep's directory or inside a study's
+    archive: the trials would mix into that sweep's or study's runs and records. One that is
+    such a folder itself is refused as not empty, or, with --resume, as holding no sweep."""
+    from simoun_lab.study.owner import check_not_in_sweep, check_not_inside_study
+
+    check_not_inside_study(sweep_dir, "--sweep-dir")
+    check_not_in_sweep(sweep_dir, "--sweep-dir", inside_only=True)
 
 
 def check_finished_trials(trials: list[Trial]) -> None:

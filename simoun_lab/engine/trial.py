@@ -12,10 +12,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
+from simoun_agent.config import SetupError
 from simoun_agent.run.kept import reading
-from simoun_agent.run.layout import SUMMARY_NAME
+from simoun_agent.run.layout import LOCK_NAME, SUMMARY_NAME
+from simoun_agent.run.rundir import lock_holder
 
-__all__ = ["SUMMARY", "Trial", "summary_written"]
+__all__ = ["SUMMARY", "Trial", "check_no_live_runs", "summary_written"]
 
 SUMMARY = SUMMARY_NAME
 """a finished run's summary, written last: its presence marks a finished run"""
@@ -27,6 +29,29 @@ def summary_written(run_dir: Path | str) -> bool:
     path = Path(run_dir) / SUMMARY
     with reading(path):
         return path.is_file()
+
+
+def check_no_live_runs(folder: Path, what: str, kind: str = "run") -> None:
+    """SetupError naming the first run directory under ``folder`` (``what``'s: ``the sweep``,
+    ``the study``; each one a ``kind``, trial or run) whose lock a running trainer holds
+    (:func:`~simoun_agent.run.rundir.lock_holder`, which writes nothing): ``what`` is still
+    running in another process, and a second one would train the same runs over each other.
+    Called before Ray starts."""
+    if not folder.is_dir():
+        return
+    for lock in sorted(folder.rglob(LOCK_NAME)):
+        try:
+            holder = lock_holder(lock.parent)
+        except OSError:
+            continue  # a lock that cannot be read is named by the trainer that meets it
+        if holder is not None:
+            raise SetupError(
+                f"{kind} {lock.parent.relative_to(folder)} of {what} in {folder} is in use by "
+                f"another trainer (PID {holder}): {what} is still running in another process, "
+                "and two trainers in one run directory would overwrite each other's "
+                f"checkpoints. Wait for it to end, or stop it (Ctrl-C where it runs, or kill "
+                f"-TERM {holder}), then run this command again"
+            )
 
 
 @runtime_checkable

@@ -16,13 +16,13 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.kept import Damaged, checkpoint_problem, present, read_json_object
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect, load_ray
-from simoun_lab.engine.trial import summary_written
+from simoun_lab.engine.trial import check_no_live_runs, summary_written
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT
 from simoun_lab.minigrid_study.report import finished as checked_finished
 from simoun_lab.minigrid_study.run import SUMMARY
 from simoun_lab.minigrid_study.spec import StudySpec, spec_from_dict
 from simoun_lab.minigrid_study.training import write_json
-from simoun_lab.minigrid_study.trial import MiniGridTrial
+from simoun_lab.minigrid_study.trial import RUNS_DIR, MiniGridTrial
 from simoun_lab.study.provenance import code_version
 
 __all__ = ["SPEC_FILE", "finished_runs", "load_saved_spec", "run_study"]
@@ -119,6 +119,7 @@ def run_study(
     (finished before), finished and failed."""
     if concurrent < 1:
         raise SetupError(f"--concurrent must be >= 1, got {concurrent}")
+    check_no_live_runs(work_dir / RUNS_DIR, "the study")
     record_spec(spec, archive)
     checked_finished(spec, archive)  # before Ray: a damaged finished run fails nothing there
     done = set(finished_runs(spec, archive))

@@ -11,6 +11,7 @@ goes on with the runs an archive holds.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import tomllib
@@ -19,7 +20,13 @@ from simoun_agent.config import SetupError
 from simoun_agent.run.kept import Damaged, packed_folder_advice, present, read_text
 from simoun_lab.minigrid_study.spec import StudySpec, load_spec
 from simoun_lab.study.given_path import shown
-from simoun_lab.study.owner import check_not_inside_archive, check_not_inside_study, sac_study
+from simoun_lab.study.owner import (
+    check_not_in_sweep,
+    check_not_inside_archive,
+    check_not_inside_study,
+    check_not_other_archive,
+    sac_study,
+)
 from simoun_lab.study.runner import PPO_SPEC_FILE, STUDY_FILE, StudyOptions
 
 __all__ = ["check_run_places", "is_ppo_spec", "load_ppo_spec", "plan", "report", "run"]
@@ -104,9 +111,13 @@ def run(spec: StudySpec, options: StudyOptions) -> int:
 
 def check_run_places(places: dict[str, Path]) -> None:
     """Refuse, by its flag, a directory of ``places`` where a MiniGrid study would run that
-    belongs to another study: a SAC study's directory or archive (its ``study.json``), or a
-    folder inside any study's archive (:func:`~simoun_lab.study.owner.check_not_inside_study`);
+    belongs to another study or sweep: a SAC study's directory or archive (its ``study.json``),
+    a MiniGrid study's archive given as the working directory beside another ``--archive``
+    (:func:`~simoun_lab.study.owner.check_not_other_archive`), a folder inside any study's
+    archive (:func:`~simoun_lab.study.owner.check_not_inside_study`), or a simoun-sweep
+    directory or a folder inside one (:func:`~simoun_lab.study.owner.check_not_in_sweep`);
     before anything is written into it."""
+    archive = places.get("--archive")
     for flag, where in places.items():
         study = sac_study(where)
         if study is not None:
@@ -116,7 +127,10 @@ def check_run_places(places: dict[str, Path]) -> None:
                 f"new {flag} (or the one of this MiniGrid study), and continue that study with "
                 f"its own spec ({shown(where / STUDY_FILE)} names it)"
             )
+        if archive is None or os.path.realpath(where) != os.path.realpath(archive):
+            check_not_other_archive(where, flag)
         check_not_inside_study(where, flag)
+        check_not_in_sweep(where, flag)
 
 
 def refuse_sac_study(study_dir: Path, flag: str = "--study-dir") -> None:

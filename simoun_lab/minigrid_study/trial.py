@@ -8,6 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from simoun_agent.run.rundir import lock_run_dir
 from simoun_lab.engine.trial import summary_written
 from simoun_lab.minigrid_study.checkpoint import CHECKPOINT
 from simoun_lab.minigrid_study.run import RUN_FILES, train_run
@@ -44,4 +45,10 @@ class MiniGridTrial:
         return summary_written(self.run_dir)
 
     def train(self, on_checkpoint: Callable[[Path], None] | None = None) -> None:
-        train_run(self.spec, self.run, Path(self.run_dir), self.commit, on_checkpoint)
+        """Train the run, holding its run directory's lock
+        (:func:`~simoun_agent.run.rundir.lock_run_dir`) as simoun-train does: a second study
+        started on the same work directory is refused before it trains the run again."""
+        run_dir = Path(self.run_dir)
+        run_dir.mkdir(parents=True, exist_ok=True)
+        with lock_run_dir(run_dir):
+            train_run(self.spec, self.run, run_dir, self.commit, on_checkpoint)

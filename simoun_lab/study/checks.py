@@ -19,7 +19,6 @@ import os
 import re
 import sys
 from collections.abc import Iterable
-from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -100,33 +99,41 @@ def in_spec_terms(message: str) -> str:
     return FLAG.sub(lambda flag: flag[1].replace("-", "_"), message)
 
 
-def setting_at_fault(spec: StudySpec, config: TrainConfig) -> tuple[str, ...] | None:
+def setting_at_fault(
+    spec: StudySpec, config: TrainConfig, overrides: dict[str, Any]
+) -> tuple[str, ...] | None:
     """Where the spec gives the env setting (:data:`ENV_SETTINGS`) without which ``config``'s
     task is made and stepped, for a task refused with it; None when the task itself is at
-    fault (an unknown id, discrete actions), or when no setting the spec gives is."""
+    fault (an unknown id, discrete actions), or when no setting the spec gives is. Without it
+    means the run's ``overrides`` less that key, resolved as the run is: the preset's value of
+    the key then stands (highway's continuous actions in its ``env_kwargs``), not the default."""
     for key in ENV_SETTINGS:
         place = key_place(spec, config.env, key)
         if place is None:
             continue
+        unset = {name: value for name, value in overrides.items() if name != key}
         try:
-            check_task(replace(config, **{key: DEFAULTS[key]}))
+            check_task(resolve(spec.preset, unset))
         except SetupError:
             continue
         return place
     return None
 
 
-DEFAULTS = {item.name: getattr(TrainConfig(), item.name) for item in fields(TrainConfig)}
-"""A run's config values when nothing sets them."""
-
-
 def task_error(
-    source: Source, spec: StudySpec, phase: str, config: TrainConfig, err: SetupError
+    source: Source,
+    spec: StudySpec,
+    phase: str,
+    run: tuple[TrainConfig, dict[str, Any]],
+    err: SetupError,
 ) -> SetupError:
-    """The refusal of a task the recipes cannot train on, at the spec's line: the env setting
-    at fault (:func:`setting_at_fault`), in the spec's terms, else the phase's tasks."""
+    """The refusal of a task the recipes cannot train on (``run``: the config of a run on it,
+    and the spec's overrides it was resolved from), at the spec's line: the env setting at
+    fault (:func:`setting_at_fault`) where the spec writes it, in the spec's terms, else the
+    phase's tasks."""
+    config, overrides = run
     said = str(err).rstrip(".")
-    place = setting_at_fault(spec, config)
+    place = setting_at_fault(spec, config, overrides)
     if place is not None:
         return source.error(
             place,
@@ -193,13 +200,16 @@ def check_study(spec: StudySpec, spec_path: str) -> None:
     source = Source(Path(spec_path), spec_text(Path(spec_path)))
     made: dict[str, int | None] = {}
     found = configs(spec)
-    for phase, recipe, _, config in found:
+    for phase, recipe, setting, config in found:
         env = json.dumps([config.env, config.env_kwargs, config.env_module], sort_keys=True)
         if env not in made:
             try:
                 made[env] = check_task(config)
             except SetupError as err:
-                raise task_error(source, spec, phase, config, err) from None
+                overrides = spec.overrides(
+                    recipe, config.env, setting, config.seed, config.total_env_steps
+                )
+                raise task_error(source, spec, phase, (config, overrides), err) from None
         check_run_config(source, spec, phase, config, made[env])
         check_study_devices(source, spec, config)
         try:

@@ -70,7 +70,7 @@ def enclosing_study(path: Path) -> tuple[Path, str] | None:
     (:func:`sac_study`, :func:`minigrid_study`): a parent that keeps a study's record or spec,
     with ``path`` under one of the folders that study writes (:func:`own_folders`); None when it
     lies in none."""
-    full = path.absolute()
+    full = Path(os.path.abspath(path))  # sw/base/.. is sw itself, not a folder inside it
     for parent in full.parents:
         if full.relative_to(parent).parts[0] not in own_folders(parent):
             continue  # a folder of the study's own, not one beside its archive
@@ -105,4 +105,66 @@ def check_not_inside_study(path: Path, flag: str) -> None:
         f"{flag} {shown(path)} lies inside {shown(archive)}, the archive of {study}: a study "
         f"written there would mix its record and runs into that archive's; pass a directory of "
         f"its own, outside {shown(archive)} (e.g. a new one beside it)"
+    )
+
+
+SWEEP_FILE = "sweep.json"
+"""A simoun-sweep directory's record (:data:`simoun_lab.sweep.grid.SWEEP_FILE`)."""
+
+
+def sweep_folder(where: Path) -> str | None:
+    """``"a simoun-sweep directory (DIR/sweep.json)"`` when ``where`` keeps a sweep's record."""
+    if not (where / SWEEP_FILE).is_file():
+        return None
+    return f"a simoun-sweep directory ({shown(where / SWEEP_FILE)})"
+
+
+def enclosing_sweep(path: Path) -> tuple[Path, str] | None:
+    """The sweep directory ``path`` lies inside (relative, as ``path`` is given), with what it
+    is (:func:`sweep_folder`); None when it lies in none. Every folder of a sweep directory is
+    the sweep's: its trials' and its report's."""
+    full = Path(os.path.abspath(path))  # sw/base/.. is sw itself, not a folder inside it
+    for parent in full.parents:
+        given = Path(os.path.relpath(parent)) if not path.is_absolute() else parent
+        found = sweep_folder(given)
+        if found is not None:
+            return given, found
+    return None
+
+
+def check_not_in_sweep(path: Path, flag: str, inside_only: bool = False) -> None:
+    """Refuse ``flag``'s directory ``path``, where a study or sweep is about to write, when it
+    is a simoun-sweep directory (unless ``inside_only``: ``--sweep-dir`` itself names one to
+    resume) or lies inside one: its runs and records would mix into that sweep's, whose report
+    reads every run under it."""
+    found = None if inside_only else sweep_folder(path)
+    if found is not None:
+        raise SetupError(
+            f"{flag} {shown(path)} is {found}: writing there would mix runs and records into "
+            f"that sweep's; pass a new directory (resume the sweep with simoun-sweep --resume "
+            f"--sweep-dir {shown(path)})"
+        )
+    inside = enclosing_sweep(path)
+    if inside is not None:
+        sweep, found = inside
+        raise SetupError(
+            f"{flag} {shown(path)} lies inside {shown(sweep)}, {found}: its runs and records "
+            f"would mix into that sweep's, whose report reads every run under it; pass a "
+            f"directory of its own, outside {shown(sweep)}"
+        )
+
+
+def check_not_other_archive(path: Path, flag: str) -> None:
+    """Refuse ``flag``'s working directory ``path`` (Ray's records and the runs in progress)
+    when it is a study's archive (:func:`sac_study`, :func:`minigrid_study`): the archive given
+    with it is another folder, so this one is another study's, whose runs and records the work
+    would mix with."""
+    found = sac_study(path) or minigrid_study(path)
+    if found is None:
+        return
+    record = PPO_SPEC_FILE if minigrid_study(path) else STUDY_FILE
+    raise SetupError(
+        f"{flag} {shown(path)} is the archive of another study, {found}: Ray's records and the "
+        f"runs in progress would go among that study's runs; pass a new directory to {flag} "
+        f"(that study is resumed with its own archive, which holds its {record})"
     )

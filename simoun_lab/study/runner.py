@@ -24,6 +24,7 @@ from simoun_agent.run.kept import (
 from simoun_agent.run.layout import CHECKPOINT_NAME, SUMMARY_NAME
 from simoun_lab.engine.launcher import changed_keys, run_trials
 from simoun_lab.engine.ray_start import connect
+from simoun_lab.engine.trial import check_no_live_runs
 from simoun_lab.study import archive as archiving
 from simoun_lab.study.archive import GENERALIZATION_CSV
 from simoun_lab.study.checks import (
@@ -425,6 +426,7 @@ def run_study(spec: StudySpec, spec_path: str, options: StudyOptions, ray: Modul
     status (the sweep's: 130/143 stopped, 1 failed)."""
     study_dir, archive = options.study_dir, options.archive
     check_study(spec, spec_path)
+    check_no_live_runs(study_dir, "the study")  # before its record gains a part
     record = open_study(spec, spec_path, options)
     save_record(record, [study_dir] + ([archive] if archive is not None else []))
     phases = Phases(spec, spec_path, options, ray)
