@@ -9,6 +9,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -409,6 +410,7 @@ def test_an_unknown_mujoco_gl_is_refused_in_one_line(tmp_path):
         text=True,
         timeout=300,
         env={**os.environ, "MUJOCO_GL": "bogus"},
+        cwd=tmp_path,
     )
     assert done.returncode == 2, done.stderr
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
@@ -422,13 +424,15 @@ def refusal_in_one_line(command: str, argv: list[str], **variables: str) -> str:
     'Exception ignored'."""
     unset = ("DISPLAY", "WAYLAND_DISPLAY", "MUJOCO_GL", "PYOPENGL_PLATFORM", "SDL_VIDEODRIVER")
     env = {key: value for key, value in os.environ.items() if key not in unset}
-    done = subprocess.run(
-        [sys.executable, "-m", f"simoun_agent.cli.{command}", *argv],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**env, **variables},
-    )
+    with tempfile.TemporaryDirectory() as here:  # MuJoCo's error leaves MUJOCO_LOG.TXT in the cwd
+        done = subprocess.run(
+            [sys.executable, "-m", f"simoun_agent.cli.{command}", *argv],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            env={**env, **variables},
+            cwd=here,
+        )
     assert done.returncode == 2, done.stderr
     assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
     assert "GLFWError" not in done.stderr, done.stderr
