@@ -86,6 +86,13 @@ def _numbers(values: object, where: str) -> np.ndarray:
     return array
 
 
+def _first_where(mask: np.ndarray) -> tuple[tuple[int, ...], int | tuple[int, ...]]:
+    """The first True position of ``mask``: as an index tuple, and as the index a message shows
+    (a plain number for one dimension)."""
+    first = tuple(int(i) for i in np.argwhere(mask)[0])
+    return first, first[0] if len(first) == 1 else first
+
+
 def _finite(
     array: np.ndarray,
     where: str,
@@ -96,8 +103,7 @@ def _finite(
     pass for a real score; ``fix`` says how to leave such values out."""
     bad = ~np.isfinite(array)
     if bad.any():
-        first = tuple(int(i) for i in np.argwhere(bad)[0])
-        index = first[0] if len(first) == 1 else first
+        first, index = _first_where(bad)
         raise ValueError(
             f"{where} has {int(bad.sum())} NaN or infinite value(s) ({array[first]} at index "
             f"{index}): {why}; leave them out, e.g. {fix}"
@@ -298,8 +304,7 @@ def normalize(env_id: str, returns: np.ndarray) -> np.ndarray:
         return values
     above = values > maximum * (1 + 1e-9)
     if above.any():
-        first = tuple(int(i) for i in np.argwhere(above)[0])
-        index = first[0] if len(first) == 1 else first
+        first, index = _first_where(above)
         raise ValueError(
             f"normalize: returns of {env_id} must be at most its maximum return {maximum:g} "
             f"(NORMALIZERS), got {values[first]:g} at index {index}; "
