@@ -36,7 +36,7 @@ from simoun_agent.run.layout import CONFIG_NAME, SUMMARY_NAME
 from simoun_agent.run.make_env import check_task
 from simoun_agent.run.memory import SPEC_KEYS, check_memory, check_replay
 from simoun_lab.study.plan import EVALUATION, TUNING, StudyRun, evaluation_runs, tuning_runs
-from simoun_lab.study.spec import Source, StudySpec, spec_text
+from simoun_lab.study.spec import Source, StudySpec, key_place, spec_text
 from simoun_lab.sweep.grid import devices_problem
 
 MEMORY_KEYS = ("image_size", "agent.batch_size", "replay_capacity")
@@ -70,18 +70,6 @@ def memory_line(spec: StudySpec, task: str) -> tuple[str, ...]:
         if place is not None:
             return place
     return ("base",)
-
-
-def key_place(spec: StudySpec, task: str, key: str) -> tuple[str, ...] | None:
-    """Where the spec gives config ``key`` for ``task``: its [grid], the task's own table, or
-    [base] (the first that holds it, as they override each other); None when it does not."""
-    if key in spec.grid:
-        return ("grid", *key.split("."))
-    if key in spec.task_config.get(task, {}):
-        return ("tasks", task, *key.split("."))
-    if key in spec.base:
-        return ("base", *key.split("."))
-    return None
 
 
 ENV_SETTINGS = ("env_module", "env_kwargs", "cameras", "action_repeat")

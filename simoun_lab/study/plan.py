@@ -22,7 +22,7 @@ from simoun_agent.config.envs import env_label
 from simoun_agent.config.rules import show
 from simoun_agent.run.layout import SUMMARY_NAME
 from simoun_lab.study import probe
-from simoun_lab.study.spec import StudySpec
+from simoun_lab.study.spec import StudySpec, key_place
 from simoun_lab.sweep.grid import Trial, path_part, typed
 
 TUNING, EVALUATION = "tuning", "evaluation"
@@ -190,7 +190,6 @@ def sparse_evaluation_notes(spec: StudySpec) -> list[str]:
     """A note for each phase and task whose runs evaluate less often than their budget (an
     ``eval_every`` beyond ``env_steps``): simoun-train then evaluates only at step 0 and at the
     end, which the spec may mean (a final score) or not (a learning curve, an area under it)."""
-    from simoun_lab.study.checks import key_place  # it reads the plan: imported when needed
 
     notes = []
     for phase in (spec.tuning, spec.evaluation):

@@ -925,3 +925,15 @@ def fixed_by(key: str, recipes: list[str]) -> dict[str, Any]:
 def json_round_trip(spec: StudySpec) -> StudySpec:
     """The spec as it reads back from ``study.json`` (tuples as lists), so both compare equal."""
     return StudySpec.from_json(spec.to_json())
+
+
+def key_place(spec: StudySpec, task: str, key: str) -> tuple[str, ...] | None:
+    """Where the spec gives config ``key`` for ``task``: its [grid], the task's own table, or
+    [base] (the first that holds it, as they override each other); None when it does not."""
+    if key in spec.grid:
+        return ("grid", *key.split("."))
+    if key in spec.task_config.get(task, {}):
+        return ("tasks", task, *key.split("."))
+    if key in spec.base:
+        return ("base", *key.split("."))
+    return None
